@@ -1,0 +1,106 @@
+"""The Hydra application behind ``tcbench run`` and the checks made before any job starts."""
+
+from __future__ import annotations
+
+import itertools
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import hydra
+from hydra import compose, initialize_config_dir
+from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.errors import HydraException, MissingConfigException
+from omegaconf import DictConfig, OmegaConf
+from omegaconf.errors import OmegaConfBaseException
+
+from tcbench.config import ConfigError, as_dict, register_schema, validate
+from tcbench.job import run_job
+
+CONF_DIR = Path(__file__).resolve().parent / "conf"
+log = logging.getLogger(__name__)
+
+register_schema()
+
+
+@hydra.main(version_base="1.3", config_path="conf", config_name="config")
+def hydra_main(cfg: DictConfig) -> None:
+    """Hydra task function: one job per call."""
+    run_job(cfg)
+
+
+@dataclass
+class Plan:
+    """What a ``tcbench run`` command line will do, known before any job starts."""
+
+    jobs: int
+    tracking_uri: str | None
+    experiment: str
+    sweep_id: str | None
+
+
+def _known_options(group: str) -> list[str]:
+    return sorted(p.stem for p in (CONF_DIR / group).glob("*.yaml"))
+
+
+def _explain(exc: Exception) -> str:
+    """One line for a Hydra/OmegaConf composition error."""
+    if isinstance(exc, MissingConfigException) and exc.missing_cfg_file and "/" in exc.missing_cfg_file:
+        group, name = exc.missing_cfg_file.split("/", 1)
+        known = ", ".join(exc.options or _known_options(group))
+        return f"unknown {group} {name!r}; known: {known}"
+    first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return first
+
+
+def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
+    try:
+        return compose("config", overrides=overrides, return_hydra_config=hydra_cfg)
+    except (HydraException, OmegaConfBaseException, ValueError) as exc:
+        raise ConfigError(_explain(exc)) from None
+
+
+def plan(args: list[str]) -> Plan:
+    """Compose and validate every job of a command line; raise ConfigError on the first bad one."""
+    multirun = "-m" in args or "--multirun" in args
+    raw = [a for a in args if not a.startswith("-")]
+    parser = OverridesParser.create()
+    try:
+        parsed = parser.parse_overrides(raw)
+    except HydraException as exc:
+        raise ConfigError(_explain(exc)) from None
+    with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
+        fixed = [o.input_line for o in parsed if not o.is_sweep_override()]
+        sweeps = {o.get_key_element(): list(o.sweep_string_iterator()) for o in parsed if o.is_sweep_override()}
+        if sweeps and not multirun:
+            key = next(iter(sweeps))
+            raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
+        if multirun:
+            first = [f"{k}={v[0]}" for k, v in sweeps.items()]
+            base = _compose(fixed + first, hydra_cfg=True)
+            for key, value in (base.hydra.sweeper.get("params") or {}).items():
+                if key not in sweeps:
+                    (o,) = parser.parse_overrides([f"{key}={value}"])
+                    vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
+                    sweeps[key] = [str(v) for v in vals]
+        seeds = sweeps.pop("seed", None)
+        keys = list(sweeps)
+        combos = list(itertools.product(*sweeps.values())) or [()]
+        last: dict[str, Any] = {}
+        for combo in combos:
+            cfg = _compose(fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)])
+            validate(cfg)
+            last = as_dict(cfg)
+        for s in seeds or []:
+            if not s.lstrip("-").isdigit() or int(s) < 0:
+                raise ConfigError(f"seed must be a non-negative integer, got {s!r}")
+    jobs = len(combos) * (len(seeds) if seeds else 1)
+    track = last["tracking"]
+    return Plan(jobs, track.get("uri"), track["experiment"], track.get("sweep_id"))
+
+
+def resolved(args: list[str]) -> dict[str, Any]:
+    """The composed config of a single (non-sweep) command line, as a dict."""
+    with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
+        return OmegaConf.to_container(_compose([a for a in args if not a.startswith("-")]), resolve=True)  # type: ignore[return-value]

@@ -1,0 +1,166 @@
+"""``tcbench`` command line: run, leaderboard, quickstart, list."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import uuid
+from pathlib import Path
+
+USAGE = """usage: tcbench <command> [args]
+
+commands:
+  run [-m] [key=value ...]   run one job, or a Hydra sweep with -m (e.g. optimiser=fa,ifa seed='range(30)')
+  leaderboard [options]      aggregate finished runs into leaderboards/<task>.md/.csv/.png
+  quickstart                 FA against IFA on 2-D Rastrigin, 10 seeds each, with a results table
+  list                       registered tasks and optimisers
+
+`tcbench run --help` shows the Hydra options and config groups.
+"""
+
+
+class UserError(Exception):
+    """A mistake in what the user asked for: reported in one line, exit code 2."""
+
+
+def _fail(message: str, code: int = 2) -> int:
+    print(f"tcbench: error: {message}", file=sys.stderr)
+    return code
+
+
+def _run_sweep(args: list[str]) -> tuple[int, str, str, str | None]:
+    """Validate, then run Hydra; return (exit code, sweep id, experiment, tracking uri)."""
+    from tcbench.app import hydra_main, plan
+    from tcbench.config import ConfigError
+
+    if not any(a.startswith("tracking.sweep_id=") for a in args):
+        args = [*args, f"tracking.sweep_id={uuid.uuid4().hex[:12]}"]
+    passthrough = any(a in {"--help", "-h", "--hydra-help", "--info", "--cfg", "-c", "--shell-completion"} for a in args)
+    if not passthrough:
+        try:
+            p = plan(args)
+        except ConfigError as exc:
+            raise UserError(str(exc)) from None
+        print(f"tcbench: {p.jobs} job{'s' if p.jobs != 1 else ''} to run", file=sys.stderr)
+    saved = sys.argv
+    sys.argv = ["tcbench", *args]
+    try:
+        hydra_main()
+    finally:
+        sys.argv = saved
+    if passthrough:
+        return 0, "", "", None
+    assert p.sweep_id is not None
+    return 0, p.sweep_id, p.experiment, p.tracking_uri
+
+
+def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
+    """Print how many runs of a sweep finished and failed; 1 if any failed."""
+    from tcbench import leaderboard, tracking
+
+    client = tracking.client(uri)
+    runs = leaderboard.load_runs(client, [experiment], sweep)
+    failed = runs[runs["status"] != "FINISHED"] if len(runs) else runs
+    print(
+        f"tcbench: {len(runs)} runs recorded in {tracking.tracking_uri(uri)} "
+        f"(experiment {experiment!r}, sweep {sweep}): {len(runs) - len(failed)} finished, "
+        f"{len(failed)} failed",
+    )
+    for r in failed.itertuples():
+        print(f"  FAILED {r.method} on {r.task} seed {r.seed}: {r.error_message}")
+    return 1 if len(failed) else 0
+
+
+def cmd_run(args: list[str]) -> int:
+    code, sweep, experiment, uri = _run_sweep(args)
+    if sweep and experiment:
+        try:
+            return _sweep_report(sweep, experiment, uri)
+        except LookupError:
+            return code  # tracking disabled: nothing recorded to report on
+    return code
+
+
+def cmd_leaderboard(argv: list[str]) -> int:
+    ap = argparse.ArgumentParser(prog="tcbench leaderboard", description="Aggregate runs into leaderboards.")
+    ap.add_argument("--experiment", action="append", help="MLflow experiment (repeatable; default: tcbench)")
+    ap.add_argument("--sweep", help="only runs of this sweep id")
+    ap.add_argument("--out", default="leaderboards", help="output directory (default: leaderboards)")
+    ap.add_argument("--tracking-uri", help="MLflow store (default: $MLFLOW_TRACKING_URI or ./mlflow.db)")
+    ns = ap.parse_args(argv)
+    from tcbench import leaderboard, tracking
+
+    experiments = ns.experiment or ["tcbench"]
+    client = tracking.client(ns.tracking_uri)
+    try:
+        runs = leaderboard.load_runs(client, experiments, ns.sweep)
+    except LookupError as exc:
+        raise UserError(f"{exc} in {tracking.tracking_uri(ns.tracking_uri)}") from None
+    if runs.empty:
+        raise UserError(f"no tcbench runs in experiment {', '.join(experiments)}")
+    source = f"MLflow experiment {', '.join(experiments)}" + (f", sweep {ns.sweep}" if ns.sweep else "")
+    for board in leaderboard.boards(runs):
+        paths = leaderboard.write(board, Path(ns.out), client, source)
+        print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
+        print(leaderboard.markdown_table(board.table))
+        print(f"\nwritten: {paths['md']}, {paths['csv']}, {paths['png']}")
+    return 0
+
+
+def cmd_quickstart(argv: list[str]) -> int:
+    if argv:
+        raise UserError("quickstart takes no arguments; use `tcbench run -m ...` for your own sweep")
+    sweep = uuid.uuid4().hex[:12]
+    out = Path("tcbench-quickstart")
+    print("tcbench quickstart: FA vs IFA on 2-D Rastrigin (seed 000 settings), 10 seeds each")
+    code, sweep, experiment, uri = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}"])
+    status = _sweep_report(sweep, experiment, uri)
+    lb = cmd_leaderboard(["--experiment", experiment, "--sweep", sweep, "--out", str(out)])
+    from tcbench import tracking
+
+    print(
+        f"\nRuns (params, per-generation curves, config, convergence plots) are in MLflow at "
+        f"{tracking.tracking_uri(uri)}; browse them with\n"
+        f"  mlflow ui --backend-store-uri {tracking.tracking_uri(uri)}\n"
+        f"Leaderboard table and plot: {out.resolve()}/\n"
+        f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/"
+    )
+    return code or status or lb
+
+
+def cmd_list(argv: list[str]) -> int:
+    from tcbench.optimisers import registry
+    from tcbench.tasks import FUNCTIONS, env_id
+
+    print("tasks:")
+    for key, fn in FUNCTIONS.items():
+        print(f"  {env_id(key):26s} {fn.title}, domain [{fn.lower:g}, {fn.upper:g}]^d, x*={fn.x_opt:g}")
+    print("optimisers:")
+    for name, entry in registry.available().items():
+        print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package})")
+    for name, err in registry.broken().items():
+        print(f"  {name:10s} BROKEN: {err}")
+    return 0
+
+
+COMMANDS = {"run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list}
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] in {"-h", "--help", "help"}:
+        print(USAGE)
+        return 0 if argv else 2
+    command, rest = argv[0], argv[1:]
+    if command not in COMMANDS:
+        return _fail(f"unknown command {command!r}; known: {', '.join(COMMANDS)}")
+    try:
+        return COMMANDS[command](rest)
+    except UserError as exc:
+        return _fail(str(exc))
+    except KeyboardInterrupt:
+        return _fail("interrupted", 130)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,99 @@
+"""Structured config of a tcbench job and its validation.
+
+The dataclasses are registered with Hydra's ConfigStore as ``base_config`` so OmegaConf checks
+types at composition; :func:`validate` then checks ranges and names (task function, dimension,
+optimiser name and parameters, budget against one generation) and raises :class:`ConfigError`
+with one line that names the offending key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from hydra.core.config_store import ConfigStore
+from omegaconf import MISSING, DictConfig, OmegaConf
+
+from tcbench.optimisers import registry
+from tcbench.optimisers.protocol import make_params
+from tcbench.tasks.function_env import FunctionEnv
+
+
+class ConfigError(ValueError):
+    """A config value is out of range or names something unknown."""
+
+
+@dataclass
+class TaskConfig:
+    """Which function task to solve and how (see :class:`tcbench.tasks.FunctionEnv`)."""
+
+    name: str = MISSING
+    dim: int = 2
+    shift: bool = False
+    target_precision: float = 1e-8
+    lower: float | None = None
+    upper: float | None = None
+
+
+@dataclass
+class TrackingConfig:
+    """Where and how runs are recorded in MLflow."""
+
+    enabled: bool = True
+    uri: str | None = None  # None: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd
+    experiment: str = "tcbench"
+    sweep_id: str | None = None  # None: derived from the multirun sweep directory
+    plots: bool = True
+
+
+@dataclass
+class JobConfig:
+    """One optimisation job: task, optimiser, seed and evaluation budget."""
+
+    task: TaskConfig = field(default_factory=TaskConfig)
+    optimiser: dict[str, Any] = field(default_factory=lambda: {"name": MISSING})
+    seed: int = 0
+    budget: int = 1000
+    progress: bool = False
+    tracking: TrackingConfig = field(default_factory=TrackingConfig)
+
+
+def register_schema() -> None:
+    """Make the structured schema available to Hydra as ``base_config``."""
+    ConfigStore.instance().store(name="base_config", node=JobConfig)
+
+
+def as_dict(cfg: DictConfig | dict[str, Any]) -> dict[str, Any]:
+    """Plain, resolved dict of a (sub)config."""
+    if isinstance(cfg, DictConfig):
+        return OmegaConf.to_container(cfg, resolve=True)  # type: ignore[return-value]
+    return dict(cfg)
+
+
+def validate(cfg: DictConfig | dict[str, Any]) -> None:
+    """Check ranges and names of a composed job config; raise :class:`ConfigError` if wrong."""
+    c = as_dict(cfg)
+    if c["seed"] < 0:
+        raise ConfigError(f"seed must be >= 0, got {c['seed']}")
+    if c["budget"] < 1:
+        raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
+    task = {k: v for k, v in c["task"].items() if k != "name"}
+    try:
+        FunctionEnv(function=c["task"]["name"], budget=c["budget"], **task)
+    except (KeyError, ValueError) as exc:
+        raise ConfigError(f"task: {exc}") from None
+    opt = dict(c["optimiser"])
+    name = opt.pop("name", None)
+    opt.pop("label", None)  # leaderboard name, not a parameter
+    try:
+        cls = registry.get(str(name))
+        params = make_params(cls, opt)
+    except registry.UnknownOptimiserError as exc:
+        raise ConfigError(str(exc)) from None
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"optimiser {name}: {exc}") from None
+    if c["budget"] < params.population:
+        raise ConfigError(
+            f"budget of {c['budget']} evaluations is smaller than one generation "
+            f"(optimiser {name}: population {params.population})"
+        )

@@ -1,0 +1,112 @@
+"""One Hydra job: validate the config, run the optimisation, record it in MLflow."""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import tempfile
+import traceback
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tcbench import plots
+from tcbench.config import as_dict, validate
+from tcbench.runner import RunResult, run_optimisation
+
+log = logging.getLogger(__name__)
+
+
+def task_key(task: dict[str, Any]) -> str:
+    """Leaderboard key of a task config, e.g. ``rastrigin-2d`` or ``rastrigin-10d-shifted``."""
+    key = f"{task['name']}-{task['dim']}d"
+    if task.get("shift"):
+        key += "-shifted"
+    if task.get("lower") is not None or task.get("upper") is not None:
+        key += f"-[{task.get('lower')},{task.get('upper')}]"
+    return key
+
+
+def method_label(opt: dict[str, Any]) -> str:
+    """Leaderboard name of a method: the optimiser's ``label`` if set, else its name."""
+    return str(opt.get("label") or opt["name"])
+
+
+def sweep_id_from_hydra() -> str:
+    """Id shared by the jobs of one multirun (hash of its sweep dir), or the run dir's."""
+    try:
+        from hydra.core.hydra_config import HydraConfig
+        from hydra.types import RunMode
+
+        hc = HydraConfig.get()
+        where = hc.sweep.dir if hc.mode == RunMode.MULTIRUN else hc.run.dir
+        return hashlib.sha256(str(Path(where).resolve()).encode()).hexdigest()[:12]
+    except (ImportError, ValueError):
+        return "interactive"
+
+
+def result_metrics(result: RunResult) -> dict[str, float]:
+    """Final metrics of a run as logged to MLflow."""
+    metrics = {
+        "final_best": result.best_f,
+        "final_error": result.error,
+        "evaluations": result.evaluations,
+        "generations": result.generations,
+        "nonfinite_evaluations": result.nonfinite,
+        "target_hit": float(result.target_hit_at is not None),
+    }
+    if result.target_hit_at is not None:
+        metrics["evals_to_target"] = result.target_hit_at
+    return metrics
+
+
+def run_job(cfg: Any) -> RunResult | None:
+    """Run one configured job. Tracked jobs that raise are recorded FAILED and return None."""
+    c = as_dict(cfg)
+    optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
+    if not c["tracking"]["enabled"]:
+        validate(c)
+        return run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"])
+
+    from tcbench import tracking
+
+    sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
+    tkey, method = task_key(c["task"]), method_label(c["optimiser"])
+    tags = {
+        "tcbench.sweep_id": sweep,
+        "tcbench.task": tkey,
+        "tcbench.method": method,
+        "tcbench.seed": str(c["seed"]),
+        "tcbench.kind": "optimisation",
+    }
+    try:
+        with tracking.job_run(c, f"{method}-{tkey}-s{c['seed']}", tags) as run:
+            validate(c)
+            result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"])
+            t = result.trace
+            run.log_series("best_f", t.best_f, t.evaluations)
+            run.log_series("pop_mean_f", t.mean_f, t.evaluations)
+            run.log_series("generation", [float(g) for g in t.generation], t.evaluations)
+            run.log_metrics(result_metrics(result) | {"f_opt": result.f_opt})
+            with tempfile.TemporaryDirectory() as tmp:
+                cfg_path = Path(tmp) / "config.yaml"
+                cfg_path.write_text(yaml.safe_dump(c, sort_keys=False))
+                run.log_artifact(cfg_path)
+                if c["tracking"]["plots"]:
+                    png = plots.run_convergence(
+                        Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
+                        result.f_opt, f"{method} on {tkey}, seed {c['seed']}",
+                    )
+                    run.log_artifact(png)
+                if result.nonfinite:
+                    run.set_tag("tcbench.warning", f"{result.nonfinite} NaN/inf evaluations")
+    except Exception as exc:  # recorded as FAILED by job_run; the sweep goes on
+        log.error("job %s failed: %s: %s", f"{method}-{tkey}-s{c['seed']}", type(exc).__name__, exc)
+        log.debug("%s", traceback.format_exc())
+        return None
+    log.info(
+        "%s on %s seed %d: best %.6g (error %.3g) after %d evaluations",
+        method, tkey, c["seed"], result.best_f, result.error, result.evaluations,
+    )
+    return result

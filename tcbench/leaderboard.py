@@ -1,0 +1,206 @@
+"""Leaderboards: finished and failed runs from MLflow aggregated over seeds with pandas.
+
+Per task and method: runs, failed runs, median and IQR of the final error (best - optimum),
+success rate at the task's target precision, expected running time (ERT) to that target, and a
+rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
+and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
+Rank orders methods by success rate (higher first), then ERT, then median final error.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from tcbench import plots
+
+COLUMNS = [
+    "rank", "method", "runs", "failed", "median_error", "iqr_error",
+    "success_rate", "ert_evals", "median_evals",
+]
+
+
+@dataclass
+class Board:
+    """Leaderboard of one task: the table and what it was computed from."""
+
+    task: str
+    table: pd.DataFrame
+    runs: pd.DataFrame
+    target_precision: float
+    f_opt: float
+
+
+def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
+    """One row per tcbench optimisation run (finished, failed or unfinished)."""
+    ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
+    if not ids:
+        raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
+    query = "tags.`tcbench.kind` = 'optimisation'"
+    if sweep:
+        query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
+    rows = []
+    token = None
+    while True:
+        page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)
+        for r in page:
+            m, p, t = r.data.metrics, r.data.params, r.data.tags
+            rows.append({
+                "run_id": r.info.run_id,
+                "status": r.info.status,
+                "task": t.get("tcbench.task"),
+                "method": t.get("tcbench.method"),
+                "seed": int(t.get("tcbench.seed", -1)),
+                "sweep": t.get("tcbench.sweep_id"),
+                "error_message": t.get("tcbench.error", ""),
+                "budget": int(p.get("budget", 0)),
+                "target_precision": float(p.get("task.target_precision", "nan")),
+                "final_error": m.get("final_error", np.nan),
+                "final_best": m.get("final_best", np.nan),
+                "f_opt": m.get("f_opt", np.nan),
+                "evaluations": m.get("evaluations", np.nan),
+                "target_hit": m.get("target_hit", 0.0) > 0,
+                "evals_to_target": m.get("evals_to_target", np.nan),
+            })
+        token = page.token
+        if not token:
+            break
+    return pd.DataFrame(rows)
+
+
+def expected_running_time(evaluations: np.ndarray, hit_at: np.ndarray, hit: np.ndarray) -> float:
+    """ERT over runs: evaluations spent until success (or in total when not) / successes."""
+    spent = np.where(hit, hit_at, evaluations).sum()
+    n_hit = int(np.count_nonzero(hit))
+    return float(spent / n_hit) if n_hit else float("inf")
+
+
+def summarise(runs: pd.DataFrame) -> pd.DataFrame:
+    """Leaderboard table of one task's runs (all methods)."""
+    rows = []
+    for method, g in runs.groupby("method", sort=True):
+        ok = g["status"] == "FINISHED"
+        err = g.loc[ok, "final_error"].to_numpy(float)
+        hit = (g["target_hit"] & ok).to_numpy(bool)
+        evals = np.where(ok, g["evaluations"].fillna(0), g["budget"]).astype(float)
+        q25, q50, q75 = np.percentile(err, [25, 50, 75]) if err.size else (np.nan,) * 3
+        rows.append({
+            "method": method,
+            "runs": len(g),
+            "failed": int((~ok).sum()),
+            "median_error": q50,
+            "iqr_error": q75 - q25,
+            "success_rate": hit.mean(),
+            "ert_evals": expected_running_time(evals, g["evals_to_target"].to_numpy(float), hit),
+            "median_evals": float(np.median(evals)),
+        })
+    table = pd.DataFrame(rows)
+    if table.empty:
+        return pd.DataFrame(columns=COLUMNS)
+    table = table.sort_values(
+        ["success_rate", "ert_evals", "median_error"], ascending=[False, True, True],
+        na_position="last",
+    )
+    table.insert(0, "rank", np.arange(1, len(table) + 1))
+    return table[COLUMNS].reset_index(drop=True)
+
+
+def boards(runs: pd.DataFrame) -> list[Board]:
+    """One :class:`Board` per task in ``runs``."""
+    out = []
+    for task, g in runs.groupby("task", sort=True):
+        finite = g["f_opt"].dropna()
+        out.append(Board(
+            task=str(task),
+            table=summarise(g),
+            runs=g,
+            target_precision=float(g["target_precision"].dropna().iloc[0]) if g["target_precision"].notna().any() else float("nan"),
+            f_opt=float(finite.iloc[0]) if len(finite) else float("nan"),
+        ))
+    return out
+
+
+def step_curves(
+    client, runs: pd.DataFrame, metric: str, grid: np.ndarray  # type: ignore[no-untyped-def]
+) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Per method, each finished run's ``metric`` held piecewise-constant on ``grid`` (evaluations)."""
+    curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for method, g in runs[runs["status"] == "FINISHED"].groupby("method", sort=True):
+        ys = []
+        for run_id in g["run_id"]:
+            hist = sorted((m.step, m.value) for m in client.get_metric_history(run_id, metric))
+            if not hist:
+                continue
+            steps, values = np.array(hist).T
+            idx = np.searchsorted(steps, grid, side="right") - 1
+            ys.append(np.where(idx >= 0, values[np.maximum(idx, 0)], np.nan))
+        if ys:
+            curves[str(method)] = (grid, np.vstack(ys))
+    return curves
+
+
+def _fmt(value: object) -> str:
+    if isinstance(value, (float, np.floating)):
+        if np.isinf(value):
+            return "∞"
+        if np.isnan(value):
+            return "–"
+        return f"{value:.3g}"
+    return str(value)
+
+
+def markdown_table(table: pd.DataFrame) -> str:
+    """A pandas table as a GitHub markdown table."""
+    head = "| " + " | ".join(table.columns) + " |"
+    rule = "|" + "|".join("---" for _ in table.columns) + "|"
+    body = ["| " + " | ".join(_fmt(v) for v in row) + " |" for row in table.itertuples(index=False)]
+    return "\n".join([head, rule, *body])
+
+
+def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]:  # type: ignore[no-untyped-def]
+    """Write ``<task>.md``, ``<task>.csv`` and ``<task>_convergence.png`` into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = {
+        "md": out_dir / f"{board.task}.md",
+        "csv": out_dir / f"{board.task}.csv",
+        "png": out_dir / f"{board.task}_convergence.png",
+    }
+    budget = int(board.runs["budget"].max())
+    grid = np.unique(np.linspace(1, budget, 200).round().astype(int))
+    curves = step_curves(client, board.runs, "best_f", grid)
+    if curves:
+        plots.band_convergence(
+            paths["png"], curves, board.f_opt,
+            f"{board.task}: best so far (median, IQR over seeds)",
+        )
+    failed = board.runs[board.runs["status"] != "FINISHED"]
+    lines = [
+        f"# Leaderboard: {board.task}",
+        "",
+        f"Source: {source}. Optimum value f* = {board.f_opt:g}; error = final best − f*; "
+        f"target precision {board.target_precision:g}; budget {budget} evaluations.",
+        "Rank: success rate, then ERT (expected evaluations to reach the target), then median "
+        "error. IQR = inter-quartile range of the final error over seeds. Failed runs count as "
+        "unsuccessful runs that used their whole budget.",
+        "",
+        markdown_table(board.table),
+        "",
+    ]
+    if curves:
+        lines += [f"![convergence]({paths['png'].name})", ""]
+    if len(failed):
+        lines += ["Failed or unfinished runs:", ""]
+        lines += [
+            f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip()
+            for r in failed.itertuples()
+        ]
+        lines.append("")
+    tmp_md, tmp_csv = paths["md"].with_suffix(".md.tmp"), paths["csv"].with_suffix(".csv.tmp")
+    tmp_md.write_text("\n".join(lines))
+    board.table.to_csv(tmp_csv, index=False)
+    tmp_md.replace(paths["md"])
+    tmp_csv.replace(paths["csv"])
+    return paths

@@ -1,0 +1,204 @@
+"""The ask/tell optimiser protocol shared by built-in and plugin optimisers.
+
+An optimiser is built with box bounds, an evaluation budget, an explicit
+``numpy.random.Generator`` and its parameters (a dataclass, mirrored by the Hydra config). The
+caller loops ``X = opt.ask(); F = f(X); opt.tell(X, F)`` until ``opt.done``. The optimiser never
+calls the objective itself. This base class owns the bookkeeping every optimiser needs: budget
+accounting, checking that ``tell`` answers the last ``ask``, treating NaN/inf values as worst,
+and the best point seen so far. Subclasses implement :meth:`_ask` and :meth:`_tell`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+
+class ProtocolError(RuntimeError):
+    """An optimiser or its caller broke the ask/tell contract."""
+
+
+@dataclass(frozen=True)
+class Best:
+    """Best point seen so far and its objective value (``inf`` before any finite value)."""
+
+    x: np.ndarray
+    f: float
+
+
+@dataclass(frozen=True)
+class OptimiserParams:
+    """Base class for optimiser parameter dataclasses; subclasses validate in ``__post_init__``."""
+
+    population: int = 10
+
+    def __post_init__(self) -> None:
+        if self.population < 2:
+            raise ValueError(f"population must be >= 2, got {self.population}")
+
+
+def worst_if_nonfinite(f: np.ndarray) -> np.ndarray:
+    """Replace NaN and +-inf objective values by +inf (the worst for minimisation)."""
+    return np.where(np.isfinite(f), f, np.inf)
+
+
+class Optimiser(ABC):
+    """Base class of ask/tell optimisers (single objective, minimisation)."""
+
+    name: ClassVar[str] = ""
+    Params: ClassVar[type[OptimiserParams]] = OptimiserParams
+
+    def __init__(
+        self,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        budget: int,
+        rng: np.random.Generator,
+        params: OptimiserParams | dict[str, Any] | None = None,
+    ) -> None:
+        self.lower = np.asarray(lower, dtype=np.float64).reshape(-1)
+        self.upper = np.asarray(upper, dtype=np.float64).reshape(-1)
+        if self.lower.shape != self.upper.shape or not np.all(self.lower < self.upper):
+            raise ValueError("bounds must have equal shapes with lower < upper everywhere")
+        if not isinstance(rng, np.random.Generator):
+            raise TypeError("rng must be a numpy.random.Generator")
+        self.params = make_params(type(self), params)
+        if int(budget) != budget or budget < self.params.population:
+            raise ValueError(
+                f"budget of {budget} evaluations is smaller than one generation "
+                f"(population {self.params.population})"
+            )
+        self.dim = self.lower.size
+        self.budget = int(budget)
+        self.rng = rng
+        self.evaluations = 0
+        self.generation = 0
+        self.nonfinite = 0
+        self._best = Best(np.full(self.dim, np.nan), np.inf)
+        self._pending: np.ndarray | None = None
+
+    # -- public protocol -------------------------------------------------------------------
+    @property
+    def remaining(self) -> int:
+        """Evaluations left in the budget."""
+        return self.budget - self.evaluations
+
+    @property
+    def done(self) -> bool:
+        """True once the budget (or the optimiser's own stopping rule) ends the run."""
+        return self.remaining <= 0 or self._stopped()
+
+    @property
+    def best(self) -> Best:
+        """Best point told so far."""
+        return self._best
+
+    @property
+    def population_fitness(self) -> np.ndarray:
+        """Objective values of the current population (``inf`` where non-finite)."""
+        return np.asarray(getattr(self, "fitness", np.empty(0)))
+
+    def ask(self) -> np.ndarray:
+        """Candidates to evaluate next, shape ``(k, d)``, inside the bounds, ``k <= remaining``."""
+        if self._pending is not None:
+            raise ProtocolError(f"{self.name}: ask() called twice without tell()")
+        if self.done:
+            raise ProtocolError(f"{self.name}: ask() after the run is done")
+        x = np.asarray(self._ask(), dtype=np.float64)
+        if x.ndim != 2 or x.shape[1] != self.dim or not 0 < x.shape[0] <= self.remaining:
+            raise ProtocolError(
+                f"{self.name}: ask() returned shape {x.shape}; expected (k, {self.dim}) "
+                f"with 0 < k <= {self.remaining}"
+            )
+        if np.any(x < self.lower) or np.any(x > self.upper) or not np.all(np.isfinite(x)):
+            raise ProtocolError(f"{self.name}: ask() returned points outside the bounds")
+        self._pending = x
+        return x.copy()
+
+    def tell(self, x: np.ndarray, f: np.ndarray) -> None:
+        """Report objective values ``f`` (shape ``(k,)``) of the points returned by ``ask``."""
+        if self._pending is None:
+            raise ProtocolError(f"{self.name}: tell() without a preceding ask()")
+        x = np.asarray(x, dtype=np.float64)
+        f = np.asarray(f, dtype=np.float64).reshape(-1)
+        if x.shape != self._pending.shape or not np.array_equal(x, self._pending):
+            raise ProtocolError(f"{self.name}: tell() must receive the points of the last ask()")
+        if f.shape != (x.shape[0],):
+            raise ProtocolError(f"{self.name}: tell() got {f.shape[0]} values for {x.shape[0]} points")
+        self._pending = None
+        self.nonfinite += int(np.count_nonzero(~np.isfinite(f)))
+        f = worst_if_nonfinite(f)
+        self.evaluations += f.size
+        i = int(np.argmin(f))
+        if f[i] < self._best.f:
+            self._best = Best(x[i].copy(), float(f[i]))
+        self._tell(x, f)
+
+    # -- subclass hooks --------------------------------------------------------------------
+    @abstractmethod
+    def _ask(self) -> np.ndarray:
+        """Return the next candidates; may use ``self.remaining`` to shorten the last batch."""
+
+    @abstractmethod
+    def _tell(self, x: np.ndarray, f: np.ndarray) -> None:
+        """Absorb finite-or-``inf`` values ``f`` of ``x``; advance ``self.generation``."""
+
+    def _stopped(self) -> bool:
+        """Optimiser-specific stopping rule (e.g. a generation limit); none by default."""
+        return False
+
+    # -- helpers for subclasses ------------------------------------------------------------
+    def clip(self, x: np.ndarray) -> np.ndarray:
+        """Put points back inside the bounds by clamping each coordinate (seed 000 eq. 11)."""
+        return np.clip(x, self.lower, self.upper)
+
+    def uniform(self, n: int) -> np.ndarray:
+        """``n`` points drawn uniformly in the bounds."""
+        return self.rng.uniform(self.lower, self.upper, size=(n, self.dim))
+
+
+def make_params(cls: type[Optimiser], params: OptimiserParams | dict[str, Any] | None) -> OptimiserParams:
+    """Build and validate ``cls.Params`` from a dataclass instance, a mapping or ``None``."""
+    if isinstance(params, cls.Params):
+        return params
+    values = dict(params or {})
+    known = {f.name: f for f in dataclasses.fields(cls.Params)}
+    unknown = sorted(set(values) - set(known))
+    if unknown:
+        raise ValueError(
+            f"optimiser {cls.name!r} has no parameter {', '.join(map(repr, unknown))}; "
+            f"known: {', '.join(sorted(known))}"
+        )
+    for key, value in values.items():
+        values[key] = _coerce(cls.name, key, known[key].type, value)
+    return cls.Params(**values)
+
+
+def _coerce(owner: str, key: str, annotation: Any, value: Any) -> Any:
+    """Check a parameter value against a simple annotation (int, float, bool, str, optional)."""
+    ann = str(annotation)
+    optional = "None" in ann
+    if value is None:
+        if optional:
+            return None
+        raise ValueError(f"{owner}.{key} must not be null")
+    base = ann.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
+    if base == "bool":
+        if isinstance(value, bool):
+            return value
+    elif base == "int":
+        if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+            return int(value)
+    elif base == "float":
+        if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
+            return float(value)
+    elif base == "str":
+        if isinstance(value, str):
+            return value
+    else:
+        return value
+    raise ValueError(f"{owner}.{key} must be {base}, got {value!r}")

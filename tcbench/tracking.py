@@ -1,0 +1,146 @@
+"""MLflow tracking of tcbench jobs: one run per job, embedded store by default.
+
+The store is ``sqlite:///mlflow.db`` in the working directory unless ``MLFLOW_TRACKING_URI`` (or
+the ``tracking.uri`` config key) says otherwise; artifacts go to ``./mlartifacts/<experiment>``
+(set explicitly when the experiment is created, so they never land relative to another
+directory). MLflow's telemetry is off unless ``MLFLOW_DISABLE_TELEMETRY`` is set by the user.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
+
+import mlflow  # noqa: E402
+from mlflow.entities import Metric, Param, RunStatus  # noqa: E402
+from mlflow.tracking import MlflowClient  # noqa: E402
+
+import tcbench  # noqa: E402
+
+TAG_PREFIX = "tcbench."
+_BATCH = 1000
+
+
+def tracking_uri(uri: str | None = None) -> str:
+    """The store to use: explicit ``uri``, else ``$MLFLOW_TRACKING_URI``, else ./mlflow.db."""
+    if uri:
+        return uri
+    env = os.environ.get("MLFLOW_TRACKING_URI")
+    if env:
+        return env
+    return f"sqlite:///{Path.cwd() / 'mlflow.db'}"
+
+
+def client(uri: str | None = None) -> MlflowClient:
+    """An MLflow client on the resolved store."""
+    return MlflowClient(tracking_uri=tracking_uri(uri))
+
+
+def experiment_id(c: MlflowClient, name: str) -> str:
+    """Id of experiment ``name``, creating it with an explicit artifact location if needed."""
+    found = c.get_experiment_by_name(name)
+    if found is not None:
+        return found.experiment_id
+    location = (Path.cwd() / "mlartifacts" / name).resolve().as_uri()
+    try:
+        return c.create_experiment(name, artifact_location=location)
+    except mlflow.exceptions.MlflowException:  # created meanwhile by a concurrent job
+        found = c.get_experiment_by_name(name)
+        if found is None:
+            raise
+        return found.experiment_id
+
+
+def flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
+    """``{"a": {"b": 1}}`` -> ``{"a.b": "1"}``: a nested config as MLflow params."""
+    out: dict[str, str] = {}
+    for key, value in cfg.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            out.update(flatten(value, f"{name}."))
+        else:
+            out[name] = json.dumps(value) if isinstance(value, (list, tuple)) else str(value)
+    return out
+
+
+def config_hash(cfg: Mapping[str, Any]) -> str:
+    """Stable short hash of a job's config without its seed and tracking settings."""
+    content = {k: v for k, v in cfg.items() if k not in {"seed", "tracking", "progress"}}
+    blob = json.dumps(content, sort_keys=True, default=str).encode()
+    return hashlib.sha256(blob).hexdigest()[:16]
+
+
+def git_commit() -> str:
+    """Commit of the tcbench source tree, or ``unknown`` outside a git checkout."""
+    src = Path(tcbench.__file__).resolve().parent
+    try:
+        out = subprocess.run(
+            ["git", "-C", str(src), "rev-parse", "HEAD"],
+            capture_output=True, text=True, timeout=5, check=True,
+        )
+        return out.stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+class JobRun:
+    """Handle on an active MLflow run that knows how to log a tcbench job."""
+
+    def __init__(self, c: MlflowClient, run_id: str) -> None:
+        self.client = c
+        self.run_id = run_id
+
+    def log_series(self, name: str, values: list[float], steps: list[int]) -> None:
+        """Log ``values`` of metric ``name`` at ``steps`` in batches."""
+        ts = mlflow.utils.time.get_current_time_millis()
+        metrics = [Metric(name, float(v), ts, int(s)) for v, s in zip(values, steps, strict=True)]
+        for i in range(0, len(metrics), _BATCH):
+            self.client.log_batch(self.run_id, metrics=metrics[i : i + _BATCH])
+
+    def log_metrics(self, values: Mapping[str, float]) -> None:
+        ts = mlflow.utils.time.get_current_time_millis()
+        metrics = [Metric(k, float(v), ts, 0) for k, v in values.items()]
+        self.client.log_batch(self.run_id, metrics=metrics)
+
+    def log_artifact(self, path: Path) -> None:
+        self.client.log_artifact(self.run_id, str(path))
+
+    def set_tag(self, key: str, value: str) -> None:
+        self.client.set_tag(self.run_id, key, value)
+
+
+@contextmanager
+def job_run(
+    cfg: Mapping[str, Any], run_name: str, tags: Mapping[str, str]
+) -> Iterator[JobRun]:
+    """Open a run for one job; mark it FAILED (with the error as a tag) if the body raises."""
+    track = cfg["tracking"]
+    c = client(track.get("uri"))
+    exp = experiment_id(c, track["experiment"])
+    all_tags = {
+        f"{TAG_PREFIX}version": tcbench.__version__,
+        f"{TAG_PREFIX}git_commit": git_commit(),
+        f"{TAG_PREFIX}config_hash": config_hash(cfg),
+        **tags,
+    }
+    run = c.create_run(exp, run_name=run_name, tags=all_tags)
+    handle = JobRun(c, run.info.run_id)
+    params = flatten(cfg)
+    items = [Param(k, v[:6000]) for k, v in params.items()]
+    for i in range(0, len(items), 100):
+        c.log_batch(run.info.run_id, params=items[i : i + 100])
+    try:
+        yield handle
+    except BaseException as exc:
+        c.set_tag(run.info.run_id, f"{TAG_PREFIX}error", f"{type(exc).__name__}: {exc}"[:4900])
+        c.set_terminated(run.info.run_id, status=RunStatus.to_string(RunStatus.FAILED))
+        raise
+    c.set_terminated(run.info.run_id, status="FINISHED")
