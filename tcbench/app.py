@@ -13,7 +13,7 @@ from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig, OmegaConf
-from omegaconf.errors import OmegaConfBaseException
+from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
 from tcbench.config import ConfigError, as_dict, register_schema, validate
 from tcbench.job import run_job
@@ -50,8 +50,14 @@ def _explain(exc: Exception) -> str:
         group, name = exc.missing_cfg_file.split("/", 1)
         known = ", ".join(exc.options or _known_options(group))
         return f"unknown {group} {name!r}; known: {known}"
-    first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    return first
+    cause = exc.__cause__
+    if isinstance(cause, OmegaConfBaseException):
+        key = getattr(cause, "full_key", None) or "config"
+        if isinstance(cause, ConfigAttributeError):
+            return f"{key}: no such config key"
+        return f"{key}: {str(cause).strip().splitlines()[0]}"
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:

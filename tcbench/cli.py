@@ -62,7 +62,7 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
     runs = leaderboard.load_runs(client, [experiment], sweep)
     failed = runs[runs["status"] != "FINISHED"] if len(runs) else runs
     print(
-        f"tcbench: {len(runs)} runs recorded in {tracking.tracking_uri(uri)} "
+        f"tcbench: {len(runs)} run{'s' if len(runs) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
         f"(experiment {experiment!r}, sweep {sweep}): {len(runs) - len(failed)} finished, "
         f"{len(failed)} failed",
     )

@@ -170,7 +170,7 @@ def make_params(cls: type[Optimiser], params: OptimiserParams | dict[str, Any] |
     unknown = sorted(set(values) - set(known))
     if unknown:
         raise ValueError(
-            f"optimiser {cls.name!r} has no parameter {', '.join(map(repr, unknown))}; "
+            f"{cls.name} has no parameter {', '.join(map(repr, unknown))}; "
             f"known: {', '.join(sorted(known))}"
         )
     for key, value in values.items():

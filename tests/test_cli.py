@@ -1,0 +1,96 @@
+"""The command line end to end: one job, a sweep with its leaderboard, and bad input."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import mlflow
+import pandas as pd
+import pytest
+
+
+def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "tcbench", *args], cwd=cwd, capture_output=True, text=True,
+        timeout=300,
+    )
+
+
+def test_single_run_is_tracked(workdir: Path) -> None:
+    out = tcbench("run", "task=sphere", "optimiser=ifa", "seed=3", "budget=200", cwd=workdir)
+    assert out.returncode == 0, out.stderr
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    exp = client.get_experiment_by_name("tcbench")
+    assert exp.artifact_location == (workdir / "mlartifacts" / "tcbench").as_uri()
+    (run,) = client.search_runs([exp.experiment_id])
+    assert run.info.status == "FINISHED"
+    p, m, t = run.data.params, run.data.metrics, run.data.tags
+    assert p["task.name"] == "sphere" and p["optimiser.name"] == "ifa" and p["seed"] == "3"
+    assert p["optimiser.epsilon"] == "0.01" and p["budget"] == "200"
+    assert m["evaluations"] == 200 and m["final_best"] >= 0
+    assert {"tcbench.version", "tcbench.git_commit", "tcbench.config_hash", "tcbench.sweep_id"} <= set(t)
+    best = client.get_metric_history(run.info.run_id, "best_f")
+    mean = client.get_metric_history(run.info.run_id, "pop_mean_f")
+    assert len(best) == len(mean) == m["generations"] + 1
+    values = [h.value for h in sorted(best, key=lambda h: h.step)]
+    assert all(b <= a for a, b in zip(values, values[1:]))  # best so far never worsens
+    assert values[-1] == m["final_best"]
+    names = {a.path for a in client.list_artifacts(run.info.run_id)}
+    assert names == {"config.yaml", "convergence.png"}
+
+
+def test_sweep_then_leaderboard(workdir: Path) -> None:
+    out = tcbench(
+        "run", "-m", "task=sphere", "optimiser=fa,ifa", "seed=range(3)", "budget=100",
+        "tracking.experiment=t", "task.target_precision=1e-2", cwd=workdir,
+    )
+    assert out.returncode == 0, out.stderr
+    assert "6 runs recorded" in out.stdout and "6 finished, 0 failed" in out.stdout
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    runs = client.search_runs([client.get_experiment_by_name("t").experiment_id])
+    assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1
+    lb = tcbench("leaderboard", "--experiment", "t", "--out", "lb", cwd=workdir)
+    assert lb.returncode == 0, lb.stderr
+    table = pd.read_csv(workdir / "lb" / "sphere-2d.csv")
+    assert sorted(table["method"]) == ["fa", "ifa"]
+    assert table["runs"].tolist() == [3, 3] and table["failed"].tolist() == [0, 0]
+    assert sorted(table["rank"]) == [1, 2]
+    assert (workdir / "lb" / "sphere-2d_convergence.png").stat().st_size > 5000
+    assert "| rank | method |" in (workdir / "lb" / "sphere-2d.md").read_text()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["task=nope"], "unknown task 'nope'; known: ackley, griewank, levy, rastrigin"),
+        (["optimiser=nope"], "unknown optimiser 'nope'; known: fa"),
+        (["seed=abc"], "seed: Value 'abc'"),
+        (["seed=-1"], "seed must be >= 0"),
+        (["budget=5"], "smaller than one generation"),
+        (["optimiser.beta0=2"], "beta0 must be in (0, 1]"),
+        (["+optimiser.colour=3"], "no parameter 'colour'"),
+        (["task.dim=0"], "dim must be an integer >= 1"),
+        (["tracking.plots=maybe"], "tracking.plots: Value 'maybe' is not a valid bool"),
+        (["optimiser.alpha0=1,2"], "add -m"),
+        (["-m", "optimiser=fa,ifa", "optimiser.gamma=-1"], "gamma must be >= 0"),
+    ],
+)
+def test_bad_config_one_line_no_job(workdir: Path, args: list[str], message: str) -> None:
+    out = tcbench("run", *args, cwd=workdir)
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], out.stderr
+    assert "Traceback" not in out.stderr + out.stdout
+    assert not (workdir / "mlflow.db").exists()  # validated before any job started
+
+
+def test_unknown_command(workdir: Path) -> None:
+    out = tcbench("frobnicate", cwd=workdir)
+    assert out.returncode == 2 and "unknown command 'frobnicate'" in out.stderr
+
+
+def test_leaderboard_without_runs(workdir: Path) -> None:
+    out = tcbench("leaderboard", "--experiment", "none", cwd=workdir)
+    assert out.returncode == 2 and "no MLflow experiment named none" in out.stderr
