@@ -35,13 +35,14 @@ Use ``--alpha/--gamma/--theta`` to try other settings (always applied to both li
 
 What cannot be matched: NiaPy evaluates the objective after *every* pairwise move (firefly i
 toward each j with ``f_i >= f_j``, j = i included) and moves in place, so later pairs see
-already-moved fireflies and updated values. One generation therefore costs about
-``n (n + 1) / 2`` evaluations (~770 for n = 40), not ``n``. tcbench composes the chain of moves
-of one generation in closed form from the start-of-generation positions and evaluates each
-firefly once (``n`` evaluations per generation, plus ``n`` for the initial population). Both
-libraries run the same 500 generations, so NiaPy spends roughly 19x more evaluations; the report
-gives both counts, the per-evaluation cost, and an extra NiaPy row capped at tcbench's
-evaluation count (``Task(max_evals=...)``) to compare fitness at equal evaluations.
+already-moved fireflies and updated values. One generation therefore costs up to
+``n (n + 1) / 2`` evaluations (about 760 measured for n = 40), not ``n``. tcbench composes the
+chain of moves of one generation in closed form from the start-of-generation positions and
+evaluates each firefly once (``n`` evaluations per generation, plus ``n`` for the initial
+population). Both libraries run the same 500 generations, so NiaPy spends roughly 19x more
+evaluations; the report gives both counts, the per-evaluation cost, and an extra NiaPy row
+capped at tcbench's evaluation count (``Task(max_evals=...)``) to compare fitness at equal
+evaluations.
 
 Usage::
 
@@ -177,8 +178,8 @@ def markdown(summary: dict[str, dict[str, float]], ratios: dict[str, float],
         "niapy-equal-evals": "NiaPy, capped at tcbench's evaluations",
     }
     lines = [
-        f"| library | median wall time (s) | median final best | mean final best "
-        f"| evaluations (median) | generations | µs / evaluation |",
+        "| library | median wall time (s) | median final best | mean final best "
+        "| evaluations (median) | generations | µs / evaluation |",
         "|---|---:|---:|---:|---:|---:|---:|",
     ]
     for library, s in summary.items():
