@@ -24,7 +24,7 @@ def task_key(task: dict[str, Any]) -> str:
     if task.get("shift"):
         key += "-shifted"
     if task.get("lower") is not None or task.get("upper") is not None:
-        key += f"-[{task.get('lower')},{task.get('upper')}]"
+        key += f"-domain{task.get('lower')}_{task.get('upper')}"
     return key
 
 
