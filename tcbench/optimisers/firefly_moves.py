@@ -54,9 +54,13 @@ def move_towards(
     keep = 1.0 - coef
     through = np.cumprod(keep[:, ::-1], axis=1)[:, ::-1]  # prod_{l >= j} c_il
     after = np.concatenate([through[:, 1:], np.ones((n, 1))], axis=1)  # prod_{l > j} c_il
-    weight = after * moves
-    noise = (rng.random((n, n, d)) - 0.5) * step
-    out = through[:, :1] * x + (after * coef) @ x + np.einsum("ij,ijd->id", weight, noise)
+    out = through[:, :1] * x + (after * coef) @ x
+    # One random step per move actually made, drawn in (i, j) row-major order.
+    rows, cols = np.nonzero(moves)
+    if rows.size:
+        noise = (rng.random((rows.size, d)) - 0.5) * step * after[rows, cols][:, None]
+        starts = np.flatnonzero(np.r_[True, rows[1:] != rows[:-1]])
+        out[rows[starts]] += np.add.reduceat(noise, starts, axis=0)
     lone = ~moves.any(axis=1)
     if lone.any():
         out[lone] = x[lone] + (rng.random((int(lone.sum()), d)) - 0.5) * step

@@ -16,7 +16,7 @@ follows eq. 6: ``alpha(n+1) = k alpha(n) exp(n / (n - maxgen))``.
 
 Choices where the paper is silent (all parameters, see :class:`IFAParams`):
 
-- ``k = 1``: eq. 6's nonlinear factor alone already decays the step to ~1 % of alpha0 by
+- ``k = 1``: eq. 6's nonlinear factor alone already decays the step to ~0.5 % of alpha0 by
   ``n = 0.4 maxgen``; ``k < 1`` decays it faster.
 - ``epsilon = 0.01``: T runs from ``0.01 maxgen`` to 0.01 in objective units, so early on a
   best-firefly move that is worse by ``0.01 maxgen`` is accepted with probability 1/e.
