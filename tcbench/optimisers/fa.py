@@ -72,8 +72,8 @@ class FireflyAlgorithm(Optimiser):
 
     def __init__(self, lower, upper, budget, rng, params=None) -> None:  # type: ignore[no-untyped-def]
         super().__init__(lower, upper, budget, rng, params)
-        width = self.upper - self.lower
-        self.alpha = self.params.alpha0 * (width if self.params.alpha_relative else 1.0)
+        self.width = self.upper - self.lower
+        self.alpha = self.params.alpha0 * (self.width if self.params.alpha_relative else 1.0)
         self.x = np.empty((0, self.dim))
         self.fitness = np.empty(0)
 
@@ -81,14 +81,18 @@ class FireflyAlgorithm(Optimiser):
         limit = self.params.max_generations
         return limit is not None and self.generation >= limit
 
+    def moved(self, follow: np.ndarray) -> np.ndarray:
+        """The population after one round of moves, firefly i pulled by j where ``follow[i, j]``
+        (and j is brighter); positions clamped to the domain (eq. 11)."""
+        p = self.params
+        beta = attractiveness(squared_distances(self.x), p.beta0, p.gamma, p.beta_min)
+        coef = np.where(follow & brighter_mask(self.fitness), beta, 0.0)
+        return self.clip(move_towards(self.x, coef, self.alpha, self.rng))
+
     def _ask(self) -> np.ndarray:
         if self.fitness.size == 0:
             return self.uniform(self.params.population)
-        p = self.params
-        beta = attractiveness(squared_distances(self.x), p.beta0, p.gamma, p.beta_min)
-        coef = np.where(brighter_mask(self.fitness), beta, 0.0)
-        moved = self.clip(move_towards(self.x, coef, self.alpha, self.rng))
-        return moved[: self.remaining]
+        return self.moved(np.ones((len(self.fitness),) * 2, dtype=bool))[: self.remaining]
 
     def _tell(self, x: np.ndarray, f: np.ndarray) -> None:
         if self.fitness.size == 0:

@@ -34,14 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcbench.optimisers.fa import FAParams
-from tcbench.optimisers.firefly_moves import (
-    attractiveness,
-    brighter_mask,
-    move_towards,
-    squared_distances,
-)
-from tcbench.optimisers.protocol import Optimiser
+from tcbench.optimisers.fa import FAParams, FireflyAlgorithm
 
 
 @dataclass(frozen=True)
@@ -111,7 +104,7 @@ def random_subsets(n: int, size: int, rng: np.random.Generator) -> np.ndarray:
     return mask
 
 
-class ImprovedFireflyAlgorithm(Optimiser):
+class ImprovedFireflyAlgorithm(FireflyAlgorithm):
     """Improved firefly algorithm (IFA), population-vectorised ask/tell."""
 
     name = "ifa"
@@ -121,14 +114,10 @@ class ImprovedFireflyAlgorithm(Optimiser):
     def __init__(self, lower, upper, budget, rng, params=None) -> None:  # type: ignore[no-untyped-def]
         super().__init__(lower, upper, budget, rng, params)
         p = self.params
-        self.width = self.upper - self.lower
-        self.alpha = p.alpha0 * (self.width if p.alpha_relative else 1.0)
         after_init = self.budget - p.population
         self.maxgen = p.max_generations or max(1, math.ceil(after_init / p.population))
         self.subset_size = max(1, round(p.subset_fraction * (p.population - 1)))
         self.accepted_worse = 0
-        self.x = np.empty((0, self.dim))
-        self.fitness = np.empty(0)
         self._phase = "init"
 
     def _stopped(self) -> bool:
@@ -140,12 +129,8 @@ class ImprovedFireflyAlgorithm(Optimiser):
         if self._phase == "best":
             dx = mutation_step(self.generation, self.maxgen, self.width, self.rng)  # eq. 9
             return self.clip(self.x[:1] + dx)  # eq. 10-11
-        p = self.params
-        n = len(self.fitness)
-        beta = attractiveness(squared_distances(self.x), p.beta0, p.gamma, p.beta_min)
-        follow = random_subsets(n, self.subset_size, self.rng) & brighter_mask(self.fitness)
-        moved = self.clip(move_towards(self.x, np.where(follow, beta, 0.0), self.alpha, self.rng))
-        return moved[1:][: self.remaining]
+        follow = random_subsets(len(self.fitness), self.subset_size, self.rng)
+        return self.moved(follow)[1:][: self.remaining]
 
     def _tell(self, x: np.ndarray, f: np.ndarray) -> None:
         if self._phase == "init":
