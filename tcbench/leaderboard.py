@@ -1,6 +1,7 @@
 """Leaderboards: finished and failed runs from MLflow aggregated over seeds with pandas.
 
-Per task and method: runs, failed runs, median and IQR of the final error (best - optimum),
+Per task and method: seeds (one run each), failed runs, median final best, median and IQR of
+the final error (best - optimum),
 success rate at the task's target precision, expected running time (ERT) to that target, and a
 rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
 and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
@@ -18,7 +19,7 @@ import pandas as pd
 from tcbench import plots
 
 COLUMNS = [
-    "rank", "method", "runs", "failed", "median_error", "iqr_error",
+    "rank", "method", "seeds", "failed", "median_best", "median_error", "iqr_error",
     "success_rate", "ert_evals", "median_evals",
 ]
 
@@ -89,8 +90,9 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         q25, q50, q75 = np.percentile(err, [25, 50, 75]) if err.size else (np.nan,) * 3
         rows.append({
             "method": method,
-            "runs": len(g),
+            "seeds": len(g),
             "failed": int((~ok).sum()),
+            "median_best": float(np.median(g.loc[ok, "final_best"])) if ok.any() else np.nan,
             "median_error": q50,
             "iqr_error": q75 - q25,
             "success_rate": hit.mean(),

@@ -55,7 +55,7 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
     assert lb.returncode == 0, lb.stderr
     table = pd.read_csv(workdir / "lb" / "sphere-2d.csv")
     assert sorted(table["method"]) == ["fa", "ifa"]
-    assert table["runs"].tolist() == [3, 3] and table["failed"].tolist() == [0, 0]
+    assert table["seeds"].tolist() == [3, 3] and table["failed"].tolist() == [0, 0]
     assert sorted(table["rank"]) == [1, 2]
     assert (workdir / "lb" / "sphere-2d_convergence.png").stat().st_size > 5000
     assert "| rank | method |" in (workdir / "lb" / "sphere-2d.md").read_text()

@@ -58,7 +58,7 @@ def test_failed_job_is_recorded_and_counted(workdir: Path) -> None:
     assert (failed["error_message"] == "RuntimeError: boom in generation 2").all()
     (board,) = leaderboard.boards(runs)
     row = board.table.set_index("method").loc["exploding"]
-    assert row["runs"] == 2 and row["failed"] == 2 and row["success_rate"] == 0
+    assert row["seeds"] == 2 and row["failed"] == 2 and row["success_rate"] == 0
     paths = leaderboard.write(board, workdir / "lb", client, "test")
     assert "exploding seed 1: FAILED RuntimeError: boom" in paths["md"].read_text()
 
@@ -115,11 +115,29 @@ def test_summarise_ranks_and_statistics() -> None:
     for method, errors, hits in [("a", [1.0, 2.0, 3.0, 4.0], [0, 0, 0, 0]), ("b", [0.0, 0.0, 5.0, 9.0], [1, 1, 0, 0])]:
         for seed, (e, h) in enumerate(zip(errors, hits)):
             rows.append({
-                "method": method, "status": "FINISHED", "final_error": e, "target_hit": bool(h),
+                "method": method, "status": "FINISHED", "final_error": e, "final_best": e - 1.0,
+                "target_hit": bool(h),
                 "evaluations": 100.0, "evals_to_target": 50.0 if h else np.nan, "budget": 100,
             })
     table = leaderboard.summarise(pd.DataFrame(rows)).set_index("method")
     assert table.loc["b", "rank"] == 1 and table.loc["a", "rank"] == 2  # success rate first
+    assert table.loc["a", "median_best"] == 1.5
     assert table.loc["a", "median_error"] == 2.5 and table.loc["a", "iqr_error"] == pytest.approx(1.5)
     assert table.loc["b", "success_rate"] == 0.5 and table.loc["b", "ert_evals"] == 150.0
     assert table.loc["a", "ert_evals"] == np.inf
+
+
+def test_sweep_goes_on_after_a_failing_job(workdir: Path, capsys) -> None:
+    """A multirun in which some jobs raise: they are FAILED in MLflow, the others finish,
+    and the command lists the failures and exits 1."""
+    from tcbench.cli import main
+
+    register("exploding", Exploding)
+    code = main([
+        "run", "-m", "task=sphere", "budget=60", "seed=range(2)", "tracking.experiment=sweep",
+        "optimiser=fa", "+optimiser.label=x", "optimiser.name=fa,exploding",
+    ])
+    out = capsys.readouterr().out
+    assert code == 1
+    assert "4 runs recorded" in out and "2 finished, 2 failed" in out
+    assert out.count("FAILED x on sphere-2d seed") == 2 and "boom in generation 2" in out
