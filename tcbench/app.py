@@ -12,13 +12,17 @@ import hydra
 from hydra import compose, initialize_config_dir
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException, MissingConfigException
-from omegaconf import DictConfig, OmegaConf
+from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
 from tcbench.config import ConfigError, as_dict, register_schema, validate
 from tcbench.job import run_job
 
 CONF_DIR = Path(__file__).resolve().parent / "conf"
+# Hydra flags followed by a value; those that change where configs come from make tcbench
+# skip its up-front check (each job still validates its own config).
+VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
+CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
 log = logging.getLogger(__name__)
 
 register_schema()
@@ -35,9 +39,10 @@ class Plan:
     """What a ``tcbench run`` command line will do, known before any job starts."""
 
     jobs: int
+    tracking_enabled: bool
     tracking_uri: str | None
     experiment: str
-    sweep_id: str | None
+    sweep_id: str
 
 
 def _known_options(group: str) -> list[str]:
@@ -67,10 +72,23 @@ def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
         raise ConfigError(_explain(exc)) from None
 
 
+def overrides_of(args: list[str]) -> list[str]:
+    """The ``key=value`` overrides of a Hydra command line (flags and their values dropped)."""
+    out, skip = [], False
+    for a in args:
+        if skip:
+            skip = False
+        elif a in VALUE_FLAGS:
+            skip = True
+        elif not a.startswith("-"):
+            out.append(a)
+    return out
+
+
 def plan(args: list[str]) -> Plan:
     """Compose and validate every job of a command line; raise ConfigError on the first bad one."""
     multirun = "-m" in args or "--multirun" in args
-    raw = [a for a in args if not a.startswith("-")]
+    raw = overrides_of(args)
     parser = OverridesParser.create()
     try:
         parsed = parser.parse_overrides(raw)
@@ -103,10 +121,5 @@ def plan(args: list[str]) -> Plan:
                 raise ConfigError(f"seed must be a non-negative integer, got {s!r}")
     jobs = len(combos) * (len(seeds) if seeds else 1)
     track = last["tracking"]
-    return Plan(jobs, track.get("uri"), track["experiment"], track.get("sweep_id"))
+    return Plan(jobs, track["enabled"], track.get("uri"), track["experiment"], str(track["sweep_id"]))
 
-
-def resolved(args: list[str]) -> dict[str, Any]:
-    """The composed config of a single (non-sweep) command line, as a dict."""
-    with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
-        return OmegaConf.to_container(_compose([a for a in args if not a.startswith("-")]), resolve=True)  # type: ignore[return-value]

@@ -6,6 +6,10 @@ import argparse
 import sys
 import uuid
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tcbench.app import Plan
 
 USAGE = """usage: tcbench <command> [args]
 
@@ -19,6 +23,9 @@ commands:
 """
 
 
+HYDRA_INFO_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc"}
+
+
 class UserError(Exception):
     """A mistake in what the user asked for: reported in one line, exit code 2."""
 
@@ -28,30 +35,30 @@ def _fail(message: str, code: int = 2) -> int:
     return code
 
 
-def _run_sweep(args: list[str]) -> tuple[int, str, str, str | None]:
-    """Validate, then run Hydra; return (exit code, sweep id, experiment, tracking uri)."""
-    from tcbench.app import hydra_main, plan
+def _run_sweep(args: list[str]) -> Plan | None:
+    """Validate every job, then run them through Hydra; the plan, or None if not checked."""
+    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan
     from tcbench.config import ConfigError
 
     if not any(a.startswith("tracking.sweep_id=") for a in args):
         args = [*args, f"tracking.sweep_id={uuid.uuid4().hex[:12]}"]
-    passthrough = any(a in {"--help", "-h", "--hydra-help", "--info", "--cfg", "-c", "--shell-completion"} for a in args)
-    if not passthrough:
+    checked: Plan | None = None
+    if any(a in CONFIG_SOURCE_FLAGS for a in args):
+        print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)
+    elif not any(a in HYDRA_INFO_FLAGS for a in args):
         try:
-            p = plan(args)
+            checked = plan(args)
         except ConfigError as exc:
             raise UserError(str(exc)) from None
-        print(f"tcbench: {p.jobs} job{'s' if p.jobs != 1 else ''} to run", file=sys.stderr)
+        n = checked.jobs
+        print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
     saved = sys.argv
     sys.argv = ["tcbench", *args]
     try:
         hydra_main()
     finally:
         sys.argv = saved
-    if passthrough:
-        return 0, "", "", None
-    assert p.sweep_id is not None
-    return 0, p.sweep_id, p.experiment, p.tracking_uri
+    return checked
 
 
 def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
@@ -72,13 +79,10 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
 
 
 def cmd_run(args: list[str]) -> int:
-    code, sweep, experiment, uri = _run_sweep(args)
-    if sweep and experiment:
-        try:
-            return _sweep_report(sweep, experiment, uri)
-        except LookupError:
-            return code  # tracking disabled: nothing recorded to report on
-    return code
+    checked = _run_sweep(args)
+    if checked is None or not checked.tracking_enabled:
+        return 0
+    return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri)
 
 
 def cmd_leaderboard(argv: list[str]) -> int:
@@ -113,19 +117,20 @@ def cmd_quickstart(argv: list[str]) -> int:
     sweep = uuid.uuid4().hex[:12]
     out = Path("tcbench-quickstart")
     print("tcbench quickstart: FA vs IFA on 2-D Rastrigin (seed 000 settings), 10 seeds each")
-    code, sweep, experiment, uri = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}"])
-    status = _sweep_report(sweep, experiment, uri)
-    lb = cmd_leaderboard(["--experiment", experiment, "--sweep", sweep, "--out", str(out)])
+    checked = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}"])
+    assert checked is not None
+    status = _sweep_report(sweep, checked.experiment, checked.tracking_uri)
+    lb = cmd_leaderboard(["--experiment", checked.experiment, "--sweep", sweep, "--out", str(out)])
     from tcbench import tracking
 
+    uri = tracking.tracking_uri(checked.tracking_uri)
     print(
         f"\nRuns (params, per-generation curves, config, convergence plots) are in MLflow at "
-        f"{tracking.tracking_uri(uri)}; browse them with\n"
-        f"  mlflow ui --backend-store-uri {tracking.tracking_uri(uri)}\n"
+        f"{uri}; browse them with\n  mlflow ui --backend-store-uri {uri}\n"
         f"Leaderboard table and plot: {out.resolve()}/\n"
         f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/"
     )
-    return code or status or lb
+    return status or lb
 
 
 def cmd_list(argv: list[str]) -> int:
