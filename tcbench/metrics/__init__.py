@@ -1,0 +1,1 @@
+"""Paper metrics: accelerometer, gyroscope and optimisation."""

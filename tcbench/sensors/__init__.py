@@ -1,0 +1,1 @@
+"""Sensor simulators, test protocols and recordings."""

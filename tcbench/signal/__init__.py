@@ -1,0 +1,1 @@
+"""Signal processing: Allan deviation and (later) decomposition, entropy and filtering."""
