@@ -1,0 +1,83 @@
+"""Device populations: a device seed draws one unit's parameters from a realistic spread.
+
+Repeated experiments on one device differ only by the run seed (noise, ambient); different
+device seeds differ like different parts from one wafer lot. The spreads are set so the raw
+metrics of the population span the seed papers' raw figures (see
+``experiments/raw-sensors/README.md``); the calibration choices are stated next to each draw.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tcbench.sensors.models import MSRA, Gyro, Unit, gyro_effects, msra_effects
+
+
+def _rng(kind: str, device_seed: int) -> np.random.Generator:
+    if int(device_seed) != device_seed or device_seed < 0:
+        raise ValueError(f"device_seed must be a non-negative integer, got {device_seed!r}")
+    return np.random.default_rng([int(device_seed), sum(map(ord, kind))])
+
+
+def msra_unit(device_seed: int) -> Unit:
+    """One MSRA. Residual common-mode mismatch ``m`` of the resonators' frequency coefficients
+    (11-15 %, giving dU/dT of about -0.16 Hz/K, ~800 micro-g/K of bias) and a log-uniform
+    scale-factor coefficient gK in 60-600 ppm/K (scale-factor variation 2 000-20 000 ppm over
+    -40..60 degC) are the draws that set the full-temperature figures."""
+    rng = _rng("msra", device_seed)
+    f0_1 = 30000.0 + rng.normal(0.0, 30.0)
+    f0 = (f0_1, f0_1 - rng.normal(150.0, 20.0))
+    k = tuple(100.0 * (1.0 + rng.normal(0.0, 0.02, 2)))
+    tce = -30.0 + rng.normal(0.0, 2.0)
+    stress_1 = -10.0 + rng.normal(0.0, 2.0)
+    mismatch = rng.uniform(0.11, 0.15)
+    c1_1 = tce + stress_1
+    c1_2 = c1_1 * (1.0 - mismatch) * f0[0] / f0[1]  # f0_2 c1_2 = (1 - m) f0_1 c1_1
+    c2_1 = -20.0 + rng.normal(0.0, 3.0)
+    gk = float(np.exp(rng.uniform(np.log(60.0), np.log(600.0))))
+    draws = {
+        "mismatch": mismatch, "gk_ppm_per_k": gk, "lag_tau_s": rng.uniform(360.0, 840.0),
+        "white_ug": rng.uniform(10.0, 14.0), "flicker_ug": rng.uniform(3.5, 6.5),
+    }
+    model = MSRA(
+        f0_hz=f0,
+        k_hz_per_g=k,  # type: ignore[arg-type]
+        tce_ppm_per_k=(tce, tce),
+        stress_ppm_per_k=(stress_1, c1_2 - tce),
+        c2_ppb_per_k2=(c2_1, c2_1 * (1.0 + rng.normal(0.0, 0.03))),
+        gk_ppm_per_k=gk,
+        misalignment_rad=rng.normal(0.0, 1e-3),
+        effects=msra_effects(f0, k, draws["lag_tau_s"], draws["white_ug"], draws["flicker_ug"]),  # type: ignore[arg-type]
+    )
+    return Unit(f"msra-{device_seed:04d}", model, draws)
+
+
+def gyro_unit(device_seed: int) -> Unit:
+    """One dual-mass gyroscope around PHYSICS.md §6's defaults (bias 1.10 u + 4.0e-3 u^2 +
+    1.5e-4 u^3 deg/h, ARW 0.52 deg/sqrt(h), bias instability 33 deg/h, lag 8 min)."""
+    rng = _rng("gyro", device_seed)
+    draws = {
+        "lag_tau_s": rng.uniform(390.0, 570.0),
+        "c3_dph_per_k3": 1.5e-4 * (1.0 + rng.normal(0.0, 0.1)),
+        "rate_dph_per_c_per_min": rng.uniform(2.5, 3.5),
+        "arw_deg_per_sqrt_h": 0.52 * (1.0 + rng.normal(0.0, 0.04)),
+        "bias_instability_dph": 33.0 * (1.0 + rng.normal(0.0, 0.08)),
+    }
+    model = Gyro(
+        sf_ppm_per_k=-280.0 + rng.normal(0.0, 30.0),
+        b0_dph=rng.normal(0.0, 20.0),
+        b1_dph_per_k=1.10 * (1.0 + rng.normal(0.0, 0.08)),
+        b2_dph_per_k2=4.0e-3 * (1.0 + rng.normal(0.0, 0.1)),
+        effects=gyro_effects(**draws),
+    )
+    return Unit(f"gyro-{device_seed:04d}", model, draws)
+
+
+UNITS = {"msra": msra_unit, "gyro": gyro_unit}
+
+
+def unit(sensor: str, device_seed: int) -> Unit:
+    """The unit ``device_seed`` of sensor kind ``sensor`` (``msra`` or ``gyro``)."""
+    if sensor not in UNITS:
+        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(UNITS)}")
+    return UNITS[sensor](device_seed)

@@ -1,0 +1,258 @@
+"""The effect library: named, parametric physical effects a sensor model is composed of.
+
+Each effect has an ``id`` (PHYSICS.md §3), parameters, and a form for simulation. Effects act
+at one of three stages:
+
+- ``die``: change the die temperature the physics sees (``thermal_lag``);
+- ``output``: add a term to the output, in the sensor's output unit (Hz for the MSRA, deg/s
+  for the gyroscope);
+- ``final``: transform the finished output (``quantisation``).
+
+The same objects serve simulation now and diagnosis later (fitting their parameters to a
+residual), so each is a small frozen dataclass whose fields are its parameters.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from tcbench.sensors import noise
+from tcbench.sensors.thermal import first_order_lag
+
+
+@dataclass
+class Signals:
+    """What effects see: time since power-on, temperatures and the applied input, per sample.
+
+    ``temp_rate_c_per_s`` is the thermometer's rate of change; ``accel_g`` the acceleration
+    along the sensitive axis (MSRA) and ``cross_g`` across it; ``rate_dps`` the applied rate.
+    """
+
+    t_s: np.ndarray
+    dt_s: float
+    temp_meas_c: np.ndarray
+    temp_die_c: np.ndarray
+    temp_rate_c_per_s: np.ndarray
+    accel_g: np.ndarray
+    cross_g: np.ndarray
+    rate_dps: np.ndarray
+    ref_c: float = 25.0
+
+
+@dataclass(frozen=True)
+class Effect:
+    """Base of all effects; subclasses set ``id`` and ``stage`` and implement one method."""
+
+    id: ClassVar[str] = ""
+    stage: ClassVar[str] = "output"
+
+    def die_temperature(self, s: Signals) -> np.ndarray:
+        """Stage ``die``: the die temperature after this effect."""
+        raise NotImplementedError
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        """Stage ``output``: the additive output term (output unit)."""
+        raise NotImplementedError
+
+    def transform(self, y: np.ndarray) -> np.ndarray:
+        """Stage ``final``: the output after this effect."""
+        raise NotImplementedError
+
+    def params(self) -> dict[str, float]:
+        """Parameters by name."""
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class ThermalLag(Effect):
+    """The die follows the thermometer: ``dT_die/dt = (T_meas - T_die) / tau_s``."""
+
+    id: ClassVar[str] = "thermal_lag"
+    stage: ClassVar[str] = "die"
+    tau_s: float = 600.0
+
+    def die_temperature(self, s: Signals) -> np.ndarray:
+        return first_order_lag(s.temp_meas_c, s.dt_s, self.tau_s)
+
+
+@dataclass(frozen=True)
+class TemperatureRate(Effect):
+    """Thermal-gradient term ``coef * dT_meas/dt`` (output unit per degC/s); zero at rest."""
+
+    id: ClassVar[str] = "temperature_rate"
+    coef_per_c_per_s: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.coef_per_c_per_s * s.temp_rate_c_per_s
+
+
+def play_operator(temp_c: np.ndarray, width_c: float) -> np.ndarray:
+    """Play (backlash) operator of half-width ``width_c``: the state lags the input by at most
+    ``width_c`` and only moves when pushed. Sequential by nature, so it runs over the thermal
+    samples (1 Hz or slower in the protocols), not over output samples."""
+    out = np.empty_like(temp_c)
+    y = float(temp_c[0])
+    for i, x in enumerate(temp_c.tolist()):
+        y = min(max(y, x - width_c), x + width_c)
+        out[i] = y
+    return out
+
+
+@dataclass(frozen=True)
+class Hysteresis(Effect):
+    """``amplitude * s(t)``, ``s = (T_die - play(T_die)) / width`` in [-1, 1]: +1 after heating,
+    -1 after cooling, remembered through a soak."""
+
+    id: ClassVar[str] = "hysteresis"
+    amplitude: float = 0.0
+    width_c: float = 2.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        step = max(1, int(round(1.0 / s.dt_s)))  # the play operator on a <= 1 Hz grid
+        coarse = s.temp_die_c[::step]
+        state = (coarse - play_operator(coarse, self.width_c)) / self.width_c
+        return self.amplitude * np.interp(s.t_s, s.t_s[::step], state)
+
+
+@dataclass(frozen=True)
+class Warmup(Effect):
+    """``amplitude * exp(-t / tau_s)`` after power-on (self-heating, stress settling)."""
+
+    id: ClassVar[str] = "warmup"
+    amplitude: float = 0.0
+    tau_s: float = 1200.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.amplitude * np.exp(-s.t_s / self.tau_s)
+
+
+@dataclass(frozen=True)
+class AgingDrift(Effect):
+    """``rate_per_h * t + relax_amplitude * exp(-t / relax_tau_s)``: drift with time, not
+    temperature (linear ageing plus stress relaxation)."""
+
+    id: ClassVar[str] = "aging_drift"
+    rate_per_h: float = 0.0
+    relax_amplitude: float = 0.0
+    relax_tau_s: float = 6000.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.rate_per_h * s.t_s / 3600.0 + self.relax_amplitude * np.exp(-s.t_s / self.relax_tau_s)
+
+
+@dataclass(frozen=True)
+class TemperatureCubic(Effect):
+    """``c3 * (T_die - ref)^3`` beyond a quadratic model (output unit per degC^3)."""
+
+    id: ClassVar[str] = "temperature_cubic"
+    c3_per_c3: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.c3_per_c3 * (s.temp_die_c - s.ref_c) ** 3
+
+
+@dataclass(frozen=True)
+class AccelNonlinearity(Effect):
+    """``k2 * a^2`` with ``a`` the acceleration along the sensitive axis (output unit per g^2)."""
+
+    id: ClassVar[str] = "accel_nonlinearity"
+    k2_per_g2: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.k2_per_g2 * s.accel_g**2
+
+
+@dataclass(frozen=True)
+class BiasInstability(Effect):
+    """Flicker bias noise with Allan floor ``0.664 b`` (``b`` in output units)."""
+
+    id: ClassVar[str] = "bias_instability"
+    b: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return noise.flicker(s.t_s.size, s.dt_s, self.b, rng)
+
+
+@dataclass(frozen=True)
+class WhiteNoise(Effect):
+    """White output noise of density ``density`` (output unit per sqrt(Hz), i.e. the angle or
+    velocity random walk); per sample its standard deviation is ``density * sqrt(fs)``."""
+
+    id: ClassVar[str] = "white_noise"
+    density: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return noise.white(s.t_s.size, self.density / np.sqrt(s.dt_s), rng)
+
+
+@dataclass(frozen=True)
+class RandomWalk(Effect):
+    """Rate random walk, ``k`` in output unit per sqrt(s)."""
+
+    id: ClassVar[str] = "random_walk"
+    k_per_sqrt_s: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return noise.random_walk(s.t_s.size, s.dt_s, self.k_per_sqrt_s, rng)
+
+
+@dataclass(frozen=True)
+class Quantisation(Effect):
+    """Output rounded to multiples of ``step`` (counter or ADC resolution)."""
+
+    id: ClassVar[str] = "quantisation"
+    stage: ClassVar[str] = "final"
+    step: float = 0.0
+
+    def transform(self, y: np.ndarray) -> np.ndarray:
+        return noise.quantise(y, self.step)
+
+
+EFFECTS: dict[str, type[Effect]] = {
+    cls.id: cls
+    for cls in (
+        ThermalLag, TemperatureRate, Hysteresis, Warmup, AgingDrift, TemperatureCubic,
+        AccelNonlinearity, BiasInstability, WhiteNoise, RandomWalk, Quantisation,
+    )
+}
+
+
+def make_effect(effect_id: str, **params: Any) -> Effect:
+    """Build an effect by id; unknown ids or parameters raise ``ValueError`` naming the known ones."""
+    if effect_id not in EFFECTS:
+        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(sorted(EFFECTS))}")
+    cls = EFFECTS[effect_id]
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(params) - known)
+    if unknown:
+        raise ValueError(f"effect {effect_id!r} has no parameter {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    return cls(**{k: float(v) for k, v in params.items()})
+
+
+def apply_effects(
+    base: np.ndarray, effects: list[Effect], s: Signals, rng: np.random.Generator
+) -> np.ndarray:
+    """Add the ``output`` terms to ``base`` and apply the ``final`` stage, in list order, each
+    effect drawing from its own child stream of ``rng``."""
+    streams = rng.spawn(len(effects)) if effects else []
+    y = base.copy()
+    for effect, stream in zip(effects, streams, strict=True):
+        if effect.stage == "output":
+            y += effect.term(s, stream)
+    for effect in effects:
+        if effect.stage == "final":
+            y = effect.transform(y)
+    return y
+
+
+def die_temperature(effects: list[Effect], s: Signals) -> np.ndarray:
+    """Die temperature after the ``die`` stage effects (the thermometer's if none)."""
+    temp = s.temp_meas_c
+    for effect in effects:
+        if effect.stage == "die":
+            temp = effect.die_temperature(dataclasses.replace(s, temp_meas_c=temp))
+    return temp

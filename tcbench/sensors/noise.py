@@ -1,0 +1,59 @@
+"""Sensor noise processes, vectorised and seeded (PHYSICS.md §4).
+
+All amplitudes are in the sensor's output unit (Hz for the MSRA, deg/s for the gyroscope).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tcbench.sensors.thermal import gauss_markov
+
+# Per-process std of the Gauss-Markov bank, per unit of bias instability B, for two processes
+# per decade; with it the Allan deviation floor is 0.664 B (checked in tests/test_noise.py).
+FLICKER_SIGMA_PER_B = 0.605
+_PER_DECADE = 2
+_MAX_STEPS_PER_TC = 40  # a process slower than this many samples is drawn coarser, then interpolated
+
+
+def white(n: int, sigma: float, rng: np.random.Generator) -> np.ndarray:
+    """White noise with per-sample standard deviation ``sigma``."""
+    return rng.standard_normal(n) * sigma
+
+
+def random_walk(n: int, dt_s: float, k_per_sqrt_s: float, rng: np.random.Generator) -> np.ndarray:
+    """Rate random walk: increments ``K sqrt(dt)`` (``K`` in output unit per sqrt(s))."""
+    return np.cumsum(rng.standard_normal(n) * (k_per_sqrt_s * np.sqrt(dt_s)))
+
+
+def flicker(
+    n: int, dt_s: float, b: float, rng: np.random.Generator, tau_max_s: float | None = None
+) -> np.ndarray:
+    """Flicker (1/f) bias noise whose Allan deviation floor is ``0.664 b``.
+
+    A bank of Gauss-Markov processes with correlation times log-spaced two per decade from
+    ``max(1 s, 2 dt)`` to ten times ``tau_max_s`` (default: the record length). Slow processes
+    are drawn on a coarser grid and linearly interpolated, which keeps 24 h at 100 Hz fast.
+    """
+    duration_s = n * dt_s
+    t_hi = 10.0 * (tau_max_s or duration_s)
+    t_lo = max(1.0, 2.0 * dt_s)
+    count = max(1, int(np.ceil(_PER_DECADE * np.log10(t_hi / t_lo))) + 1)
+    tcs = np.logspace(np.log10(t_lo), np.log10(t_hi), count)
+    sigma = FLICKER_SIGMA_PER_B * b
+    out = np.zeros(n)
+    t = np.arange(n) * dt_s
+    for tc in tcs:
+        step = max(1, int(tc / dt_s / _MAX_STEPS_PER_TC))
+        if step == 1:
+            out += gauss_markov(n, dt_s, tc, sigma, rng)
+        else:
+            coarse_n = n // step + 2
+            coarse = gauss_markov(coarse_n, dt_s * step, tc, sigma, rng)
+            out += np.interp(t, np.arange(coarse_n) * dt_s * step, coarse)
+    return out
+
+
+def quantise(x: np.ndarray, step: float) -> np.ndarray:
+    """Round to a multiple of ``step`` (counter or ADC resolution); ``step <= 0`` leaves x."""
+    return np.round(x / step) * step if step > 0 else x
