@@ -18,6 +18,8 @@ commands:
   leaderboard [options]      aggregate finished runs into leaderboards/<task>.md/.csv/.png
   quickstart                 FA against IFA on 2-D Rastrigin, 10 seeds each, with a results table
   list                       registered tasks and optimisers
+  simulate key=value ...     simulate a recording: sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR
+  metrics PATH [key=value]   validate a recording and compute the papers' metrics, with plots
 
 `tcbench run --help` shows the Hydra options and config groups.
 """
@@ -148,7 +150,28 @@ def cmd_list(argv: list[str]) -> int:
     return 0
 
 
-COMMANDS = {"run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list}
+def cmd_simulate(argv: list[str]) -> int:
+    from tcbench.sensors_cli import CommandError, simulate
+
+    try:
+        return simulate(argv)
+    except CommandError as exc:
+        raise UserError(str(exc)) from None
+
+
+def cmd_metrics(argv: list[str]) -> int:
+    from tcbench.sensors_cli import CommandError, metrics
+
+    try:
+        return metrics(argv)
+    except CommandError as exc:
+        raise UserError(str(exc)) from None
+
+
+COMMANDS = {
+    "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
+    "simulate": cmd_simulate, "metrics": cmd_metrics,
+}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -87,9 +87,9 @@ def _from_segments(
     rate = np.zeros_like(t)
     table = np.array([[s.accel_g, s.cross_g, s.rate_dps] for s in segments])
     accel[held], cross[held], rate[held] = table[seg[held]].T
-    # During ramps the unit rests in the previous segment's orientation (the first one's at start).
-    last = np.maximum.accumulate(np.where(held, seg, 0))
-    accel[~held], cross[~held], rate[~held] = table[last[~held]].T
+    # During a ramp the unit already rests in the orientation of the segment it ramps to.
+    upcoming = np.minimum.accumulate(np.where(held, seg, len(segments) - 1)[::-1])[::-1]
+    accel[~held], cross[~held], rate[~held] = table[upcoming[~held]].T
     labels = None
     if any(s.position for s in segments):
         names = np.array([""] + [s.position for s in segments])

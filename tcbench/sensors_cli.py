@@ -1,0 +1,163 @@
+"""``tcbench simulate`` and ``tcbench metrics``: recordings from the command line."""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from omegaconf import OmegaConf
+from omegaconf.errors import OmegaConfBaseException
+
+from tcbench.config import TrackingConfig
+
+
+class CommandError(ValueError):
+    """A bad argument: reported in one line."""
+
+
+@dataclass
+class SimulateConfig:
+    """``tcbench simulate`` arguments (``key=value``); ``protocol_params.<name>=`` overrides a
+    protocol keyword (e.g. ``protocol_params.duration_s=3600``)."""
+
+    sensor: str = "msra"
+    protocol: str = "fulltemp"
+    device_seed: int = 0
+    seed: int = 0
+    out: str = "recordings"
+    format: str = "csv"
+    name: str | None = None
+    protocol_params: dict[str, Any] = field(default_factory=dict)
+    metrics: bool = True
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="simulations"))
+
+
+def parse(args: list[str], schema: type) -> Any:
+    """``key=value`` arguments checked against a dataclass schema (types and known keys)."""
+    bad = [a for a in args if "=" not in a or a.startswith("=")]
+    if bad:
+        raise CommandError(f"expected key=value, got {bad[0]!r}")
+    try:
+        cfg = OmegaConf.merge(OmegaConf.structured(schema), OmegaConf.from_dotlist(args))
+        return OmegaConf.to_object(cfg)
+    except OmegaConfBaseException as exc:
+        key = getattr(exc, "full_key", None)
+        first = str(exc).strip().splitlines()[0]
+        raise CommandError(f"{key}: {first}" if key else first) from None
+
+
+def simulate(args: list[str]) -> int:
+    from tcbench.sensors.recording import write_recording
+    from tcbench.sensors.simulate import protocol_names, simulate_recording
+
+    cfg: SimulateConfig = parse(args, SimulateConfig)
+    try:
+        names = protocol_names(cfg.sensor)
+    except ValueError as exc:
+        raise CommandError(str(exc)) from None
+    if cfg.protocol not in names:
+        raise CommandError(f"unknown protocol {cfg.protocol!r} for {cfg.sensor}; known: {', '.join(names)}")
+    if cfg.format not in {"csv", "parquet"}:
+        raise CommandError(f"format must be csv or parquet, got {cfg.format!r}")
+    if cfg.device_seed < 0 or cfg.seed < 0:
+        raise CommandError("device_seed and seed must be non-negative integers")
+    out = Path(cfg.out)
+    stem = cfg.name or f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
+    try:
+        rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed, **cfg.protocol_params)
+    except (TypeError, ValueError) as exc:
+        raise CommandError(str(exc)) from None
+    out.mkdir(parents=True, exist_ok=True)
+    path = write_recording(rec, out / f"{stem}.{cfg.format}")
+    print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
+          f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
+    if cfg.metrics:
+        _report(path, rec, out / f"{stem}_metrics", None, cfg.tracking, {"kind": "simulation", "args": args})
+    return 0
+
+
+@dataclass
+class MetricsConfig:
+    """``tcbench metrics`` arguments: ``recording=PATH`` and options."""
+
+    recording: str = ""
+    out: str | None = None
+    scale_factor_hz_per_g: float | None = None
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
+
+
+def metrics(args: list[str]) -> int:
+    from tcbench.sensors.recording import RecordingError, read_recording
+
+    if args and "=" not in args[0]:
+        args = [f"recording={args[0]}", *args[1:]]
+    cfg: MetricsConfig = parse(args, MetricsConfig)
+    if not cfg.recording:
+        raise CommandError("say which recording: tcbench metrics recording=PATH")
+    path = Path(cfg.recording)
+    try:
+        rec = read_recording(path)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    out = Path(cfg.out) if cfg.out else path.with_name(f"{path.stem}_metrics")
+    _report(path, rec, out, cfg.scale_factor_hz_per_g, cfg.tracking, {"kind": "metrics"})
+    return 0
+
+
+def _report(path: Path, rec: Any, out: Path, scale_factor: float | None, track: TrackingConfig,
+            tags: dict[str, Any]) -> None:
+    from tcbench.metrics.report import analyse
+
+    try:
+        report = analyse(rec, out, scale_factor)
+    except ValueError as exc:
+        raise CommandError(f"{path}: {exc}") from None
+    width = max(len(k) for k in report.metrics)
+    print(f"\nmetrics of {path.name} ({rec.meta.sensor}, {rec.meta.device_id}):")
+    for key, value in report.metrics.items():
+        print(f"  {key:{width}s}  {value:.6g}")
+    for line in report.conventions:
+        print(f"  convention: {line}")
+    if report.nodes is not None:
+        print("\n" + report.nodes.round(6).to_string(index=False))
+    print(f"\nplots and tables: {', '.join(str(p) for p in report.files.values())}")
+    if track.enabled:
+        run_id = _log_to_mlflow(path, rec, report, track, tags)
+        from tcbench import tracking
+
+        print(f"logged to MLflow run {run_id} in {tracking.tracking_uri(track.uri)} (experiment {track.experiment!r})")
+
+
+def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tags: dict[str, Any]) -> str:
+    from tcbench import tracking
+
+    client = tracking.client(track.uri)
+    exp = tracking.experiment_id(client, track.experiment)
+    run = client.create_run(exp, run_name=f"{rec.meta.device_id}-{path.stem}", tags={
+        "tcbench.kind": str(tags["kind"]), "tcbench.sensor": str(rec.meta.sensor),
+        "tcbench.device_id": str(rec.meta.device_id), "tcbench.recording": str(path.resolve()),
+        "tcbench.version": __import__("tcbench").__version__,
+    })
+    run_id = run.info.run_id
+    handle = tracking.JobRun(client, run_id)
+    try:
+        extra = rec.meta.extra or {}
+        params = {"sensor": rec.meta.sensor, "sample_rate_hz": rec.meta.sample_rate_hz,
+                  "protocol": extra.get("protocol"), "device_seed": extra.get("device_seed"),
+                  "seed": extra.get("seed"), "samples": len(rec.data)}
+        for key, value in tracking.flatten(params).items():
+            client.log_param(run_id, key, value)
+        handle.log_metrics({k: v for k, v in report.metrics.items() if v == v})
+        for file in report.files.values():
+            handle.log_artifact(file)
+        with tempfile.TemporaryDirectory() as tmp:
+            sidecar = Path(tmp) / "sidecar.json"
+            sidecar.write_text(OmegaConf.to_yaml(OmegaConf.create(extra)) if extra else "{}")
+            handle.log_artifact(sidecar)
+    except BaseException:
+        client.set_terminated(run_id, status="FAILED")
+        raise
+    client.set_terminated(run_id, status="FINISHED")
+    return run_id
