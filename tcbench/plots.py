@@ -70,6 +70,14 @@ def band_convergence(
     return path
 
 
+def _block_means(t_s: np.ndarray, y: np.ndarray, block_s: float) -> tuple[np.ndarray, np.ndarray]:
+    per = max(1, int(round(block_s / float(np.median(np.diff(t_s)))))) if t_s.size > 1 else 1
+    m = y.size // per
+    if m == 0:
+        return t_s, y
+    return t_s[: m * per].reshape(m, per).mean(axis=1), y[: m * per].reshape(m, per).mean(axis=1)
+
+
 def recording_overview(
     path: Path,
     t_s: np.ndarray,
@@ -79,27 +87,34 @@ def recording_overview(
     title: str,
     max_points: int = 20000,
 ) -> Path:
-    """Temperature and output against time, and output against temperature with heating and
-    cooling drawn in different colours so that loops between them show."""
-    step = max(1, t_s.size // max_points)
-    t_h, temp, out = t_s[::step] / 3600.0, temperature_c[::step], output[::step]
-    rate_c_per_min = np.gradient(temp, t_h * 60.0) if temp.size > 1 else np.zeros_like(temp)
+    """Temperature and output against time, and output against temperature with heating,
+    cooling and steady spans in different colours, so that loops between them show. The output
+    is drawn raw (light) and as means over ``duration / 1000`` (at least 10 s, dark)."""
+    duration_s = float(t_s[-1] - t_s[0]) if t_s.size > 1 else 1.0
+    tm, ym = _block_means(t_s, output, max(10.0, duration_s / 1000.0))
+    _, temp_m = _block_means(t_s, temperature_c, max(10.0, duration_s / 1000.0))
+    # rate of the thermometer over +-30 s, robust to its noise and resolution
+    rate_c_per_min = np.interp(tm + 30.0, t_s, temperature_c) - np.interp(tm - 30.0, t_s, temperature_c)
     heating, cooling = rate_c_per_min > 0.05, rate_c_per_min < -0.05
+    still = ~(heating | cooling)
+    step = max(1, t_s.size // max_points)
     fig = plt.figure(figsize=(11, 6.5))
     grid = fig.add_gridspec(2, 2, width_ratios=[1.6, 1])
     ax_t = fig.add_subplot(grid[0, 0])
     ax_y = fig.add_subplot(grid[1, 0], sharex=ax_t)
     ax_xy = fig.add_subplot(grid[:, 1])
-    ax_t.plot(t_h, temp, color="tab:red", lw=0.8)
+    ax_t.plot(t_s[::step] / 3600.0, temperature_c[::step], color="tab:red", lw=0.8)
     ax_t.set(ylabel="thermometer (°C)", title=title)
-    ax_y.plot(t_h, out, color="tab:blue", lw=0.5)
+    ax_y.plot(t_s[::step] / 3600.0, output[::step], color="tab:blue", lw=0.4, alpha=0.35, label="raw")
+    ax_y.plot(tm / 3600.0, ym, color="navy", lw=0.9, label="block means")
     ax_y.set(xlabel="time (h)", ylabel=output_label)
-    still = ~(heating | cooling)
-    ax_xy.scatter(temp[still], out[still], s=1, color="0.6", label="steady (< 0.05 °C/min)")
-    ax_xy.scatter(temp[heating], out[heating], s=1, color="tab:red", label="heating")
-    ax_xy.scatter(temp[cooling], out[cooling], s=1, color="tab:blue", label="cooling")
-    ax_xy.set(xlabel="thermometer (°C)", ylabel=output_label, title="output against temperature")
-    ax_xy.legend(markerscale=6)
+    ax_y.legend(fontsize=8, loc="best")
+    ax_xy.scatter(temp_m[still], ym[still], s=2, color="0.6", label="steady (< 0.05 °C/min)")
+    ax_xy.scatter(temp_m[heating], ym[heating], s=2, color="tab:red", label="heating")
+    ax_xy.scatter(temp_m[cooling], ym[cooling], s=2, color="tab:blue", label="cooling")
+    ax_xy.set(xlabel="thermometer (°C)", ylabel=f"{output_label}, block means",
+              title="output against temperature")
+    ax_xy.legend(markerscale=4, fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

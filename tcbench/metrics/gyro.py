@@ -37,15 +37,22 @@ def soak_mean(
     window_s: float = 600.0,
     tol_c: float = 0.5,
 ) -> float:
-    """Mean output over the last ``window_s`` of the last soak within ``tol_c`` of ``target_c``."""
+    """Mean output over the last ``window_s`` of the last soak within ``tol_c`` of ``target_c``.
+
+    A soak is a run of samples within the tolerance lasting at least ``window_s`` (a noisy
+    thermometer flickers in and out of the band while a ramp crosses it; those runs are skipped).
+    """
     near = np.abs(temperature_c - target_c) <= tol_c
-    if not near.any():
-        raise ValueError(f"the recording never reaches {target_c:g} degC (within {tol_c} degC)")
-    last = int(np.flatnonzero(near)[-1])
-    gaps = np.flatnonzero(~near[: last + 1])
-    soak = slice(int(gaps[-1]) + 1 if gaps.size else 0, last + 1)
-    recent = t_s[soak] >= t_s[last] - window_s
-    return float(np.mean(output[soak][recent]))
+    edges = np.flatnonzero(np.diff(np.r_[0, near.astype(np.int8), 0]))
+    starts, stops = edges[::2], edges[1::2]  # runs near[start:stop]
+    long_enough = t_s[stops - 1] - t_s[starts] >= window_s
+    if not long_enough.any():
+        raise ValueError(
+            f"the recording never stays within {tol_c} degC of {target_c:g} degC for {window_s:g} s"
+        )
+    start, stop = starts[long_enough][-1], stops[long_enough][-1]
+    recent = t_s[start:stop] >= t_s[stop - 1] - window_s
+    return float(np.mean(output[start:stop][recent]))
 
 
 def drift_dps(
