@@ -19,8 +19,9 @@ class CommandError(ValueError):
 
 @dataclass
 class SimulateConfig:
-    """``tcbench simulate`` arguments (``key=value``); ``protocol_params.<name>=`` overrides a
-    protocol keyword (e.g. ``protocol_params.duration_s=3600``)."""
+    """``tcbench simulate`` arguments (``key=value``). ``protocol_params.<name>=`` overrides a
+    protocol keyword (``protocol_params.duration_s=3600``); ``effects.<id>.<param>=`` changes or
+    adds an effect (``effects.hysteresis.amplitude=0.02``); ``without=[white_noise]`` drops some."""
 
     sensor: str = "msra"
     protocol: str = "fulltemp"
@@ -30,6 +31,8 @@ class SimulateConfig:
     format: str = "csv"
     name: str | None = None
     protocol_params: dict[str, Any] = field(default_factory=dict)
+    effects: dict[str, dict[str, Any]] = field(default_factory=dict)
+    without: list[str] = field(default_factory=list)
     metrics: bool = True
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="simulations"))
 
@@ -66,7 +69,8 @@ def simulate(args: list[str]) -> int:
     out = Path(cfg.out)
     stem = cfg.name or f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
     try:
-        rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed, **cfg.protocol_params)
+        rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed,
+                                 effects=cfg.effects, without=tuple(cfg.without), **cfg.protocol_params)
     except (TypeError, ValueError) as exc:
         raise CommandError(str(exc)) from None
     out.mkdir(parents=True, exist_ok=True)

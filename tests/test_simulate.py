@@ -108,3 +108,29 @@ def test_cli_metrics_on_malformed_files(workdir: Path, name: str) -> None:
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and Path(name).stem in lines[0], out.stderr
     assert "Traceback" not in out.stderr
+
+
+def test_effects_changed_added_and_removed() -> None:
+    base = simulate_recording("msra", "fulltemp", 0, 0, without=("white_noise", "bias_instability"))
+    loops = simulate_recording("msra", "fulltemp", 0, 0, effects={"hysteresis": {"amplitude": 0.05}},
+                               without=("white_noise", "bias_instability"))
+    assert "hysteresis" in loops.meta.extra["device"]["effects"]
+    assert "white_noise" not in loops.meta.extra["device"]["effects"]
+    diff = loops.output - base.output
+    assert 0.03 < np.abs(diff).max() <= 0.05 + 1e-3  # hysteresis term bounded by its amplitude
+    slow = simulate_recording("msra", "fulltemp", 0, 0, effects={"thermal_lag": {"tau_s": 1800.0}})
+    assert slow.meta.extra["device"]["effects"]["thermal_lag"] == {"tau_s": 1800.0}
+    with pytest.raises(ValueError, match="unknown effect 'nope'"):
+        simulate_recording("msra", "roomtemp", 0, 0, effects={"nope": {}})
+
+
+def test_cli_effect_arguments(workdir: Path) -> None:
+    out = tcbench("simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=600",
+                  "protocol_params.sample_rate_hz=10", "effects.warmup.amplitude=0.01",
+                  "without=[bias_instability]", "metrics=false", "out=rec", cwd=workdir)
+    assert out.returncode == 0, out.stderr
+    meta = json.loads((workdir / "rec" / "gyro-static-dev0-seed0.json").read_text())
+    assert meta["extra"]["device"]["effects"]["warmup"]["amplitude"] == 0.01
+    assert "bias_instability" not in meta["extra"]["device"]["effects"]
+    bad = tcbench("simulate", "effects.hysteresis.colour=1", "out=rec2", cwd=workdir)
+    assert bad.returncode == 2 and "has no parameter colour" in bad.stderr

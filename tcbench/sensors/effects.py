@@ -230,7 +230,13 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
     unknown = sorted(set(params) - known)
     if unknown:
         raise ValueError(f"effect {effect_id!r} has no parameter {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-    return cls(**{k: float(v) for k, v in params.items()})
+    values = {}
+    for key, value in params.items():
+        try:
+            values[key] = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"effect {effect_id!r}: {key} must be a number, got {value!r}") from None
+    return cls(**values)
 
 
 def apply_effects(

@@ -57,6 +57,21 @@ class SensorModel:
         """The same model with those effects removed."""
         return dataclasses.replace(self, effects=tuple(e for e in self.effects if e.id not in effect_ids))
 
+    def with_effects(self, changes: dict[str, dict[str, float]]) -> SensorModel:
+        """The model with effects changed or added: ``{effect_id: {param: value}}``. An existing
+        effect keeps its other parameters; a new one is added before the ``final`` stage."""
+        current = list(self.effects)
+        for effect_id, params in changes.items():
+            mine = self.effect(effect_id)
+            if mine is None:
+                new = fx.make_effect(effect_id, **params)
+                at = next((i for i, e in enumerate(current) if e.stage == "final"), len(current))
+                current.insert(at, new)
+            else:
+                merged = mine.params() | dict(params)
+                current[current.index(mine)] = fx.make_effect(effect_id, **merged)
+        return dataclasses.replace(self, effects=tuple(current))
+
     def describe(self) -> dict[str, Any]:
         """Parameters and effects as plain data (for sidecars and tracking)."""
         core = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "effects"}

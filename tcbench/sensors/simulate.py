@@ -49,23 +49,33 @@ def build_profile(
 
 
 def simulate_recording(
-    sensor: str, protocol: str, device_seed: int, seed: int = 0, **protocol_params: Any
+    sensor: str,
+    protocol: str,
+    device_seed: int,
+    seed: int = 0,
+    effects: dict[str, dict[str, float]] | None = None,
+    without: tuple[str, ...] = (),
+    **protocol_params: Any,
 ) -> Recording:
     """Simulate device ``device_seed`` through ``protocol``; ``seed`` draws the run's noise and
-    ambient. The sidecar's ``extra`` records everything needed to reproduce it."""
+    ambient. ``effects`` changes or adds effects (``{id: {param: value}}``), ``without``
+    removes some. The sidecar's ``extra`` records everything needed to reproduce it."""
     device = unit(sensor, device_seed)
+    model = device.model.with_effects(effects or {}).without(*without)
     profile_rng, sensor_rng, thermometer_rng = (
         np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
     )
     profile = build_profile(sensor, protocol, profile_rng, **protocol_params)
-    output = device.model.simulate(profile, sensor_rng)
+    output = model.simulate(profile, sensor_rng)
     reading = profile.temp_c + thermometer_rng.standard_normal(profile.t_s.size) * THERMOMETER_NOISE_C
     extra = {
         "protocol": protocol,
         "device_seed": int(device_seed),
         "seed": int(seed),
         "protocol_params": {k: v for k, v in protocol_params.items() if v is not None},
-        "device": device.model.describe(),
+        "device": model.describe(),
+        "effect_changes": effects or {},
+        "without": list(without),
         "device_draws": device.draws,
         "scale_factor_hz_per_g": getattr(device.model, "scale_factor_hz_per_g", None),
         **profile.info,
