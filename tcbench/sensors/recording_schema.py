@@ -1,0 +1,202 @@
+"""Recording schema v1: its constants, :class:`RecordingError`, :class:`RecordingMeta` and the checks.
+
+Validation shared by reading and writing: column names, normalisation to the canonical table,
+row-level table checks, sidecar parsing, units and sidecar-against-table consistency. The file
+layout itself is described in :mod:`tcbench.sensors.recording`.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+SCHEMA_VERSION = 1
+SENSORS = ("msra", "gyro")
+POSITIONS = ("+0g", "+1g", "-0g", "-1g")
+NUMERIC_COLUMNS = ("time_s", "temperature_c", "input", "output")
+COLUMNS = (*NUMERIC_COLUMNS, "position")
+STANDARD_UNITS = {
+    "msra": {"time_s": "s", "temperature_c": "degC", "input": "g", "output": "Hz"},
+    "gyro": {"time_s": "s", "temperature_c": "degC", "input": "deg/s", "output": "deg/s"},
+}
+KNOWN_UNITS = {c: tuple(dict.fromkeys(u[c] for u in STANDARD_UNITS.values())) for c in NUMERIC_COLUMNS}
+FORMATS = (".csv", ".parquet")
+RATE_TOLERANCE = 0.01
+_SIDECAR_KEYS = ("schema_version", "sensor", "units", "sample_rate_hz", "device_id")
+
+
+class RecordingError(ValueError):
+    """A recording breaks schema v1; ``str(err)`` is one line: ``file: row r, column 'c': problem``."""
+
+    def __init__(self, problem: str, *, file: str | None = None, row: int | None = None,
+                 column: str | None = None) -> None:
+        self.problem, self.file, self.row, self.column = problem, file, row, column
+        where = ", ".join(p for p in (row and f"row {row}", column and f"column {column!r}") if p)
+        message = ": ".join(p for p in (file, where, problem) if p)
+        super().__init__(" ".join(message.splitlines()))
+
+    def located(self, file: str) -> RecordingError:
+        """The same error attributed to ``file`` (kept if it already names one)."""
+        return self if self.file else RecordingError(self.problem, file=file, row=self.row, column=self.column)
+
+
+@dataclass(frozen=True)
+class RecordingMeta:
+    """Sidecar contents; ``RecordingMeta()`` (sensor ``None``) stands for "no sidecar, unknown"."""
+
+    sensor: str | None = None
+    units: dict[str, str] = field(default_factory=dict)
+    sample_rate_hz: float | None = None
+    device_id: str | None = None
+    schema_version: int = SCHEMA_VERSION
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def known(self) -> bool:
+        """True when the sensor kind (and so the units) is known."""
+        return self.sensor is not None
+
+
+# -- validation shared by reading and writing ----------------------------------------------------
+@contextlib.contextmanager
+def _in_file(name: str | None) -> Iterator[None]:
+    """Attribute :class:`RecordingError` raised inside the block to file ``name``."""
+    try:
+        yield
+    except RecordingError as err:
+        if name is None:
+            raise
+        raise err.located(name) from None
+
+
+def _check_columns(names: list[str]) -> None:
+    """Required columns present, no unknown or duplicate ones."""
+    dup = sorted({c for c in names if names.count(c) > 1})
+    if dup:
+        raise RecordingError(f"duplicate column {dup[0]!r}")
+    unknown = [c for c in names if c not in COLUMNS]
+    missing = [c for c in NUMERIC_COLUMNS if c not in names]
+    if missing:
+        also = f" (found unknown {', '.join(map(repr, unknown))})" if unknown else ""
+        raise RecordingError(f"missing column {missing[0]!r}{also}")
+    if unknown:
+        allowed = ", ".join(COLUMNS)
+        raise RecordingError(f"unknown column {', '.join(map(repr, unknown))} (schema v1 allows only {allowed})")
+
+
+def _normalise(data: pd.DataFrame) -> pd.DataFrame:
+    """Canonical table: columns in schema order, float64 numbers, object positions (str or None)."""
+    _check_columns([str(c) for c in data.columns])
+    out = {}
+    for c in NUMERIC_COLUMNS:
+        if data[c].dtype.kind not in "iuf":
+            raise RecordingError(f"holds {data[c].dtype} values, expected numbers", column=c)
+        out[c] = data[c].to_numpy(dtype=np.float64, na_value=np.nan)
+    if "position" in data:
+        out["position"] = pd.Series(_positions(data["position"]), dtype=object)
+    return pd.DataFrame(out)
+
+
+def _positions(col: pd.Series) -> np.ndarray:
+    """Position labels as an object array, with ``None`` for missing or empty cells."""
+    labels = col.to_numpy(dtype=object, na_value=None, copy=True)
+    labels[labels == ""] = None
+    return labels
+
+
+def _check_table(data: pd.DataFrame) -> None:
+    """Row-level checks of a normalised table: rows present, finite numbers, positions, time."""
+    if len(data) == 0:
+        raise RecordingError("no data rows")
+    values = data[list(NUMERIC_COLUMNS)].to_numpy(dtype=np.float64)
+    bad = ~np.isfinite(values)
+    if bad.any():
+        i, j = divmod(int(np.argmax(bad)), values.shape[1])
+        raise RecordingError(f"{values[i, j]} is not finite", row=i + 1, column=NUMERIC_COLUMNS[j])
+    if "position" in data:
+        labels = pd.Series(data["position"].to_numpy(dtype=object), dtype=object)
+        wrong = ~(labels.isna() | labels.isin(POSITIONS)).to_numpy()
+        if wrong.any():
+            i = int(np.argmax(wrong))
+            raise RecordingError(f"{labels[i]!r} is not a position (expected one of {', '.join(POSITIONS)} or empty)",
+                                 row=i + 1, column="position")
+    t = values[:, 0]
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        i = int(back[0])
+        prev, cur = float(t[i]), float(t[i + 1])
+        problem = (f"duplicate time_s {cur!r} (same as row {i + 1})" if cur == prev
+                   else f"time_s goes back from {prev!r} to {cur!r}")
+        raise RecordingError(problem, row=i + 2, column="time_s")
+
+
+def _meta_from_dict(doc: Any) -> RecordingMeta:
+    """Validate a sidecar document (parsed JSON) and build its :class:`RecordingMeta`."""
+    if not isinstance(doc, dict):
+        raise RecordingError("the sidecar must hold a JSON object")
+    if "schema_version" not in doc:
+        raise RecordingError("missing key 'schema_version'")
+    version = doc["schema_version"]
+    if version != SCHEMA_VERSION or isinstance(version, bool):
+        raise RecordingError(f"unknown schema_version {version!r} (this tcbench reads {SCHEMA_VERSION})")
+    for key in _SIDECAR_KEYS:
+        if key not in doc:
+            raise RecordingError(f"missing key {key!r}")
+    unknown = [k for k in doc if k not in (*_SIDECAR_KEYS, "extra")]
+    if unknown:
+        raise RecordingError(f"unknown key {unknown[0]!r} (free-form data goes under 'extra')")
+    sensor = doc["sensor"]
+    if sensor not in SENSORS:
+        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    units = _check_units(doc["units"], sensor)
+    rate = doc["sample_rate_hz"]
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not math.isfinite(rate) or rate <= 0:
+        raise RecordingError(f"sample_rate_hz must be a positive number, got {rate!r}")
+    device = doc["device_id"]
+    if not isinstance(device, str) or not device:
+        raise RecordingError(f"device_id must be a non-empty string, got {device!r}")
+    extra = doc.get("extra", {})
+    if not isinstance(extra, dict):
+        raise RecordingError(f"extra must be a JSON object, got {extra!r}")
+    return RecordingMeta(sensor, units, float(rate), device, SCHEMA_VERSION, extra)
+
+
+def _check_units(units: Any, sensor: str) -> dict[str, str]:
+    """Every column's unit known to the schema and the one of ``sensor``."""
+    if not isinstance(units, dict):
+        raise RecordingError(f"units must be a JSON object, got {units!r}")
+    extra = [c for c in units if c not in NUMERIC_COLUMNS]
+    if extra:
+        raise RecordingError(f"units for unknown column {extra[0]!r} (expected {', '.join(NUMERIC_COLUMNS)})")
+    for c in NUMERIC_COLUMNS:
+        if c not in units:
+            raise RecordingError("no unit given", column=c)
+        unit, expected = units[c], STANDARD_UNITS[sensor][c]
+        if unit not in KNOWN_UNITS[c]:
+            raise RecordingError(f"unknown unit {unit!r}; accepted: {', '.join(KNOWN_UNITS[c])}", column=c)
+        if unit != expected:
+            raise RecordingError(f"unit {unit!r} does not fit a {sensor} recording (expected {expected!r})", column=c)
+    return {c: units[c] for c in NUMERIC_COLUMNS}
+
+
+def _check_consistency(data: pd.DataFrame, meta: RecordingMeta, table: str | None, side: str | None) -> None:
+    """Sidecar against table: sample rate vs the median time step, positions only for MSRA."""
+    if meta.sensor == "gyro" and "position" in data:
+        given = data["position"].notna().to_numpy()
+        if given.any():
+            raise RecordingError("gyro recordings have no positions", file=table, row=int(np.argmax(given)) + 1,
+                                 column="position")
+    t = data["time_s"].to_numpy()
+    if meta.sample_rate_hz is None or t.size < 2:
+        return
+    step_s = float(np.median(np.diff(t)))
+    if abs(1.0 / step_s - meta.sample_rate_hz) > RATE_TOLERANCE * meta.sample_rate_hz:
+        raise RecordingError(
+            f"sample_rate_hz {meta.sample_rate_hz:g} does not match the table: its median time step "
+            f"{step_s:.6g} s means {1.0 / step_s:.6g} Hz (they must agree within 1 %)", file=side)
