@@ -11,6 +11,7 @@ variants. One generation costs ``population`` evaluations.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -70,8 +71,8 @@ class FireflyAlgorithm(Optimiser):
     Params = FAParams
     params: FAParams
 
-    def __init__(self, lower, upper, budget, rng, params=None) -> None:  # type: ignore[no-untyped-def]
-        super().__init__(lower, upper, budget, rng, params)
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
         self.width = self.upper - self.lower
         self.alpha = self.params.alpha0 * (self.width if self.params.alpha_relative else 1.0)
         self.x = np.empty((0, self.dim))

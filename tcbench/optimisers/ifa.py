@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -111,8 +112,8 @@ class ImprovedFireflyAlgorithm(FireflyAlgorithm):
     Params = IFAParams
     params: IFAParams
 
-    def __init__(self, lower, upper, budget, rng, params=None) -> None:  # type: ignore[no-untyped-def]
-        super().__init__(lower, upper, budget, rng, params)
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
         p = self.params
         after_init = self.budget - p.population
         self.maxgen = p.max_generations or max(1, math.ceil(after_init / p.population))

@@ -17,6 +17,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tcbench.optimisers.pareto import nondominated
+
 
 class ProtocolError(RuntimeError):
     """An optimiser or its caller broke the ask/tell contract."""
@@ -31,6 +33,14 @@ class Best:
 
 
 @dataclass(frozen=True)
+class ParetoSet:
+    """Non-dominated points told so far (multi-objective): ``x`` (p, d) and ``f`` (p, m)."""
+
+    x: np.ndarray
+    f: np.ndarray
+
+
+@dataclass(frozen=True)
 class OptimiserParams:
     """Base class for optimiser parameter dataclasses; subclasses validate in ``__post_init__``."""
 
@@ -42,7 +52,10 @@ class OptimiserParams:
 
 
 def worst_if_nonfinite(f: np.ndarray) -> np.ndarray:
-    """Replace NaN and +-inf objective values by +inf (the worst for minimisation)."""
+    """Replace NaN and +-inf objective values by +inf (the worst for minimisation); in a
+    multi-objective row (``f`` of shape (k, m)) one non-finite value makes the whole row worst."""
+    if f.ndim == 2:
+        return np.where(np.isfinite(f).all(axis=1, keepdims=True), f, np.inf)
     return np.where(np.isfinite(f), f, np.inf)
 
 
@@ -51,6 +64,8 @@ class Optimiser(ABC):
 
     name: ClassVar[str] = ""
     Params: ClassVar[type[OptimiserParams]] = OptimiserParams
+    single_objective: ClassVar[bool] = True  # can minimise one objective
+    multi_objective: ClassVar[bool] = False  # can handle n_objectives > 1
 
     def __init__(
         self,
@@ -59,7 +74,15 @@ class Optimiser(ABC):
         budget: int,
         rng: np.random.Generator,
         params: OptimiserParams | dict[str, Any] | None = None,
+        n_objectives: int = 1,
     ) -> None:
+        if int(n_objectives) != n_objectives or n_objectives < 1:
+            raise ValueError(f"n_objectives must be a positive integer, got {n_objectives}")
+        if n_objectives > 1 and not self.multi_objective:
+            raise ValueError(f"optimiser {self.name!r} is single-objective; the task has {n_objectives} objectives")
+        if n_objectives == 1 and not self.single_objective:
+            raise ValueError(f"optimiser {self.name!r} is multi-objective only; the task has one objective")
+        self.n_objectives = int(n_objectives)
         self.lower = np.asarray(lower, dtype=np.float64).reshape(-1)
         self.upper = np.asarray(upper, dtype=np.float64).reshape(-1)
         if self.lower.shape != self.upper.shape or not np.all(self.lower < self.upper):
@@ -79,6 +102,7 @@ class Optimiser(ABC):
         self.generation = 0
         self.nonfinite = 0
         self._best = Best(np.full(self.dim, np.nan), np.inf)
+        self._front = ParetoSet(np.empty((0, self.dim)), np.empty((0, self.n_objectives)))
         self._pending: np.ndarray | None = None
 
     # -- public protocol -------------------------------------------------------------------
@@ -94,8 +118,15 @@ class Optimiser(ABC):
 
     @property
     def best(self) -> Best:
-        """Best point told so far."""
+        """Best point told so far (single objective)."""
+        if self.n_objectives > 1:
+            raise ProtocolError(f"{self.name}: best is single-objective; use front")
         return self._best
+
+    @property
+    def front(self) -> ParetoSet:
+        """Non-dominated points among everything told so far (multi-objective)."""
+        return self._front
 
     @property
     def population_fitness(self) -> np.ndarray:
@@ -120,23 +151,37 @@ class Optimiser(ABC):
         return x.copy()
 
     def tell(self, x: np.ndarray, f: np.ndarray) -> None:
-        """Report objective values ``f`` (shape ``(k,)``) of the points returned by ``ask``."""
+        """Report objective values ``f`` of the points returned by ``ask``: shape ``(k,)`` for
+        one objective, ``(k, m)`` for ``m`` objectives."""
         if self._pending is None:
             raise ProtocolError(f"{self.name}: tell() without a preceding ask()")
         x = np.asarray(x, dtype=np.float64)
-        f = np.asarray(f, dtype=np.float64).reshape(-1)
+        f = np.asarray(f, dtype=np.float64)
+        if self.n_objectives == 1:
+            f = f.reshape(-1)
         if x.shape != self._pending.shape or not np.array_equal(x, self._pending):
             raise ProtocolError(f"{self.name}: tell() must receive the points of the last ask()")
-        if f.shape != (x.shape[0],):
-            raise ProtocolError(f"{self.name}: tell() got {f.shape[0]} values for {x.shape[0]} points")
+        want = (x.shape[0],) if self.n_objectives == 1 else (x.shape[0], self.n_objectives)
+        if f.shape != want:
+            raise ProtocolError(f"{self.name}: tell() got values of shape {f.shape} for {x.shape[0]} points; expected {want}")
         self._pending = None
-        self.nonfinite += int(np.count_nonzero(~np.isfinite(f)))
+        self.nonfinite += int(np.count_nonzero(~np.isfinite(f).reshape(f.shape[0], -1).all(axis=1)))
         f = worst_if_nonfinite(f)
-        self.evaluations += f.size
-        i = int(np.argmin(f))
-        if f[i] < self._best.f:
-            self._best = Best(x[i].copy(), float(f[i]))
+        self.evaluations += f.shape[0]
+        if self.n_objectives == 1:
+            i = int(np.argmin(f))
+            if f[i] < self._best.f:
+                self._best = Best(x[i].copy(), float(f[i]))
+        else:
+            self._update_front(x, f)
         self._tell(x, f)
+
+    def _update_front(self, x: np.ndarray, f: np.ndarray) -> None:
+        finite = np.isfinite(f).all(axis=1)
+        xs = np.concatenate([self._front.x, x[finite]])
+        fs = np.concatenate([self._front.f, f[finite]])
+        keep = nondominated(fs)
+        self._front = ParetoSet(xs[keep], fs[keep])
 
     # -- subclass hooks --------------------------------------------------------------------
     @abstractmethod
@@ -145,7 +190,8 @@ class Optimiser(ABC):
 
     @abstractmethod
     def _tell(self, x: np.ndarray, f: np.ndarray) -> None:
-        """Absorb finite-or-``inf`` values ``f`` of ``x``; advance ``self.generation``."""
+        """Absorb finite-or-``inf`` values ``f`` of ``x`` (``(k,)``, or ``(k, m)`` for ``m``
+        objectives); advance ``self.generation``."""
 
     def _stopped(self) -> bool:
         """Optimiser-specific stopping rule (e.g. a generation limit); none by default."""

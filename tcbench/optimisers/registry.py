@@ -99,6 +99,7 @@ def create(
     budget: int,
     rng: np.random.Generator,
     params: OptimiserParams | dict[str, Any] | None = None,
+    n_objectives: int = 1,
 ) -> Optimiser:
     """Instantiate the optimiser ``name`` with bounds, budget, generator and parameters."""
-    return get(name)(lower, upper, budget, rng, params)
+    return get(name)(lower, upper, budget, rng, params, n_objectives=n_objectives)
