@@ -11,5 +11,6 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
 from tcbench import tasks as tasks  # noqa: E402  (registers the gymnasium envs)
+from tcbench.check import OptimizerContractError, check_optimizer  # noqa: E402
 
-__all__ = ["__version__", "tasks"]
+__all__ = ["OptimizerContractError", "__version__", "check_optimizer", "tasks"]

@@ -1,0 +1,108 @@
+"""The public contract checker, on every registered optimiser and on broken ones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tcbench import OptimizerContractError, check_optimizer
+from tcbench.check import Case, _check_best, _run
+from tcbench.optimisers import available
+from tcbench.optimisers.fa import FireflyAlgorithm
+
+REGISTERED = sorted(available())
+
+
+@pytest.mark.parametrize("name", REGISTERED)
+def test_every_registered_optimiser_passes(name: str) -> None:
+    assert check_optimizer(available()[name].cls) >= 2
+
+
+@pytest.mark.parametrize("name", REGISTERED)
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    dim=st.integers(1, 6),
+    budget=st.integers(1, 400),
+    low=st.floats(-1e3, 1e3, allow_nan=False),
+    width=st.floats(1e-3, 1e3, allow_nan=False),
+    seed=st.integers(0, 2**32 - 1),
+    nasty=st.booleans(),
+)
+def test_contract_over_random_problems(name, dim, budget, low, width, seed, nasty) -> None:
+    cls = available()[name].cls
+    m = 1 if cls.single_objective else 2
+    lower = np.full(dim, low)
+    case = Case(lower, lower + width, budget, seed, m, nasty)
+    try:
+        asked, told, opt = _run(cls, case)
+    except ValueError as exc:  # a budget below one generation must be refused clearly
+        assert "budget" in str(exc)
+        return
+    _check_best(name, case, asked, told, opt)
+
+
+class OutOfBounds(FireflyAlgorithm):
+    name = "out-of-bounds"
+
+    def ask(self):  # bypasses the base class checks, as a careless plugin might
+        x = super().ask()
+        return x + 1e3
+
+
+class Greedy(FireflyAlgorithm):
+    name = "greedy"
+
+    def ask(self):
+        x = super().ask()
+        return np.concatenate([x] * 10)  # more points than the budget has left
+
+
+class Forgetful(FireflyAlgorithm):
+    name = "forgetful"
+
+    @property
+    def best(self):
+        b = super().best
+        return type(b)(b.x, b.f + 1.0)
+
+
+class Moody(FireflyAlgorithm):
+    name = "moody"
+
+    def _ask(self):
+        x = super()._ask()
+        return self.clip(x + np.random.default_rng().normal(0, 1e-3, x.shape))
+
+
+@pytest.mark.parametrize(
+    ("cls", "message"),
+    [
+        (OutOfBounds, "optimiser 'out-of-bounds' .*outside the bounds"),
+        (Greedy, "optimiser 'greedy' .*ask\\(\\) returned shape"),
+        (Forgetful, "optimiser 'forgetful' .*best.f = "),
+        (Moody, "optimiser 'moody' .*same seed asked different points"),
+    ],
+    ids=["out-of-bounds", "greedy", "forgetful", "moody"],
+)
+def test_broken_optimisers_are_named(cls, message) -> None:
+    with pytest.raises(OptimizerContractError, match=message):
+        check_optimizer(cls)
+
+
+class Crashing(FireflyAlgorithm):
+    name = "crashing"
+
+    def _tell(self, x, f):
+        raise ZeroDivisionError("oops")
+
+
+def test_exceptions_inside_the_optimiser_are_reported() -> None:
+    with pytest.raises(OptimizerContractError, match="optimiser 'crashing' .*tell\\(\\) raised ZeroDivisionError: oops"):
+        check_optimizer(Crashing)
+
+
+def test_not_an_optimiser() -> None:
+    with pytest.raises(TypeError, match="not a tcbench Optimiser subclass"):
+        check_optimizer(dict)  # type: ignore[arg-type]
