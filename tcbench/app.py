@@ -72,6 +72,22 @@ def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
         raise ConfigError(_explain(exc)) from None
 
 
+def plugin_config_packages() -> list[str]:
+    """``pkg://`` search-path entries of installed plugins' Hydra configs (entry-point group
+    ``tcbench.configs``, each naming a package that holds e.g. ``optimiser/<name>.yaml``)."""
+    from importlib.metadata import entry_points
+
+    return [f"pkg://{ep.value}" for ep in sorted(entry_points(group="tcbench.configs"), key=lambda e: e.name)]
+
+
+def with_plugin_configs(args: list[str]) -> list[str]:
+    """The command line plus a ``hydra.searchpath`` override naming the plugins' configs."""
+    paths = plugin_config_packages()
+    if not paths or any(a.startswith(("hydra.searchpath=", "+hydra.searchpath=")) for a in args):
+        return args
+    return [*args, f"hydra.searchpath=[{','.join(paths)}]"]
+
+
 def overrides_of(args: list[str]) -> list[str]:
     """The ``key=value`` overrides of a Hydra command line (flags and their values dropped)."""
     out, skip = [], False

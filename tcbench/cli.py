@@ -39,11 +39,12 @@ def _fail(message: str, code: int = 2) -> int:
 
 def _run_sweep(args: list[str]) -> Plan | None:
     """Validate every job, then run them through Hydra; the plan, or None if not checked."""
-    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan
+    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan, with_plugin_configs
     from tcbench.config import ConfigError
 
     if not any(a.startswith("tracking.sweep_id=") for a in args):
         args = [*args, f"tracking.sweep_id={uuid.uuid4().hex[:12]}"]
+    args = with_plugin_configs(args)
     checked: Plan | None = None
     if any(a in CONFIG_SOURCE_FLAGS for a in args):
         print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)

@@ -12,7 +12,7 @@ from tqdm.auto import tqdm
 
 import tcbench.tasks as tasks
 from tcbench.optimisers import registry
-from tcbench.optimisers.protocol import Optimiser
+from tcbench.optimisers.protocol import Optimiser, ProtocolError
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +61,23 @@ def make_task(task: dict[str, Any], budget: int) -> tasks.FunctionEnv:
     return env.unwrapped  # type: ignore[return-value]
 
 
+def checked_batch(opt: Optimiser, x: np.ndarray, env: tasks.FunctionEnv) -> np.ndarray:
+    """``x`` if it is a valid batch for ``env``; else a :class:`ProtocolError` naming ``opt``
+    (guards against plugins that bypass the base class's own checks)."""
+    x = np.asarray(x, dtype=np.float64)
+    left = env.budget - env.evaluations
+    problem = None
+    if x.ndim != 2 or x.shape[1] != env.dim:
+        problem = f"asked a batch of shape {x.shape}, expected (k, {env.dim})"
+    elif not 0 < x.shape[0] <= left:
+        problem = f"asked {x.shape[0]} evaluations with {left} left in the budget of {env.budget}"
+    elif not np.all(np.isfinite(x)) or np.any(x < env.lower) or np.any(x > env.upper):
+        problem = "asked points outside the bounds"
+    if problem:
+        raise ProtocolError(f"optimiser {opt.name or type(opt).__name__!r} broke the protocol: {problem}")
+    return x
+
+
 def _population_mean(opt: Optimiser) -> float:
     f = opt.population_fitness
     f = f[np.isfinite(f)]
@@ -85,7 +102,7 @@ def run_optimisation(
     last_generation = -1
     with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
         while not opt.done:
-            x = opt.ask()
+            x = checked_batch(opt, opt.ask(), env)
             f, _, _, _, info = env.step(x)
             opt.tell(x, f)
             bar.update(len(f))

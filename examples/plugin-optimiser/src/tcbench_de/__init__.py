@@ -1,0 +1,1 @@
+"""Differential evolution for tcbench (a plugin package)."""

@@ -1,0 +1,92 @@
+"""Optimiser plugins from other packages: the example package, a broken one, a rogue one."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "plugin-optimiser"
+
+
+def tcbench(*args: str, cwd: Path, path: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(path)}
+    env.pop("MLFLOW_TRACKING_URI", None)
+    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    """The example plugin installed (not editable) into a directory put on PYTHONPATH."""
+    target = tmp_path_factory.mktemp("site")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
+         "--target", str(target), str(EXAMPLE)],
+        check=True, capture_output=True, text=True, timeout=300,
+    )
+    return target
+
+
+def _fake_distribution(site: Path, name: str, entry_points: str, module: str = "", code: str = "") -> None:
+    info = site / f"{name}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(entry_points)
+    if module:
+        (site / f"{module}.py").write_text(code)
+
+
+def test_example_plugin_on_a_leaderboard(site: Path, tmp_path: Path) -> None:
+    listed = tcbench("list", cwd=tmp_path, path=site)
+    assert "de         tcbench_de.de.DifferentialEvolution  (from tcbench-de)" in listed.stdout
+    run = tcbench("run", "-m", "optimiser=de,ifa", "task=sphere", "seed=range(2)", "budget=200",
+                  "tracking.experiment=plugins", cwd=tmp_path, path=site)
+    assert run.returncode == 0, run.stderr
+    assert "4 finished, 0 failed" in run.stdout
+    board = tcbench("leaderboard", "--experiment", "plugins", "--out", "lb", cwd=tmp_path, path=site)
+    assert board.returncode == 0, board.stderr
+    table = pd.read_csv(tmp_path / "lb" / "sphere-2d.csv")
+    assert sorted(table["method"]) == ["de", "ifa"] and table["seeds"].tolist() == [2, 2]
+
+
+def test_example_plugin_own_tests(site: Path) -> None:
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(EXAMPLE / "tests")],
+                         env=env, capture_output=True, text=True, timeout=300, cwd=site)
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_broken_plugin_is_reported_and_skipped(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    _fake_distribution(site, "broken_plugin", "[tcbench.optimisers]\nbroken = no_such_module:Nope\n")
+    listed = tcbench("list", cwd=tmp_path, path=site)
+    assert listed.returncode == 0
+    assert "broken     BROKEN: ModuleNotFoundError: No module named 'no_such_module'" in listed.stdout
+    assert "ifa" in listed.stdout
+    run = tcbench("run", "task=sphere", "optimiser=fa", "budget=50", cwd=tmp_path, path=site)
+    assert run.returncode == 0, run.stderr
+    assert "1 finished, 0 failed" in run.stdout
+
+
+def test_protocol_breaking_plugin_is_stopped_and_named(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    code = (
+        "from tcbench.optimisers.fa import FireflyAlgorithm\n"
+        "class Rogue(FireflyAlgorithm):\n"
+        "    name = 'rogue'\n"
+        "    def ask(self):\n"
+        "        return super().ask() * 1000.0\n"
+    )
+    _fake_distribution(site, "rogue_plugin", "[tcbench.optimisers]\nrogue = rogue_mod:Rogue\n", "rogue_mod", code)
+    run = tcbench("run", "-m", "task=sphere", "optimiser=fa", "optimiser.name=rogue,fa", "budget=50",
+                  cwd=tmp_path, path=site)
+    assert run.returncode == 1
+    assert "1 finished, 1 failed" in run.stdout
+    assert "ProtocolError: optimiser 'rogue' broke the protocol: asked points outside the bounds" in run.stdout
