@@ -44,6 +44,7 @@ class TrackingConfig:
     experiment: str = "tcbench"
     sweep_id: str | None = None  # None: derived from the multirun sweep directory
     plots: bool = True
+    resume: bool = False  # skip jobs whose config and seed already FINISHED in this experiment
 
 
 @dataclass

@@ -73,6 +73,11 @@ def run_job(cfg: Any) -> RunResult | None:
 
     sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
     tkey, method = task_key(c["task"]), method_label(c["optimiser"])
+    if c["tracking"].get("resume"):
+        done = tracking.finished_run(c)
+        if done is not None:
+            log.info("%s on %s seed %d already FINISHED in run %s; skipped", method, tkey, c["seed"], done)
+            return None
     tags = {
         "tcbench.sweep_id": sweep,
         "tcbench.task": tkey,

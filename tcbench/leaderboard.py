@@ -56,6 +56,8 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
                 "method": t.get("tcbench.method"),
                 "seed": int(t.get("tcbench.seed", -1)),
                 "sweep": t.get("tcbench.sweep_id"),
+                "config_hash": t.get("tcbench.config_hash"),
+                "start_time": r.info.start_time,
                 "error_message": t.get("tcbench.error", ""),
                 "budget": int(p.get("budget", 0)),
                 "target_precision": float(p.get("task.target_precision", "nan")),
@@ -110,10 +112,20 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     return table[COLUMNS].reset_index(drop=True)
 
 
+def one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
+    """Keep one run per job (task, method, config, seed): the latest FINISHED one, else the
+    latest attempt, so a resumed or repeated sweep does not count a seed twice."""
+    if runs.empty:
+        return runs
+    order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
+    keys = ["task", "method", "config_hash", "seed"]
+    return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
+
+
 def boards(runs: pd.DataFrame) -> list[Board]:
-    """One :class:`Board` per task in ``runs``."""
+    """One :class:`Board` per task in ``runs`` (one run per job, see :func:`one_run_per_job`)."""
     out = []
-    for task, g in runs.groupby("task", sort=True):
+    for task, g in one_run_per_job(runs).groupby("task", sort=True):
         finite = g["f_opt"].dropna()
         out.append(Board(
             task=str(task),

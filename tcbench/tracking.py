@@ -74,6 +74,7 @@ def flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
 def config_hash(cfg: Mapping[str, Any]) -> str:
     """Stable short hash of a job's config without its seed and tracking settings."""
     content = {k: v for k, v in cfg.items() if k not in {"seed", "tracking", "progress"}}
+    content["optimiser"] = {k: v for k, v in content.get("optimiser", {}).items() if k != "label"}
     blob = json.dumps(content, sort_keys=True, default=str).encode()
     return hashlib.sha256(blob).hexdigest()[:16]
 
@@ -89,6 +90,19 @@ def git_commit() -> str:
         return out.stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown"
+
+
+def finished_run(cfg: Mapping[str, Any]) -> str | None:
+    """Id of a FINISHED run of the same config (hash) and seed in the job's experiment, if any."""
+    track = cfg["tracking"]
+    c = client(track.get("uri"))
+    exp = c.get_experiment_by_name(track["experiment"])
+    if exp is None:
+        return None
+    query = (f"tags.`{TAG_PREFIX}config_hash` = '{config_hash(cfg)}' and "
+             f"tags.`{TAG_PREFIX}seed` = '{cfg['seed']}' and attributes.status = 'FINISHED'")
+    runs = c.search_runs([exp.experiment_id], filter_string=query, max_results=1)
+    return runs[0].info.run_id if runs else None
 
 
 class JobRun:

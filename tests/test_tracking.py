@@ -141,3 +141,25 @@ def test_sweep_goes_on_after_a_failing_job(workdir: Path, capsys) -> None:
     assert code == 1
     assert "4 runs recorded" in out and "2 finished, 2 failed" in out
     assert out.count("FAILED x on sphere-2d seed") == 2 and "boom in generation 2" in out
+
+
+def test_resume_skips_finished_jobs(workdir: Path) -> None:
+    register("exploding", Exploding)
+    first = [run_job(cfg(seed=s)) for s in range(2)] + [run_job(cfg(optimiser={"name": "exploding"}, seed=0))]
+    assert first[0] is not None and first[2] is None
+    again = [run_job(cfg(seed=s, tracking__resume=True, tracking__sweep_id="s2")) for s in range(3)]
+    assert again[0] is None and again[1] is None and again[2] is not None  # only seed 2 ran
+    redo = run_job(cfg(optimiser={"name": "exploding"}, seed=0, tracking__resume=True, tracking__sweep_id="s2"))
+    assert redo is None  # FAILED before, so it was tried again (and failed again)
+    runs = leaderboard.load_runs(tracking.client(), ["t"])
+    assert len(runs) == 5  # 3 first attempts, 1 new seed, 1 retried failure
+    (board,) = leaderboard.boards(runs)
+    table = board.table.set_index("method")
+    assert table.loc["fa", "seeds"] == 3 and table.loc["exploding", "seeds"] == 1
+
+
+def test_repeated_job_counted_once(workdir: Path) -> None:
+    run_job(cfg(seed=0))
+    run_job(cfg(seed=0))
+    (board,) = leaderboard.boards(leaderboard.load_runs(tracking.client(), ["t"]))
+    assert board.table.loc[0, "seeds"] == 1
