@@ -6,6 +6,9 @@ success rate at the task's target precision, expected running time (ERT) to that
 rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
 and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
 Rank orders methods by success rate (higher first), then ERT, then median final error.
+``ci95_low``/``ci95_high``: percentile-bootstrap 95 % interval of the median error over seeds;
+``p_vs_next``: two-sided Wilcoxon signed-rank p-value of the final errors of this method and
+the next-ranked one, paired by seed (finished runs both have; NaN below 6 shared seeds).
 """
 
 from __future__ import annotations
@@ -17,10 +20,11 @@ import numpy as np
 import pandas as pd
 
 from tcbench import plots
+from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 COLUMNS = [
-    "rank", "method", "seeds", "failed", "median_best", "median_error", "iqr_error",
-    "success_rate", "ert_evals", "median_evals",
+    "rank", "method", "seeds", "failed", "median_best", "median_error", "ci95_low", "ci95_high",
+    "iqr_error", "success_rate", "ert_evals", "median_evals", "p_vs_next",
 ]
 
 
@@ -83,19 +87,23 @@ def expected_running_time(evaluations: np.ndarray, hit_at: np.ndarray, hit: np.n
 
 def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     """Leaderboard table of one task's runs (all methods)."""
-    rows = []
+    rows, errors = [], {}
     for method, g in runs.groupby("method", sort=True):
         ok = g["status"] == "FINISHED"
         err = g.loc[ok, "final_error"].to_numpy(float)
+        errors[method] = pd.Series(err, index=g.loc[ok, "seed"].to_numpy())
         hit = (g["target_hit"] & ok).to_numpy(bool)
         evals = np.where(ok, g["evaluations"].fillna(0), g["budget"]).astype(float)
         q25, q50, q75 = np.percentile(err, [25, 50, 75]) if err.size else (np.nan,) * 3
+        low, high = bootstrap_median_ci(err)
         rows.append({
             "method": method,
             "seeds": len(g),
             "failed": int((~ok).sum()),
             "median_best": float(np.median(g.loc[ok, "final_best"])) if ok.any() else np.nan,
             "median_error": q50,
+            "ci95_low": low,
+            "ci95_high": high,
             "iqr_error": q75 - q25,
             "success_rate": hit.mean(),
             "ert_evals": expected_running_time(evals, g["evals_to_target"].to_numpy(float), hit),
@@ -107,9 +115,13 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     table = table.sort_values(
         ["success_rate", "ert_evals", "median_error"], ascending=[False, True, True],
         na_position="last",
-    )
+    ).reset_index(drop=True)
     table.insert(0, "rank", np.arange(1, len(table) + 1))
-    return table[COLUMNS].reset_index(drop=True)
+    methods = table["method"].tolist()
+    table["p_vs_next"] = [
+        paired_p_value(errors[m], errors[n]) for m, n in zip(methods, methods[1:], strict=False)
+    ] + [np.nan]
+    return table[COLUMNS]
 
 
 def one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
@@ -197,8 +209,10 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
         f"Source: {source}. Optimum value f* = {board.f_opt:g}; error = final best − f*; "
         f"target precision {board.target_precision:g}; budget {budget} evaluations.",
         "Rank: success rate, then ERT (expected evaluations to reach the target), then median "
-        "error. IQR = inter-quartile range of the final error over seeds. Failed runs count as "
-        "unsuccessful runs that used their whole budget.",
+        "error. ci95 = bootstrap 95 % interval of the median error; IQR = inter-quartile range of "
+        "the final error over seeds; p_vs_next = Wilcoxon signed-rank p-value against the next "
+        "row, paired by seed (p ≥ 0.05: the two are not told apart by these seeds). Failed runs "
+        "count as unsuccessful runs that used their whole budget.",
         "",
         markdown_table(board.table),
         "",

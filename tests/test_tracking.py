@@ -115,7 +115,7 @@ def test_summarise_ranks_and_statistics() -> None:
     for method, errors, hits in [("a", [1.0, 2.0, 3.0, 4.0], [0, 0, 0, 0]), ("b", [0.0, 0.0, 5.0, 9.0], [1, 1, 0, 0])]:
         for seed, (e, h) in enumerate(zip(errors, hits)):
             rows.append({
-                "method": method, "status": "FINISHED", "final_error": e, "final_best": e - 1.0,
+                "method": method, "seed": seed, "status": "FINISHED", "final_error": e, "final_best": e - 1.0,
                 "target_hit": bool(h),
                 "evaluations": 100.0, "evals_to_target": 50.0 if h else np.nan, "budget": 100,
             })
