@@ -2,9 +2,10 @@
 
 - :func:`hypervolume`: Lebesgue measure of the region dominated by a point set and bounded
   above by a reference point. Exact: a sort-and-sweep for 2 objectives (O(n log n)); for 3
-  objectives slices along the third objective, each a 2-D sweep, vectorised over the slices
-  (O(n^2) time, memory bounded by chunking); for 4 or more objectives the same slicing applied
-  recursively (O(n^(m-1)), meant for small sets). Points that do not strictly dominate the
+  objectives a sweep along the third objective that keeps the 2-D staircase of the points
+  passed and its area up to date (Beume et al. 2009, O(n log n)); for 4 or more objectives
+  slabs along the last objective, each measured recursively one dimension down
+  (O(n^(m-2) n log n), meant for small sets). Points that do not strictly dominate the
   reference point, and rows with a non-finite value, contribute nothing and are ignored.
 - :func:`igd`: inverted generational distance, the mean over the points of a reference front of
   the Euclidean distance to the nearest obtained point (lower is better; 0 when every
@@ -18,11 +19,13 @@ Both distance indicators work in chunks of reference points so that memory stays
 
 from __future__ import annotations
 
+from bisect import bisect_left
+
 import numpy as np
 
 Array = np.ndarray
 
-#: Upper bound on the number of floats in one temporary (distance or slice) matrix.
+#: Upper bound on the number of floats in one temporary distance matrix of IGD / IGD+.
 CHUNK_ELEMENTS = 1 << 22
 
 
@@ -47,38 +50,41 @@ def _hv2(f: Array, ref: Array) -> float:
     return float(np.sum(widths * (ref[1] - run_min)))
 
 
-def _hv3(f: Array, ref: Array, chunk_elements: int) -> float:
-    """3-D hypervolume of points that all strictly dominate ``ref``.
+def _hv3(f: Array, ref: Array) -> float:
+    """3-D hypervolume of points that all strictly dominate ``ref`` (Beume et al.'s sweep).
 
-    Slab ``i`` lies between the i-th and (i+1)-th smallest f3 (the last one up to ``ref[2]``);
-    its cross-section is the 2-D hypervolume of the points with the i+1 smallest f3. All
-    cross-sections are computed together: row ``i`` of a matrix holds, in f1 order, f2 of the
-    points active in slab ``i`` (``ref[1]`` for the others); a running minimum along each row
-    and a dot product with the f1 widths give the areas.
+    Points are taken in increasing f3; the 2-D staircase of those seen so far (f1 strictly
+    increasing, f2 strictly decreasing, kept in sorted lists) and its area against
+    ``ref[:2]`` are updated per point, and each slab between consecutive f3 values adds that
+    area times its depth. A point weakly dominated in (f1, f2) by the staircase adds nothing;
+    otherwise it replaces the staircase points it dominates and the area grows by the strip
+    between them and the point. O(n log n) comparisons (list splices are memmoves).
     """
-    n = f.shape[0]
-    by1 = np.lexsort((f[:, 2], f[:, 1], f[:, 0]))
-    x, y = f[by1, 0], f[by1, 1]
-    widths = np.diff(np.append(x, ref[0]))
-    # Rank of each point (in f1 order) in f3 order: point j is active in slabs i >= rank[j].
-    by3 = np.argsort(f[by1, 2], kind="stable")
-    rank = np.empty(n, dtype=np.int64)
-    rank[by3] = np.arange(n)
-    z = np.sort(f[:, 2])
-    depths = np.diff(np.append(z, ref[2]))
-    rows = max(1, chunk_elements // max(n, 1))
-    total = 0.0
-    for start in range(0, n, rows):
-        i = np.arange(start, min(n, start + rows))
-        active = rank[None, :] <= i[:, None]
-        heights = np.where(active, y[None, :], ref[1])
-        np.minimum.accumulate(heights, axis=1, out=heights)
-        areas = (ref[1] - heights) @ widths
-        total += float(areas @ depths[i])
-    return total
+    r1, r2, r3 = (float(v) for v in ref)
+    pts = f[np.argsort(f[:, 2], kind="stable")].tolist()
+    xs: list[float] = []
+    ys: list[float] = []
+    area = volume = 0.0
+    z_prev = pts[0][2]
+    for x, y, z in pts:
+        volume += area * (z - z_prev)
+        z_prev = z
+        i = bisect_left(xs, x)  # xs[:i] < x <= xs[i:]
+        if (i > 0 and ys[i - 1] <= y) or (i < len(xs) and xs[i] == x and ys[i] <= y):
+            continue
+        cur_x, cur_h = x, (ys[i - 1] if i > 0 else r2)
+        j = i
+        while j < len(xs) and ys[j] >= y:  # staircase points the new one dominates
+            area += (xs[j] - cur_x) * (cur_h - y)
+            cur_x, cur_h = xs[j], ys[j]
+            j += 1
+        area += ((xs[j] if j < len(xs) else r1) - cur_x) * (cur_h - y)
+        xs[i:j] = [x]
+        ys[i:j] = [y]
+    return volume + area * (r3 - z_prev)
 
 
-def _hv_recursive(f: Array, ref: Array, chunk_elements: int) -> float:
+def _hv_recursive(f: Array, ref: Array) -> float:
     m = f.shape[1]
     if f.shape[0] == 0:
         return 0.0
@@ -87,7 +93,7 @@ def _hv_recursive(f: Array, ref: Array, chunk_elements: int) -> float:
     if m == 2:
         return _hv2(f, ref)
     if m == 3:
-        return _hv3(f, ref, chunk_elements)
+        return _hv3(f, ref)
     order = np.argsort(f[:, -1], kind="stable")
     f = f[order]
     z = np.append(f[:, -1], ref[-1])
@@ -95,11 +101,11 @@ def _hv_recursive(f: Array, ref: Array, chunk_elements: int) -> float:
     for i in range(f.shape[0]):
         depth = z[i + 1] - z[i]
         if depth > 0:
-            total += depth * _hv_recursive(f[: i + 1, :-1], ref[:-1], chunk_elements)
+            total += depth * _hv_recursive(f[: i + 1, :-1], ref[:-1])
     return total
 
 
-def hypervolume(f: Array, ref: Array, chunk_elements: int = CHUNK_ELEMENTS) -> float:
+def hypervolume(f: Array, ref: Array) -> float:
     """Exact hypervolume of ``f`` (``(n, m)``, minimisation) against reference point ``ref``.
 
     Only rows that are finite and strictly better than ``ref`` in every objective count;
@@ -112,7 +118,7 @@ def hypervolume(f: Array, ref: Array, chunk_elements: int = CHUNK_ELEMENTS) -> f
     if a.shape[1] != r.size:
         raise ValueError(f"f has {a.shape[1]} objectives but ref has {r.size}")
     keep = np.all(np.isfinite(a), axis=1) & np.all(a < r, axis=1)
-    return _hv_recursive(a[keep], r, int(chunk_elements))
+    return _hv_recursive(a[keep], r)
 
 
 def _nearest(

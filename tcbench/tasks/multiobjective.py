@@ -321,7 +321,7 @@ PROBLEMS: dict[str, MultiObjectiveProblem] = {
         ),
         MultiObjectiveProblem(
             "zdt3", "ZDT3", "ZDT3 (disconnected front)", zdt3, 2, 30, 2, zdt3_front, _zdt_set,
-            (1.1, 1.1), 1.3317629086570204,  # = zdt3_front_hypervolume((1.1, 1.1)), checked in tests
+            (1.1, 1.1), 1.3317629086570204,  # zdt3_front_hypervolume((1.1, 1.1)); checked in tests
         ),
         MultiObjectiveProblem(
             "dtlz2", "DTLZ2", "DTLZ2 (spherical front, 3 objectives)", dtlz2, 3, 3 + DTLZ_K - 1,
