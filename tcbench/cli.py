@@ -110,7 +110,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
         paths = leaderboard.write(board, Path(ns.out), client, source)
         print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
         print(leaderboard.markdown_table(board.table))
-        print(f"\nwritten: {paths['md']}, {paths['csv']}, {paths['png']}")
+        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
     return 0
 
 

@@ -16,7 +16,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import make_params
-from tcbench.tasks.function_env import FunctionEnv
+from tcbench.tasks import task_class
 
 
 class ConfigError(ValueError):
@@ -80,7 +80,7 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
     task = {k: v for k, v in c["task"].items() if k != "name"}
     try:
-        FunctionEnv(function=c["task"]["name"], budget=c["budget"], **task)
+        env = task_class(c["task"]["name"])(function=c["task"]["name"], budget=c["budget"], **task)
     except (KeyError, ValueError) as exc:
         raise ConfigError(f"task: {exc}") from None
     opt = dict(c["optimiser"])
@@ -93,6 +93,11 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(str(exc)) from None
     except (TypeError, ValueError) as exc:
         raise ConfigError(f"optimiser {name}: {exc}") from None
+    m = getattr(env, "n_objectives", 1)
+    if m > 1 and not cls.multi_objective:
+        raise ConfigError(f"optimiser {name} is single-objective; task {c['task']['name']} has {m} objectives")
+    if m == 1 and not cls.single_objective:
+        raise ConfigError(f"optimiser {name} is multi-objective only; task {c['task']['name']} has one objective")
     if c["budget"] < params.population:
         raise ConfigError(
             f"budget of {c['budget']} evaluations is smaller than one generation "

@@ -9,6 +9,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from tcbench import plots
@@ -58,6 +59,8 @@ def result_metrics(result: RunResult) -> dict[str, float]:
     }
     if result.target_hit_at is not None:
         metrics["evals_to_target"] = result.target_hit_at
+    if result.n_objectives > 1:
+        metrics |= {"hypervolume": float(result.hypervolume), "igd": float(result.igd)}
     return metrics
 
 
@@ -83,6 +86,7 @@ def run_job(cfg: Any) -> RunResult | None:
         "tcbench.task": tkey,
         "tcbench.method": method,
         "tcbench.seed": str(c["seed"]),
+        "tcbench.task_name": str(c["task"]["name"]),
         "tcbench.kind": "optimisation",
     }
     try:
@@ -90,18 +94,25 @@ def run_job(cfg: Any) -> RunResult | None:
             validate(c)
             result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"])
             t = result.trace
-            run.log_series("best_f", t.best_f, t.evaluations)
-            run.log_series("pop_mean_f", t.mean_f, t.evaluations)
+            multi = result.n_objectives > 1
+            run.log_series("hv_gap" if multi else "best_f", t.best_f, t.evaluations)
+            run.log_series("igd" if multi else "pop_mean_f", t.mean_f, t.evaluations)
             run.log_series("generation", [float(g) for g in t.generation], t.evaluations)
             run.log_metrics(result_metrics(result) | {"f_opt": result.f_opt})
             with tempfile.TemporaryDirectory() as tmp:
                 cfg_path = Path(tmp) / "config.yaml"
                 cfg_path.write_text(yaml.safe_dump(c, sort_keys=False))
                 run.log_artifact(cfg_path)
+                if multi:
+                    front = Path(tmp) / "front.csv"
+                    np.savetxt(front, result.front_f, delimiter=",", header=",".join(
+                        f"f{i + 1}" for i in range(result.n_objectives)), comments="")
+                    run.log_artifact(front)
                 if c["tracking"]["plots"]:
                     png = plots.run_convergence(
                         Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
                         result.f_opt, f"{method} on {tkey}, seed {c['seed']}",
+                        labels=("hypervolume gap 1 - HV/HV*", "IGD") if multi else None,
                     )
                     run.log_artifact(png)
                 if result.nonfinite:

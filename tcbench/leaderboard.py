@@ -26,6 +26,11 @@ COLUMNS = [
     "rank", "method", "seeds", "failed", "median_best", "median_error", "ci95_low", "ci95_high",
     "iqr_error", "success_rate", "ert_evals", "median_evals", "p_vs_next",
 ]
+# Several objectives: error = hypervolume gap 1 - HV/HV*; median HV and IGD instead of best.
+MO_COLUMNS = [
+    "rank", "method", "seeds", "failed", "median_hv", "median_igd", "median_error", "ci95_low",
+    "ci95_high", "iqr_error", "success_rate", "ert_evals", "median_evals", "p_vs_next",
+]
 
 
 @dataclass
@@ -71,6 +76,9 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
                 "evaluations": m.get("evaluations", np.nan),
                 "target_hit": m.get("target_hit", 0.0) > 0,
                 "evals_to_target": m.get("evals_to_target", np.nan),
+                "hypervolume": m.get("hypervolume", np.nan),
+                "igd": m.get("igd", np.nan),
+                "task_name": t.get("tcbench.task_name"),
             })
         token = page.token
         if not token:
@@ -108,10 +116,13 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
             "success_rate": hit.mean(),
             "ert_evals": expected_running_time(evals, g["evals_to_target"].to_numpy(float), hit),
             "median_evals": float(np.median(evals)),
+            "median_hv": float(np.median(g.loc[ok, "hypervolume"])) if "hypervolume" in g and ok.any() else np.nan,
+            "median_igd": float(np.median(g.loc[ok, "igd"])) if "igd" in g and ok.any() else np.nan,
         })
     table = pd.DataFrame(rows)
+    columns = MO_COLUMNS if is_multiobjective(runs) else COLUMNS
     if table.empty:
-        return pd.DataFrame(columns=COLUMNS)
+        return pd.DataFrame(columns=columns)
     table = table.sort_values(
         ["success_rate", "ert_evals", "median_error"], ascending=[False, True, True],
         na_position="last",
@@ -121,7 +132,12 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     table["p_vs_next"] = [
         paired_p_value(errors[m], errors[n]) for m, n in zip(methods, methods[1:], strict=False)
     ] + [np.nan]
-    return table[COLUMNS]
+    return table[columns]
+
+
+def is_multiobjective(runs: pd.DataFrame) -> bool:
+    """True when the runs carry hypervolumes (a multi-objective task)."""
+    return "hypervolume" in runs and bool(runs["hypervolume"].notna().any())
 
 
 def one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
@@ -168,6 +184,26 @@ def step_curves(
     return curves
 
 
+def _front_plot(board: Board, client, path: Path) -> bool:  # type: ignore[no-untyped-def]
+    """Each method's front from its median-IGD run against the true front; False if none."""
+    import tempfile
+
+    from tcbench.tasks.multiobjective import get_problem
+
+    done = board.runs[(board.runs["status"] == "FINISHED") & board.runs["igd"].notna()]
+    if done.empty:
+        return False
+    fronts = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for method, g in done.groupby("method", sort=True):
+            median_run = g.iloc[(g["igd"] - g["igd"].median()).abs().argsort().iloc[0]]
+            local = client.download_artifacts(median_run["run_id"], "front.csv", tmp)
+            fronts[str(method)] = np.loadtxt(local, delimiter=",", skiprows=1, ndmin=2)
+    problem = get_problem(str(done["task_name"].iloc[0]))
+    plots.front_plot(path, fronts, problem.true_front(400), f"{board.task}: final fronts (median-IGD run)")
+    return True
+
+
 def _fmt(value: object) -> str:
     if isinstance(value, (float, np.floating)):
         if np.isinf(value):
@@ -196,12 +232,18 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
     }
     budget = int(board.runs["budget"].max())
     grid = np.unique(np.linspace(1, budget, 200).round().astype(int))
-    curves = step_curves(client, board.runs, "best_f", grid)
+    multi = is_multiobjective(board.runs)
+    curves = step_curves(client, board.runs, "hv_gap" if multi else "best_f", grid)
     if curves:
         plots.band_convergence(
             paths["png"], curves, board.f_opt,
-            f"{board.task}: best so far (median, IQR over seeds)",
+            f"{board.task}: {'hypervolume gap' if multi else 'best so far'} (median, IQR over seeds)",
+            ylabel="1 - HV/HV*" if multi else "best so far - optimum",
         )
+    if multi:
+        paths["front"] = out_dir / f"{board.task}_front.png"
+        if not _front_plot(board, client, paths["front"]):
+            del paths["front"]
     failed = board.runs[board.runs["status"] != "FINISHED"]
     lines = [
         f"# Leaderboard: {board.task}",
@@ -219,6 +261,8 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
     ]
     if curves:
         lines += [f"![convergence]({paths['png'].name})", ""]
+    if "front" in paths:
+        lines += [f"![front]({paths['front'].name})", ""]
     if len(failed):
         lines += ["Failed or unfinished runs:", ""]
         lines += [

@@ -24,12 +24,18 @@ def run_convergence(
     mean_f: Sequence[float],
     f_opt: float,
     title: str,
+    labels: tuple[str, str] | None = None,
 ) -> Path:
-    """Best-so-far and population-mean fitness against evaluations for one run."""
+    """Best-so-far and population-mean fitness against evaluations for one run (or two other
+    curves named by ``labels``, e.g. hypervolume gap and IGD)."""
+    first, second = labels or ("best so far", "population mean")
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(evaluations, best_f, label="best so far")
-    ax.plot(evaluations, mean_f, label="population mean", alpha=0.8)
-    ax.axhline(f_opt, color="k", lw=0.8, ls=":", label=f"optimum ({f_opt:g})")
+    ax.plot(evaluations, best_f, label=first)
+    ax.plot(evaluations, mean_f, label=second, alpha=0.8)
+    if labels:
+        ax.set_yscale("log")
+    else:
+        ax.axhline(f_opt, color="k", lw=0.8, ls=":", label=f"optimum ({f_opt:g})")
     ax.set(xlabel="evaluations", ylabel="objective", title=title)
     ax.legend()
     fig.tight_layout()
@@ -138,6 +144,32 @@ def allan_plot(
     ax.set_ylim(adev.min() / 3, adev.max() * 3)
     ax.set(xlabel="τ (s)", ylabel=f"σ(τ) ({unit})", title=title)
     ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def front_plot(
+    path: Path, fronts: Mapping[str, np.ndarray], true_front: np.ndarray, title: str
+) -> Path:
+    """Obtained fronts against the true Pareto front (2 objectives: plane; 3: 3-D scatter)."""
+    m = true_front.shape[1]
+    fig = plt.figure(figsize=(6.5, 5))
+    ax = fig.add_subplot(projection="3d" if m == 3 else None)
+    if m == 3:
+        ax.scatter(*true_front.T, s=2, color="0.7", label="true front")
+        for method, f in fronts.items():
+            ax.scatter(*f.T, s=8, label=f"{method} ({len(f)} points)")
+        ax.set(xlabel="f1", ylabel="f2", zlabel="f3")
+    else:
+        order = np.argsort(true_front[:, 0])
+        ax.plot(*true_front[order].T, ".", ms=2, color="0.6", label="true front")
+        for method, f in fronts.items():
+            ax.plot(f[:, 0], f[:, 1], "o", ms=3, label=f"{method} ({len(f)} points)")
+        ax.set(xlabel="f1", ylabel="f2")
+    ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

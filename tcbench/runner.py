@@ -12,6 +12,7 @@ from tqdm.auto import tqdm
 
 import tcbench.tasks as tasks
 from tcbench.optimisers import registry
+from tcbench.metrics.multiobjective import igd
 from tcbench.optimisers.protocol import Optimiser, ProtocolError
 
 log = logging.getLogger(__name__)
@@ -19,7 +20,11 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class Trace:
-    """Per-generation history of one run (generation 0 is the initial population)."""
+    """Per-generation history of one run (generation 0 is the initial population).
+
+    Single objective: ``best_f`` best so far, ``mean_f`` population mean. Several objectives:
+    ``best_f`` is the hypervolume gap ``1 - HV/HV*`` of everything evaluated so far, ``mean_f``
+    its IGD to the true front."""
 
     generation: list[int] = field(default_factory=list)
     evaluations: list[int] = field(default_factory=list)
@@ -29,7 +34,8 @@ class Trace:
 
 @dataclass
 class RunResult:
-    """Outcome of one optimisation run."""
+    """Outcome of one optimisation run. For several objectives ``best_f`` is the final
+    hypervolume gap ``1 - HV/HV*`` (``f_opt`` = 0) and ``front_f`` the non-dominated set."""
 
     best_f: float
     best_x: np.ndarray
@@ -41,6 +47,10 @@ class RunResult:
     nonfinite: int
     generations: int
     trace: Trace
+    n_objectives: int = 1
+    hypervolume: float | None = None
+    igd: float | None = None
+    front_f: np.ndarray | None = None
 
     @property
     def error(self) -> float:
@@ -54,14 +64,14 @@ def seed_streams(seed: int) -> tuple[int, np.random.Generator]:
     return int(env_seq.generate_state(1)[0]), np.random.default_rng(opt_seq)
 
 
-def make_task(task: dict[str, Any], budget: int) -> tasks.FunctionEnv:
+def make_task(task: dict[str, Any], budget: int) -> Any:
     """Build the task environment from its config (``name``, ``dim``, ``shift`` ...)."""
     kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
-    env = gym.make(tasks.env_id(task["name"]), budget=budget, **kwargs)
-    return env.unwrapped  # type: ignore[return-value]
+    env = gym.make(tasks.task_id(task["name"]), budget=budget, **kwargs)
+    return env.unwrapped
 
 
-def checked_batch(opt: Optimiser, x: np.ndarray, env: tasks.FunctionEnv) -> np.ndarray:
+def checked_batch(opt: Optimiser, x: np.ndarray, env: Any) -> np.ndarray:
     """``x`` if it is a valid batch for ``env``; else a :class:`ProtocolError` naming ``opt``
     (guards against plugins that bypass the base class's own checks)."""
     x = np.asarray(x, dtype=np.float64)
@@ -84,6 +94,28 @@ def _population_mean(opt: Optimiser) -> float:
     return float(np.mean(f)) if f.size else float("nan")
 
 
+class _Progress:
+    """Per-generation record: best so far and population mean, or HV gap and IGD."""
+
+    def __init__(self, env: Any) -> None:
+        self.trace = Trace()
+        self.multi = getattr(env, "n_objectives", 1) > 1
+        if self.multi:
+            self.reference = env.problem.true_front(500)
+            self.hv_star = env.problem.front_hypervolume
+
+    def record(self, opt: Optimiser, info: dict[str, Any]) -> None:
+        t = self.trace
+        t.generation.append(opt.generation)
+        t.evaluations.append(info["evaluations"])
+        if self.multi:
+            t.best_f.append(1.0 - info["hypervolume"] / self.hv_star)
+            t.mean_f.append(igd(info["front_f"], self.reference) if len(info["front_f"]) else float("inf"))
+        else:
+            t.best_f.append(info["best_f"])
+            t.mean_f.append(_population_mean(opt))
+
+
 def run_optimisation(
     task: dict[str, Any],
     optimiser: dict[str, Any],
@@ -96,8 +128,9 @@ def run_optimisation(
     env_seed, rng = seed_streams(seed)
     env.reset(seed=env_seed)
     params = {k: v for k, v in optimiser.items() if k != "name"}
-    opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, params)
-    trace = Trace()
+    n_objectives = getattr(env, "n_objectives", 1)
+    opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, params, n_objectives)
+    recorder = _Progress(env)
     info: dict[str, Any] = {}
     last_generation = -1
     with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
@@ -108,21 +141,23 @@ def run_optimisation(
             bar.update(len(f))
             if opt.generation != last_generation:
                 last_generation = opt.generation
-                trace.generation.append(opt.generation)
-                trace.evaluations.append(info["evaluations"])
-                trace.best_f.append(info["best_f"])
-                trace.mean_f.append(_population_mean(opt))
+                recorder.record(opt, info)
     if env.nonfinite:
         log.warning("%d evaluations returned NaN or inf; they were treated as worst", env.nonfinite)
+    common = {
+        "evaluations": int(info["evaluations"]), "budget": budget, "nonfinite": int(info["nonfinite"]),
+        "generations": opt.generation, "trace": recorder.trace, "n_objectives": n_objectives,
+    }
+    if recorder.multi:
+        gap = 1.0 - info["hypervolume"] / recorder.hv_star
+        precision = float(task.get("target_precision") or 1e-8)
+        hits = [e for e, g in zip(recorder.trace.evaluations, recorder.trace.best_f, strict=True) if g <= precision]
+        return RunResult(
+            best_f=gap, best_x=np.asarray(info["front_x"]), f_opt=0.0, target_precision=precision,
+            target_hit_at=hits[0] if hits else None, hypervolume=float(info["hypervolume"]),
+            igd=recorder.trace.mean_f[-1], front_f=np.asarray(info["front_f"]), **common,
+        )
     return RunResult(
-        best_f=float(info["best_f"]),
-        best_x=np.asarray(info["best_x"]),
-        f_opt=env.f_opt,
-        evaluations=int(info["evaluations"]),
-        budget=budget,
-        target_precision=env.target_precision,
-        target_hit_at=info["target_hit_at"],
-        nonfinite=int(info["nonfinite"]),
-        generations=opt.generation,
-        trace=trace,
+        best_f=float(info["best_f"]), best_x=np.asarray(info["best_x"]), f_opt=env.f_opt,
+        target_precision=env.target_precision, target_hit_at=info["target_hit_at"], **common,
     )

@@ -6,6 +6,8 @@ import gymnasium as gym
 
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
 from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
+from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
+from tcbench.tasks.multiobjective import PROBLEMS
 
 ENV_VERSION = "v0"
 
@@ -28,14 +30,37 @@ def register_envs() -> None:
             )
 
 
+def is_multiobjective(name: str) -> bool:
+    """True for the multi-objective problems (ZDT1-3, DTLZ2)."""
+    return name.lower() in PROBLEMS
+
+
+def task_id(name: str) -> str:
+    """Gymnasium id of any task by its config name (``rastrigin``, ``zdt1``, ...)."""
+    return mo_env_id(name) if is_multiobjective(name) else env_id(name)
+
+
+def task_class(name: str) -> type[FunctionEnv] | type[MultiObjectiveEnv]:
+    """The env class serving a task name."""
+    return MultiObjectiveEnv if is_multiobjective(name) else FunctionEnv
+
+
 register_envs()
+register_mo_envs()
 
 __all__ = [
     "FUNCTIONS",
+    "PROBLEMS",
     "BudgetExceededError",
     "FunctionEnv",
+    "MultiObjectiveEnv",
     "ObjectiveFunction",
     "env_id",
     "get_function",
+    "is_multiobjective",
+    "mo_env_id",
     "register_envs",
+    "register_mo_envs",
+    "task_class",
+    "task_id",
 ]
