@@ -40,6 +40,7 @@ class Plan:
 
     jobs: int
     tracking_enabled: bool
+    resume: bool
     tracking_uri: str | None
     experiment: str
     sweep_id: str
@@ -137,5 +138,6 @@ def plan(args: list[str]) -> Plan:
                 raise ConfigError(f"seed must be a non-negative integer, got {s!r}")
     jobs = len(combos) * (len(seeds) if seeds else 1)
     track = last["tracking"]
-    return Plan(jobs, track["enabled"], track.get("uri"), track["experiment"], str(track["sweep_id"]))
+    return Plan(jobs, track["enabled"], track["resume"], track.get("uri"), track["experiment"],
+                str(track["sweep_id"]))
 

@@ -55,6 +55,10 @@ def _run_sweep(args: list[str]) -> Plan | None:
             raise UserError(str(exc)) from None
         n = checked.jobs
         print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
+        if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
+            from tcbench import tracking
+
+            tracking.experiment_id(tracking.client(checked.tracking_uri), checked.experiment)
     saved = sys.argv
     sys.argv = ["tcbench", *args]
     try:
@@ -64,8 +68,9 @@ def _run_sweep(args: list[str]) -> Plan | None:
     return checked
 
 
-def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
-    """Print how many runs of a sweep finished and failed; 1 if any failed."""
+def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | None = None) -> int:
+    """Print how many runs of a sweep finished and failed; 1 if any failed or, when
+    ``expected`` is given, if fewer runs than jobs were recorded."""
     from tcbench import leaderboard, tracking
 
     client = tracking.client(uri)
@@ -78,14 +83,19 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None) -> int:
     )
     for r in failed.itertuples():
         print(f"  FAILED {r.method} on {r.task} seed {r.seed}: {r.error_message}")
-    return 1 if len(failed) else 0
+    missing = (expected - len(runs)) if expected is not None else 0
+    if missing > 0:
+        print(f"  {missing} job{'s' if missing != 1 else ''} left no run in MLflow "
+              f"(skipped by resume, or the tracking store failed: see the job logs)")
+    return 1 if len(failed) or missing > 0 else 0
 
 
 def cmd_run(args: list[str]) -> int:
     checked = _run_sweep(args)
     if checked is None or not checked.tracking_enabled:
         return 0
-    return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri)
+    expected = None if checked.resume else checked.jobs
+    return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri, expected)
 
 
 def cmd_leaderboard(argv: list[str]) -> int:

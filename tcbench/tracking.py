@@ -49,7 +49,10 @@ def experiment_id(c: MlflowClient, name: str) -> str:
     found = c.get_experiment_by_name(name)
     if found is not None:
         return found.experiment_id
-    location = (Path.cwd() / "mlartifacts" / name).resolve().as_uri()
+    # A local store gets an explicit artifact folder; a tracking server keeps its own default
+    # (proxied artifacts), which every machine of a shared sweep can reach.
+    remote = str(c.tracking_uri).startswith(("http://", "https://"))
+    location = None if remote else (Path.cwd() / "mlartifacts" / name).resolve().as_uri()
     try:
         return c.create_experiment(name, artifact_location=location)
     except mlflow.exceptions.MlflowException:  # created meanwhile by a concurrent job

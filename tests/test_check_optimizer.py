@@ -106,3 +106,21 @@ def test_exceptions_inside_the_optimiser_are_reported() -> None:
 def test_not_an_optimiser() -> None:
     with pytest.raises(TypeError, match="not a tcbench Optimiser subclass"):
         check_optimizer(dict)  # type: ignore[arg-type]
+
+
+def test_merge_front_equals_full_recomputation() -> None:
+    from tcbench.optimisers.pareto import merge_front, nondominated
+
+    rng = np.random.default_rng(0)
+    front_x = np.empty((0, 1))
+    front_f = np.empty((0, 2))
+    all_f = []
+    for _ in range(20):
+        f = np.round(rng.random((15, 2)), 1)  # ties and duplicates on purpose
+        x = f[:, :1].copy()
+        front_x, front_f = merge_front(front_x, front_f, x, f)
+        all_f.append(f)
+    everything = np.concatenate(all_f)
+    expected = np.unique(everything[nondominated(everything)], axis=0)
+    np.testing.assert_array_equal(np.unique(front_f, axis=0), expected)
+    assert len(front_f) == len(expected)  # no duplicates kept

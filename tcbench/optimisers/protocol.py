@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from tcbench.optimisers.pareto import nondominated
+from tcbench.optimisers.pareto import merge_front
 
 
 class ProtocolError(RuntimeError):
@@ -178,10 +178,7 @@ class Optimiser(ABC):
 
     def _update_front(self, x: np.ndarray, f: np.ndarray) -> None:
         finite = np.isfinite(f).all(axis=1)
-        xs = np.concatenate([self._front.x, x[finite]])
-        fs = np.concatenate([self._front.f, f[finite]])
-        keep = nondominated(fs)
-        self._front = ParetoSet(xs[keep], fs[keep])
+        self._front = ParetoSet(*merge_front(self._front.x, self._front.f, x[finite], f[finite]))
 
     # -- subclass hooks --------------------------------------------------------------------
     @abstractmethod
