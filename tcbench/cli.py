@@ -104,6 +104,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
     ap.add_argument("--sweep", help="only runs of this sweep id")
     ap.add_argument("--out", default="leaderboards", help="output directory (default: leaderboards)")
     ap.add_argument("--tracking-uri", help="MLflow store (default: $MLFLOW_TRACKING_URI or ./mlflow.db)")
+    ap.add_argument("--ecdf", action="store_true", help="also write COCO-style ECDF plots per dimension")
     ns = ap.parse_args(argv)
     from tcbench import leaderboard, tracking
 
@@ -121,6 +122,11 @@ def cmd_leaderboard(argv: list[str]) -> int:
         print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
         print(leaderboard.markdown_table(board.table))
         print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
+    if ns.ecdf:
+        from tcbench.ecdf import write_ecdf_plots
+
+        written = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), Path(ns.out))
+        print(f"\nECDF plots: {', '.join(map(str, written)) or 'none (no single-objective runs)'}")
     return 0
 
 

@@ -69,6 +69,7 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
                 "start_time": r.info.start_time,
                 "error_message": t.get("tcbench.error", ""),
                 "budget": int(p.get("budget", 0)),
+                "dim": int(p.get("task.dim", 0) or 0),
                 "target_precision": float(p.get("task.target_precision", "nan")),
                 "final_error": m.get("final_error", np.nan),
                 "final_best": m.get("final_best", np.nan),

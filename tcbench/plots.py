@@ -175,3 +175,19 @@ def front_plot(
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def ecdf_plot(path: Path, evaluations: np.ndarray, curves: Mapping[str, np.ndarray], title: str) -> Path:
+    """COCO-style runtime ECDF: fraction of (function, target) pairs solved against evaluations."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for method, frac in sorted(curves.items(), key=lambda kv: -kv[1][-1]):
+        ax.step(evaluations, frac, where="post", label=f"{method} ({frac[-1]:.0%})")
+    ax.set_xscale("log")
+    ax.set_ylim(0, 1)
+    ax.set(xlabel="evaluations", ylabel="fraction of (function, target) pairs", title=title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
