@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
@@ -103,3 +104,7 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
             f"budget of {c['budget']} evaluations is smaller than one generation "
             f"(optimiser {name}: population {params.population})"
         )
+    try:  # the optimiser's own construction checks (e.g. BAS needs two evaluations per beetle)
+        cls(env.lower, env.upper, c["budget"], np.random.default_rng(0), params, n_objectives=m)
+    except ValueError as exc:
+        raise ConfigError(f"optimiser {name}: {exc}") from None

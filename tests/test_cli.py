@@ -65,7 +65,7 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
     ("args", "message"),
     [
         (["task=nope"], "unknown task 'nope'; known: ackley, "),
-        (["optimiser=nope"], "unknown optimiser 'nope'; known: fa"),
+        (["optimiser=nope"], "unknown optimiser 'nope'; known: bas, fa, "),
         (["seed=abc"], "seed: Value 'abc'"),
         (["seed=-1"], "seed must be >= 0"),
         (["budget=5"], "smaller than one generation"),
@@ -75,6 +75,8 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
         (["tracking.plots=maybe"], "tracking.plots: Value 'maybe' is not a valid bool"),
         (["optimiser.alpha0=1,2"], "add -m"),
         (["-m", "optimiser=fa,ifa", "optimiser.gamma=-1"], "gamma must be >= 0"),
+        (["optimiser=bas", "optimiser.population=8", "budget=10"], "smaller than one BAS iteration"),
+        (["task=zdt1", "optimiser=ifa"], "single-objective; task zdt1 has 2 objectives"),
     ],
 )
 def test_bad_config_one_line_no_job(workdir: Path, args: list[str], message: str) -> None:
