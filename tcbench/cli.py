@@ -154,16 +154,22 @@ def cmd_quickstart(argv: list[str]) -> int:
 
 def cmd_list(argv: list[str]) -> int:
     from tcbench.optimisers import registry
-    from tcbench.tasks import FUNCTIONS, env_id
+    from tcbench.tasks import FUNCTIONS, PROBLEMS, env_id, mo_env_id
 
-    print("tasks:")
+    print("tasks (single objective):")
     for key, fn in FUNCTIONS.items():
-        print(f"  {env_id(key):26s} {fn.title}, domain [{fn.lower:g}, {fn.upper:g}]^d, x*={fn.x_opt:g}")
+        print(f"  {env_id(key):26s} task={key:11s} {fn.title}, domain [{fn.lower:g}, {fn.upper:g}]^d, x*={fn.x_opt:g}")
+    print("tasks (multi-objective):")
+    for key, p in PROBLEMS.items():
+        print(f"  {mo_env_id(key):26s} task={key:11s} {p.title}, {p.n_objectives} objectives, "
+              f"{p.default_dim} variables in [{p.lower:g}, {p.upper:g}]")
     print("optimisers:")
     for name, entry in registry.available().items():
-        print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package})")
+        kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective), ("multi", entry.cls.multi_objective)) if ok)
+        print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package}; {kinds}-objective)")
     for name, err in registry.broken().items():
         print(f"  {name:10s} BROKEN: {err}")
+    print("learners:\n  none yet (the learner track is not built)")
     return 0
 
 

@@ -43,7 +43,7 @@ def _fake_distribution(site: Path, name: str, entry_points: str, module: str = "
 
 def test_example_plugin_on_a_leaderboard(site: Path, tmp_path: Path) -> None:
     listed = tcbench("list", cwd=tmp_path, path=site)
-    assert "de         tcbench_de.de.DifferentialEvolution  (from tcbench-de)" in listed.stdout
+    assert "de         tcbench_de.de.DifferentialEvolution  (from tcbench-de; single-objective)" in listed.stdout
     run = tcbench("run", "-m", "optimiser=de,ifa", "task=sphere", "seed=range(2)", "budget=200",
                   "tracking.experiment=plugins", cwd=tmp_path, path=site)
     assert run.returncode == 0, run.stderr
