@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-import mlflow
 import numpy as np
 import pandas as pd
 import pytest

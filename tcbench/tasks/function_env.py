@@ -22,6 +22,25 @@ class BudgetExceededError(RuntimeError):
     """A step asked for more evaluations than the budget has left."""
 
 
+def as_batch(action: np.ndarray, dim: int) -> tuple[np.ndarray, bool]:
+    """An action as an ``(n, dim)`` batch, and whether it was a single ``(dim,)`` point."""
+    x = np.asarray(action, dtype=np.float64)
+    single = x.ndim == 1
+    x2 = x.reshape(1, -1) if single else x
+    if x2.ndim != 2 or x2.shape[1] != dim:
+        raise ValueError(f"action must have shape ({dim},) or (n, {dim}), got {x.shape}")
+    return x2, single
+
+
+def check_budget(evaluations: int, n: int, budget: int) -> None:
+    """Raise :class:`BudgetExceededError` if ``n`` more evaluations do not fit in ``budget``."""
+    if evaluations + n > budget:
+        raise BudgetExceededError(
+            f"{n} evaluations requested but only {budget - evaluations} of the "
+            f"budget of {budget} are left; call reset()"
+        )
+
+
 class FunctionEnv(gym.Env[np.ndarray, np.ndarray]):
     """Minimise ``function`` in ``dim`` dimensions within ``budget`` evaluations.
 
@@ -110,19 +129,8 @@ class FunctionEnv(gym.Env[np.ndarray, np.ndarray]):
     def step(
         self, action: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
-        x = np.asarray(action, dtype=np.float64)
-        single = x.ndim == 1
-        x2 = x.reshape(1, -1) if single else x
-        if x2.ndim != 2 or x2.shape[1] != self.dim:
-            raise ValueError(
-                f"action must have shape ({self.dim},) or (n, {self.dim}), got {x.shape}"
-            )
-        n = x2.shape[0]
-        if self.evaluations + n > self.budget:
-            raise BudgetExceededError(
-                f"{n} evaluations requested but only {self.budget - self.evaluations} of the "
-                f"budget of {self.budget} are left; call reset()"
-            )
+        x2, single = as_batch(action, self.dim)
+        check_budget(self.evaluations, x2.shape[0], self.budget)
         f = np.asarray(self.evaluate(x2), dtype=np.float64)
         self._record(x2, f)
         truncated = self.evaluations >= self.budget

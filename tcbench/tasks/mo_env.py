@@ -26,8 +26,8 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.metrics.multiobjective import hypervolume
-from tcbench.optimisers.pareto import nondominated
-from tcbench.tasks.function_env import BudgetExceededError
+from tcbench.optimisers.pareto import merge_front
+from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.multiobjective import PROBLEMS, MultiObjectiveProblem, get_problem
 
 MO_ENV_VERSION = "v0"
@@ -35,16 +35,6 @@ MO_ENV_VERSION = "v0"
 # New points are merged into the archive this many at a time, so the dominance matrices stay
 # at (archive size x chunk) rather than growing with the square of a large batch.
 _MERGE_CHUNK = 256
-
-
-def _weakly_dominates(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``out[i, j]``: row ``a[i]`` is no worse than row ``b[j]`` in every objective (equal rows
-    included). One comparison per objective: much faster than reducing over a short last
-    axis when the archive is large."""
-    out = np.ones((a.shape[0], b.shape[0]), dtype=bool)
-    for k in range(a.shape[1]):
-        out &= a[:, k, None] <= b[None, :, k]
-    return out
 
 
 class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -126,24 +116,13 @@ class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
     def step(
         self, action: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
-        x = np.asarray(action, dtype=np.float64)
-        single = x.ndim == 1
-        x2 = x.reshape(1, -1) if single else x
-        if x2.ndim != 2 or x2.shape[1] != self.dim:
-            raise ValueError(
-                f"action must have shape ({self.dim},) or (n, {self.dim}), got {x.shape}"
-            )
+        x2, single = as_batch(action, self.dim)
         if not np.all((x2 >= self.lower) & (x2 <= self.upper)):
             raise ValueError(
                 f"action outside the domain [{self.problem.lower}, {self.problem.upper}]^"
                 f"{self.dim} of {self.problem.name} (or not finite)"
             )
-        n = x2.shape[0]
-        if self.evaluations + n > self.budget:
-            raise BudgetExceededError(
-                f"{n} evaluations requested but only {self.budget - self.evaluations} of the "
-                f"budget of {self.budget} are left; call reset()"
-            )
+        check_budget(self.evaluations, x2.shape[0], self.budget)
         f = np.asarray(self.evaluate(x2), dtype=np.float64)
         self._record(x2, f)
         truncated = self.evaluations >= self.budget
@@ -159,26 +138,12 @@ class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
         x, f = x[finite], f[finite]
         changed = False
         for start in range(0, f.shape[0], _MERGE_CHUNK):
-            changed |= self._merge(x[start : start + _MERGE_CHUNK], f[start : start + _MERGE_CHUNK])
+            chunk = slice(start, start + _MERGE_CHUNK)
+            old = self.front_f
+            self.front_x, self.front_f = merge_front(self.front_x, old, x[chunk], f[chunk])
+            changed |= not np.array_equal(old, self.front_f)
         if changed:
             self.hypervolume = hypervolume(self.front_f, self.ref_point)
-
-    def _merge(self, x: np.ndarray, f: np.ndarray) -> bool:
-        """Add the non-dominated new points to the archive, drop archive points they dominate;
-        True if the archive changed. A new point equal to an archived one is dropped (the
-        first evaluated copy stays)."""
-        keep = nondominated(f)  # among the new points, first copy of equal vectors kept
-        old = self.front_f
-        if old.shape[0]:
-            keep &= ~_weakly_dominates(old, f).any(axis=0)
-        if not keep.any():
-            return False
-        x, f = x[keep], f[keep]
-        # no new point equals an archived one now, so weak dominance is dominance here
-        survive = ~_weakly_dominates(f, old).any(axis=0)
-        self.front_f = np.concatenate([old[survive], f])
-        self.front_x = np.concatenate([self.front_x[survive], x])
-        return True
 
     def _info(self) -> dict[str, Any]:
         return {
