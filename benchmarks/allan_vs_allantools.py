@@ -19,20 +19,22 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
-import json
-import os
-import platform
-import shlex
-import sys
-import time
-import tracemalloc
-from collections.abc import Callable
-from importlib.metadata import version
 from pathlib import Path
 
 import allantools
 import numpy as np
+from common import (
+    add_json,
+    best_time_s,
+    command_line,
+    parser_for,
+    peak_mib,
+    print_heading,
+    table_head,
+    table_row,
+    versions,
+    write_json,
+)
 
 from tcbench.signal.allan import allan_deviation
 
@@ -50,31 +52,11 @@ def make_signal(n: int, seed: int = 0) -> np.ndarray:
     return white + walk
 
 
-def best_time_s(fn: Callable[[], object], repeats: int) -> float:
-    """Best of ``repeats`` wall times of ``fn()``."""
-    best = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
-
-
-def peak_mib(fn: Callable[[], object]) -> float:
-    """Peak traced allocation during one ``fn()`` call, MiB."""
-    tracemalloc.start()
-    tracemalloc.reset_peak()
-    fn()
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    return peak / 2**20
-
-
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = parser_for(__doc__)
     parser.add_argument("--samples", type=int, default=1_000_000)
     parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON)
+    add_json(parser, DEFAULT_JSON, help_text=None)
     args = parser.parse_args(argv)
 
     rate = make_signal(args.samples)
@@ -112,42 +94,30 @@ def main(argv: list[str] | None = None) -> int:
             lambda: allantools.oadev(rate, rate=FS_HZ, data_type="freq", taus=tau_s)
         )
 
-    versions = {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "allantools": version("allantools"),
-        "tcbench": version("tcbench"),
-    }
-    command = "python " + " ".join(shlex.quote(a) for a in [sys.argv[0], *sys.argv[1:]])
-    print(f"## Allan deviation vs allantools ({args.samples} samples)\n")
-    print(f"Command: `{command}`\n")
-    print(
-        f"Machine: {platform.system()} {platform.machine()}, {os.cpu_count()} cores; "
-        + ", ".join(f"{k} {v}" for k, v in versions.items())
-        + "\n"
-    )
+    libraries = versions("numpy", "allantools", "tcbench")
+    print_heading(f"Allan deviation vs allantools ({args.samples} samples)", command_line(),
+                  libraries)
     print(
         f"Signal: white noise (sigma {WHITE_SIGMA}/sample) + rate random walk "
         f"(K = {RRW_K}/sqrt(s)) at {FS_HZ:g} Hz, seed 0; best of {args.repeats} runs.\n"
     )
-    print(
-        "| taus | n taus | tcbench (s) | allantools (s) | ratio allantools/tcbench "
-        "| max rel. diff | tcbench peak (MiB) | allantools peak (MiB) |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+    print("\n".join(table_head(
+        ["taus", "n taus", "tcbench (s)", "allantools (s)", "ratio allantools/tcbench",
+         "max rel. diff", "tcbench peak (MiB)", "allantools peak (MiB)"],
+        "lrrrrrrr",
+    )))
     for r in rows:
-        print(
-            f"| {r['taus']} | {r['n_taus']} | {r['tcbench_s']:.4f} | {r['allantools_s']:.4f} "
-            f"| {r['ratio']:.1f}x | {r['max_rel_diff']:.1e} | {r['tcbench_peak_mib']:.1f} "
-            f"| {r['allantools_peak_mib']:.1f} |"
-        )
+        print(table_row([
+            r["taus"], r["n_taus"], f"{r['tcbench_s']:.4f}", f"{r['allantools_s']:.4f}",
+            f"{r['ratio']:.1f}x", f"{r['max_rel_diff']:.1e}", f"{r['tcbench_peak_mib']:.1f}",
+            f"{r['allantools_peak_mib']:.1f}",
+        ]))
     input_mib = rate.nbytes / 2**20
     print(f"\n(input array: {input_mib:.1f} MiB, not counted in the peaks)")
-    args.json.write_text(
-        json.dumps(
-            {"samples": args.samples, "repeats": args.repeats, "versions": versions, "rows": rows},
-            indent=2,
-        )
+    write_json(
+        args.json,
+        {"samples": args.samples, "repeats": args.repeats, "versions": libraries, "rows": rows},
+        final_newline=False,
     )
     return 0
 

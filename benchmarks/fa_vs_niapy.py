@@ -52,18 +52,26 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import platform
-import shlex
 import statistics
-import sys
 import time
 from dataclasses import asdict, dataclass
-from importlib.metadata import version
 from pathlib import Path
 
 import numpy as np
+from common import (
+    add_json,
+    add_seeds,
+    check_seeds,
+    command_line,
+    environment,
+    footer,
+    median_of,
+    parser_for,
+    progress,
+    table_head,
+    table_row,
+    write_report,
+)
 from niapy.algorithms.basic import FireflyAlgorithm as NiaPyFA
 from niapy.task import Task
 
@@ -144,29 +152,17 @@ def summarise(runs: list[RunResult]) -> dict[str, dict[str, float]]:
     out: dict[str, dict[str, float]] = {}
     for library in dict.fromkeys(r.library for r in runs):
         mine = [r for r in runs if r.library == library]
-        seconds = statistics.median(r.seconds for r in mine)
-        evals = statistics.median(r.evaluations for r in mine)
+        seconds = median_of(mine, "seconds")
+        evals = median_of(mine, "evaluations")
         out[library] = {
             "median_seconds": seconds,
-            "median_best": statistics.median(r.best for r in mine),
+            "median_best": median_of(mine, "best"),
             "mean_best": statistics.fmean(r.best for r in mine),
             "median_evaluations": evals,
-            "median_generations": statistics.median(r.generations for r in mine),
+            "median_generations": median_of(mine, "generations"),
             "microseconds_per_evaluation": 1e6 * seconds / evals,
         }
     return out
-
-
-def environment() -> dict[str, str | int | None]:
-    """Versions and machine description for the report."""
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "niapy": version("niapy"),
-        "tcbench": version("tcbench"),
-        "platform": platform.platform(),
-        "cpus": os.cpu_count(),
-    }
 
 
 def markdown(summary: dict[str, dict[str, float]], ratios: dict[str, float],
@@ -177,59 +173,53 @@ def markdown(summary: dict[str, dict[str, float]], ratios: dict[str, float],
         "niapy": "NiaPy `FireflyAlgorithm`",
         "niapy-equal-evals": "NiaPy, capped at tcbench's evaluations",
     }
-    lines = [
-        "| library | median wall time (s) | median final best | mean final best "
-        "| evaluations (median) | generations | µs / evaluation |",
-        "|---|---:|---:|---:|---:|---:|---:|",
-    ]
+    lines = table_head(
+        ["library", "median wall time (s)", "median final best", "mean final best",
+         "evaluations (median)", "generations", "µs / evaluation"],
+        "lrrrrrr",
+    )
     for library, s in summary.items():
-        lines.append(
-            f"| {titles[library]} | {s['median_seconds']:.3f} | {s['median_best']:.2f} "
-            f"| {s['mean_best']:.2f} | {s['median_evaluations']:.0f} "
-            f"| {s['median_generations']:.0f} | {s['microseconds_per_evaluation']:.1f} |"
-        )
+        lines.append(table_row([
+            titles[library], f"{s['median_seconds']:.3f}", f"{s['median_best']:.2f}",
+            f"{s['mean_best']:.2f}", f"{s['median_evaluations']:.0f}",
+            f"{s['median_generations']:.0f}", f"{s['microseconds_per_evaluation']:.1f}",
+        ]))
     lines += [
         "",
         f"Speed ratio (NiaPy median time / tcbench median time, 500 generations each): "
         f"**{ratios['per_run']:.1f}x**; per evaluation: {ratios['per_evaluation']:.1f}x. "
         f"Seeds: {seeds}.",
-        "",
-        f"Python {env['python']}, numpy {env['numpy']}, NiaPy {env['niapy']}, "
-        f"tcbench {env['tcbench']}; {env['platform']}, {env['cpus']} CPUs.",
-        "",
-        f"Command: `{command}`",
+        *footer(env, f"NiaPy {env['niapy']}", command),
     ]
     return "\n".join(lines)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
-    parser.add_argument("--seeds", type=int, default=5, help="number of seeds (>= 5), 0..N-1")
+    parser = parser_for(__doc__)
+    add_seeds(parser)
     parser.add_argument("--alpha", type=float, default=1.0, help="random step, fraction of width")
     parser.add_argument("--gamma", type=float, default=0.01, help="absorption coefficient")
     parser.add_argument("--theta", type=float, default=0.97, help="alpha decay per generation")
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON, help="where to write results")
+    add_json(parser, DEFAULT_JSON)
     args = parser.parse_args(argv)
-    if args.seeds < 5:
-        parser.error("--seeds must be >= 5")
+    check_seeds(parser, args.seeds)
     return args
 
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
     setting = Setting(alpha=args.alpha, gamma=args.gamma, theta=args.theta)
-    command = shlex.join(["python", *sys.argv]) if argv is None else shlex.join(argv)
+    command = command_line(argv)
     runs: list[RunResult] = []
     for seed in range(args.seeds):
         ours = run_tcbench(seed, setting)
         theirs = run_niapy(seed, setting)
         capped = run_niapy(seed, setting, max_evals=ours.evaluations)
         runs += [ours, theirs, capped]
-        print(
+        progress(
             f"seed {seed}: tcbench {ours.seconds:.3f}s f={ours.best:.2f} ({ours.evaluations} ev) | "
             f"niapy {theirs.seconds:.3f}s f={theirs.best:.2f} ({theirs.evaluations} ev) | "
-            f"niapy@{capped.evaluations} ev f={capped.best:.2f}",
-            file=sys.stderr, flush=True,
+            f"niapy@{capped.evaluations} ev f={capped.best:.2f}"
         )
     summary = summarise(runs)
     t, n = summary["tcbench"], summary["niapy"]
@@ -237,22 +227,16 @@ def main(argv: list[str] | None = None) -> None:
         "per_run": n["median_seconds"] / t["median_seconds"],
         "per_evaluation": n["microseconds_per_evaluation"] / t["microseconds_per_evaluation"],
     }
-    env = environment()
+    env = environment("niapy")
     print(markdown(summary, ratios, env, command, args.seeds))
-    report = {
-        "benchmark": "fa_vs_niapy",
+    setup = {
         "problem": {"function": "rastrigin", "dim": DIM, "lower": LOWER, "upper": UPPER},
         "population": POPULATION,
         "generations": GENERATIONS,
         "setting": asdict(setting),
-        "seeds": list(range(args.seeds)),
-        "command": command,
-        "environment": env,
-        "summary": summary,
-        "speed_ratio": ratios,
-        "runs": [asdict(r) for r in runs],
     }
-    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    write_report(args.json, "fa_vs_niapy", setup, args.seeds, command, env,
+                 {"summary": summary, "speed_ratio": ratios}, runs)
 
 
 if __name__ == "__main__":

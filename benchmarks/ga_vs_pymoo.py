@@ -66,19 +66,32 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import platform
-import shlex
-import statistics
-import sys
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
-from importlib.metadata import version
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from common import (
+    add_time_ratio,
+    case_cells,
+    case_columns,
+    command_line,
+    footer,
+    groups,
+    median_of,
+    objective_list,
+    objective_seconds,
+    parse_case,
+    parse_case_args,
+    pymoo_environment,
+    pymoo_versions,
+    run_cases,
+    spread,
+    table_head,
+    table_row,
+    write_report,
+)
 from pymoo.algorithms.soo.nonconvex.ga import GA
 from pymoo.core.population import Population
 from pymoo.core.problem import Problem
@@ -100,7 +113,6 @@ FUNCTIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "rastrigin": rastrigin,
     "sphere": sphere,
 }
-DEFAULT_CASES = ("rastrigin-10", "rastrigin-30", "sphere-10", "sphere-30")
 DEFAULT_JSON = Path(__file__).with_name("ga_vs_pymoo.json")
 METHODS = {
     "tcbench": "tcbench `ga` (elite 2, generational)",
@@ -155,15 +167,8 @@ class ElitistGenerational(Survival):
         return Population.merge(parents[order[: n_survive - k]], pop[n_survive:])
 
 
-def parse_case(case: str) -> tuple[str, int]:
-    name, dim = case.rsplit("-", 1)
-    if name not in FUNCTIONS:
-        raise ValueError(f"unknown function {name!r}; known: {', '.join(FUNCTIONS)}")
-    return name, int(dim)
-
-
 def run_tcbench(case: str, seed: int) -> RunResult:
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     fn = FUNCTIONS[name]
     params = {
         "population": POPULATION, "crossover_prob": CROSSOVER_PROB,
@@ -183,7 +188,7 @@ def run_tcbench(case: str, seed: int) -> RunResult:
 
 
 def run_pymoo(case: str, seed: int, tcbench_survival: bool) -> RunResult:
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     problem = CountingProblem(FUNCTIONS[name], dim)
     start = time.perf_counter()
     extra = (
@@ -216,136 +221,70 @@ def run_pymoo(case: str, seed: int, tcbench_survival: bool) -> RunResult:
 def objective_alone(case: str, repeats: int = 5) -> float:
     """Best-of-``repeats`` time of evaluating the objective on BUDGET / POPULATION batches of
     POPULATION random points (the batches tcbench's and pymoo's loops hand it)."""
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     fn = FUNCTIONS[name]
     x = np.random.default_rng(0).uniform(LOWER, UPPER, size=(POPULATION, dim))
-    best = np.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(BUDGET // POPULATION):
-            fn(x)
-        best = min(best, time.perf_counter() - t0)
-    return best
+    return objective_seconds(fn, x, BUDGET // POPULATION, repeats)
 
 
 def summarise(runs: list[RunResult], objective_s: dict[str, float]) -> list[dict]:
     rows = []
-    for case in dict.fromkeys(r.case for r in runs):
-        for method in METHODS:
-            mine = [r for r in runs if r.case == case and r.method == method]
-            if not mine:
-                continue
-            seconds = statistics.median(r.seconds for r in mine)
-            gens = statistics.median(r.generations for r in mine)
-            rows.append({
-                "case": case, "method": method,
-                "median_seconds": seconds,
-                "median_best": statistics.median(r.best for r in mine),
-                "min_best": min(r.best for r in mine),
-                "max_best": max(r.best for r in mine),
-                "evaluations": statistics.median(r.evaluations for r in mine),
-                "generations": gens,
-                "overhead_ms_per_generation": 1e3 * (seconds - objective_s[case]) / (gens + 1),
-            })
-    tc = {row["case"]: row["median_seconds"] for row in rows if row["method"] == "tcbench"}
-    for row in rows:
-        row["time_ratio_vs_tcbench"] = row["median_seconds"] / tc[row["case"]]
-    return rows
-
-
-def environment() -> dict[str, str | int | None]:
-    from pymoo.functions import is_compiled
-
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pymoo": version("pymoo"),
-        "pymoo_compiled": str(is_compiled()),
-        "tcbench": version("tcbench"),
-        "platform": platform.platform(),
-        "cpus": os.cpu_count(),
-    }
+    for case, method, mine in groups(runs, "case", METHODS):
+        seconds = median_of(mine, "seconds")
+        gens = median_of(mine, "generations")
+        rows.append({
+            "case": case, "method": method,
+            "median_seconds": seconds,
+            **spread([r.best for r in mine], "best"),
+            "evaluations": median_of(mine, "evaluations"),
+            "generations": gens,
+            "overhead_ms_per_generation": 1e3 * (seconds - objective_s[case]) / (gens + 1),
+        })
+    return add_time_ratio(rows)
 
 
 def markdown(rows: list[dict], objective_s: dict[str, float], env: dict, command: str,
              seeds: int) -> str:
-    lines = [
-        "| problem | method | median wall time (s) | time / tcbench | median final best "
-        "| best .. worst seed | evaluations | generations | overhead ms / generation |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
-    ]
+    lines = table_head([*case_columns("method"), "generations", "overhead ms / generation"],
+                       "llrrrrrrr")
     for r in rows:
-        lines.append(
-            f"| {r['case']} | {METHODS[r['method']]} | {r['median_seconds']:.3f} "
-            f"| {r['time_ratio_vs_tcbench']:.1f}x | {r['median_best']:.4g} "
-            f"| {r['min_best']:.3g} .. {r['max_best']:.3g} | {r['evaluations']:.0f} "
-            f"| {r['generations']:.0f} | {r['overhead_ms_per_generation']:.2f} |"
-        )
-    obj = ", ".join(f"{c} {1e3 * s:.1f} ms" for c, s in objective_s.items())
+        lines.append(table_row([*case_cells(r, METHODS), f"{r['generations']:.0f}",
+                                f"{r['overhead_ms_per_generation']:.2f}"]))
+    obj = objective_list(objective_s)
     lines += [
         "",
         f"Objective alone ({BUDGET // POPULATION} batches of {POPULATION}): {obj}. "
         f"Overhead = (wall time - objective time) / (generations + 1, the initial population). "
         f"Seeds: {seeds}; population {POPULATION}, {BUDGET} evaluations per run.",
-        "",
-        f"Python {env['python']}, numpy {env['numpy']}, pymoo {env['pymoo']} "
-        f"(compiled extensions: {env['pymoo_compiled']}), tcbench {env['tcbench']}; "
-        f"{env['platform']}, {env['cpus']} CPUs.",
-        "",
-        f"Command: `{command}`",
+        *footer(env, pymoo_versions(env), command),
     ]
     return "\n".join(lines)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
-    parser.add_argument("--seeds", type=int, default=5, help="number of seeds (>= 5), 0..N-1")
-    parser.add_argument("--cases", nargs="+", default=list(DEFAULT_CASES),
-                        help="function-dimension pairs, e.g. rastrigin-10 sphere-30")
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON, help="where to write results")
-    args = parser.parse_args(argv)
-    if args.seeds < 5:
-        parser.error("--seeds must be >= 5")
-    for case in args.cases:
-        try:
-            parse_case(case)
-        except ValueError as err:
-            parser.error(str(err))
-    return args
+    return parse_case_args(__doc__, DEFAULT_JSON, FUNCTIONS, argv)
 
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
-    command = shlex.join(["python", *sys.argv]) if argv is None else shlex.join(argv)
-    runs: list[RunResult] = []
-    for case in args.cases:
-        for seed in range(args.seeds):
-            trio = [run_tcbench(case, seed), run_pymoo(case, seed, False),
-                    run_pymoo(case, seed, True)]
-            runs += trio
-            print(f"{case} seed {seed}: " + " | ".join(
-                f"{r.method} {r.seconds:.3f}s f={r.best:.4g} ({r.evaluations} ev)" for r in trio
-            ), file=sys.stderr, flush=True)
+    command = command_line(argv)
+    runs = run_cases(args.cases, args.seeds, lambda case, seed: [
+        run_tcbench(case, seed), run_pymoo(case, seed, False), run_pymoo(case, seed, True),
+    ])
     objective_s = {case: objective_alone(case) for case in args.cases}
     rows = summarise(runs, objective_s)
-    env = environment()
+    env = pymoo_environment()
     print(markdown(rows, objective_s, env, command, args.seeds))
-    report = {
-        "benchmark": "ga_vs_pymoo",
+    setup = {
         "domain": [LOWER, UPPER],
         "population": POPULATION,
         "budget": BUDGET,
         "operators": {"eta_c": ETA_C, "eta_m": ETA_M, "crossover_prob": CROSSOVER_PROB,
                       "crossover_var_prob": CROSSOVER_VAR_PROB, "mutation_prob": "1/d",
                       "elite": ELITE},
-        "seeds": list(range(args.seeds)),
-        "command": command,
-        "environment": env,
-        "objective_seconds": objective_s,
-        "summary": rows,
-        "runs": [asdict(r) for r in runs],
     }
-    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    write_report(args.json, "ga_vs_pymoo", setup, args.seeds, command, env,
+                 {"objective_seconds": objective_s, "summary": rows}, runs)
 
 
 if __name__ == "__main__":

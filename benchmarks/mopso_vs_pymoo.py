@@ -70,18 +70,29 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import platform
-import shlex
-import statistics
-import sys
 import time
-from dataclasses import asdict, dataclass
-from importlib.metadata import version
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from common import (
+    add_json,
+    add_seeds,
+    check_each,
+    check_seeds,
+    command_line,
+    footer,
+    groups,
+    median_of,
+    parser_for,
+    progress,
+    pymoo_environment,
+    pymoo_versions,
+    spread,
+    table_head,
+    table_row,
+    write_report,
+)
 from pymoo.algorithms.moo.mopso_cd import MOPSO_CD
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.problem import Problem
@@ -226,90 +237,61 @@ def run_pymoo(key: str, method: str, seed: int, reference: np.ndarray) -> RunRes
 
 def summarise(runs: list[RunResult]) -> list[dict]:
     rows = []
-    for key in dict.fromkeys(r.problem for r in runs):
-        for method, (_, returned_label) in METHODS.items():
-            mine = [r for r in runs if r.problem == key and r.method == method]
-            if not mine:
-                continue
-            seconds = statistics.median(r.seconds for r in mine)
-            for which, label in (("returned", returned_label), ("all", ALL_EVALUATED)):
-                rows.append({
-                    "problem": key, "method": method, "set": which, "set_label": label,
-                    "median_size": statistics.median(getattr(r, f"{which}_size") for r in mine),
-                    "median_hv": statistics.median(getattr(r, f"{which}_hv") for r in mine),
-                    "min_hv": min(getattr(r, f"{which}_hv") for r in mine),
-                    "max_hv": max(getattr(r, f"{which}_hv") for r in mine),
-                    "median_igd": statistics.median(getattr(r, f"{which}_igd") for r in mine),
-                    "median_seconds": seconds,
-                    "evaluations": statistics.median(r.evaluations for r in mine),
-                })
+    for key, method, mine in groups(runs, "problem", METHODS):
+        seconds = median_of(mine, "seconds")
+        for which, label in (("returned", METHODS[method][1]), ("all", ALL_EVALUATED)):
+            rows.append({
+                "problem": key, "method": method, "set": which, "set_label": label,
+                "median_size": median_of(mine, f"{which}_size"),
+                **spread([getattr(r, f"{which}_hv") for r in mine], "hv"),
+                "median_igd": median_of(mine, f"{which}_igd"),
+                "median_seconds": seconds,
+                "evaluations": median_of(mine, "evaluations"),
+            })
     return rows
 
 
-def environment() -> dict[str, str | int | None]:
-    from pymoo.functions import is_compiled
-
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pymoo": version("pymoo"),
-        "pymoo_compiled": str(is_compiled()),
-        "tcbench": version("tcbench"),
-        "platform": platform.platform(),
-        "cpus": os.cpu_count(),
-    }
-
-
 def markdown(rows: list[dict], env: dict, command: str, seeds: int) -> str:
-    lines = [
-        "| problem | method | set scored | median distinct points | median HV / HV(true front) "
-        "| HV worst .. best seed | median IGD | median wall time (s) | evaluations |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|",
-    ]
+    lines = table_head(
+        ["problem", "method", "set scored", "median distinct points",
+         "median HV / HV(true front)", "HV worst .. best seed", "median IGD",
+         "median wall time (s)", "evaluations"],
+        "lllrrrrrr",
+    )
     for r in rows:
-        lines.append(
-            f"| {get_problem(r['problem']).name} | {METHODS[r['method']][0]} | {r['set_label']} "
-            f"| {r['median_size']:.0f} | {r['median_hv']:.4f} "
-            f"| {r['min_hv']:.3f} .. {r['max_hv']:.3f} | {r['median_igd']:.4f} "
-            f"| {r['median_seconds']:.3f} | {r['evaluations']:.0f} |"
-        )
+        lines.append(table_row([
+            get_problem(r["problem"]).name, METHODS[r["method"]][0], r["set_label"],
+            f"{r['median_size']:.0f}", f"{r['median_hv']:.4f}",
+            f"{r['min_hv']:.3f} .. {r['max_hv']:.3f}", f"{r['median_igd']:.4f}",
+            f"{r['median_seconds']:.3f}", f"{r['evaluations']:.0f}",
+        ]))
     lines += [
         "",
         f"Seeds: {seeds}; {BUDGET} evaluations per run; population/swarm {POPULATION}; "
         f"IGD against `true_front({IGD_POINTS})`. The wall time belongs to the run, so both "
         "sets of a method show the same value.",
-        "",
-        f"Python {env['python']}, numpy {env['numpy']}, pymoo {env['pymoo']} "
-        f"(compiled extensions: {env['pymoo_compiled']}), tcbench {env['tcbench']}; "
-        f"{env['platform']}, {env['cpus']} CPUs.",
-        "",
-        f"Command: `{command}`",
+        *footer(env, pymoo_versions(env), command),
     ]
     return "\n".join(lines)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
-    parser.add_argument("--seeds", type=int, default=5, help="number of seeds (>= 5), 0..N-1")
+    parser = parser_for(__doc__)
+    add_seeds(parser)
     parser.add_argument("--problems", nargs="+", default=list(DEFAULT_PROBLEMS),
                         help="problem keys (zdt1 zdt2 zdt3 dtlz2)")
     parser.add_argument("--methods", nargs="+", default=list(METHODS), choices=list(METHODS),
                         help="methods to run (default: all)")
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON, help="where to write results")
+    add_json(parser, DEFAULT_JSON)
     args = parser.parse_args(argv)
-    if args.seeds < 5:
-        parser.error("--seeds must be >= 5")
-    for key in args.problems:
-        try:
-            get_problem(key)
-        except KeyError as err:
-            parser.error(str(err))
+    check_seeds(parser, args.seeds)
+    check_each(parser, args.problems, get_problem, errors=(KeyError,))
     return args
 
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
-    command = shlex.join(["python", *sys.argv]) if argv is None else shlex.join(argv)
+    command = command_line(argv)
     runs: list[RunResult] = []
     for key in args.problems:
         reference = get_problem(key).true_front(IGD_POINTS)
@@ -318,17 +300,15 @@ def main(argv: list[str] | None = None) -> None:
                 run = run_tcbench if method.startswith("tcbench") else run_pymoo
                 r = run(key, method, seed, reference)
                 runs.append(r)
-                print(
+                progress(
                     f"{key} seed {seed} {method}: {r.seconds:.3f}s, {r.evaluations} ev, "
                     f"returned {r.returned_size} HV {r.returned_hv:.4f} IGD {r.returned_igd:.4f}, "
-                    f"all {r.all_size} HV {r.all_hv:.4f} IGD {r.all_igd:.4f}",
-                    file=sys.stderr, flush=True,
+                    f"all {r.all_size} HV {r.all_hv:.4f} IGD {r.all_igd:.4f}"
                 )
     rows = summarise(runs)
-    env = environment()
+    env = pymoo_environment()
     print(markdown(rows, env, command, args.seeds))
-    report = {
-        "benchmark": "mopso_vs_pymoo",
+    setup = {
         "budget": BUDGET,
         "population": POPULATION,
         "archive": ARCHIVE,
@@ -336,13 +316,9 @@ def main(argv: list[str] | None = None) -> None:
         "ga": {"eta_c": ETA_C, "eta_m": ETA_M, "crossover_prob": CROSSOVER_PROB,
                "crossover_var_prob": CROSSOVER_VAR_PROB, "mutation_prob": "1/d"},
         "igd_points": IGD_POINTS,
-        "seeds": list(range(args.seeds)),
-        "command": command,
-        "environment": env,
-        "summary": rows,
-        "runs": [asdict(r) for r in runs],
     }
-    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    write_report(args.json, "mopso_vs_pymoo", setup, args.seeds, command, env,
+                 {"summary": rows}, runs)
 
 
 if __name__ == "__main__":

@@ -58,20 +58,33 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
-import shlex
-import statistics
-import sys
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
-from importlib.metadata import version
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from common import (
+    add_time_ratio,
+    case_cells,
+    case_columns,
+    command_line,
+    environment,
+    footer,
+    groups,
+    median_of,
+    objective_list,
+    objective_seconds,
+    parse_case,
+    parse_case_args,
+    run_cases,
+    spread,
+    table_head,
+    table_row,
+    write_report,
+)
 
 from tcbench.optimisers import create
 from tcbench.tasks.functions import rastrigin, sphere
@@ -85,7 +98,6 @@ FUNCTIONS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "rastrigin": rastrigin,
     "sphere": sphere,
 }
-DEFAULT_CASES = ("rastrigin-10", "rastrigin-30", "sphere-10", "sphere-30")
 DEFAULT_JSON = Path(__file__).with_name("pso_vs_pyswarms.json")
 METHODS = {"tcbench": "tcbench `pso`", "pyswarms": "pyswarms `GlobalBestPSO`"}
 _LOG_CFG = Path(tempfile.gettempdir()) / "tcbench_pyswarms_logging.yaml"
@@ -121,15 +133,8 @@ class Counted:
         return self.fn(x)
 
 
-def parse_case(case: str) -> tuple[str, int]:
-    name, dim = case.rsplit("-", 1)
-    if name not in FUNCTIONS:
-        raise ValueError(f"unknown function {name!r}; known: {', '.join(FUNCTIONS)}")
-    return name, int(dim)
-
-
 def run_tcbench(case: str, seed: int) -> RunResult:
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     f = Counted(FUNCTIONS[name])
     params = {"population": PARTICLES, "w": W, "c1": C1, "c2": C2, "constriction": False,
               "v_max_fraction": V_MAX_FRACTION}
@@ -146,7 +151,7 @@ def run_tcbench(case: str, seed: int) -> RunResult:
 def run_pyswarms(case: str, seed: int) -> RunResult:
     from pyswarms.single import GlobalBestPSO
 
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     f = Counted(FUNCTIONS[name])
     v_max = V_MAX_FRACTION * (UPPER - LOWER)
     np.random.seed(seed)  # pyswarms uses numpy's global generator
@@ -163,127 +168,66 @@ def run_pyswarms(case: str, seed: int) -> RunResult:
 
 def objective_alone(case: str, repeats: int = 5) -> float:
     """Best-of-``repeats`` time of ``ITERATIONS`` calls of the objective on one (40, d) batch."""
-    name, dim = parse_case(case)
+    name, dim = parse_case(case, FUNCTIONS)
     fn = FUNCTIONS[name]
     x = np.random.default_rng(0).uniform(LOWER, UPPER, size=(PARTICLES, dim))
-    best = np.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for _ in range(ITERATIONS):
-            fn(x)
-        best = min(best, time.perf_counter() - t0)
-    return best
+    return objective_seconds(fn, x, ITERATIONS, repeats)
 
 
 def summarise(runs: list[RunResult], objective_s: dict[str, float]) -> list[dict]:
     rows = []
-    for case in dict.fromkeys(r.case for r in runs):
-        for method in METHODS:
-            mine = [r for r in runs if r.case == case and r.method == method]
-            seconds = statistics.median(r.seconds for r in mine)
-            rows.append({
-                "case": case, "method": method,
-                "median_seconds": seconds,
-                "median_best": statistics.median(r.best for r in mine),
-                "min_best": min(r.best for r in mine),
-                "max_best": max(r.best for r in mine),
-                "evaluations": statistics.median(r.evaluations for r in mine),
-                "overhead_us_per_iteration": 1e6 * (seconds - objective_s[case]) / ITERATIONS,
-            })
-    tc = {row["case"]: row["median_seconds"] for row in rows if row["method"] == "tcbench"}
-    for row in rows:
-        row["time_ratio_vs_tcbench"] = row["median_seconds"] / tc[row["case"]]
-    return rows
-
-
-def environment() -> dict[str, str | int | None]:
-    return {
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pyswarms": version("pyswarms"),
-        "tcbench": version("tcbench"),
-        "platform": platform.platform(),
-        "cpus": os.cpu_count(),
-    }
+    for case, method, mine in groups(runs, "case", METHODS):
+        seconds = median_of(mine, "seconds")
+        rows.append({
+            "case": case, "method": method,
+            "median_seconds": seconds,
+            **spread([r.best for r in mine], "best"),
+            "evaluations": median_of(mine, "evaluations"),
+            "overhead_us_per_iteration": 1e6 * (seconds - objective_s[case]) / ITERATIONS,
+        })
+    return add_time_ratio(rows)
 
 
 def markdown(rows: list[dict], objective_s: dict[str, float], env: dict, command: str,
              seeds: int) -> str:
-    lines = [
-        "| problem | library | median wall time (s) | time / tcbench | median final best "
-        "| best .. worst seed | evaluations | overhead µs / iteration |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
-    ]
+    lines = table_head([*case_columns("library"), "overhead µs / iteration"], "llrrrrrr")
     for r in rows:
-        lines.append(
-            f"| {r['case']} | {METHODS[r['method']]} | {r['median_seconds']:.3f} "
-            f"| {r['time_ratio_vs_tcbench']:.1f}x | {r['median_best']:.4g} "
-            f"| {r['min_best']:.3g} .. {r['max_best']:.3g} | {r['evaluations']:.0f} "
-            f"| {r['overhead_us_per_iteration']:.0f} |"
-        )
-    obj = ", ".join(f"{c} {1e3 * s:.1f} ms" for c, s in objective_s.items())
+        lines.append(table_row([*case_cells(r, METHODS), f"{r['overhead_us_per_iteration']:.0f}"]))
+    obj = objective_list(objective_s)
     lines += [
         "",
         f"Objective alone ({ITERATIONS} calls on {PARTICLES} points): {obj}. Overhead = "
         f"(wall time - objective time) / {ITERATIONS} iterations. Seeds: {seeds}; "
         f"{PARTICLES} particles x {ITERATIONS} iterations = {PARTICLES * ITERATIONS} evaluations.",
-        "",
-        f"Python {env['python']}, numpy {env['numpy']}, pyswarms {env['pyswarms']}, "
-        f"tcbench {env['tcbench']}; {env['platform']}, {env['cpus']} CPUs.",
-        "",
-        f"Command: `{command}`",
+        *footer(env, f"pyswarms {env['pyswarms']}", command),
     ]
     return "\n".join(lines)
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
-    parser.add_argument("--seeds", type=int, default=5, help="number of seeds (>= 5), 0..N-1")
-    parser.add_argument("--cases", nargs="+", default=list(DEFAULT_CASES),
-                        help="function-dimension pairs, e.g. rastrigin-10 sphere-30")
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON, help="where to write results")
-    args = parser.parse_args(argv)
-    if args.seeds < 5:
-        parser.error("--seeds must be >= 5")
-    for case in args.cases:
-        try:
-            parse_case(case)
-        except ValueError as err:
-            parser.error(str(err))
-    return args
+    return parse_case_args(__doc__, DEFAULT_JSON, FUNCTIONS, argv)
 
 
 def main(argv: list[str] | None = None) -> None:
     args = parse_args(argv)
     quiet_pyswarms()
-    command = shlex.join(["python", *sys.argv]) if argv is None else shlex.join(argv)
-    runs: list[RunResult] = []
-    for case in args.cases:
-        for seed in range(args.seeds):
-            pair = [run_tcbench(case, seed), run_pyswarms(case, seed)]
-            runs += pair
-            print(f"{case} seed {seed}: " + " | ".join(
-                f"{r.method} {r.seconds:.3f}s f={r.best:.4g} ({r.evaluations} ev)" for r in pair
-            ), file=sys.stderr, flush=True)
+    command = command_line(argv)
+    runs = run_cases(args.cases, args.seeds, lambda case, seed: [
+        run_tcbench(case, seed), run_pyswarms(case, seed),
+    ])
     objective_s = {case: objective_alone(case) for case in args.cases}
     rows = summarise(runs, objective_s)
-    env = environment()
+    env = environment("pyswarms")
     print(markdown(rows, objective_s, env, command, args.seeds))
-    report = {
-        "benchmark": "pso_vs_pyswarms",
+    setup = {
         "domain": [LOWER, UPPER],
         "particles": PARTICLES,
         "iterations": ITERATIONS,
         "setting": {"w": W, "c1": C1, "c2": C2, "v_max_fraction": V_MAX_FRACTION,
                     "pyswarms_bh_strategy": "nearest"},
-        "seeds": list(range(args.seeds)),
-        "command": command,
-        "environment": env,
-        "objective_seconds": objective_s,
-        "summary": rows,
-        "runs": [asdict(r) for r in runs],
     }
-    args.json.write_text(json.dumps(report, indent=2) + "\n")
+    write_report(args.json, "pso_vs_pyswarms", setup, args.seeds, command, env,
+                 {"objective_seconds": objective_s, "summary": rows}, runs)
 
 
 if __name__ == "__main__":

@@ -55,22 +55,29 @@ import argparse
 import json
 import math
 import os
-import platform
 import re
 import resource
-import shlex
 import subprocess
 import sys
 import time
-import tracemalloc
 from collections.abc import Callable
 from dataclasses import dataclass
-from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
 import allantools
 import numpy as np
+from common import (
+    add_json,
+    command_line,
+    parser_for,
+    peak_mib,
+    print_heading,
+    table_head,
+    table_row,
+    versions,
+    write_json,
+)
 
 from tcbench.sensors import noise
 from tcbench.sensors.devices import unit
@@ -313,13 +320,7 @@ def measure_time(task: Task, cfg: Config, repeats: int) -> dict[str, Any]:
 def measure_trace(task: Task, cfg: Config) -> dict[str, Any]:
     """tracemalloc peak of one call (setup not traced), MiB."""
     state = task.setup(cfg) if task.setup else None
-    tracemalloc.start()
-    tracemalloc.reset_peak()
-    out = task.run(cfg, state)
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    del out
-    return {"tracemalloc_peak_mib": peak / 2**20}
+    return {"tracemalloc_peak_mib": peak_mib(lambda: task.run(cfg, state))}
 
 
 # --- parent side ----------------------------------------------------------------------------
@@ -344,32 +345,33 @@ def fmt(x: float | None, spec: str) -> str:
 
 
 def report(rows: dict[str, dict[str, Any]], cfg: Config, args: argparse.Namespace,
-           versions: dict[str, str], load: tuple[float, float]) -> None:
+           libraries: dict[str, str], load: tuple[float, float]) -> None:
     """Print the markdown report."""
-    command = "python " + " ".join(shlex.quote(a) for a in [sys.argv[0], *sys.argv[1:]])
     hours = f"{args.hours:g} h at {args.rate_hz:g} Hz"
-    print(f"## Simulating a {hours} gyro recording ({cfg.n} samples)\n")
-    print(f"Command: `{command}`\n")
-    print(f"Machine: {platform.system()} {platform.machine()}, {os.cpu_count()} cores; "
-          + ", ".join(f"{k} {v}" for k, v in versions.items()) + "\n")
+    print_heading(f"Simulating a {hours} gyro recording ({cfg.n} samples)", command_line(),
+                  libraries)
     print(f"1-min load average at start / end: {load[0]:.1f} / {load[1]:.1f} (other jobs on the "
           "machine inflate wall times; best-of-N only partly hides that).\n")
     print(f"Each row in a fresh child process; best of {args.repeats} calls and the first call; "
           "peak RSS from ru_maxrss (total, and above the child's RSS after imports); tracemalloc "
           "peak of one call in a separate child.\n")
-    print("| thing measured | samples | best wall time (s) | first call (s) | peak RSS (MiB) "
-          "| peak RSS above baseline (MiB) | tracemalloc peak (MiB) | < 10 s | < 2 GiB |")
-    print("|---|---:|---:|---:|---:|---:|---:|---|---|")
+    print("\n".join(table_head(
+        ["thing measured", "samples", "best wall time (s)", "first call (s)", "peak RSS (MiB)",
+         "peak RSS above baseline (MiB)", "tracemalloc peak (MiB)", "< 10 s", "< 2 GiB"],
+        "lrrrrrrll",
+    )))
     for name, r in rows.items():
         task = TASKS[name]
         if task.group == "peer":
             continue
         goal = task.group == "goal"
-        print(f"| {task.label} | {r['samples']} | {r['best_s']:.3f} | {r['first_s']:.3f} "
-              f"| {fmt(r['peak_rss_mib'], '.0f') if goal else '-'} "
-              f"| {fmt(r['peak_above_baseline_mib'], '.0f')} | {r['tracemalloc_peak_mib']:.0f} "
-              f"| {verdict(r['best_s'] < TIME_LIMIT_S) if goal else ''} "
-              f"| {verdict(r['peak_rss_mib'] < MEMORY_LIMIT_MIB) if goal else ''} |")
+        print(table_row([
+            task.label, r["samples"], f"{r['best_s']:.3f}", f"{r['first_s']:.3f}",
+            fmt(r["peak_rss_mib"], ".0f") if goal else "-",
+            fmt(r["peak_above_baseline_mib"], ".0f"), f"{r['tracemalloc_peak_mib']:.0f}",
+            verdict(r["best_s"] < TIME_LIMIT_S) if goal else "",
+            verdict(r["peak_rss_mib"] < MEMORY_LIMIT_MIB) if goal else "",
+        ]))
     full, model, rec = rows["full"], rows["model"], rows["recording"]
     print(f"\nGoal figure: the first row. Targets judged on the best time and on the *total* "
           f"peak RSS of the child (interpreter and imports included, "
@@ -384,11 +386,14 @@ def report(rows: dict[str, dict[str, Any]], cfg: Config, args: argparse.Namespac
 
     print("Noise generators, like for like (same length, sample rate and gyro 0's amplitudes); "
           "ratio = allantools time / tcbench time for the same kind of noise.\n")
-    print("| library | generator | samples | best wall time (s) | ns / sample "
-          "| ratio allantools/tcbench | peak RSS above baseline (MiB) | tracemalloc peak (MiB) "
-          f"| Allan slope {cfg.check_taus_s[0]:g}-{cfg.check_taus_s[1]:g} s (expected) "
-          f"| adev / expected at {cfg.check_taus_s[0]:g} s, {cfg.check_taus_s[1]:g} s |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---|")
+    tau1, tau2 = cfg.check_taus_s
+    print("\n".join(table_head(
+        ["library", "generator", "samples", "best wall time (s)", "ns / sample",
+         "ratio allantools/tcbench", "peak RSS above baseline (MiB)", "tracemalloc peak (MiB)",
+         f"Allan slope {tau1:g}-{tau2:g} s (expected)",
+         f"adev / expected at {tau1:g} s, {tau2:g} s"],
+        "llrrrrrrrl",
+    )))
     for name, r in rows.items():
         task = TASKS[name]
         if task.group != "peer":
@@ -396,11 +401,13 @@ def report(rows: dict[str, dict[str, Any]], cfg: Config, args: argparse.Namespac
         ref = PEER_PAIRS.get(name)
         ratio = f"{r['best_s'] / rows[ref]['best_s']:.2f}x" if ref else "-"
         a = r["allan"]
-        print(f"| {task.library} | {task.label} | {r['samples']} | {r['best_s']:.3f} "
-              f"| {1e9 * r['best_s'] / r['samples']:.1f} | {ratio} "
-              f"| {r['peak_above_baseline_mib']:.0f} | {r['tracemalloc_peak_mib']:.0f} "
-              f"| {a['slope']:+.2f} ({EXPECTED_SLOPE[task.kind]:+.1f}) "
-              f"| {a['ratio_tau1']:.2f}, {a['ratio_tau2']:.2f} |")
+        print(table_row([
+            task.library, task.label, r["samples"], f"{r['best_s']:.3f}",
+            f"{1e9 * r['best_s'] / r['samples']:.1f}", ratio,
+            f"{r['peak_above_baseline_mib']:.0f}", f"{r['tracemalloc_peak_mib']:.0f}",
+            f"{a['slope']:+.2f} ({EXPECTED_SLOPE[task.kind]:+.1f})",
+            f"{a['ratio_tau1']:.2f}, {a['ratio_tau2']:.2f}",
+        ]))
     print(f"\nThe goal figure is the full simulation above; the generator rows are the peer "
           f"comparison (no peer library simulates a gyro recording). Kasdin power-of-two row: "
           f"nr = {next_pow2(cfg.n)}, first {cfg.n} samples kept. Expected adev: N / sqrt(tau) "
@@ -410,11 +417,11 @@ def report(rows: dict[str, dict[str, Any]], cfg: Config, args: argparse.Namespac
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = parser_for(__doc__)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--hours", type=float, default=24.0)
     parser.add_argument("--rate-hz", type=float, default=100.0)
-    parser.add_argument("--json", type=Path, default=DEFAULT_JSON)
+    add_json(parser, DEFAULT_JSON, help_text=None)
     parser.add_argument("--child", choices=sorted(TASKS), help=argparse.SUPPRESS)
     parser.add_argument("--mode", choices=("time", "trace"), default="time", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -433,15 +440,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f"measuring {name} ...", file=sys.stderr, flush=True)
         rows[name] = {**in_child(name, "time", args), **in_child(name, "trace", args),
                       "samples": cfg.n}
-    versions = {name: version(dist) for name, dist in (
-        ("numpy", "numpy"), ("scipy", "scipy"), ("pandas", "pandas"), ("allantools", "allantools"),
-        ("tcbench", "tcbench"))}
-    versions = {"python": platform.python_version(), **versions}
+    libraries = versions("numpy", "scipy", "pandas", "allantools", "tcbench")
     load = (load_start, os.getloadavg()[0])
-    report(rows, cfg, args, versions, load)
-    args.json.write_text(json.dumps(
+    report(rows, cfg, args, libraries, load)
+    write_json(
+        args.json,
         {"hours": args.hours, "rate_hz": args.rate_hz, "samples": cfg.n, "repeats": args.repeats,
-         "versions": versions, "load_average_1min": load, "rows": rows}, indent=2))
+         "versions": libraries, "load_average_1min": load, "rows": rows},
+        final_newline=False,
+    )
     return 0
 
 
