@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import gymnasium as gym
-
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
 from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
 from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
 from tcbench.tasks.multiobjective import PROBLEMS
+from tcbench.tasks.registration import register_tasks
 
 ENV_VERSION = "v0"
 
@@ -19,15 +18,7 @@ def env_id(function_key: str) -> str:
 
 def register_envs() -> None:
     """Register every function task with gymnasium (idempotent)."""
-    for key in FUNCTIONS:
-        eid = env_id(key)
-        if eid not in gym.registry:
-            gym.register(
-                id=eid,
-                entry_point="tcbench.tasks.function_env:FunctionEnv",
-                kwargs={"function": key},
-                disable_env_checker=True,
-            )
+    register_tasks(FUNCTIONS, env_id, "tcbench.tasks.function_env:FunctionEnv")
 
 
 def is_multiobjective(name: str) -> bool:

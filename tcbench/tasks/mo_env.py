@@ -29,6 +29,7 @@ from tcbench.metrics.multiobjective import hypervolume
 from tcbench.optimisers.pareto import merge_front
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.multiobjective import PROBLEMS, MultiObjectiveProblem, get_problem
+from tcbench.tasks.registration import register_tasks
 
 MO_ENV_VERSION = "v0"
 
@@ -168,15 +169,4 @@ def mo_env_id(problem_key: str) -> str:
 
 def register_mo_envs() -> None:
     """Register every multi-objective task with gymnasium (idempotent)."""
-    for key in PROBLEMS:
-        eid = mo_env_id(key)
-        if eid not in gym.registry:
-            gym.register(
-                id=eid,
-                entry_point="tcbench.tasks.mo_env:MultiObjectiveEnv",
-                kwargs={"function": key},
-                disable_env_checker=True,
-            )
-
-
-__all__ = ["MO_ENV_VERSION", "MultiObjectiveEnv", "mo_env_id", "register_mo_envs"]
+    register_tasks(PROBLEMS, mo_env_id, "tcbench.tasks.mo_env:MultiObjectiveEnv")
