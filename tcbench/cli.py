@@ -71,10 +71,14 @@ def _run_sweep(args: list[str]) -> Plan | None:
 def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | None = None) -> int:
     """Print how many runs of a sweep finished and failed; 1 if any failed or, when
     ``expected`` is given, if fewer runs than jobs were recorded."""
+    import pandas as pd
+
     from tcbench import leaderboard, tracking
+    from tcbench.compensation import leaderboard as comp_board
 
     client = tracking.client(uri)
-    runs = leaderboard.load_runs(client, [experiment], sweep)
+    kinds = [leaderboard.load_runs(client, [experiment], sweep), comp_board.load_runs(client, [experiment], sweep)]
+    runs = pd.concat([k for k in kinds if not k.empty], ignore_index=True) if any(not k.empty for k in kinds) else kinds[0]
     failed = runs[runs["status"] != "FINISHED"] if len(runs) else runs
     print(
         f"tcbench: {len(runs)} run{'s' if len(runs) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
@@ -107,22 +111,29 @@ def cmd_leaderboard(argv: list[str]) -> int:
     ap.add_argument("--ecdf", action="store_true", help="also write COCO-style ECDF plots per dimension")
     ns = ap.parse_args(argv)
     from tcbench import leaderboard, tracking
+    from tcbench.compensation import leaderboard as comp_board
 
     experiments = ns.experiment or ["tcbench"]
     client = tracking.client(ns.tracking_uri)
     try:
         runs = leaderboard.load_runs(client, experiments, ns.sweep)
+        comp = comp_board.load_runs(client, experiments, ns.sweep)
     except LookupError as exc:
         raise UserError(f"{exc} in {tracking.tracking_uri(ns.tracking_uri)}") from None
-    if runs.empty:
+    if runs.empty and comp.empty:
         raise UserError(f"no tcbench runs in experiment {', '.join(experiments)}")
     source = f"MLflow experiment {', '.join(experiments)}" + (f", sweep {ns.sweep}" if ns.sweep else "")
-    for board in leaderboard.boards(runs):
+    for board in leaderboard.boards(runs) if not runs.empty else []:
         paths = leaderboard.write(board, Path(ns.out), client, source)
         print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
         print(leaderboard.markdown_table(board.table))
         print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-    if ns.ecdf:
+    for cboard in comp_board.boards(comp) if not comp.empty else []:
+        paths = comp_board.write(cboard, Path(ns.out), source)
+        print(f"\n## {cboard.task}  (compensation)\n")
+        print(leaderboard.markdown_table(cboard.table))
+        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
+    if ns.ecdf and not runs.empty:
         from tcbench.ecdf import write_ecdf_plots
 
         written = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), Path(ns.out))
@@ -169,7 +180,19 @@ def cmd_list(argv: list[str]) -> int:
         print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package}; {kinds}-objective)")
     for name, err in registry.broken().items():
         print(f"  {name:10s} BROKEN: {err}")
-    print("learners:\n  none yet (the learner track is not built)")
+    from tcbench.learners import registry as learners
+    from tcbench.tasks import MSRA_ENV_IDS
+
+    print("tasks (compensation):")
+    for key, eid in MSRA_ENV_IDS.items():
+        print(f"  {eid:26s} task={key:14s} MSRA {'four-position runs -40..60 °C' if 'full' in key else 'zero-bias runs at room temperature'}")
+    print("learners:")
+    for name, lentry in learners.available().items():
+        kind = "initial weights searchable" if lentry.cls.searchable else "closed form"
+        print(f"  {name:10s} {lentry.cls.__module__}.{lentry.cls.__name__}  (from {lentry.package}; {kind})")
+    for name, err in learners.broken().items():
+        print(f"  {name:10s} BROKEN: {err}")
+    print("  raw, oracle  baselines: no compensation; the simulator's truth (physical limit)")
     return 0
 
 

@@ -1,13 +1,15 @@
 """Structured config of a tcbench job and its validation.
 
 The dataclasses are registered with Hydra's ConfigStore as ``base_config`` so OmegaConf checks
-types at composition; :func:`validate` then checks ranges and names (task function, dimension,
-optimiser name and parameters, budget against one generation) and raises :class:`ConfigError`
-with one line that names the offending key.
+types at composition; :func:`validate` then checks the task's keys against its schema
+(:class:`TaskConfig` for function tasks, :class:`MSRATaskConfig` for compensation tasks), ranges
+and names (task, dimension, optimiser and learner names and parameters, budget against one
+generation) and raises :class:`ConfigError` with one line that names the offending key.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -16,8 +18,8 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
-from tcbench.optimisers.protocol import make_params
-from tcbench.tasks import task_class
+from tcbench.optimisers.protocol import _coerce, make_params
+from tcbench.tasks import is_compensation, task_class
 
 
 class ConfigError(ValueError):
@@ -37,6 +39,22 @@ class TaskConfig:
 
 
 @dataclass
+class MSRATaskConfig:
+    """An MSRA compensation task (see :class:`tcbench.tasks.MSRACompensationEnv`)."""
+
+    name: str = MISSING
+    device_seed: int = 0
+    recordings_seed: int | None = 0
+    n_train: int | None = None
+    n_test: int | None = None
+    train_files: list | None = None
+    test_files: list | None = None
+    train_on: str = "positions"
+    rate_window_s: float = 120.0
+    bias_form: str = "plus"
+
+
+@dataclass
 class TrackingConfig:
     """Where and how runs are recorded in MLflow."""
 
@@ -52,8 +70,9 @@ class TrackingConfig:
 class JobConfig:
     """One optimisation job: task, optimiser, seed and evaluation budget."""
 
-    task: TaskConfig = field(default_factory=TaskConfig)
+    task: dict[str, Any] = field(default_factory=lambda: {"name": MISSING})
     optimiser: dict[str, Any] = field(default_factory=lambda: {"name": MISSING})
+    learner: dict[str, Any] | None = None
     seed: int = 0
     budget: int = 1000
     progress: bool = False
@@ -72,6 +91,22 @@ def as_dict(cfg: DictConfig | dict[str, Any]) -> dict[str, Any]:
     return dict(cfg)
 
 
+def checked_task(task: dict[str, Any], schema: type) -> dict[str, Any]:
+    """The task config with every key known to ``schema`` and values of its types."""
+    fields = {f.name: f for f in dataclasses.fields(schema)}
+    unknown = sorted(set(task) - set(fields))
+    if unknown:
+        raise ConfigError(f"task.{unknown[0]}: no such key for task {task.get('name')}; "
+                          f"known: {', '.join(sorted(fields))}")
+    out = {}
+    for key, value in task.items():
+        try:
+            out[key] = _coerce("task", key, fields[key].type, value)
+        except ValueError as exc:
+            raise ConfigError(str(exc)) from None
+    return out
+
+
 def validate(cfg: DictConfig | dict[str, Any]) -> None:
     """Check ranges and names of a composed job config; raise :class:`ConfigError` if wrong."""
     c = as_dict(cfg)
@@ -79,7 +114,15 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(f"seed must be >= 0, got {c['seed']}")
     if c["budget"] < 1:
         raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
-    task = {k: v for k, v in c["task"].items() if k != "name"}
+    if is_compensation(str(c["task"].get("name"))):
+        from tcbench.compensation.validate import validate_compensation
+
+        validate_compensation(c, checked_task(c["task"], MSRATaskConfig))
+        return
+    if c.get("learner"):
+        raise ConfigError(f"learner={c['learner'].get('name')}: learners apply to compensation tasks "
+                          f"(msra_fulltemp, msra_zerobias), not to task {c['task'].get('name')}")
+    task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
     try:
         env = task_class(c["task"]["name"])(function=c["task"]["name"], budget=c["budget"], **task)
     except (KeyError, ValueError) as exc:

@@ -15,6 +15,7 @@ import yaml
 from tcbench import plots
 from tcbench.config import as_dict, validate
 from tcbench.runner import RunResult, run_optimisation
+from tcbench.tasks import is_compensation
 
 log = logging.getLogger(__name__)
 
@@ -67,6 +68,10 @@ def result_metrics(result: RunResult) -> dict[str, float]:
 def run_job(cfg: Any) -> RunResult | None:
     """Run one configured job. Tracked jobs that raise are recorded FAILED and return None."""
     c = as_dict(cfg)
+    if is_compensation(str(c["task"].get("name"))):
+        from tcbench.compensation_job import run_compensation_job
+
+        return run_compensation_job(c)  # type: ignore[return-value]
     optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
     if not c["tracking"]["enabled"]:
         validate(c)

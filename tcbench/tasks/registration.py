@@ -7,10 +7,12 @@ from collections.abc import Callable, Iterable
 import gymnasium as gym
 
 
-def register_tasks(keys: Iterable[str], env_id: Callable[[str], str], entry_point: str) -> None:
-    """Register ``entry_point`` once per task key as ``env_id(key)`` (idempotent)."""
+def register_tasks(keys: Iterable[str], env_id: Callable[[str], str], entry_point: str,
+                   key_arg: str = "function") -> None:
+    """Register ``entry_point`` once per task key as ``env_id(key)``, passing the key as the
+    keyword ``key_arg`` (idempotent)."""
     for key in keys:
         eid = env_id(key)
         if eid not in gym.registry:
-            gym.register(id=eid, entry_point=entry_point, kwargs={"function": key},
+            gym.register(id=eid, entry_point=entry_point, kwargs={key_arg: key},
                          disable_env_checker=True)

@@ -1,0 +1,1 @@
+"""Temperature compensation: data of the MSRA tasks, baselines, the physical limit, scoring."""

@@ -1,0 +1,56 @@
+"""Compensation methods on an MSRA task: a learner, no compensation (raw), and the oracle.
+
+Each method is a *compensator*: a function of a test recording and an output array (the
+recorded one, or a probe of it) returning the compensated output (g for fulltemp, Hz for
+roomtemp), so the scorer can also ask how a method answers at accelerations it never saw.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from tcbench.compensation.data import MSRAData, TaskDataError, TaskRecording
+from tcbench.compensation.oracle import oracle_bias, oracle_inverse
+from tcbench.learners.base import FitHistory, Learner
+
+BASELINES = ("raw", "oracle")
+Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
+
+
+def train(data: MSRAData, learner: Learner, init: np.ndarray | None = None) -> FitHistory:
+    """Fit ``learner`` on the task's training set from ``init`` (None: its own random start)."""
+    x, y = data.training_set(learner.sequential)
+    return learner.fit(x, y, init=init)
+
+
+def training_rmse_ug(data: MSRAData, learner: Learner) -> float:
+    """RMSE of the trained learner on its training set, in micro-g."""
+    x, y = data.training_set(learner.sequential)
+    rmse = float(np.sqrt(np.mean((learner.predict(x) - y) ** 2)))
+    per_g = 1.0 if data.form == "inverse" else data.scale_factor_hz_per_g
+    return rmse / per_g * 1e6
+
+
+def learner_compensator(data: MSRAData, learner: Learner) -> Compensator:
+    """A trained learner's compensation of a test recording."""
+    def compensate(tr: TaskRecording, output: np.ndarray) -> np.ndarray:
+        x, _ = data.features(tr.recording, output)
+        return data.compensate(output, learner.predict(x))
+
+    return compensate
+
+
+def raw_compensator(data: MSRAData) -> Compensator:
+    """No compensation: the output itself (Hz)."""
+    return lambda tr, output: np.asarray(output, dtype=np.float64)
+
+
+def oracle_compensator(data: MSRAData) -> Compensator:
+    """The physical limit: the simulator's deterministic model inverted at the true die
+    temperature, so what is left is noise alone (simulated recordings only)."""
+    if any(tr.truth is None for tr in data.test):
+        raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
+    fn = oracle_inverse if data.form == "inverse" else oracle_bias
+    return lambda tr, output: fn(output, tr.truth)  # type: ignore[arg-type]

@@ -1,0 +1,154 @@
+"""The paper's metrics before and after compensation, per test recording (seed 000 Tables 1-2).
+
+Conventions (stated in every report):
+
+- fulltemp (Table 2): four-position scale factor ``K1 = (U(+1g) - U(-1g))/2`` and bias
+  ``B0 = (U(+0g) + U(-0g))/(U(+1g) - U(-1g)) g`` per node (eq. 12 with the plus sign by
+  default; ``bias_form=printed`` gives the printed minus); variation = ``std/mean`` of K1 in ppm
+  and ``std`` of B0 in micro-g over the nodes (ddof=1). Before: on the raw output U (Hz);
+  after: on the compensated acceleration (g), so K1 is in g/g.
+- fulltemp probe (not in the paper): ``halfg_error_ug``, the RMS error in micro-g of the
+  compensated output when the 0 g samples are moved to +-0.5 g (the output shifted by +-0.5 K1
+  of their node, K1 measured on the raw output), i.e. at accelerations no training sample had.
+  A method that learned the three trained levels rather than the sensor (flat steps that swallow
+  the noise around -1, 0 and +1 g) can even beat the oracle on Table 2 and fails here.
+- roomtemp (Table 1): zero-bias stability = 1 sigma (ddof=1) of non-overlapping 10 s means of
+  output / scale factor, from 30 min, 20 min and 0 min after power-on, in micro-g.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from tcbench.compensation.data import MSRAData, TaskRecording
+from tcbench.compensation.methods import Compensator
+from tcbench.metrics import accelerometer as acc
+
+FULLTEMP_METRICS = ("sf_variation_ppm", "bias_variation_ug", "halfg_error_ug")
+PROBE_G = 0.5
+ROOMTEMP_METRICS = ("zb_after_30min_ug", "zb_after_20min_ug", "zb_zero_start_ug")
+PRIMARY = {"fulltemp": "bias_variation_ug", "roomtemp": "zb_zero_start_ug"}
+CONVENTIONS = {
+    "fulltemp": [
+        "scale factor K1 = (U(+1g) - U(-1g))/2; bias B0 = (U(+0g) + U(-0g))/(U(+1g) - U(-1g)) g "
+        "(eq. 12 with the plus sign unless bias_form=printed)",
+        "variation over the nodes: std/mean of K1 (ppm), std of B0 (micro-g), sample std (ddof=1); "
+        "before = raw output U (Hz), after = compensated acceleration (g)",
+    ],
+    "roomtemp": [
+        "zero-bias stability: 1 sigma (ddof=1) of non-overlapping 10 s means of output / scale factor "
+        "from 30 min, 20 min and 0 min after power-on (micro-g)",
+    ],
+}
+
+
+@dataclass
+class RecordingScore:
+    """Metrics of one test recording before and after, and what the plots need."""
+
+    name: str
+    before: dict[str, float]
+    after: dict[str, float]
+    nodes_before: pd.DataFrame | None = None
+    nodes_after: pd.DataFrame | None = None
+    t_s: np.ndarray | None = None
+    before_ug: np.ndarray | None = None
+    after_ug: np.ndarray | None = None
+
+
+@dataclass
+class Score:
+    """Outcome of one compensation method on the test recordings."""
+
+    protocol: str
+    recordings: list[RecordingScore]
+    train_rmse_ug: float = float("nan")
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def metric_names(self) -> tuple[str, ...]:
+        return FULLTEMP_METRICS if self.protocol == "fulltemp" else ROOMTEMP_METRICS
+
+    def summary(self) -> dict[str, float]:
+        """Flat metrics: per recording (``test1.*``), means over recordings (``*`` after,
+        ``raw_*`` before) and improvement factors (``gain_*`` = before / after)."""
+        out: dict[str, float] = {}
+        names = [k for k in self.metric_names if all(k in r.after for r in self.recordings)]
+        for i, r in enumerate(self.recordings, start=1):
+            for k in names:
+                out[f"test{i}.{k}"] = r.after[k]
+                if k in r.before:
+                    out[f"test{i}.raw_{k}"] = r.before[k]
+        for k in names:
+            out[k] = after = float(np.mean([r.after[k] for r in self.recordings]))
+            if all(k in r.before for r in self.recordings):
+                out[f"raw_{k}"] = before = float(np.mean([r.before[k] for r in self.recordings]))
+                out[f"gain_{k}"] = before / after if after > 0 else float("inf")
+        out["train_rmse_ug"] = self.train_rmse_ug
+        return out
+
+
+def _probe_error_ug(rec: TaskRecording, fn: Compensator, nodes: pd.DataFrame, pos: np.ndarray) -> float:
+    """RMS error (micro-g) of the compensated 0 g samples moved to +-0.5 g (see module doc)."""
+    r = rec.recording
+    blocks = acc.position_blocks(pos)
+    node = np.repeat(np.arange(len(blocks)) // 4, (blocks["stop"] - blocks["start"]).to_numpy())
+    rows = np.concatenate([np.arange(a, b) for a, b in zip(blocks["start"], blocks["stop"], strict=True)])
+    zero = np.isin(pos[rows], ["+0g", "-0g"])
+    rows, node = rows[zero], node[zero]
+    k1 = nodes["scale_factor_hz_per_g"].to_numpy()[node]
+    base = fn(rec, r.output)[rows]
+    errors = []
+    for g in (PROBE_G, -PROBE_G):
+        shifted = r.output.copy()
+        shifted[rows] += g * k1
+        errors.append(fn(rec, shifted)[rows] - base - g)
+    return float(np.sqrt(np.mean(np.concatenate(errors) ** 2)) * 1e6)
+
+
+def _fulltemp(rec: TaskRecording, fn: Compensator, bias_form: str, probe: bool) -> RecordingScore:
+    r = rec.recording
+    pos = np.where(r.position == None, "", r.position).astype(str)  # noqa: E711
+    compensated_g = fn(rec, r.output)
+    nodes_b = acc.four_position(r.temperature_c, r.output, pos, bias_form)
+    nodes_a = acc.four_position(r.temperature_c, compensated_g, pos, bias_form)
+    vb, va = acc.temperature_variation(nodes_b), acc.temperature_variation(nodes_a)
+    after = {"sf_variation_ppm": va.scale_factor_ppm, "bias_variation_ug": va.bias_ug}
+    if probe:
+        after["halfg_error_ug"] = _probe_error_ug(rec, fn, nodes_b, pos)
+    return RecordingScore(
+        rec.name,
+        {"sf_variation_ppm": vb.scale_factor_ppm, "bias_variation_ug": vb.bias_ug},
+        after, nodes_before=nodes_b, nodes_after=nodes_a,
+    )
+
+
+def _zero_bias(values: dict[str, float]) -> dict[str, float]:
+    return {"zb_after_30min_ug": values["after_30min_ug"], "zb_after_20min_ug": values["after_20min_ug"],
+            "zb_zero_start_ug": values["zero_start_ug"]}
+
+
+def _roomtemp(rec: TaskRecording, fn: Compensator, sf: float) -> RecordingScore:
+    r = rec.recording
+    compensated_hz = fn(rec, r.output)
+    before = _zero_bias(acc.zero_bias_table(r.time_s, r.output, sf))
+    after = _zero_bias(acc.zero_bias_table(r.time_s, compensated_hz, sf))
+    return RecordingScore(rec.name, before, after, t_s=r.time_s,
+                          before_ug=r.output / sf * 1e6, after_ug=compensated_hz / sf * 1e6)
+
+
+def score_outputs(data: MSRAData, fn: Compensator, bias_form: str = "plus",
+                  train_rmse_ug: float = float("nan"), probe: bool = True) -> Score:
+    """Metrics before and after for each test recording compensated by ``fn``; ``probe``
+    adds the +-0.5 g probe (fulltemp; not for the raw output, which is not in g)."""
+    recs = []
+    for rec in data.test:
+        if data.protocol == "fulltemp":
+            recs.append(_fulltemp(rec, fn, bias_form, probe))
+        else:
+            recs.append(_roomtemp(rec, fn, data.scale_factor_hz_per_g))
+    return Score(data.protocol, recs, train_rmse_ug)

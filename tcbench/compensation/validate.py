@@ -1,0 +1,76 @@
+"""Checks of a compensation job's config before any job starts (one line per problem)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from tcbench.compensation.data import TaskDataError, file_data
+from tcbench.compensation.methods import BASELINES
+from tcbench.learners import registry as learners
+from tcbench.optimisers import registry as optimisers
+from tcbench.optimisers.protocol import make_params
+
+
+def _error(message: str) -> Exception:
+    from tcbench.config import ConfigError
+
+    return ConfigError(message)
+
+
+def learner_of(c: dict[str, Any]) -> dict[str, Any]:
+    """The job's learner config; BP when none is given."""
+    return dict(c.get("learner") or {"name": "bp"})
+
+
+def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
+    """Learner, optimiser and task of a compensation job; raise ConfigError naming the key."""
+    from tcbench.tasks.msra_env import MSRACompensationEnv
+
+    learner = learner_of(c)
+    name = str(learner.pop("name", None))
+    learner.pop("label", None)
+    if name not in BASELINES:
+        try:
+            cls = learners.get(name)
+        except learners.UnknownLearnerError as exc:
+            raise _error(f"{exc}, {', '.join(BASELINES)}") from None
+        try:
+            make_params(cls, {k: v for k, v in learner.items() if k != "form" or v != "auto"})  # type: ignore[arg-type]
+        except (TypeError, ValueError) as exc:
+            text = str(exc)
+            raise _error(f"learner {text}" if text.startswith(f"{name}") else f"learner {name}: {text}") from None
+    kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
+    try:
+        env = MSRACompensationEnv(task["name"], None if name in BASELINES else name, learner,
+                                  budget=c["budget"], **kwargs)
+    except ValueError as exc:
+        raise _error(f"task {task['name']}: {exc}") from None
+    if kwargs.get("train_files"):
+        try:
+            file_data(env.protocol, list(kwargs["train_files"]), list(kwargs["test_files"]),
+                      env.train_on, env.rate_window_s)
+        except TaskDataError as exc:
+            raise _error(str(exc)) from None
+    opt = dict(c["optimiser"])
+    oname = str(opt.pop("name", None))
+    opt.pop("label", None)
+    if oname == "none" or env.learner is None or not env.learner.searchable:
+        return
+    try:
+        ocls = optimisers.get(oname)
+        params = make_params(ocls, opt)
+    except optimisers.UnknownOptimiserError as exc:
+        raise _error(f"{exc}, none") from None
+    except (TypeError, ValueError) as exc:
+        raise _error(f"optimiser {oname}: {exc}") from None
+    if not ocls.single_objective:
+        raise _error(f"optimiser {oname} is multi-objective only; initial weights have one objective")
+    if c["budget"] < params.population:
+        raise _error(f"budget of {c['budget']} evaluations is smaller than one generation "
+                     f"(optimiser {oname}: population {params.population})")
+    try:
+        ocls(env.lower, env.upper, c["budget"], np.random.default_rng(0), params)
+    except ValueError as exc:
+        raise _error(f"optimiser {oname}: {exc}") from None

@@ -1,0 +1,140 @@
+"""One compensation job: run it, record it in MLflow with the paper's figures."""
+
+from __future__ import annotations
+
+import json
+import logging
+import tempfile
+import traceback
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tcbench.compensation.methods import BASELINES
+from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
+from tcbench.compensation.validate import learner_of
+from tcbench.config import validate
+from tcbench.runner import CompensationResult, run_compensation
+
+log = logging.getLogger(__name__)
+
+
+def compensation_task_key(task: dict[str, Any]) -> str:
+    """Leaderboard key of a compensation task, e.g. ``msra_fulltemp-dev0``."""
+    if task.get("train_files"):
+        return f"{task['name']}-files"
+    key = f"{task['name']}-dev{task.get('device_seed', 0)}"
+    if task.get("recordings_seed", 0) != 0:
+        key += f"-rec{task.get('recordings_seed')}"
+    return key
+
+
+def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any]) -> str:
+    """Leaderboard name: ``raw``, ``oracle``, ``poly3``, ``IFA-BP-gd``, ``random-BP-lm`` ..."""
+    if learner.get("label"):
+        return str(learner["label"])
+    name = str(learner["name"])
+    if name in BASELINES:
+        return name
+    if name == "poly":
+        return f"poly{learner.get('degree', 3)}"
+    opt = str(optimiser.get("label") or optimiser["name"])
+    prefix = "random" if opt == "none" else opt.upper()
+    label = f"{prefix}-{name.upper() if name == 'bp' else name}"
+    return f"{label}-{learner['training']}" if learner.get("training") else label
+
+
+def score_document(score: Score) -> dict[str, Any]:
+    """Per-recording metrics before and after, with the conventions used."""
+    return {
+        "protocol": score.protocol,
+        "conventions": CONVENTIONS[score.protocol],
+        "train_rmse_ug": score.train_rmse_ug,
+        "recordings": [{"name": r.name, "before": r.before, "after": r.after} for r in score.recordings],
+        "summary": score.summary(),
+    }
+
+
+def figures(score: Score, history_loss: list[float] | None, where: Path, title: str) -> list[Path]:
+    """The paper's figures for this run: Fig. 7 (zero bias) or Figs. 8-10 (full temperature)."""
+    from tcbench.compensation import plots as cplots
+
+    paths = []
+    for i, r in enumerate(score.recordings, start=1):
+        if r.nodes_before is not None and r.nodes_after is not None:
+            paths.append(cplots.four_position_before_after(
+                where / f"fig8_test{i}.png", r.nodes_before, r.nodes_after, f"{title}: test {i} ({r.name})"))
+            paths.append(cplots.positions_vs_temperature(
+                where / f"fig9_test{i}.png", r.nodes_before, r.nodes_after, f"{title}: test {i} ({r.name})"))
+        elif r.t_s is not None:
+            paths.append(cplots.zero_bias_before_after(
+                where / f"fig7_test{i}.png", r.t_s, r.before_ug, r.after_ug, f"{title}: test {i} ({r.name})"))
+    if history_loss and len(history_loss) > 1:
+        paths.append(cplots.training_curve(where / "training_curve.png", history_loss, f"{title}: training"))
+    return paths
+
+
+def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
+    """Run one compensation job; tracked jobs that raise are recorded FAILED and return None."""
+    learner = learner_of(c)
+    optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
+    learner_cfg = {k: v for k, v in learner.items() if k != "label"}
+    if not c["tracking"]["enabled"]:
+        validate(c)
+        return run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
+
+    from tcbench import tracking
+    from tcbench.job import sweep_id_from_hydra
+
+    sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
+    tkey, method = compensation_task_key(c["task"]), compensation_label(learner, c["optimiser"])
+    name = f"{method}-{tkey}-s{c['seed']}"
+    if c["tracking"].get("resume"):
+        done = tracking.finished_run(c)
+        if done is not None:
+            log.info("%s already FINISHED in run %s; skipped", name, done)
+            return None
+    tags = {
+        "tcbench.sweep_id": sweep, "tcbench.task": tkey, "tcbench.method": method,
+        "tcbench.seed": str(c["seed"]), "tcbench.task_name": str(c["task"]["name"]),
+        "tcbench.kind": "compensation",
+    }
+    try:
+        with tracking.job_run(c, name, tags) as run:
+            validate(c)
+            result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
+            summary = result.score.summary()
+            primary = PRIMARY[result.score.protocol]
+            run.log_metrics({k: v for k, v in summary.items() if v == v} | {
+                "final_error": summary[primary], "search_evaluations": result.search_evaluations,
+                "init_loss": result.init_loss if result.init_loss == result.init_loss else -1.0,
+                "seconds_search": result.seconds_search, "seconds_train": result.seconds_train,
+            })
+            if result.trace.evaluations:
+                run.log_series("init_best_f", result.trace.best_f, result.trace.evaluations)
+            loss = result.history.loss if result.history else None
+            if loss:
+                run.log_series("train_loss", loss, list(range(len(loss))))
+            with tempfile.TemporaryDirectory() as tmp:
+                where = Path(tmp)
+                (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))
+                (where / "scores.json").write_text(json.dumps(score_document(result.score), indent=2))
+                files = [where / "config.yaml", where / "scores.json"]
+                for i, r in enumerate(result.score.recordings, start=1):
+                    if r.nodes_after is not None:
+                        nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
+                        nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
+                        files.append(where / f"nodes_test{i}.csv")
+                if c["tracking"]["plots"]:
+                    files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}")
+                for f in files:
+                    run.log_artifact(f)
+    except Exception as exc:  # recorded as FAILED by job_run; the sweep goes on
+        log.error("job %s failed: %s: %s", name, type(exc).__name__, exc)
+        log.debug("%s", traceback.format_exc())
+        return None
+    s = result.score.summary()
+    log.info("%s: %s %.4g (raw %.4g), training RMSE %.3g µg", name, primary, s[primary], s[f"raw_{primary}"],
+             s["train_rmse_ug"])
+    return result

@@ -1,0 +1,150 @@
+"""Polynomial temperature model: the compensation flight stacks ship, fitted in closed form.
+
+Two forms, chosen by the task (``form="auto"`` is a placeholder the task must resolve):
+
+- ``inverse``: inputs ``[output, temperature]``, target the applied input (g for the MSRA). The
+  sensor is modelled as ``output = b(T) + K(T) * target`` with a bias ``b`` and a scale factor
+  ``K``, both polynomials of ``degree`` in ``T``; one linear least-squares solve fits both, and
+  the prediction inverts the model, ``target = (output - b(T)) / K(T)``.
+- ``bias``: ``target = b(x0)``, a polynomial of ``degree`` in the first input column (the
+  temperature); any other input column (e.g. the temperature rate) is ignored.
+
+Everything is solved in the normalised [-1, 1] units of :class:`~tcbench.learners.base.Scaler`
+(an affine change of units keeps both model forms), so the temperature is on [-1, 1] over the
+training data and the polynomials are Chebyshev series there, which keeps the solve well
+conditioned up to degree 6.
+
+**Flat parameter vector** (:meth:`PolynomialModel.get_params`), Chebyshev coefficients of
+increasing order in normalised units: ``inverse``: ``b_0..b_d`` then ``K_0..K_d``
+(``2 (d + 1)`` values); ``bias``: ``b_0..b_d`` (``d + 1`` values). It exists only after
+:meth:`PolynomialModel.fit`, which also fixes the normalisation it refers to.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, ClassVar, cast
+
+import numpy as np
+from numpy.polynomial import chebyshev
+
+from tcbench.learners.base import FitHistory, Learner, LearnerParams
+
+FORMS = ("auto", "inverse", "bias")
+MAX_DEGREE = 6
+AUTO_ERROR = "poly: form 'auto' must be resolved by the task; set form=inverse or form=bias"
+
+
+@dataclass(frozen=True)
+class PolynomialParams(LearnerParams):
+    """Polynomial model parameters.
+
+    degree: degree of the temperature polynomials b(T) and K(T), 1..6.
+    form: "inverse" (inputs [output, temperature] -> applied input), "bias" (temperature ->
+        output bias) or "auto" (the task chooses; fitting with "auto" is an error).
+    """
+
+    degree: int = 3
+    form: str = "auto"
+
+    def __post_init__(self) -> None:
+        if isinstance(self.degree, bool) or not isinstance(self.degree, (int, np.integer)) \
+                or not 1 <= self.degree <= MAX_DEGREE:
+            raise ValueError(f"poly: degree must be an integer in 1..{MAX_DEGREE}, got {self.degree!r}")
+        if self.form not in FORMS:
+            raise ValueError(f"poly: form must be one of {', '.join(FORMS)}, got {self.form!r}")
+
+
+class PolynomialModel(Learner):
+    """Bias and scale factor polynomial in temperature, least squares in one solve."""
+
+    name: ClassVar[str] = "poly"
+    Params: ClassVar[type[LearnerParams]] = PolynomialParams
+    searchable: ClassVar[bool] = False
+
+    def __init__(self, n_inputs: int, params: LearnerParams | dict[str, Any] | None = None,
+                 rng: np.random.Generator | None = None) -> None:
+        super().__init__(n_inputs, params, rng)
+        self.settings = cast(PolynomialParams, self.params)
+        if self.settings.form == "inverse" and self.n_inputs != 2:
+            raise ValueError(f"poly: form 'inverse' takes 2 inputs [output, temperature], got {self.n_inputs}")
+        self._coef: np.ndarray | None = None
+        self._form: str | None = None  # the form the coefficients belong to
+
+    # -- the flat parameter vector -------------------------------------------------------
+    def _fitted(self) -> np.ndarray:
+        if self._coef is None:
+            raise RuntimeError("poly: the coefficients exist only after fit() (closed-form solve)")
+        return self._coef
+
+    @property
+    def n_params(self) -> int:
+        return int(self._fitted().size)
+
+    def get_params(self) -> np.ndarray:
+        return self._fitted().copy()
+
+    def set_params(self, params: np.ndarray) -> None:
+        self._fitted()
+        self._coef = self._check_vector(params)
+
+    # -- fit and predict -----------------------------------------------------------------
+    def _form_checked(self) -> str:
+        form = self.settings.form
+        if form == "auto":
+            raise ValueError(AUTO_ERROR)
+        if form == "inverse" and self.n_inputs != 2:
+            raise ValueError(f"poly: form 'inverse' takes 2 inputs [output, temperature], got {self.n_inputs}")
+        return form
+
+    def _basis(self, temp_scaled: np.ndarray) -> np.ndarray:
+        """Chebyshev basis T_0..T_d of the normalised temperature, shape (n, d + 1)."""
+        return chebyshev.chebvander(temp_scaled, self.settings.degree)
+
+    def fit(self, inputs: np.ndarray, targets: np.ndarray, init: np.ndarray | None = None) -> FitHistory:
+        """One least-squares solve in normalised units; ``init`` is ignored (closed form).
+        Raises ``ValueError`` if the data cannot determine the coefficients (e.g. form
+        ``inverse`` with a target that does not vary at the training temperatures)."""
+        start = time.perf_counter()
+        form = self._form_checked()
+        x, y = self._scaled(inputs, targets)
+        assert y is not None
+        if form == "inverse":
+            basis = self._basis(x[:, 1])
+            design = np.hstack([basis, basis * y[:, None]])
+            rhs = x[:, 0]
+        else:
+            design = self._basis(x[:, 0])
+            rhs = y
+        coef, _, rank, _ = np.linalg.lstsq(design, rhs, rcond=None)
+        if rank < design.shape[1]:
+            why = ("the target must vary at each temperature" if form == "inverse"
+                   else "need more distinct temperatures than the degree")
+            raise ValueError(f"poly: form {form!r} of degree {self.settings.degree} is not determined "
+                             f"by the training data ({why})")
+        self._coef, self._form = coef, form
+        loss = float(0.5 * np.mean((self._predict_scaled(x) - y) ** 2))
+        return FitHistory(loss=[loss], iterations=1, stopped="closed_form",
+                          seconds=time.perf_counter() - start)
+
+    def _predict_scaled(self, x: np.ndarray) -> np.ndarray:
+        coef = self._fitted()
+        if self._form == "inverse":
+            basis = self._basis(x[:, 1])
+            half = coef.size // 2
+            return (x[:, 0] - basis @ coef[:half]) / (basis @ coef[half:])
+        return self._basis(x[:, 0]) @ coef
+
+    def predict(self, inputs: np.ndarray) -> np.ndarray:
+        self._fitted()
+        x, _ = self._scaled(inputs)
+        assert self.y_scaler is not None
+        return self.y_scaler.inverse(self._predict_scaled(x))
+
+    def describe(self) -> dict[str, Any]:
+        """Name and parameters, with the fitted form when there is one."""
+        out = super().describe()
+        if self._form is not None:
+            out["fitted_form"] = self._form
+        return out

@@ -1,0 +1,88 @@
+"""Registries fed by entry-point groups: the built-ins and plugin packages are found the same way.
+
+A package declares classes under a group in its ``pyproject.toml``::
+
+    [project.entry-points."tcbench.optimisers"]
+    de = "my_package.de:DifferentialEvolution"
+
+An entry point that fails to load (or names the wrong kind of class) is recorded as broken with
+its error and skipped; the others still work.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, Generic, TypeVar
+
+log = logging.getLogger(__name__)
+T = TypeVar("T")
+
+
+class UnknownPluginError(KeyError):
+    """No class of that name is registered in the group."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+@dataclass(frozen=True)
+class Entry(Generic[T]):
+    """A registered class and the distribution that provides it."""
+
+    cls: type[T]
+    package: str
+
+
+class PluginRegistry(Generic[T]):
+    """Classes of kind ``base`` registered under the entry-point group ``group``."""
+
+    def __init__(self, group: str, base: type[T], kind: str,
+                 unknown_error: type[UnknownPluginError] = UnknownPluginError) -> None:
+        self.group, self.base, self.kind, self.unknown_error = group, base, kind, unknown_error
+        self._entries: dict[str, Entry[T]] | None = None
+        self._broken: dict[str, str] = {}
+
+    def _load(self) -> dict[str, Entry[T]]:
+        if self._entries is None:
+            self._entries = {}
+            for ep in entry_points(group=self.group):
+                package = ep.dist.name if ep.dist is not None else "?"
+                try:
+                    cls = ep.load()
+                    self.check_class(ep.name, cls)
+                except Exception as exc:  # a broken plugin must not take the others down
+                    self._broken[ep.name] = f"{type(exc).__name__}: {exc}"
+                    log.warning("%s plugin %r from %s skipped: %s", self.kind, ep.name, package, exc)
+                    continue
+                self._entries[ep.name] = Entry(cls, package)
+        return self._entries
+
+    def check_class(self, name: str, cls: Any) -> None:
+        """Raise ``TypeError`` unless ``cls`` is a subclass of the registry's base."""
+        if not (isinstance(cls, type) and issubclass(cls, self.base)):
+            raise TypeError(f"{name!r} does not name a {self.base.__module__}.{self.base.__name__} subclass")
+
+    def register(self, name: str, cls: type[T], package: str = "__main__") -> None:
+        """Register ``cls`` under ``name`` for this process (entry points are the lasting way)."""
+        self.check_class(name, cls)
+        self._load()[name] = Entry(cls, package)
+
+    def available(self) -> dict[str, Entry[T]]:
+        """Registered classes by name."""
+        return dict(sorted(self._load().items()))
+
+    def broken(self) -> dict[str, str]:
+        """Entry points that failed to load, with their error."""
+        self._load()
+        return dict(self._broken)
+
+    def get(self, name: str) -> type[T]:
+        """The class registered as ``name``; :class:`UnknownPluginError` naming the known ones."""
+        entries = self._load()
+        if name not in entries:
+            known = ", ".join(sorted(entries)) or "none"
+            hint = f" (plugin failed to load: {self._broken[name]})" if name in self._broken else ""
+            raise self.unknown_error(f"unknown {self.kind} {name!r}{hint}; known: {known}")
+        return entries[name].cls

@@ -1,0 +1,204 @@
+"""MSRA temperature compensation as gymnasium environments (seed 000 §2.3 and §3).
+
+The action is a candidate vector of a learner's initial weights and thresholds (or a batch of
+them, ``(n, d)``); the observation is its training error — seed 000 eq. 3 in normalised units,
+the "brightness" IFA and FA rank fireflies by — and the reward its negation. An optimiser
+searching these steps is steps 1-3 of seed 000 Fig. 5; :meth:`MSRACompensationEnv.score` is
+steps 4-6: it trains the learner from the best vector and computes the paper's metrics on the
+held-out test recordings, before and after.
+
+``reset(seed=...)`` builds the task instance: with ``recordings_seed=None`` the recordings are
+simulated from the reset seed; with an integer (default 0, the paper's setting of one fixed set
+of datasets trained on 30 times) they are fixed, and the reset seed only draws the learner's own
+random start. ``train_files``/``test_files`` replace the simulated recordings by schema-v1
+files (for example real ones).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from tcbench.compensation import methods
+from tcbench.compensation.data import (
+    DEFAULT_SPLIT,
+    MSRAData,
+    TaskDataError,
+    check_split,
+    file_data,
+    simulated_data,
+)
+from tcbench.compensation.scoring import Score, score_outputs
+from tcbench.learners import registry as learners
+from tcbench.learners.base import FitHistory, Learner
+from tcbench.tasks.function_env import as_batch, check_budget
+
+TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp"}
+ENV_IDS = {"msra_zerobias": "tcbench/MSRA-ZeroBias-v0", "msra_fulltemp": "tcbench/MSRA-FullTemp-v0"}
+BIAS_FORMS = ("plus", "printed")
+
+
+def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.random.Generator) -> Learner:
+    """A registered learner for a 2-input task; a ``form: auto`` parameter takes the task's form."""
+    cls = learners.get(name)
+    values = dict(params or {})
+    fields = {f.name for f in dataclasses.fields(cls.Params)}
+    if "form" in fields and values.get("form", "auto") == "auto":
+        values["form"] = form
+    return cls(2, values, rng)
+
+
+class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):
+    """Search a learner's initial parameters on an MSRA compensation task.
+
+    Parameters
+    ----------
+    task: ``msra_fulltemp`` or ``msra_zerobias``.
+    learner, learner_params: the registered learner and its parameters (default: BP 2-10-1);
+        ``None`` for an env that only scores the baselines (raw, oracle).
+    budget: candidate evaluations per episode.
+    device_seed: the simulated device; recordings_seed: fixes the recordings (None: from reset).
+    n_train, n_test: recordings to train on and to test on (default 3/2 fulltemp, 4/2 roomtemp).
+    train_files, test_files: schema-v1 recordings instead of simulated ones.
+    train_on: ``positions`` (fulltemp: the labelled four-position samples) or ``all`` rows.
+    rate_window_s: trailing window of the temperature-rate input (roomtemp), in s.
+    bias_form: eq. 12 ``plus`` (default) or ``printed``.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(
+        self,
+        task: str = "msra_fulltemp",
+        learner: str | None = "bp",
+        learner_params: dict[str, Any] | None = None,
+        budget: int = 1000,
+        device_seed: int = 0,
+        recordings_seed: int | None = 0,
+        n_train: int | None = None,
+        n_test: int | None = None,
+        train_files: list[str] | None = None,
+        test_files: list[str] | None = None,
+        train_on: str = "positions",
+        rate_window_s: float = 120.0,
+        bias_form: str = "plus",
+    ) -> None:
+        if task not in TASKS:
+            raise ValueError(f"unknown MSRA task {task!r}; known: {', '.join(TASKS)}")
+        self.task, self.protocol = task, TASKS[task]
+        if int(budget) != budget or budget < 1:
+            raise ValueError(f"budget must be a positive integer, got {budget}")
+        if int(device_seed) != device_seed or device_seed < 0:
+            raise ValueError(f"device_seed must be a non-negative integer, got {device_seed}")
+        if recordings_seed is not None and (int(recordings_seed) != recordings_seed or recordings_seed < 0):
+            raise ValueError(f"recordings_seed must be a non-negative integer or null, got {recordings_seed}")
+        if bias_form not in BIAS_FORMS:
+            raise ValueError(f"bias_form must be one of {', '.join(BIAS_FORMS)}, got {bias_form!r}")
+        if (train_files is None) != (test_files is None):
+            raise ValueError("give both train_files and test_files, or neither")
+        d_train, d_test = DEFAULT_SPLIT[self.protocol]
+        self.n_train = len(train_files) if train_files else (d_train if n_train is None else n_train)
+        self.n_test = len(test_files) if test_files else (d_test if n_test is None else n_test)
+        try:
+            check_split(self.protocol, self.n_train, self.n_test, train_on, rate_window_s)
+        except TaskDataError as exc:
+            raise ValueError(str(exc)) from None
+        self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), recordings_seed
+        self.train_files, self.test_files = train_files, test_files
+        self.train_on, self.rate_window_s, self.bias_form = train_on, float(rate_window_s), bias_form
+        self.learner_name, self.learner_params = learner, dict(learner_params or {})
+        form = "inverse" if self.protocol == "fulltemp" else "bias"
+        self.learner: Learner | None = None
+        if learner is not None:
+            self.learner = make_learner(learner, self.learner_params, form, np.random.default_rng(0))
+        searchable = self.learner is not None and self.learner.searchable
+        dim = self.learner.n_params if searchable else 1
+        low, high = self.learner.init_bounds() if searchable else (-1.0, 1.0)
+        self.dim = dim
+        self.lower, self.upper = np.full(dim, float(low)), np.full(dim, float(high))
+        self.action_space = gym.spaces.Box(self.lower, self.upper, dtype=np.float64)
+        self.observation_space = gym.spaces.Box(0.0, np.inf, shape=(1,), dtype=np.float64)
+        self.f_opt = 0.0
+        self.target_precision = 0.0
+        self.data: MSRAData | None = None
+        self._x = self._y = None
+        self._reset_counters()
+
+    # -- episode ---------------------------------------------------------------------------
+    def _reset_counters(self) -> None:
+        self.evaluations = 0
+        self.best_f = np.inf
+        self.best_x = np.full(self.dim, np.nan)
+        self.nonfinite = 0
+
+    def _load(self) -> MSRAData:
+        if self.train_files is not None and self.test_files is not None:
+            return file_data(self.protocol, list(self.train_files), list(self.test_files), self.train_on,
+                             self.rate_window_s)
+        rseed = self.recordings_seed
+        if rseed is None:
+            rseed = int(self.np_random.integers(0, 2**31 - 1))
+        return simulated_data(self.protocol, self.device_seed, rseed, self.n_train, self.n_test,
+                              self.train_on, self.rate_window_s)
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        self.data = self._load()
+        learner_rng = np.random.default_rng(int(self.np_random.integers(0, 2**63 - 1)))
+        if self.learner_name is not None:
+            self.learner = make_learner(self.learner_name, self.learner_params, self.data.form, learner_rng)
+            self._x, self._y = self.data.training_set(self.learner.sequential)
+            if self.learner.searchable:
+                self.learner.scale_to(self._x, self._y)
+        self._reset_counters()
+        return np.array([np.inf]), self._info()
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
+        if self.data is None:
+            raise RuntimeError("call reset() before step()")
+        if self.learner is None or not self.learner.searchable:
+            raise TypeError(f"learner {self.learner_name!r} has no initial parameters to search")
+        x2, single = as_batch(action, self.dim)
+        check_budget(self.evaluations, x2.shape[0], self.budget)
+        f = np.asarray(self.learner.loss_batch(x2, self._x, self._y), dtype=np.float64)
+        finite = np.isfinite(f)
+        self.nonfinite += int(np.count_nonzero(~finite))
+        ranked = np.where(finite, f, np.inf)
+        i = int(np.argmin(ranked))
+        if ranked[i] < self.best_f:
+            self.best_f, self.best_x = float(ranked[i]), x2[i].copy()
+        self.evaluations += len(f)
+        reward: np.ndarray | float = float(-f[0]) if single else -f
+        return f, reward, False, self.evaluations >= self.budget, self._info()
+
+    def _info(self) -> dict[str, Any]:
+        return {
+            "best_f": self.best_f, "best_x": self.best_x.copy(), "evaluations": self.evaluations,
+            "budget": self.budget, "lower": self.lower.copy(), "upper": self.upper.copy(),
+            "f_opt": self.f_opt, "target_hit_at": None, "nonfinite": self.nonfinite,
+        }
+
+    # -- final scorer ----------------------------------------------------------------------
+    def score(self, init: np.ndarray | None = None) -> tuple[Score, FitHistory]:
+        """Train the learner from ``init`` (None: its own random start) and score the test
+        recordings before and after (steps 4-6 of seed 000 Fig. 5)."""
+        if self.data is None or self.learner is None:
+            raise RuntimeError("call reset() on an env with a learner before score()")
+        history = methods.train(self.data, self.learner, init)
+        rmse = methods.training_rmse_ug(self.data, self.learner)
+        fn = methods.learner_compensator(self.data, self.learner)
+        return score_outputs(self.data, fn, self.bias_form, rmse), history
+
+    def score_baseline(self, which: str) -> Score:
+        """``raw`` (no compensation) or ``oracle`` (the simulator's truth: noise alone)."""
+        if self.data is None:
+            raise RuntimeError("call reset() before score_baseline()")
+        if which == "raw":
+            return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
+        if which == "oracle":
+            return score_outputs(self.data, methods.oracle_compensator(self.data), self.bias_form)
+        raise ValueError(f"unknown baseline {which!r}; known: {', '.join(methods.BASELINES)}")

@@ -1,0 +1,55 @@
+"""The causal temperature rate: loop reference, exact ramps, causality."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tcbench.compensation.features import temperature_rate_c_per_s
+
+
+def _loop_reference(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> np.ndarray:
+    out = np.zeros(t_s.size)
+    for i in range(t_s.size):
+        keep = (t_s > t_s[i] - window_s) & (t_s <= t_s[i])
+        if keep.sum() >= 2:
+            out[i] = np.polyfit(t_s[keep], temp_c[keep], 1)[0]
+    return out
+
+
+def test_matches_a_loop_reference_on_irregular_times() -> None:
+    rng = np.random.default_rng(0)
+    t_s = 1000.0 + np.cumsum(rng.uniform(0.5, 1.5, 600))
+    temp_c = 25.0 + 2.0 * np.sin(t_s / 200.0) + rng.normal(0.0, 0.01, t_s.size)
+    got = temperature_rate_c_per_s(t_s, temp_c, window_s=60.0)
+    np.testing.assert_allclose(got, _loop_reference(t_s, temp_c, 60.0), rtol=0.0, atol=1e-9)
+    assert got[0] == 0.0
+
+
+def test_recovers_an_exact_ramp() -> None:
+    t_s = np.arange(0.0, 40000.0, 1.0)
+    slope_c_per_s = 1.0 / 60.0
+    rate = temperature_rate_c_per_s(t_s, -40.0 + slope_c_per_s * t_s, window_s=120.0)
+    assert rate[0] == 0.0
+    np.testing.assert_allclose(rate[1:], slope_c_per_s, rtol=0.0, atol=1e-9)
+
+
+def test_is_causal() -> None:
+    rng = np.random.default_rng(1)
+    t_s = np.arange(500.0)
+    temp_c = 20.0 + np.cumsum(rng.normal(0.0, 0.01, t_s.size))
+    base = temperature_rate_c_per_s(t_s, temp_c)
+    changed = temp_c.copy()
+    changed[300] += 5.0
+    after = temperature_rate_c_per_s(t_s, changed)
+    np.testing.assert_array_equal(after[:300], base[:300])
+    assert after[300] != base[300]
+
+
+def test_rejects_bad_input() -> None:
+    with pytest.raises(ValueError, match="strictly increasing"):
+        temperature_rate_c_per_s(np.array([0.0, 1.0, 1.0]), np.zeros(3))
+    with pytest.raises(ValueError, match="window_s"):
+        temperature_rate_c_per_s(np.arange(3.0), np.zeros(3), window_s=0.0)
+    with pytest.raises(ValueError, match="samples"):
+        temperature_rate_c_per_s(np.arange(3.0), np.zeros(4))
