@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Reproduce seed 000 §3 (Tables 1-2): FA-BP and IFA-BP, 30 trainings each, BP from random
+# weights (GD and LM), the polynomial baseline, raw and the oracle, on both MSRA tasks; then
+# regenerate leaderboards/paper-ifa-bp/ and this folder's tables.
+# Usage (from the repository root, with tcbench installed): bash experiments/paper_ifa_bp/run.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+here=experiments/paper_ifa_bp
+out=leaderboards/paper-ifa-bp
+export MLFLOW_TRACKING_URI="sqlite:///$PWD/$here/mlflow.db"
+rm -f "$here/mlflow.db"
+sweep=paper-ifa-bp-$(date -u +%Y%m%dT%H%M%S)
+common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra/launcher=joblib hydra.launcher.n_jobs=2)
+tcbench run -m experiment=paper_ifa_bp "${common[@]}"
+tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,oracle,poly optimiser=none \
+  tracking.experiment=paper-ifa-bp "${common[@]}"
+rm -rf "$out" && mkdir -p "$out"
+tcbench leaderboard --experiment paper-ifa-bp --sweep "$sweep" --out "$out"
+python "$here/tables.py" --experiment paper-ifa-bp --sweep "$sweep" --out "$out"
