@@ -3,7 +3,7 @@
 Each training is what ``tcbench run task=msra_fulltemp learner=bp optimiser=fa|ifa seed=S``
 computes, without tracking: the weight search (population 10, 50 iterations = 510 evaluations
 of the training error, batched per generation), BP training from the best vector (gradient
-descent, 2000 epochs, the paper's; or ``--training lm``), and the Table 2 metrics and the
+descent, 1000 epochs by default; or ``--training lm``), and the Table 2 metrics and the
 +-0.5 g probe on the two test recordings. The five recordings are simulated once per worker
 process (included in the time). Jobs are spread over ``--workers`` processes (joblib/loky),
 each with one BLAS thread so the workers do not oversubscribe the cores. Target of the issue:

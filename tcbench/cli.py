@@ -165,7 +165,7 @@ def cmd_quickstart(argv: list[str]) -> int:
 
 def cmd_list(argv: list[str]) -> int:
     from tcbench.optimisers import registry
-    from tcbench.tasks import FUNCTIONS, PROBLEMS, env_id, mo_env_id
+    from tcbench.tasks import FUNCTIONS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
 
     print("tasks (single objective):")
     for key, fn in FUNCTIONS.items():
@@ -174,6 +174,9 @@ def cmd_list(argv: list[str]) -> int:
     for key, p in PROBLEMS.items():
         print(f"  {mo_env_id(key):26s} task={key:11s} {p.title}, {p.n_objectives} objectives, "
               f"{p.default_dim} variables in [{p.lower:g}, {p.upper:g}]")
+    print("tasks (compensation):")
+    for key, eid in MSRA_ENV_IDS.items():
+        print(f"  {eid:26s} task={key:14s} MSRA {'four-position runs -40..60 °C' if 'full' in key else 'zero-bias runs at room temperature'}")
     print("optimisers:")
     for name, entry in registry.available().items():
         kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective), ("multi", entry.cls.multi_objective)) if ok)
@@ -181,11 +184,7 @@ def cmd_list(argv: list[str]) -> int:
     for name, err in registry.broken().items():
         print(f"  {name:10s} BROKEN: {err}")
     from tcbench.learners import registry as learners
-    from tcbench.tasks import MSRA_ENV_IDS
 
-    print("tasks (compensation):")
-    for key, eid in MSRA_ENV_IDS.items():
-        print(f"  {eid:26s} task={key:14s} MSRA {'four-position runs -40..60 °C' if 'full' in key else 'zero-bias runs at room temperature'}")
     print("learners:")
     for name, lentry in learners.available().items():
         kind = "initial weights searchable" if lentry.cls.searchable else "closed form"

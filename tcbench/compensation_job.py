@@ -9,6 +9,7 @@ import traceback
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from tcbench.compensation.methods import BASELINES
@@ -106,11 +107,12 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
             result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
             summary = result.score.summary()
             primary = PRIMARY[result.score.protocol]
-            run.log_metrics({k: v for k, v in summary.items() if v == v} | {
+            values = summary | {
                 "final_error": summary[primary], "search_evaluations": result.search_evaluations,
-                "init_loss": result.init_loss if result.init_loss == result.init_loss else -1.0,
-                "seconds_search": result.seconds_search, "seconds_train": result.seconds_train,
-            })
+                "init_loss": result.init_loss, "seconds_search": result.seconds_search,
+                "seconds_train": result.seconds_train,
+            }
+            run.log_metrics({k: v for k, v in values.items() if not np.isnan(v)})
             if result.trace.evaluations:
                 run.log_series("init_best_f", result.trace.best_f, result.trace.evaluations)
             loss = result.history.loss if result.history else None

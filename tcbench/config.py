@@ -18,7 +18,7 @@ from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
-from tcbench.optimisers.protocol import _coerce, make_params
+from tcbench.optimisers.protocol import coerce_param, make_params
 from tcbench.tasks import is_compensation, task_class
 
 
@@ -101,7 +101,7 @@ def checked_task(task: dict[str, Any], schema: type) -> dict[str, Any]:
     out = {}
     for key, value in task.items():
         try:
-            out[key] = _coerce("task", key, fields[key].type, value)
+            out[key] = coerce_param("task", key, fields[key].type, value)
         except ValueError as exc:
             raise ConfigError(str(exc)) from None
     return out

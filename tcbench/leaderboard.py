@@ -13,8 +13,10 @@ the next-ranked one, paired by seed (finished runs both have; NaN below 6 shared
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -44,46 +46,52 @@ class Board:
     f_opt: float
 
 
-def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
-    """One row per tcbench optimisation run (finished, failed or unfinished)."""
+def search_runs(client, experiments: list[str], kind: str, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
+    """Every MLflow run of ``kind`` (``optimisation``, ``compensation``) in the experiments,
+    optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
     ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
     if not ids:
         raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
-    query = "tags.`tcbench.kind` = 'optimisation'"
+    query = f"tags.`tcbench.kind` = '{kind}'"
     if sweep:
         query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
-    rows = []
     token = None
     while True:
         page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)
-        for r in page:
-            m, p, t = r.data.metrics, r.data.params, r.data.tags
-            rows.append({
-                "run_id": r.info.run_id,
-                "status": r.info.status,
-                "task": t.get("tcbench.task"),
-                "method": t.get("tcbench.method"),
-                "seed": int(t.get("tcbench.seed", -1)),
-                "sweep": t.get("tcbench.sweep_id"),
-                "config_hash": t.get("tcbench.config_hash"),
-                "start_time": r.info.start_time,
-                "error_message": t.get("tcbench.error", ""),
-                "budget": int(p.get("budget", 0)),
-                "dim": int(p.get("task.dim", 0) or 0),
-                "target_precision": float(p.get("task.target_precision", "nan")),
-                "final_error": m.get("final_error", np.nan),
-                "final_best": m.get("final_best", np.nan),
-                "f_opt": m.get("f_opt", np.nan),
-                "evaluations": m.get("evaluations", np.nan),
-                "target_hit": m.get("target_hit", 0.0) > 0,
-                "evals_to_target": m.get("evals_to_target", np.nan),
-                "hypervolume": m.get("hypervolume", np.nan),
-                "igd": m.get("igd", np.nan),
-                "task_name": t.get("tcbench.task_name"),
-            })
+        yield from page
         token = page.token
         if not token:
             break
+
+
+def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
+    """One row per tcbench optimisation run (finished, failed or unfinished)."""
+    rows = []
+    for r in search_runs(client, experiments, "optimisation", sweep):
+        m, p, t = r.data.metrics, r.data.params, r.data.tags
+        rows.append({
+            "run_id": r.info.run_id,
+            "status": r.info.status,
+            "task": t.get("tcbench.task"),
+            "method": t.get("tcbench.method"),
+            "seed": int(t.get("tcbench.seed", -1)),
+            "sweep": t.get("tcbench.sweep_id"),
+            "config_hash": t.get("tcbench.config_hash"),
+            "start_time": r.info.start_time,
+            "error_message": t.get("tcbench.error", ""),
+            "budget": int(p.get("budget", 0)),
+            "dim": int(p.get("task.dim", 0) or 0),
+            "target_precision": float(p.get("task.target_precision", "nan")),
+            "final_error": m.get("final_error", np.nan),
+            "final_best": m.get("final_best", np.nan),
+            "f_opt": m.get("f_opt", np.nan),
+            "evaluations": m.get("evaluations", np.nan),
+            "target_hit": m.get("target_hit", 0.0) > 0,
+            "evals_to_target": m.get("evals_to_target", np.nan),
+            "hypervolume": m.get("hypervolume", np.nan),
+            "igd": m.get("igd", np.nan),
+            "task_name": t.get("tcbench.task_name"),
+        })
     return pd.DataFrame(rows)
 
 

@@ -119,6 +119,24 @@ class _Progress:
             t.mean_f.append(_population_mean(opt))
 
 
+def ask_tell(opt: Optimiser, env: Any, budget: int, progress: bool) -> tuple[_Progress, dict[str, Any]]:
+    """Run ``opt`` on ``env`` until it is done: ``X = ask(); F = step(X); tell(X, F)``, one
+    batch per ask; the per-generation record and the last step's ``info``."""
+    recorder = _Progress(env)
+    info: dict[str, Any] = {}
+    last_generation = -1
+    with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
+        while not opt.done:
+            x = checked_batch(opt, opt.ask(), env)
+            f, _, _, _, info = env.step(x)
+            opt.tell(x, f)
+            bar.update(len(f))
+            if opt.generation != last_generation:
+                last_generation = opt.generation
+                recorder.record(opt, info)
+    return recorder, info
+
+
 def run_optimisation(
     task: dict[str, Any],
     optimiser: dict[str, Any],
@@ -133,18 +151,7 @@ def run_optimisation(
     params = {k: v for k, v in optimiser.items() if k != "name"}
     n_objectives = getattr(env, "n_objectives", 1)
     opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, params, n_objectives)
-    recorder = _Progress(env)
-    info: dict[str, Any] = {}
-    last_generation = -1
-    with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
-        while not opt.done:
-            x = checked_batch(opt, opt.ask(), env)
-            f, _, _, _, info = env.step(x)
-            opt.tell(x, f)
-            bar.update(len(f))
-            if opt.generation != last_generation:
-                last_generation = opt.generation
-                recorder.record(opt, info)
+    recorder, info = ask_tell(opt, env, budget, progress)
     if env.nonfinite:
         log.warning("%d evaluations returned NaN or inf; they were treated as worst", env.nonfinite)
     common = {
@@ -210,19 +217,7 @@ def run_compensation(
     if env.learner.searchable and optimiser["name"] != "none":
         opt_params = {k: v for k, v in optimiser.items() if k not in {"name", "label"}}
         opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, opt_params)
-        recorder = _Progress(env)
-        last_generation = -1
-        info: dict[str, Any] = {}
-        with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
-            while not opt.done:
-                x = checked_batch(opt, opt.ask(), env)
-                f, _, _, _, info = env.step(x)
-                opt.tell(x, f)
-                bar.update(len(f))
-                if opt.generation != last_generation:
-                    last_generation = opt.generation
-                    recorder.record(opt, info)
-        trace = recorder.trace
+        trace = ask_tell(opt, env, budget, progress)[0].trace
         init, init_loss = opt.best.x, float(opt.best.f)
     elif env.learner.searchable:
         init = env.learner.initial_params(rng)

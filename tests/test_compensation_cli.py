@@ -103,3 +103,10 @@ def test_foreign_test_set_is_refused(workdir: Path, foreign_files: tuple[str, st
     out = tcbench("run", "task=msra_fulltemp", "learner=poly", "optimiser=none", f"task.train_files=[{gyro}]",
                   f"task.test_files=[{full}]", cwd=workdir)
     assert out.returncode == 2 and "training recording is from a gyro sensor" in out.stderr
+    room = workdir / "room.csv"
+    write_recording(simulate_recording("msra", "roomtemp", 0, 0), room)
+    out = tcbench("run", "task=msra_fulltemp", "learner=poly", "optimiser=none", f"task.train_files=[{room}]",
+                  f"task.test_files=[{full}]", cwd=workdir)
+    lines = out.stderr.strip().splitlines()
+    assert out.returncode == 2 and len(lines) == 1 and "room.csv: training recording has no four-position test" in lines[0]
+    assert not (workdir / "mlflow.db").exists()

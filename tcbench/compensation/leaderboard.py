@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from tcbench.compensation.scoring import FULLTEMP_METRICS, PRIMARY, ROOMTEMP_METRICS
-from tcbench.leaderboard import markdown_table, one_run_per_job
+from tcbench.leaderboard import markdown_table, one_run_per_job, search_runs
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp"}
@@ -39,27 +39,16 @@ class CompensationBoard:
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
     """One row per compensation run with its status, tags and every metric."""
-    ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
-    if not ids:
-        raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
-    query = "tags.`tcbench.kind` = 'compensation'"
-    if sweep:
-        query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
-    rows, token = [], None
-    while True:
-        page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)
-        for r in page:
-            t = r.data.tags
-            rows.append({
-                "run_id": r.info.run_id, "status": r.info.status, "task": t.get("tcbench.task"),
-                "method": t.get("tcbench.method"), "seed": int(t.get("tcbench.seed", -1)),
-                "sweep": t.get("tcbench.sweep_id"), "config_hash": t.get("tcbench.config_hash"),
-                "start_time": r.info.start_time, "error_message": t.get("tcbench.error", ""),
-                "task_name": t.get("tcbench.task_name"), **r.data.metrics,
-            })
-        token = page.token
-        if not token:
-            break
+    rows = []
+    for r in search_runs(client, experiments, "compensation", sweep):
+        t = r.data.tags
+        rows.append({
+            "run_id": r.info.run_id, "status": r.info.status, "task": t.get("tcbench.task"),
+            "method": t.get("tcbench.method"), "seed": int(t.get("tcbench.seed", -1)),
+            "sweep": t.get("tcbench.sweep_id"), "config_hash": t.get("tcbench.config_hash"),
+            "start_time": r.info.start_time, "error_message": t.get("tcbench.error", ""),
+            "task_name": t.get("tcbench.task_name"), **r.data.metrics,
+        })
     return pd.DataFrame(rows)
 
 

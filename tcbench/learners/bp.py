@@ -28,7 +28,7 @@ HIDDEN_ACTIVATIONS = ("tanh", "sigmoid")
 OUTPUT_ACTIVATIONS = ("linear", "tanh")
 TRAININGS = ("gd", "lm")
 CHUNK_FLOATS = 50_000_000  # largest (k, n, hidden) block loss_batch builds at once
-GRAD_BLOCK_ROWS = 2048  # samples per block of the gradient (a cache-sized working set)
+GRAD_BLOCK_ROWS = 8192  # samples per block of the gradient (a cache-sized working set)
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,8 @@ class BPParams(LearnerParams):
     hidden_activation: sigma of eq. 2, ``tanh`` or ``sigmoid`` (logistic).
     output_activation: phi of eq. 2, ``linear`` or ``tanh``.
     training: ``gd`` (gradient descent with momentum) or ``lm`` (Levenberg-Marquardt).
-    epochs: gradient-descent epochs, or LM iterations, >= 1; ``None``: 2000 for GD, 200 for LM.
+    epochs: gradient-descent epochs, or LM iterations, >= 1; ``None``: 1000 for GD (the default
+        of MATLAB's ``traingd``/``traingdm``, the paper gives none), 200 for LM.
     learning_rate: gradient-descent step eta, > 0 (normalised units).
     momentum: gradient-descent momentum mu in [0, 1): ``v <- mu v - eta grad C``.
     goal: stop once the eq. 3 error (normalised units) is <= goal, >= 0.
@@ -61,7 +62,7 @@ class BPParams(LearnerParams):
         """The epoch (GD) or iteration (LM) limit in force."""
         if self.epochs is not None:
             return self.epochs
-        return 2000 if self.training == "gd" else 200
+        return 1000 if self.training == "gd" else 200
 
     def __post_init__(self) -> None:
         checks = [
@@ -83,9 +84,10 @@ class BPParams(LearnerParams):
 
 
 def _tanh(a: np.ndarray) -> np.ndarray:
-    """tanh as ``1 - 2 / (exp(2a) + 1)``: the same values to ~1e-16 absolute, about twice as
-    fast as ``np.tanh`` on float64 arrays (one exp, in place after that)."""
-    out = np.exp(2.0 * a)
+    """tanh as ``1 - 2 / (exp(2a) + 1)``, computed in place over ``a`` (which it overwrites):
+    the same values to ~1e-16 absolute, about twice as fast as ``np.tanh`` on float64 arrays."""
+    a *= 2.0
+    out = np.exp(a, out=a)
     out += 1.0
     np.divide(-2.0, out, out=out)
     out += 1.0
@@ -93,7 +95,8 @@ def _tanh(a: np.ndarray) -> np.ndarray:
 
 
 def _sigma(a: np.ndarray, kind: str) -> np.ndarray:
-    return _tanh(a) if kind == "tanh" else expit(a)
+    """The hidden activation of ``a``, overwriting ``a``."""
+    return _tanh(a) if kind == "tanh" else expit(a, out=a)
 
 
 def _sigma_slope(out: np.ndarray, kind: str) -> np.ndarray:
@@ -217,9 +220,12 @@ class BPNetwork(Learner):
         with np.errstate(all="ignore"):
             for s in range(0, len(pk), step):
                 w1, b1, w2, b2 = self._split(pk[s:s + step])
-                a1 = x @ np.swapaxes(w1, 1, 2) + b1[:, None, :]  # (k, n, l), batched matmul
-                h = _sigma(a1, self.params.hidden_activation)
-                y = (h @ w2[:, :, None])[..., 0] + b2[:, None]
+                k, nh = w1.shape[0], self.params.hidden
+                # all candidates' hidden layers side by side: (n, k * l), one 2-D matmul
+                a1 = x @ w1.transpose(2, 0, 1).reshape(self.n_inputs, k * nh)
+                a1 += b1.reshape(-1)
+                h = _sigma(a1, self.params.hidden_activation).reshape(len(x), k, nh)
+                y = np.einsum("nkl,kl->kn", h, w2) + b2[:, None]  # (k, n)
                 if self.params.output_activation == "tanh":
                     y = np.tanh(y)
                 out[s:s + step] = 0.5 * np.mean((y - t) ** 2, axis=1)

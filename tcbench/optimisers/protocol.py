@@ -217,11 +217,11 @@ def make_params(cls: type[Optimiser], params: OptimiserParams | dict[str, Any] |
             f"known: {', '.join(sorted(known))}"
         )
     for key, value in values.items():
-        values[key] = _coerce(cls.name, key, known[key].type, value)
+        values[key] = coerce_param(cls.name, key, known[key].type, value)
     return cls.Params(**values)
 
 
-def _coerce(owner: str, key: str, annotation: Any, value: Any) -> Any:
+def coerce_param(owner: str, key: str, annotation: Any, value: Any) -> Any:
     """Check a parameter value against a simple annotation (int, float, bool, str, optional)."""
     ann = str(annotation)
     optional = "None" in ann

@@ -56,6 +56,7 @@ register_msra_envs()
 
 __all__ = [
     "FUNCTIONS",
+    "MSRA_ENV_IDS",
     "PROBLEMS",
     "BudgetExceededError",
     "FunctionEnv",
