@@ -164,7 +164,7 @@ def blas_threads() -> str:
 def main(argv: list[str] | None = None) -> None:
     parser = parser_for(__doc__ or "")
     parser.add_argument("--repeats", type=int, default=5, help="fits per method (median reported)")
-    parser.add_argument("--lm-epochs", type=int, nargs="+", default=[10, 20, 50, 200],
+    parser.add_argument("--lm-epochs", type=int, nargs="+", default=[3, 5, 10, 20, 50, 200],
                         help="tcbench LM budgets (limit on residual evaluations), one row each")
     parser.add_argument("--blas-threads", type=int, default=None,
                         help="limit BLAS threads of every method (default: leave as found)")

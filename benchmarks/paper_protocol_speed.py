@@ -47,7 +47,7 @@ def main() -> None:
     ap.add_argument("--training", default="gd", choices=("gd", "lm"))
     add_json(ap, DEFAULT_JSON)
     ns = ap.parse_args()
-    env = environment("numpy", "scipy", "joblib", "tcbench")
+    env = environment("scipy", "joblib")
     blas = sorted({f"{i['internal_api']} {i['version']} ({i['num_threads']} threads by default)"
                    for i in threadpool_info()})
     jobs = [(o, s) for o in ("fa", "ifa") for s in range(ns.seeds)]
@@ -56,7 +56,8 @@ def main() -> None:
     wall = time.perf_counter() - t0
     print(f"# Seed 000 protocol: {len(jobs)} trainings (FA-BP, IFA-BP x {ns.seeds}), BP {ns.training}\n")
     print(f"Command: `{command_line()}`\n")
-    print(environment_line(env, "numpy, scipy, joblib") + f"; BLAS: {'; '.join(blas)}, 1 thread per worker\n")
+    libs = f"scipy {env['scipy']}, joblib {env['joblib']}"
+    print(environment_line(env, libs) + f" BLAS: {'; '.join(blas)}, 1 thread per worker.\n")
     print("| optimiser | runs | median run (s) | median search (s) | median training (s) | median bias var. (µg) |")
     print("|---|---:|---:|---:|---:|---:|")
     for o in ("fa", "ifa"):

@@ -79,6 +79,7 @@ def figures(score: Score, history_loss: list[float] | None, where: Path, title: 
 def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
     """Run one compensation job; tracked jobs that raise are recorded FAILED and return None."""
     learner = learner_of(c)
+    c = {**c, "learner": learner}  # the default learner made explicit, so it is logged and hashed
     optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
     learner_cfg = {k: v for k, v in learner.items() if k != "label"}
     if not c["tracking"]["enabled"]:

@@ -6,7 +6,8 @@ training RMSE", the paper's selection) and the improvement over the raw output (
 Rows are ordered by the median of the task's primary metric (bias variation for full
 temperature, zero-start stability for zero bias); raw and the oracle are deterministic, one run.
 ``p_vs_next``: Wilcoxon signed-rank p-value of the primary metric against the next row, paired
-by seed (NaN below 6 shared seeds).
+by seed (NaN below 6 shared seeds). ``note`` flags a method whose median is below the oracle's,
+the physical limit: it cannot be compensating the sensor better than its own noise allows.
 """
 
 from __future__ import annotations
@@ -80,7 +81,25 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     names = table["method"].tolist()
     table["p_vs_next"] = [paired_p_value(values[a], values[b]) for a, b in zip(names, names[1:], strict=False)] + [np.nan]
+    table["note"] = _notes(table, protocol)
     return table
+
+
+def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
+    """Flag a method whose median beats the oracle: that is not physics but a model of the
+    trained acceleration levels (its +-0.5 g probe error tells how far off it is elsewhere)."""
+    primary = f"median_{SHORT[PRIMARY[protocol]]}"
+    oracle = table.loc[table["method"] == "oracle", primary]
+    if oracle.empty:
+        return [""] * len(table)
+    limit = float(oracle.iloc[0])
+    notes = []
+    for row in table.itertuples(index=False):
+        below = row.method != "oracle" and getattr(row, primary) < limit
+        probe = getattr(row, "median_halfg_ug", np.nan)
+        notes.append(f"below the physical limit: fits the trained levels, ±0.5 g error {probe:.3g} µg"
+                     if below and np.isfinite(probe) else "below the physical limit" if below else "")
+    return notes
 
 
 def boards(runs: pd.DataFrame) -> list[CompensationBoard]:
@@ -139,7 +158,9 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
         "\"best of 30\" selection); gain = raw / median. raw = no compensation; oracle = the simulator's "
         "own model at the true die temperature (noise alone: the physical limit); poly3 = bias and scale "
         "factor cubic in temperature (least squares). p_vs_next = Wilcoxon signed-rank p-value of "
-        f"{primary} against the next row, paired by seed.", "",
+        f"{primary} against the next row, paired by seed. note: a median below the oracle's is not "
+        "physics — such a method has learned the trained acceleration levels, which its ±0.5 g probe "
+        "error (halfg) shows.", "",
         markdown_table(board.table), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
     if len(failed):

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from tcbench.compensation.data import TaskDataError, file_data
 from tcbench.compensation.methods import BASELINES
@@ -20,8 +22,10 @@ def _error(message: str) -> Exception:
 
 
 def learner_of(c: dict[str, Any]) -> dict[str, Any]:
-    """The job's learner config; BP when none is given."""
-    return dict(c.get("learner") or {"name": "bp"})
+    """The job's learner config; ``conf/learner/bp.yaml`` when none is given."""
+    if c.get("learner"):
+        return dict(c["learner"])
+    return dict(yaml.safe_load((Path(__file__).resolve().parents[1] / "conf" / "learner" / "bp.yaml").read_text()))
 
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
