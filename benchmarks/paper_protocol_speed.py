@@ -19,7 +19,14 @@ import statistics
 import time
 from pathlib import Path
 
-from common import add_json, command_line, environment, environment_line, parser_for, write_json
+from common import (
+    add_json,
+    command_line,
+    environment,
+    environment_line,
+    parser_for,
+    write_json,
+)
 from joblib import Parallel, delayed
 from threadpoolctl import threadpool_info, threadpool_limits
 

@@ -272,16 +272,22 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
         lines += [f"![convergence]({paths['png'].name})", ""]
     if "front" in paths:
         lines += [f"![front]({paths['front'].name})", ""]
-    if len(failed):
-        lines += ["Failed or unfinished runs:", ""]
-        lines += [
-            f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip()
-            for r in failed.itertuples()
-        ]
-        lines.append("")
+    write_board_files(lines + failed_lines(failed), board.table, paths)
+    return paths
+
+
+def failed_lines(failed: pd.DataFrame) -> list[str]:
+    """Markdown lines listing failed or unfinished runs (none when there are none)."""
+    if not len(failed):
+        return []
+    return ["Failed or unfinished runs:", "",
+            *[f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip() for r in failed.itertuples()], ""]
+
+
+def write_board_files(lines: list[str], table: pd.DataFrame, paths: dict[str, Path]) -> None:
+    """Write the markdown ``lines`` and the ``table`` CSV, each renamed into place when complete."""
     tmp_md, tmp_csv = paths["md"].with_suffix(".md.tmp"), paths["csv"].with_suffix(".csv.tmp")
     tmp_md.write_text("\n".join(lines))
-    board.table.to_csv(tmp_csv, index=False)
+    table.to_csv(tmp_csv, index=False)
     tmp_md.replace(paths["md"])
     tmp_csv.replace(paths["csv"])
-    return paths

@@ -19,7 +19,13 @@ import numpy as np
 import pandas as pd
 
 from tcbench.compensation.scoring import FULLTEMP_METRICS, PRIMARY, ROOMTEMP_METRICS
-from tcbench.leaderboard import markdown_table, one_run_per_job, search_runs
+from tcbench.leaderboard import (
+    failed_lines,
+    markdown_table,
+    one_run_per_job,
+    search_runs,
+    write_board_files,
+)
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp"}
@@ -163,13 +169,5 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
         "error (halfg) shows.", "",
         markdown_table(board.table), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
-    if len(failed):
-        lines += ["Failed or unfinished runs:", ""]
-        lines += [f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip() for r in failed.itertuples()]
-        lines.append("")
-    tmp_md, tmp_csv = paths["md"].with_suffix(".md.tmp"), paths["csv"].with_suffix(".csv.tmp")
-    tmp_md.write_text("\n".join(lines))
-    board.table.to_csv(tmp_csv, index=False)
-    tmp_md.replace(paths["md"])
-    tmp_csv.replace(paths["csv"])
+    write_board_files(lines + failed_lines(failed), board.table, paths)
     return paths
