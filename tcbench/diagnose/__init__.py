@@ -1,0 +1,1 @@
+"""Diagnosis: where a simulator departs from a recording, and which physical effect it misses."""

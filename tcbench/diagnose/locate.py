@@ -1,0 +1,307 @@
+"""Where a model's residual departs from white noise (DESIGN.md "Diagnosis", the ``mismatch`` list).
+
+:func:`locate` runs five families of tests on a residual ``r`` (any unit) sampled at times
+``t_s`` with thermometer temperature ``temp_c``; the family-wise false-alarm probability
+``false_alarm`` under white noise is split between the five families by Šidák's rule,
+``a_f = 1 - (1 - false_alarm)^(1/5)``, and inside each family by Šidák (or Bonferroni) over its
+number of tests:
+
+- time spans: non-overlapping windows of ``window_s``; every run of consecutive windows
+  ``i..j`` gets ``z = sum(r) / (sigma sqrt(n))`` (the mean times sqrt(n) / sigma); the threshold
+  is two-sided over the ``K (K + 1) / 2`` runs of ``K`` windows. Runs are picked greedily by
+  largest ``|z|`` among those not overlapping a run already picked, then adjacent picks of the
+  same sign are merged into one span.
+- temperature bands: the same scan over bins of ``band_c`` of temperature (empty bins skipped).
+- heating vs cooling: dT/dt > +eps against dT/dt < -eps, the difference of mean residuals taken
+  in each temperature bin where both occur and combined with inverse-variance weights (a
+  Welch-type z, each group's variance over its effective sample count ``n (1 - rho)/(1 + rho)``,
+  ``rho`` the residual's lag-1 autocorrelation).
+- soak vs ramp: |dT/dt| < eps against |dT/dt| > eps, the same test.
+- frequency band: overlapping Allan deviation of ``r`` at ``tau = m / fs`` (m = 10, 20, 40, ...,
+  at most N / 10) against the white line ``sigma / sqrt(m)``; a tau is flagged when the Allan
+  variance exceeds the line by more than the chi-square bound ``chi2.isf(a, edf) / edf`` with
+  the white-FM equivalent degrees of freedom of the overlapping estimator
+  ``edf = (3 (N - 1) / (2 m) - 2 (N - 2) / N) 4 m^2 / (4 m^2 + 5)``, Bonferroni over the taus.
+  When sigma is estimated from the data, its own relative variance (about 7 / N for the MAD of
+  first differences) widens the bound.
+
+``sigma`` (per-sample white-noise standard deviation, unit of ``r``) is ``white_sigma`` when given,
+otherwise ``1.4826 MAD(diff(r)) / sqrt(2)``, which drift and steps barely move.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from scipy.stats import chi2, norm
+
+from tcbench.signal.allan import allan_deviation
+
+MIN_SAMPLES = 100
+N_FAMILIES = 5  # time spans, temperature bands, heating/cooling, soak/ramp, frequency band
+MIN_WINDOWS = 10  # the time scan shrinks its windows to have at least this many
+MAX_WINDOWS = 1500  # ... and widens them to have at most this many (memory of the K x K scan)
+MIN_GROUP = 10  # a temperature bin enters a two-group test with at least this many per group
+MIN_ALLAN_M = 10  # the frequency test starts at tau = 10 samples
+MAD_TO_SIGMA = 1.4826
+SIGMA2_REL_VAR = 7.0  # N * var(sigma_hat^2 / sigma^2) for the MAD of first differences (measured)
+MAX_FINDINGS = 20  # per scan family
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """One departure from white noise between ``t_start_s`` and ``t_end_s`` (s, same clock as
+    the input), described by ``what``; ``statistic`` exceeded ``threshold`` (|z| for the scans and
+    the two-group tests, Allan deviation / white line for the frequency band)."""
+
+    t_start_s: float
+    t_end_s: float
+    what: str
+    statistic: float
+    threshold: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain dict with the report's keys ``t_start_s``, ``t_end_s``, ``what`` and the test's
+        ``statistic`` and ``threshold``."""
+        return {k: (v if isinstance(v, str) else float(v)) for k, v in asdict(self).items()}
+
+
+def _check(
+    t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, white_sigma: float | None,
+    false_alarm: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    arrays = {}
+    for name, a in (("t_s", t_s), ("temp_c", temp_c), ("residual", residual)):
+        a = np.asarray(a, dtype=np.float64)
+        if a.ndim != 1:
+            raise ValueError(f"{name} must be 1-D, got shape {a.shape}")
+        bad = ~np.isfinite(a)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{name} must be finite: {name}[{i}] = {a[i]}")
+        arrays[name] = a
+    t, temp, r = arrays["t_s"], arrays["temp_c"], arrays["residual"]
+    if not (t.size == temp.size == r.size):
+        raise ValueError(
+            f"t_s, temp_c and residual must have the same length, got {t.size}, {temp.size}, {r.size}"
+        )
+    if t.size < MIN_SAMPLES:
+        raise ValueError(f"residual needs at least {MIN_SAMPLES} samples, got {t.size}")
+    if not (np.diff(t) > 0).all():
+        raise ValueError("t_s must be strictly increasing")
+    if white_sigma is not None and not (np.isfinite(white_sigma) and white_sigma > 0):
+        raise ValueError(f"white_sigma must be None or a finite number > 0, got {white_sigma}")
+    if not (0.0 < false_alarm < 1.0):
+        raise ValueError(f"false_alarm must be in (0, 1), got {false_alarm}")
+    return t, temp, r
+
+
+def robust_white_sigma(residual: np.ndarray) -> float:
+    """Per-sample white-noise sigma from the MAD of first differences (unit of ``residual``)."""
+    d = np.diff(np.asarray(residual, dtype=np.float64))
+    return float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+
+
+def _sidak(alpha: float, n_tests: int) -> float:
+    """Per-test level so that ``n_tests`` independent tests have family-wise level ``alpha``."""
+    return float(-np.expm1(np.log1p(-alpha) / max(n_tests, 1)))
+
+
+def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float) -> list[tuple[int, int, float]]:
+    """Runs ``[i, j)`` of consecutive bins with ``|z| > z_thr``, greedy by largest ``|z|`` without
+    overlap, adjacent same-sign runs merged; returns ``(i, j, z)``."""
+    s = np.r_[0.0, np.cumsum(sums)]
+    c = np.r_[0.0, np.cumsum(counts)]
+    k = sums.size
+    i, j = np.triu_indices(k + 1, 1)
+    z = (s[j] - s[i]) / (sigma * np.sqrt(c[j] - c[i]))
+    absz = np.abs(z)
+    picks: list[tuple[int, int, float]] = []
+    used = np.zeros(k, dtype=np.int64)
+    alive = absz > z_thr
+    while alive.any() and len(picks) < MAX_FINDINGS:
+        best = int(np.argmax(np.where(alive, absz, -np.inf)))
+        a, b = int(i[best]), int(j[best])
+        picks.append((a, b, float(z[best])))
+        used[a:b] = 1
+        u = np.r_[0, np.cumsum(used)]
+        alive &= (u[j] - u[i]) == 0
+    picks.sort()
+    merged: list[tuple[int, int, float]] = []
+    for a, b, zz in picks:
+        if merged and merged[-1][1] == a and np.sign(merged[-1][2]) == np.sign(zz):
+            a = merged.pop()[0]
+            zz = float((s[b] - s[a]) / (sigma * np.sqrt(c[b] - c[a])))
+        merged.append((a, b, zz))
+    return merged
+
+
+def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, window_s: float) -> list[Mismatch]:
+    span_s = t[-1] - t[0]
+    w = min(max(window_s, span_s / MAX_WINDOWS), span_s / MIN_WINDOWS)
+    idx = np.minimum(((t - t[0]) / w).astype(np.int64), int(np.ceil(span_s / w)) - 1)
+    counts = np.bincount(idx).astype(np.float64)
+    sums = np.bincount(idx, weights=r)
+    keep = np.flatnonzero(counts > 0)
+    k = keep.size
+    z_thr = float(norm.isf(_sidak(alpha, k * (k + 1) // 2) / 2.0))
+    out = []
+    for a, b, z in _scan(sums[keep], counts[keep], sigma, z_thr):
+        n = counts[keep[a] : keep[b - 1] + 1].sum()
+        mean = sums[keep[a] : keep[b - 1] + 1].sum() / n
+        t0 = t[0] + keep[a] * w
+        t1 = min(t[0] + (keep[b - 1] + 1) * w, t[-1])
+        out.append(Mismatch(float(t0), float(t1), f"time span: mean residual {mean:+.3g}", abs(z), z_thr))
+    return out
+
+
+def _temperature_bands(
+    t: np.ndarray, temp: np.ndarray, r: np.ndarray, sigma: float, alpha: float, band_c: float
+) -> list[Mismatch]:
+    lo = np.floor(temp.min() / band_c) * band_c
+    idx = ((temp - lo) / band_c).astype(np.int64)
+    counts = np.bincount(idx).astype(np.float64)
+    sums = np.bincount(idx, weights=r)
+    keep = np.flatnonzero(counts > 0)
+    k = keep.size
+    z_thr = float(norm.isf(_sidak(alpha, k * (k + 1) // 2) / 2.0))
+    out = []
+    for a, b, z in _scan(sums[keep], counts[keep], sigma, z_thr):
+        b_lo, b_hi = keep[a], keep[b - 1]
+        inside = (idx >= b_lo) & (idx <= b_hi)
+        times = t[inside]
+        mean = r[inside].mean()
+        t_lo, t_hi = lo + b_lo * band_c, lo + (b_hi + 1) * band_c
+        what = f"temperature band {t_lo:g}..{t_hi:g} °C: mean residual {mean:+.3g}"
+        out.append(Mismatch(float(times[0]), float(times[-1]), what, abs(z), z_thr))
+    return out
+
+
+def _rate_c_per_s(t: np.ndarray, temp: np.ndarray, rate_window_s: float) -> np.ndarray:
+    """Centred difference of temperature over about ``rate_window_s`` (°C/s)."""
+    n = t.size
+    fs = (n - 1) / (t[-1] - t[0])
+    h = max(1, int(round(rate_window_s * fs / 2.0)))
+    k = np.arange(n)
+    hi, lo = np.minimum(k + h, n - 1), np.maximum(k - h, 0)
+    return (temp[hi] - temp[lo]) / (t[hi] - t[lo])
+
+
+def _two_group_z(
+    temp: np.ndarray, r: np.ndarray, in_a: np.ndarray, in_b: np.ndarray, band_c: float, rho: float
+) -> tuple[float, np.ndarray] | None:
+    """Welch-type z of mean(r | a) - mean(r | b) stratified by temperature bins; also the mask
+    of samples in bins that entered. None when no bin has ``MIN_GROUP`` samples of both."""
+    lo = np.floor(temp.min() / band_c) * band_c
+    idx = ((temp - lo) / band_c).astype(np.int64)
+    nb = int(idx.max()) + 1
+    stats = []
+    for m in (in_a, in_b):
+        n = np.bincount(idx[m], minlength=nb).astype(np.float64)
+        s1 = np.bincount(idx[m], weights=r[m], minlength=nb)
+        s2 = np.bincount(idx[m], weights=r[m] ** 2, minlength=nb)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = s1 / n
+            var = (s2 - s1 * mean) / (n - 1)
+        stats.append((n, mean, var))
+    (na, ma, va), (nbb, mb, vb) = stats
+    ok = (na >= MIN_GROUP) & (nbb >= MIN_GROUP)
+    if not ok.any():
+        return None
+    shrink = (1.0 - rho) / (1.0 + rho)
+    var_d = va[ok] / (na[ok] * shrink) + vb[ok] / (nbb[ok] * shrink)
+    var_d = np.maximum(var_d, np.finfo(float).tiny)
+    w = 1.0 / var_d
+    est = float(np.sum(w * (ma[ok] - mb[ok])) / np.sum(w))
+    z = est * float(np.sqrt(np.sum(w)))
+    used = ok[idx] & (in_a | in_b)
+    return z, used
+
+
+def _lag1(r: np.ndarray) -> float:
+    e = r - r.mean()
+    rho = float(np.dot(e[1:], e[:-1]) / np.dot(e, e)) if np.dot(e, e) > 0 else 0.0
+    return min(max(rho, 0.0), 0.99)
+
+
+def _group_tests(
+    t: np.ndarray, temp: np.ndarray, r: np.ndarray, alpha: float, band_c: float,
+    rate_eps_c_per_s: float, rate_window_s: float,
+) -> list[Mismatch]:
+    rate = _rate_c_per_s(t, temp, rate_window_s)
+    rho = _lag1(r)
+    z_thr = float(norm.isf(alpha / 2.0))
+    tests = (
+        ("heating vs cooling", rate > rate_eps_c_per_s, rate < -rate_eps_c_per_s),
+        ("soak vs ramp", np.abs(rate) < rate_eps_c_per_s, np.abs(rate) > rate_eps_c_per_s),
+    )
+    out = []
+    for what, a, b in tests:
+        res = _two_group_z(temp, r, a, b, band_c, rho)
+        if res is None or abs(res[0]) <= z_thr:
+            continue
+        z, used = res
+        times = t[used]
+        out.append(Mismatch(float(times[0]), float(times[-1]), what, abs(z), z_thr))
+    return out
+
+
+def _frequency_band(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool) -> list[Mismatch]:
+    n = r.size
+    fs = (n - 1) / (t[-1] - t[0])
+    m_max = min(n // 10, (n - 1) // 2)
+    if m_max < MIN_ALLAN_M:
+        return []
+    m = MIN_ALLAN_M * 2 ** np.arange(int(np.log2(m_max / MIN_ALLAN_M)) + 1)
+    ad = allan_deviation(r, fs, m / fs)
+    m = np.round(ad.tau_s * fs)
+    edf = (3.0 * (n - 1) / (2.0 * m) - 2.0 * (n - 2) / n) * 4.0 * m**2 / (4.0 * m**2 + 5.0)
+    a = alpha / m.size
+    bound = chi2.isf(a, edf) / edf
+    if estimated:
+        bound = bound * np.exp(norm.isf(a) * np.sqrt(SIGMA2_REL_VAR / n))
+    ratio2 = ad.adev**2 / (sigma**2 / m)
+    over = np.flatnonzero(ratio2 > bound)
+    if over.size == 0:
+        return []
+    k = int(over[0])
+    what = f"low-frequency excess (flicker or drift) from tau = {ad.tau_s[k]:.4g} s"
+    return [Mismatch(float(t[0]), float(t[-1]), what, float(np.sqrt(ratio2[k])), float(np.sqrt(bound[k])))]
+
+
+def locate(
+    t_s: np.ndarray,
+    temp_c: np.ndarray,
+    residual: np.ndarray,
+    white_sigma: float | None,
+    false_alarm: float = 0.01,
+    *,
+    window_s: float = 180.0,
+    band_c: float = 5.0,
+    rate_eps_c_per_s: float = 0.05 / 60.0,
+    rate_window_s: float = 60.0,
+) -> list[Mismatch]:
+    """Departures of ``residual`` (any unit) from white noise of per-sample sigma ``white_sigma``
+    (same unit; None: estimated robustly), at time ``t_s`` (s) and temperature ``temp_c`` (°C).
+
+    The probability of any finding on pure white noise is at most about ``false_alarm``.
+    ``window_s`` is the time-scan window, ``band_c`` the temperature bin, ``rate_eps_c_per_s``
+    (°C/s, default 0.05 °C/min) the dT/dt that separates soak from ramp, dT/dt taken over
+    ``rate_window_s``. Findings come in family order: time spans, temperature bands, heating vs
+    cooling, soak vs ramp, frequency band. Raises ValueError for non-finite values, unequal
+    lengths, fewer than 100 samples or non-increasing ``t_s``.
+    """
+    t, temp, r = _check(t_s, temp_c, residual, white_sigma, false_alarm)
+    estimated = white_sigma is None
+    sigma = robust_white_sigma(r) if estimated else float(white_sigma)
+    if not sigma > 0:
+        raise ValueError("residual has zero white-noise sigma (constant first differences)")
+    alpha = _sidak(false_alarm, N_FAMILIES)
+    return [
+        *_time_spans(t, r, sigma, alpha, window_s),
+        *_temperature_bands(t, temp, r, sigma, alpha, band_c),
+        *_group_tests(t, temp, r, alpha, band_c, rate_eps_c_per_s, rate_window_s),
+        *_frequency_band(t, r, sigma, alpha, estimated),
+    ]
