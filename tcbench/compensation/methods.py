@@ -13,21 +13,14 @@ import numpy as np
 
 from tcbench.compensation.data import MSRAData, TaskDataError, TaskRecording
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
-from tcbench.learners.base import FitHistory, Learner
+from tcbench.learners.base import Learner
 
 BASELINES = ("raw", "oracle")
 Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
 
 
-def train(data: MSRAData, learner: Learner, init: np.ndarray | None = None) -> FitHistory:
-    """Fit ``learner`` on the task's training set from ``init`` (None: its own random start)."""
-    x, y = data.training_set(learner.sequential)
-    return learner.fit(x, y, init=init)
-
-
-def training_rmse_ug(data: MSRAData, learner: Learner) -> float:
-    """RMSE of the trained learner on its training set, in micro-g."""
-    x, y = data.training_set(learner.sequential)
+def training_rmse_ug(data: MSRAData, learner: Learner, x: np.ndarray, y: np.ndarray) -> float:
+    """RMSE of the trained learner on its training set ``x``, ``y``, in micro-g."""
     rmse = float(np.sqrt(np.mean((learner.predict(x) - y) ** 2)))
     per_g = 1.0 if data.form == "inverse" else data.scale_factor_hz_per_g
     return rmse / per_g * 1e6

@@ -138,17 +138,25 @@ def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float) -> l
     return merged
 
 
-def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, window_s: float) -> list[Mismatch]:
-    span_s = t[-1] - t[0]
-    w = min(max(window_s, span_s / MAX_WINDOWS), span_s / MIN_WINDOWS)
-    idx = np.minimum(((t - t[0]) / w).astype(np.int64), int(np.ceil(span_s / w)) - 1)
+def _binned_scan(idx: np.ndarray, r: np.ndarray, sigma: float, alpha: float
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, list[tuple[int, int, float]]]:
+    """Residual summed per bin ``idx``; the non-empty bins, their counts and sums, the Šidák
+    threshold over all runs of consecutive non-empty bins, and the runs that exceed it."""
     counts = np.bincount(idx).astype(np.float64)
     sums = np.bincount(idx, weights=r)
     keep = np.flatnonzero(counts > 0)
     k = keep.size
     z_thr = float(norm.isf(_sidak(alpha, k * (k + 1) // 2) / 2.0))
+    return keep, counts, sums, z_thr, _scan(sums[keep], counts[keep], sigma, z_thr)
+
+
+def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, window_s: float) -> list[Mismatch]:
+    span_s = t[-1] - t[0]
+    w = min(max(window_s, span_s / MAX_WINDOWS), span_s / MIN_WINDOWS)
+    idx = np.minimum(((t - t[0]) / w).astype(np.int64), int(np.ceil(span_s / w)) - 1)
+    keep, counts, sums, z_thr, runs = _binned_scan(idx, r, sigma, alpha)
     out = []
-    for a, b, z in _scan(sums[keep], counts[keep], sigma, z_thr):
+    for a, b, z in runs:
         n = counts[keep[a] : keep[b - 1] + 1].sum()
         mean = sums[keep[a] : keep[b - 1] + 1].sum() / n
         t0 = t[0] + keep[a] * w
@@ -162,13 +170,9 @@ def _temperature_bands(
 ) -> list[Mismatch]:
     lo = np.floor(temp.min() / band_c) * band_c
     idx = ((temp - lo) / band_c).astype(np.int64)
-    counts = np.bincount(idx).astype(np.float64)
-    sums = np.bincount(idx, weights=r)
-    keep = np.flatnonzero(counts > 0)
-    k = keep.size
-    z_thr = float(norm.isf(_sidak(alpha, k * (k + 1) // 2) / 2.0))
+    keep, _, _, z_thr, runs = _binned_scan(idx, r, sigma, alpha)
     out = []
-    for a, b, z in _scan(sums[keep], counts[keep], sigma, z_thr):
+    for a, b, z in runs:
         b_lo, b_hi = keep[a], keep[b - 1]
         inside = (idx >= b_lo) & (idx <= b_hi)
         times = t[inside]

@@ -188,8 +188,8 @@ class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):
         recordings before and after (steps 4-6 of seed 000 Fig. 5)."""
         if self.data is None or self.learner is None:
             raise RuntimeError("call reset() on an env with a learner before score()")
-        history = methods.train(self.data, self.learner, init)
-        rmse = methods.training_rmse_ug(self.data, self.learner)
+        history = self.learner.fit(self._x, self._y, init=init)  # the training set built by reset()
+        rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
         fn = methods.learner_compensator(self.data, self.learner)
         return score_outputs(self.data, fn, self.bias_form, rmse), history
 
