@@ -1,4 +1,4 @@
-"""``tcbench`` command line: run, leaderboard, quickstart, list."""
+"""``tcbench`` command line: run, leaderboard, quickstart, list, simulate, metrics, diagnose."""
 
 from __future__ import annotations
 
@@ -20,6 +20,8 @@ commands:
   list                       registered tasks and optimisers
   simulate key=value ...     simulate a recording: sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR
   metrics PATH [key=value]   validate a recording and compute the papers' metrics, with plots
+  diagnose recording=PATH out=DIR [model=PATH] [sensor=msra|gyro]
+                             find the physics a model leaves out; report.json/.md, plots, model.yaml
 
 `tcbench run --help` shows the Hydra options and config groups.
 """
@@ -213,9 +215,19 @@ def cmd_metrics(argv: list[str]) -> int:
         raise UserError(str(exc)) from None
 
 
+def cmd_diagnose(argv: list[str]) -> int:
+    from tcbench.diagnose.cli import diagnose_command
+    from tcbench.sensors_cli import CommandError
+
+    try:
+        return diagnose_command(argv)
+    except CommandError as exc:
+        raise UserError(str(exc)) from None
+
+
 COMMANDS = {
     "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
-    "simulate": cmd_simulate, "metrics": cmd_metrics,
+    "simulate": cmd_simulate, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
 }
 
 

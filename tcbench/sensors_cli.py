@@ -21,7 +21,9 @@ class CommandError(ValueError):
 class SimulateConfig:
     """``tcbench simulate`` arguments (``key=value``). ``protocol_params.<name>=`` overrides a
     protocol keyword (``protocol_params.duration_s=3600``); ``effects.<id>.<param>=`` changes or
-    adds an effect (``effects.hysteresis.amplitude=0.02``); ``without=[white_noise]`` drops some."""
+    adds an effect (``effects.hysteresis.amplitude=0.02``); ``without=[white_noise]`` drops some.
+    ``model=PATH`` simulates a fitted-model file (:mod:`tcbench.diagnose.model_file`) instead of
+    a device: the sensor comes from the file, effect changes and ``without`` still apply."""
 
     sensor: str = "msra"
     protocol: str = "fulltemp"
@@ -35,6 +37,7 @@ class SimulateConfig:
     without: list[str] = field(default_factory=list)
     metrics: bool = True
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="simulations"))
+    model: str | None = None
 
 
 def parse(args: list[str], schema: type) -> Any:
@@ -56,6 +59,7 @@ def simulate(args: list[str]) -> int:
     from tcbench.sensors.simulate import protocol_names, simulate_recording
 
     cfg: SimulateConfig = parse(args, SimulateConfig)
+    fitted = _fitted_model(cfg, args) if cfg.model else None
     try:
         names = protocol_names(cfg.sensor)
     except ValueError as exc:
@@ -67,10 +71,14 @@ def simulate(args: list[str]) -> int:
     if cfg.device_seed < 0 or cfg.seed < 0:
         raise CommandError("device_seed and seed must be non-negative integers")
     out = Path(cfg.out)
-    stem = cfg.name or f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
+    if fitted is not None:
+        stem = cfg.name or f"{Path(str(cfg.model)).stem}-{cfg.protocol}-seed{cfg.seed}"
+    else:
+        stem = cfg.name or f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
     try:
         rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed,
-                                 effects=cfg.effects, without=tuple(cfg.without), **cfg.protocol_params)
+                                 effects=cfg.effects, without=tuple(cfg.without), model=fitted,
+                                 **cfg.protocol_params)
     except (TypeError, ValueError) as exc:
         raise CommandError(str(exc)) from None
     out.mkdir(parents=True, exist_ok=True)
@@ -80,6 +88,24 @@ def simulate(args: list[str]) -> int:
     if cfg.metrics:
         _report(path, rec, out / f"{stem}_metrics", None, cfg.tracking, {"kind": "simulation", "args": args})
     return 0
+
+
+def _fitted_model(cfg: SimulateConfig, args: list[str]) -> Any:
+    """The model of ``cfg.model`` as a :class:`~tcbench.sensors.fitted.PolynomialModel`; sets
+    ``cfg.sensor`` from the file (an explicit, different ``sensor=`` is an error)."""
+    from tcbench.diagnose.model_file import ModelFileError, read_model, to_sensor_model
+
+    try:
+        spec = read_model(str(cfg.model))
+    except ModelFileError as exc:
+        raise CommandError(str(exc)) from None
+    if any(a.startswith("sensor=") for a in args) and cfg.sensor != spec.sensor:
+        raise CommandError(f"{cfg.model}: the model is for a {spec.sensor}, but sensor={cfg.sensor} was given")
+    cfg.sensor = spec.sensor
+    try:
+        return to_sensor_model(spec)
+    except ValueError as exc:
+        raise CommandError(f"{cfg.model}: {exc}") from None
 
 
 @dataclass

@@ -187,7 +187,7 @@ def _rate_c_per_s(t: np.ndarray, temp: np.ndarray, rate_window_s: float) -> np.n
     """Centred difference of temperature over about ``rate_window_s`` (°C/s)."""
     n = t.size
     fs = (n - 1) / (t[-1] - t[0])
-    h = max(1, int(round(rate_window_s * fs / 2.0)))
+    h = max(1, round(rate_window_s * fs / 2.0))
     k = np.arange(n)
     hi, lo = np.minimum(k + h, n - 1), np.maximum(k - h, 0)
     return (temp[hi] - temp[lo]) / (t[hi] - t[lo])
@@ -252,12 +252,31 @@ def _group_tests(
     return out
 
 
-def _frequency_band(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool) -> list[Mismatch]:
+@dataclass(frozen=True)
+class AllanExcess:
+    """Overlapping Allan deviation of a residual against its white-noise line: ``adev`` and
+    ``white`` (= sigma / sqrt(m)) at ``tau_s``, the flagging bound on ``adev / white`` and the
+    index of the first tau above it (None: consistent with white noise)."""
+
+    tau_s: np.ndarray
+    adev: np.ndarray
+    white: np.ndarray
+    bound: np.ndarray
+    first_over: int | None
+
+
+def allan_excess(
+    t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool,
+    coloured: np.ndarray | None = None,
+) -> AllanExcess | None:
+    """The frequency-band test (module doc) at level ``alpha``; None when the residual is too
+    short for tau >= 10 samples at N / 10. ``coloured`` is a known non-white noise (one
+    realisation, per sample) whose Allan variance is added to the white line."""
     n = r.size
     fs = (n - 1) / (t[-1] - t[0])
     m_max = min(n // 10, (n - 1) // 2)
     if m_max < MIN_ALLAN_M:
-        return []
+        return None
     m = MIN_ALLAN_M * 2 ** np.arange(int(np.log2(m_max / MIN_ALLAN_M)) + 1)
     ad = allan_deviation(r, fs, m / fs)
     m = np.round(ad.tau_s * fs)
@@ -266,13 +285,20 @@ def _frequency_band(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, es
     bound = chi2.isf(a, edf) / edf
     if estimated:
         bound = bound * np.exp(norm.isf(a) * np.sqrt(SIGMA2_REL_VAR / n))
-    ratio2 = ad.adev**2 / (sigma**2 / m)
-    over = np.flatnonzero(ratio2 > bound)
-    if over.size == 0:
+    white = sigma / np.sqrt(m)
+    if coloured is not None:
+        white = np.sqrt(white**2 + allan_deviation(coloured, fs, ad.tau_s).adev ** 2)
+    over = np.flatnonzero(ad.adev**2 / white**2 > bound)
+    return AllanExcess(ad.tau_s, ad.adev, white, np.sqrt(bound), int(over[0]) if over.size else None)
+
+
+def _frequency_band(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool) -> list[Mismatch]:
+    ex = allan_excess(t, r, sigma, alpha, estimated)
+    if ex is None or ex.first_over is None:
         return []
-    k = int(over[0])
-    what = f"low-frequency excess (flicker or drift) from tau = {ad.tau_s[k]:.4g} s"
-    return [Mismatch(float(t[0]), float(t[-1]), what, float(np.sqrt(ratio2[k])), float(np.sqrt(bound[k])))]
+    k = ex.first_over
+    what = f"low-frequency excess (flicker or drift) from tau = {ex.tau_s[k]:.4g} s"
+    return [Mismatch(float(t[0]), float(t[-1]), what, float(ex.adev[k] / ex.white[k]), float(ex.bound[k]))]
 
 
 def locate(

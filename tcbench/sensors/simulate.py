@@ -10,6 +10,7 @@ import numpy as np
 
 from tcbench.sensors import protocols
 from tcbench.sensors.devices import unit
+from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.noise import quantise
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording, make_recording
@@ -55,13 +56,23 @@ def simulate_recording(
     seed: int = 0,
     effects: dict[str, dict[str, float]] | None = None,
     without: tuple[str, ...] = (),
+    *,
+    model: SensorModel | None = None,
     **protocol_params: Any,
 ) -> Recording:
     """Simulate device ``device_seed`` through ``protocol``; ``seed`` draws the run's noise and
     ambient. ``effects`` changes or adds effects (``{id: {param: value}}``), ``without``
-    removes some. The sidecar's ``extra`` records everything needed to reproduce it."""
-    device = unit(sensor, device_seed)
-    model = device.model.with_effects(effects or {}).without(*without)
+    removes some. ``model`` (e.g. a fitted :class:`~tcbench.sensors.fitted.PolynomialModel`)
+    replaces the device's model; the device is then ``fitted-<sensor>`` and ``device_seed`` is
+    only recorded. The sidecar's ``extra`` records everything needed to reproduce it."""
+    if model is None:
+        device = unit(sensor, device_seed)
+    else:
+        if model.kind != sensor:
+            raise ValueError(f"the model is for a {model.kind}, not a {sensor}")
+        device = Unit(f"fitted-{sensor}", model)
+    base = device.model
+    model = base.with_effects(effects or {}).without(*without)
     profile_rng, sensor_rng, thermometer_rng = (
         np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
     )
@@ -77,7 +88,7 @@ def simulate_recording(
         "effect_changes": effects or {},
         "without": list(without),
         "device_draws": device.draws,
-        "scale_factor_hz_per_g": getattr(device.model, "scale_factor_hz_per_g", None),
+        "scale_factor_hz_per_g": getattr(base, "scale_factor_hz_per_g", None),
         **profile.info,
     }
     return make_recording(

@@ -1,0 +1,231 @@
+"""``diagnose``: fit the starting model, locate the mismatch, attribute it to effects, refit.
+
+The :class:`Diagnosis` it returns is the report: :meth:`Diagnosis.to_json` is DESIGN.md's
+``report.json``; the arrays behind the plots ride along in ``series``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from tcbench.diagnose.attribute import (
+    DETECTION_THRESHOLD,
+    Attribution,
+    Evidence,
+    attribute,
+    recheck_with_flicker,
+)
+from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
+from tcbench.diagnose.explain import explain
+from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
+from tcbench.diagnose.signals import DiagnosisData, prepare
+from tcbench.diagnose.thermometer import propagated_noise
+from tcbench.sensors.recording import Recording
+
+log = logging.getLogger(__name__)
+FALSE_ALARM = 0.01  # of the mismatch scan and of the flicker test
+FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
+
+
+@dataclass
+class Series:
+    """Per-sample arrays behind the plots: time, thermometer (smoothed), the held-out residual of
+    the starting and of the final model, and their Allan deviations against the white line."""
+
+    t_s: np.ndarray
+    temp_c: np.ndarray
+    residual_before: np.ndarray
+    residual_after: np.ndarray
+    allan_before: AllanExcess | None
+    allan_after: AllanExcess | None
+
+
+@dataclass
+class Diagnosis:
+    """What the diagnosis found, in the shape of DESIGN.md's report (see :meth:`to_json`)."""
+
+    sensor: str
+    unit: str
+    recording: str
+    baseline: dict[str, Any]
+    mismatch: list[Mismatch]
+    effects: list[dict[str, Any]]
+    final: dict[str, Any]
+    noise: dict[str, float]
+    candidates: list[Evidence]
+    confusable: list[dict[str, Any]]
+    model: dict[str, Any]
+    series: Series = field(repr=False)
+
+    @property
+    def effect_ids(self) -> list[str]:
+        """Ids of the effects found, in the order they were kept."""
+        return [e["id"] for e in self.effects]
+
+    @property
+    def verdict(self) -> str:
+        """One line: nothing missing, or which effects."""
+        if not self.effects:
+            return "nothing missing: the residual of the starting model is consistent with its noise"
+        named = ", ".join(self.effect_ids)
+        pairs = "; ".join(f"{c['effects'][0]} cannot be told from {c['effects'][1]}" for c in self.confusable)
+        return f"missing: {named}" + (f" ({pairs})" if pairs else "")
+
+    def to_json(self) -> dict[str, Any]:
+        """``report.json``: plain JSON data."""
+        return {
+            "sensor": self.sensor, "unit": self.unit, "recording": self.recording,
+            "verdict": self.verdict, "baseline": self.baseline,
+            "mismatch": [m.to_dict() for m in self.mismatch], "effects": self.effects,
+            "final": self.final, "noise": self.noise,
+            "candidates": [_evidence_json(e) for e in self.candidates],
+            "confusable": self.confusable,
+        }
+
+
+def _evidence_json(e: Evidence) -> dict[str, Any]:
+    out: dict[str, Any] = {"id": e.effect, "status": e.status, "reason": e.reason}
+    if np.isfinite(e.gain):
+        out |= {"gain_sigma2": round(float(e.gain), 2), "threshold_sigma2": float(e.threshold)}
+    if e.value is not None and e.effect in PARAM_NAME:
+        out[PARAM_NAME[e.effect]] = float(e.value)
+    return out
+
+
+def _rmse(sse: float, n: int) -> float:
+    return float(np.sqrt(sse / n))
+
+
+def base_model(effects: dict[str, dict[str, float]]) -> Model:
+    """The starting :class:`Model` for effects already declared (``{id: params}``, as in
+    ``model.yaml``); their nonlinear parameters stay fixed, their amplitudes are refitted."""
+    model = Model()
+    for effect, params in effects.items():
+        if effect not in DETERMINISTIC:
+            continue
+        name = PARAM_NAME.get(effect)
+        model = model.with_effect(effect, float(params[name]) if name else None)
+    return model
+
+
+def _effect_params(effect: str, coef: float, value: float | None, half_range_c: float) -> dict[str, float]:
+    """An effect term's fitted coefficient (and searched value) as the effect library's parameters."""
+    if effect in ("hysteresis", "warmup"):
+        return {"amplitude": coef, PARAM_NAME[effect]: float(value)}  # type: ignore[arg-type]
+    if effect == "temperature_cubic":
+        return {"c3_per_c3": coef / half_range_c**3}  # the column is u^3, u = (T - centre) / half range
+    name = {"temperature_rate": "coef_per_c_per_s", "aging_drift": "rate_per_h", "accel_nonlinearity": "k2_per_g2"}
+    return {name[effect]: coef}
+
+
+def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, float]]]:
+    """Core polynomial and effect parameters of the final model, in model.yaml's form."""
+    d: Designer = att.designer
+    beta = att.final_fit.beta
+    n_core = len(d.core_names())
+    core = {"kind": "polynomial", "centre_c": d.centre_c, "half_range_c": d.half_range_c,
+            "bias": [float(b) for b in beta[:3]],
+            "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
+    effects: dict[str, dict[str, float]] = {}
+    if att.final.lag_tau_s:
+        effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
+    for (effect, value), coef in zip(att.final.terms, beta[n_core:], strict=True):
+        effects[effect] = _effect_params(effect, float(coef), value, d.half_range_c)
+    return core, effects
+
+
+def _flicker(
+    data: DiagnosisData, residual: np.ndarray, thermometer: np.ndarray
+) -> tuple[AllanExcess | None, float | None]:
+    """Allan test of a residual against white noise plus the ``thermometer`` noise the model
+    inherits; the flicker coefficient ``b`` when it flattens above both."""
+    dt = np.diff(data.t_s)
+    if dt.max() > 1.5 * np.median(dt):  # bursts: no Allan deviation across the gaps
+        return None, None
+    ex = allan_excess(data.t_s, residual, data.white_sigma, FALSE_ALARM, estimated=True, coloured=thermometer)
+    if ex is None or ex.first_over is None:
+        return ex, None
+    excess = np.sqrt(np.maximum(ex.adev**2 - ex.white**2, 0.0))
+    return ex, float(excess[ex.first_over:].max() / FLICKER_FLOOR)
+
+
+def diagnose(
+    rec: Recording,
+    *,
+    sensor: str | None = None,
+    declared: dict[str, dict[str, float]] | None = None,
+    name: str = "",
+    threshold: float = DETECTION_THRESHOLD,
+) -> Diagnosis:
+    """Diagnose ``rec`` against the minimal model plus the effects ``declared`` already modelled
+    (``{effect_id: params}``). Raises :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a
+    recording that cannot show anything."""
+    declared = declared or {}
+    data = prepare(rec, sensor)
+    designer = Designer(data)
+    base = base_model(declared)
+    log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", data.n, data.white_sigma, data.unit)
+    att = attribute(designer, base, threshold=threshold)
+    n = data.n
+    before, after = att.base_fit.heldout_residual, att.final_fit.heldout_residual
+    mismatch = locate(data.t_s, data.temp_c, before, data.white_sigma, FALSE_ALARM)
+    allan_before, _ = _flicker(data, before, propagated_noise(designer, att.base, att.base_fit.beta))
+    allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
+    if b is not None and len(att.final.ids) > len(base.ids):
+        rechecked = recheck_with_flicker(att, b)
+        if rechecked is not att:
+            att = rechecked
+            after = att.final_fit.heldout_residual
+            allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
+    core, fitted = _physical(att)
+    found = [e for e in att.final.ids if e not in base.ids]
+    evidence = att.evidence
+    for effect in found:
+        evidence[effect].reason = "dropping it costs more held-out error than chance allows"
+    effects_out = [
+        {"id": e, "params": fitted[e],
+         "evidence": {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold)},
+         "explanation": explain(e, fitted[e], data.unit),
+         **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})}
+        for e in found
+    ]
+    if "bias_instability" in declared:
+        evidence["bias_instability"] = Evidence("bias_instability", "in the model", reason="declared in the starting model")
+    elif allan_after is None:
+        evidence["bias_instability"] = Evidence("bias_instability", "not identifiable",
+                                                reason="no Allan deviation: the recording is too short or made of bursts")
+    elif b is None:
+        evidence["bias_instability"] = Evidence("bias_instability", "rejected",
+                                                reason="the residual's Allan deviation follows the white-noise line")
+    else:
+        k = allan_after.first_over
+        assert k is not None
+        ratio = float(allan_after.adev[k] / allan_after.white[k])
+        evidence["bias_instability"] = Evidence("bias_instability", "kept", ratio, float(allan_after.bound[k]),
+                                                reason=f"Allan deviation above the white line from tau = {allan_after.tau_s[k]:.4g} s")
+        effects_out.append({
+            "id": "bias_instability", "params": {"b": b},
+            "evidence": {"allan_ratio": ratio, "bound": float(allan_after.bound[k]), "tau_s": float(allan_after.tau_s[k])},
+            "explanation": explain("bias_instability", {"b": b}, data.unit)})
+        fitted["bias_instability"] = {"b": b}
+    for effect, params in declared.items():
+        fitted.setdefault(effect, dict(params))
+    fitted["white_noise"] = {"density": data.white_sigma / np.sqrt(data.sample_rate_hz)}
+    model = {"tcbench_model": 1, "sensor": data.sensor, "output_unit": data.unit, "core": core, "effects": fitted}
+    return Diagnosis(
+        sensor=data.sensor, unit=data.unit, recording=name,
+        baseline={"rmse_fit": _rmse(att.base_fit.sse_fit, n), "rmse_heldout": _rmse(att.base_fit.sse_heldout, n),
+                  "model": ["minimal", *base.ids]},
+        mismatch=mismatch, effects=effects_out,
+        final={"rmse_fit": _rmse(att.final_fit.sse_fit, n), "rmse_heldout": _rmse(att.final_fit.sse_heldout, n),
+               "model": ["minimal", *att.final.ids]},
+        noise={"white_sigma": data.white_sigma, "samples": n, "folds": att.k},
+        candidates=[evidence[e] for e in (*DETERMINISTIC, "bias_instability") if e in evidence],
+        confusable=[{"effects": [a, b_], "test": test} for a, b_, test in att.confusions if a in found],
+        model=model,
+        series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
+    )

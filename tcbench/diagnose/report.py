@@ -1,0 +1,53 @@
+"""Write a diagnosis to a directory: ``report.json``, ``report.md``, ``model.yaml`` and plots.
+
+Everything is written into a temporary sibling directory first and moved into ``out`` only when
+all files exist, so a failure leaves ``out`` as it was.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from tcbench.diagnose.diagnosis import Diagnosis
+from tcbench.diagnose.markdown import render_markdown
+from tcbench.diagnose.model_file import parse_model, write_model
+from tcbench.diagnose.plots import write_plots
+
+
+def _plain(value: Any) -> Any:
+    """JSON-ready copy: numpy scalars to Python numbers, non-finite floats to None."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item"):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def write_report(diag: Diagnosis, out: str | Path) -> dict[str, Path]:
+    """Write the report files into ``out`` (created if needed); returns name -> path."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
+        write_model(parse_model(_plain(diag.model), "model.yaml"), tmp / "model.yaml")
+        plots = write_plots(diag, tmp)
+        (tmp / "report.md").write_text(render_markdown(diag, plots))
+        out.mkdir(exist_ok=True)
+        written = {}
+        for item in sorted(tmp.iterdir()):
+            os.replace(item, out / item.name)
+            written[item.name] = out / item.name
+        return written
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)

@@ -1,0 +1,188 @@
+"""The arrays a diagnosis works on, taken from one recording.
+
+The thermometer reading is smoothed by a local linear fit over ``smooth_s`` of time (its
+quantisation and noise would otherwise act as an error in the regressor), and dT/dt is that
+fit's slope. Both use time windows rather than sample counts, so a recording made of bursts
+with gaps between them (a logger that wakes up every few minutes) is handled like a continuous
+one. Filters that need a uniform clock (the first-order lag, the play operator) run on a grid of
+at most 1 s and are read back at the sample times.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import pairwise
+
+import numpy as np
+from scipy.signal import lfilter, savgol_filter
+
+from tcbench.sensors.effects import play_operator
+from tcbench.sensors.recording import Recording
+
+MAD_TO_SIGMA = 1.4826
+GRID_S = 1.0  # clock of the lag filter and the play operator
+
+
+class DiagnosisDataError(ValueError):
+    """A recording that cannot be diagnosed (too short, constant temperature, ...)."""
+
+
+def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Value and slope (per s) of a least-squares line through ``x`` over ``t ± window_s / 2``
+    at every sample, by cumulative sums (O(n)); a window holding one sample keeps it."""
+    t0 = t_s - t_s.mean()
+    lo = np.searchsorted(t_s, t_s - 0.5 * window_s, side="left")
+    hi = np.searchsorted(t_s, t_s + 0.5 * window_s, side="right")
+
+    def window_sum(v: np.ndarray) -> np.ndarray:
+        c = np.concatenate(([0.0], np.cumsum(v)))
+        return c[hi] - c[lo]
+
+    n = (hi - lo).astype(float)
+    st, sx = window_sum(t0), window_sum(x)
+    stt, stx = window_sum(t0 * t0), window_sum(t0 * x)
+    var = stt - st * st / n
+    ok = var > 1e-9 * np.maximum(n, 1.0)
+    slope = np.where(ok, (stx - st * sx / n) / np.where(ok, var, 1.0), 0.0)
+    value = sx / n + slope * (t0 - st / n)
+    return value, slope
+
+
+def segments(t_s: np.ndarray) -> np.ndarray:
+    """Segment number per sample: a new segment starts after a gap of more than five median
+    sample intervals (a logger's bursts)."""
+    dt = np.diff(t_s)
+    return np.concatenate(([0], np.cumsum(dt > 5.0 * np.median(dt))))
+
+
+def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Smoothed thermometer and its rate (degC/s).
+
+    Inside a continuous segment at least ``window_s`` long: a local quadratic (Savitzky-Golay)
+    over ``window_s``, whose value has no bias where the profile bends (a local line would lag
+    by about T'' W^2 / 24 at every corner of a ramp). Segments shorter than that (bursts) take
+    the local line over ``window_s`` or, if wider, three segment spacings, which reaches across
+    the gaps.
+    """
+    seg = segments(t_s)
+    value = np.empty_like(temp_c)
+    rate = np.empty_like(temp_c)
+    starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
+    bounds = np.append(starts, t_s.size)
+    spacing = (t_s[-1] - t_s[0]) / max(starts.size, 1)
+    short_window = max(window_s, 3.0 * spacing) if starts.size > 1 else window_s
+    wide_value, wide_rate = local_linear(t_s, temp_c, short_window)
+    for a, b in pairwise(bounds):
+        n = b - a
+        fs = (n - 1) / max(t_s[b - 1] - t_s[a], 1e-12)
+        w = round(window_s * fs) | 1
+        if n >= w >= 5:
+            value[a:b] = savgol_filter(temp_c[a:b], w, 2, mode="interp")
+            rate[a:b] = savgol_filter(temp_c[a:b], w, 2, deriv=1, delta=1.0 / fs, mode="interp")
+        else:
+            value[a:b], rate[a:b] = wide_value[a:b], wide_rate[a:b]
+    return value, rate
+
+
+def on_grid(t_s: np.ndarray, x: np.ndarray, fn, grid_s: float = GRID_S) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Apply ``fn(x_grid, grid_s)`` to ``x`` resampled on a uniform clock, read back at ``t_s``."""
+    grid = np.arange(t_s[0], t_s[-1] + grid_s, grid_s)
+    return np.interp(t_s, grid, fn(np.interp(grid, t_s, x), grid_s))
+
+
+def lagged(t_s: np.ndarray, temp_c: np.ndarray, tau_s: float) -> np.ndarray:
+    """``temp_c`` through a first-order lag of ``tau_s`` (starting settled)."""
+
+    def lag(x: np.ndarray, dt: float) -> np.ndarray:
+        a = np.exp(-dt / tau_s)
+        return lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
+
+    return on_grid(t_s, temp_c, lag)
+
+
+def hysteresis_state(t_s: np.ndarray, temp_c: np.ndarray, width_c: float) -> np.ndarray:
+    """The play-operator state ``(T - play(T)) / width`` in [-1, 1]: +1 after heating, -1
+    after cooling (the regressor of the ``hysteresis`` effect)."""
+    return on_grid(t_s, temp_c, lambda x, dt: (x - play_operator(x, width_c)) / width_c)
+
+
+@dataclass(frozen=True)
+class DiagnosisData:
+    """One recording prepared for diagnosis (all arrays per sample).
+
+    ``temp_c`` the smoothed thermometer reading, ``rate_c_per_s`` its slope, ``input`` the
+    applied acceleration (g) or rate (deg/s), ``output`` in ``unit``; ``run_id`` numbers the runs
+    of constant input within a continuous segment; ``white_sigma`` the per-sample white-noise
+    standard deviation of the output from first differences inside those runs.
+    """
+
+    sensor: str
+    unit: str
+    t_s: np.ndarray
+    temp_raw_c: np.ndarray
+    temp_c: np.ndarray
+    rate_c_per_s: np.ndarray
+    input: np.ndarray
+    output: np.ndarray
+    run_id: np.ndarray
+    white_sigma: float
+    sample_rate_hz: float
+    smooth_s: float
+
+    @property
+    def n(self) -> int:
+        return int(self.t_s.size)
+
+    @property
+    def input_levels(self) -> int:
+        """How many distinct input values the recording holds (to 1e-6 of the largest)."""
+        scale = max(float(np.max(np.abs(self.input))), 1e-12)
+        return int(np.unique(np.round(self.input / scale, 6)).size)
+
+
+def prepare(
+    rec: Recording,
+    sensor: str | None = None,
+    *,
+    smooth_s: float = 120.0,
+    min_duration_s: float = 1800.0,
+    min_span_c: float = 2.0,
+    min_samples: int = 200,
+) -> DiagnosisData:
+    """Arrays for diagnosing ``rec``; ``sensor`` overrides the sidecar's kind.
+
+    Raises :class:`DiagnosisDataError` (one line) when the recording is shorter than
+    ``min_duration_s`` or ``min_samples``, its temperature spans less than ``min_span_c``, or
+    its output has no noise to measure.
+    """
+    kind = sensor or rec.meta.sensor
+    if kind not in ("msra", "gyro"):
+        raise DiagnosisDataError(f"unknown sensor {kind!r}; give sensor=msra or sensor=gyro")
+    t, temp, u, y = rec.time_s, rec.temperature_c, rec.input, rec.output
+    if t.size < min_samples or t[-1] - t[0] < min_duration_s:
+        raise DiagnosisDataError(
+            f"recording too short to identify anything: {t.size} samples over {t[-1] - t[0]:.0f} s "
+            f"(need at least {min_samples} samples over {min_duration_s:.0f} s)")
+    span = float(np.ptp(temp))
+    if span < min_span_c:
+        raise DiagnosisDataError(
+            f"temperature varies by only {span:.3g} degC (need at least {min_span_c:g} degC): "
+            "a temperature model cannot be identified at constant temperature")
+    gap = np.diff(segments(t)) > 0
+    changed = np.abs(np.diff(u)) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
+    run_id = np.concatenate(([0], np.cumsum(gap | changed)))
+    same = ~(gap | changed)
+    d = np.diff(y)[same]
+    if d.size < 10:
+        raise DiagnosisDataError("too few consecutive samples at constant input to measure the noise")
+    sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    if not sigma > 0:
+        raise DiagnosisDataError("the output has no sample-to-sample noise (constant or quantised to a few values)")
+    smooth, rate = smooth_temperature(t, temp, smooth_s)
+    units = rec.meta.units or {}
+    return DiagnosisData(
+        sensor=kind, unit=str(units.get("output", "Hz" if kind == "msra" else "deg/s")), t_s=t,
+        temp_raw_c=temp, temp_c=smooth, rate_c_per_s=rate, input=u, output=y, run_id=run_id,
+        white_sigma=sigma,
+        sample_rate_hz=float(rec.meta.sample_rate_hz or 1.0 / np.median(np.diff(t))), smooth_s=smooth_s,
+    )

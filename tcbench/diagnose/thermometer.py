@@ -1,0 +1,57 @@
+"""The thermometer's own noise, carried into the output through the model's temperature slope.
+
+A model driven by a noisy thermometer inherits its noise: after smoothing, what is left of it
+is slow (correlated over the smoothing window) and, multiplied by the output's temperature
+slope, can exceed the output's white noise at long averaging times. The diagnosis must not take
+that for flicker. :func:`propagated_noise` draws one realisation of it (fixed seed, so a
+diagnosis is repeatable) to widen the white-noise line of the Allan test.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tcbench.diagnose.design import Designer, Model
+from tcbench.diagnose.signals import lagged, smooth_temperature
+
+DELTA_C = 0.01  # step of the numerical temperature slope
+
+
+def thermometer_sigma(designer: Designer) -> float:
+    """Per-sample noise of the thermometer reading (degC): spread about its smoothed value."""
+    d = designer.data
+    return float(np.std(d.temp_raw_c - d.temp_c))
+
+
+def output_slope(designer: Designer, model: Model, beta: np.ndarray) -> np.ndarray:
+    """d(output)/dT of the fitted core at the model temperature, per sample (unit per degC)."""
+    temp = designer.temperature(model.lag_tau_s)
+    core = beta[: len(designer.core_names())]
+    up, down = designer.core(temp + DELTA_C) @ core, designer.core(temp - DELTA_C) @ core
+    return (up - down) / (2.0 * DELTA_C)
+
+
+def propagated_noise(designer: Designer, model: Model, beta: np.ndarray, seed: int = 0) -> np.ndarray:
+    """One realisation of the thermometer noise as the fitted model sees it (output unit)."""
+    d = designer.data
+    rng = np.random.default_rng(seed)
+    eps = smooth_temperature(d.t_s, rng.standard_normal(d.n) * thermometer_sigma(designer), d.smooth_s)[0]
+    if model.lag_tau_s:
+        eps = lagged(d.t_s, eps, model.lag_tau_s)
+    return output_slope(designer, model, beta) * eps
+
+
+def thermometer_variance(designer: Designer, model: Model, beta: np.ndarray, z: np.ndarray) -> float:
+    """Variance of ``z' e`` for ``e`` the thermometer noise the fitted model inherits
+    (``e = slope * lag(smooth(eps))``, eps white with the thermometer's sigma): the part of a
+    regressor ``z``'s score that is not output noise. Exact for a linear smoother and lag:
+    ``sigma_T^2 |smooth'(lag'(slope * z))|^2``, the transposes applied by reversing time."""
+    d = designer.data
+    sigma_t = thermometer_sigma(designer)
+    if sigma_t == 0:
+        return 0.0
+    w = output_slope(designer, model, beta) * z
+    if model.lag_tau_s:
+        w = lagged(d.t_s, w[::-1], model.lag_tau_s)[::-1]
+    w = smooth_temperature(d.t_s, w, d.smooth_s)[0]
+    return float(sigma_t**2 * (w @ w))

@@ -1,0 +1,92 @@
+"""A fitted sensor model: polynomial bias and scale factor in the die temperature, plus effects.
+
+The core of :class:`PolynomialModel` serves either sensor kind::
+
+    output = sum_j bias[j] u^j + input * sum_j scale_factor[j] u^j,   u = (T_die - centre_c) / half_range_c
+
+with ``input`` the acceleration along the sensitive axis in g (MSRA, output in Hz) or the
+applied rate in deg/s (gyroscope, output in deg/s). This is what ``tcbench diagnose`` fits to
+a recording and writes as a model file (:mod:`tcbench.diagnose.model_file`); the effects
+(lag, warm-up, noise, ...) are the same objects as in the physical models.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.polynomial import polynomial as npoly
+
+from tcbench.sensors import effects as fx
+from tcbench.sensors.models import SensorModel
+
+SENSORS = ("msra", "gyro")
+OUTPUT_UNITS = {"msra": "Hz", "gyro": "deg/s"}
+INPUT_UNITS = {"msra": "g", "gyro": "deg/s"}
+
+
+@dataclass(frozen=True)
+class PolynomialModel(SensorModel):
+    """Polynomial core in the normalised die temperature ``u`` (see the module docstring).
+
+    ``bias`` is in the output unit (Hz or deg/s) per power of ``u``; ``scale_factor`` in the
+    output unit per input unit (Hz/g or (deg/s)/(deg/s)) per power of ``u``. ``centre_c`` and
+    ``half_range_c`` are in degC; ``ref_c`` (the reference of effects such as
+    ``temperature_cubic``) is normally ``centre_c``.
+    """
+
+    sensor: str = "msra"
+    centre_c: float = 25.0
+    half_range_c: float = 50.0
+    bias: tuple[float, ...] = (0.0,)
+    scale_factor: tuple[float, ...] = (1.0,)
+
+    def __post_init__(self) -> None:
+        if self.sensor not in SENSORS:
+            raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join(SENSORS)}")
+        if not np.isfinite(self.centre_c):
+            raise ValueError(f"centre_c must be finite, got {self.centre_c!r}")
+        if not (np.isfinite(self.half_range_c) and self.half_range_c > 0):
+            raise ValueError(f"half_range_c must be a positive number, got {self.half_range_c!r}")
+        for name in ("bias", "scale_factor"):
+            values = tuple(float(v) for v in np.atleast_1d(getattr(self, name)))
+            if not values:
+                raise ValueError(f"{name} needs at least one coefficient")
+            if not all(np.isfinite(values)):
+                raise ValueError(f"{name} coefficients must be finite, got {values!r}")
+            object.__setattr__(self, name, values)
+        object.__setattr__(self, "centre_c", float(self.centre_c))
+        object.__setattr__(self, "half_range_c", float(self.half_range_c))
+
+    @property
+    def kind(self) -> str:  # type: ignore[override]
+        """The sensor kind, ``msra`` or ``gyro`` (checked against a protocol's)."""
+        return self.sensor
+
+    @property
+    def scale_factor_hz_per_g(self) -> float | None:
+        """Nominal MSRA scale factor at ``centre_c`` (Hz/g); None for a gyroscope."""
+        return self.scale_factor[0] if self.sensor == "msra" else None
+
+    def normalised(self, temp_c: np.ndarray) -> np.ndarray:
+        """``u = (T - centre_c) / half_range_c`` (dimensionless)."""
+        return (np.asarray(temp_c, dtype=float) - self.centre_c) / self.half_range_c
+
+    def bias_at(self, temp_c: np.ndarray) -> np.ndarray:
+        """Zero-input output at die temperature ``temp_c`` (degC), in the output unit."""
+        return npoly.polyval(self.normalised(temp_c), self.bias)
+
+    def scale_factor_at(self, temp_c: np.ndarray) -> np.ndarray:
+        """Scale factor at die temperature ``temp_c`` (degC), output unit per input unit."""
+        return npoly.polyval(self.normalised(temp_c), self.scale_factor)
+
+    def core(self, s: fx.Signals) -> np.ndarray:
+        u = self.normalised(s.temp_die_c)
+        applied = s.accel_g if self.sensor == "msra" else s.rate_dps
+        return npoly.polyval(u, self.bias) + applied * npoly.polyval(u, self.scale_factor)
+
+    def describe(self) -> dict[str, Any]:
+        core = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "effects"}
+        return {"model": "polynomial", **core, "effects": {e.id: e.params() for e in self.effects}}

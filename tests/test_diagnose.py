@@ -1,0 +1,136 @@
+"""tcbench diagnose: the API names what a recording hides, and the CLI writes a report or one error line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tcbench.cli import main
+from tcbench.diagnose.concealed import concealed_recording
+from tcbench.diagnose.crossval import block_folds, fit_cv
+from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.signals import (
+    DiagnosisDataError,
+    local_linear,
+    smooth_temperature,
+)
+from tcbench.sensors.recording import make_recording, write_recording
+from tcbench.sensors.thermal import first_order_lag
+
+
+@pytest.mark.parametrize(("sensor", "effect", "seed"), [
+    ("gyro", None, 5), ("msra", None, 6), ("gyro", "thermal_lag", 2), ("msra", "temperature_rate", 2),
+    ("gyro", "hysteresis", 4), ("msra", "accel_nonlinearity", 5), ("gyro", "bias_instability", 1),
+])
+def test_names_the_hidden_effect(sensor: str, effect: str | None, seed: int) -> None:
+    rec, truth = concealed_recording(sensor, effect, seed)
+    d = diagnose(rec)
+    assert d.effect_ids == ([effect] if effect else [])
+    assert d.final["rmse_heldout"] <= 1.15 * truth.white_sigma
+    assert d.final["rmse_heldout"] <= d.baseline["rmse_heldout"]
+
+
+def test_fitted_parameters_close_to_truth() -> None:
+    rec, truth = concealed_recording("gyro", "thermal_lag", 2)
+    found = diagnose(rec).effects[0]
+    assert found["params"]["tau_s"] == pytest.approx(truth.params["tau_s"], rel=0.25)
+    assert "lag" in found["explanation"]
+
+
+def test_declared_effect_is_not_found_again() -> None:
+    rec, truth = concealed_recording("gyro", "warmup", 3)
+    d = diagnose(rec, declared={"warmup": {"tau_s": truth.params["tau_s"]}})
+    assert d.effect_ids == []
+    assert d.baseline["model"] == ["minimal", "warmup"]
+
+
+def test_cross_validation_is_honest_about_overfitting() -> None:
+    rng = np.random.default_rng(0)
+    t = np.arange(4000.0)
+    y = rng.standard_normal(t.size)
+    fold = block_folds(t, 300.0, 5)
+    small = fit_cv(np.ones((t.size, 1)), y, fold, 5)
+    big = fit_cv(np.column_stack([np.ones(t.size), rng.standard_normal((t.size, 40))]), y, fold, 5)
+    assert big.sse_fit < small.sse_fit  # in-sample always improves
+    assert big.sse_heldout > small.sse_heldout  # held out it does not
+
+
+def test_smoothing_keeps_corners_and_handles_bursts() -> None:
+    t = np.arange(0.0, 7200.0)
+    true = first_order_lag(np.interp(t, [0, 1800, 3000, 7200], [20, 20, 40, 40]), 1.0, 180.0)  # a package
+    value, rate = smooth_temperature(t, true, 120.0)
+    line = local_linear(t, true, 120.0)[0]
+    assert np.max(np.abs(value - true)) < 0.01 < np.max(np.abs(line - true))  # no lag at the corners
+    assert rate[2900] == pytest.approx(np.gradient(true)[2900], rel=1e-3)
+    burst = np.concatenate([k * 300 + np.arange(0, 5, 0.02) for k in range(20)])
+    v, r = smooth_temperature(burst, 25 - burst / 3600, 120.0)
+    assert np.allclose(r, -1 / 3600, rtol=1e-6) and np.allclose(v, 25 - burst / 3600)
+
+
+def _cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    code = main(["diagnose", *args])
+    return code, capsys.readouterr().err
+
+
+def test_cli_writes_report_and_model_closes_the_loop(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec, _ = concealed_recording("gyro", "hysteresis", 4)
+    path = write_recording(rec, tmp_path / "rec.csv")
+    out = tmp_path / "report"
+    assert main(["diagnose", f"recording={path}", f"out={out}"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert [e["id"] for e in report["effects"]] == ["hysteresis"]
+    assert {"baseline", "mismatch", "effects", "final", "noise"} <= set(report)
+    assert {p.name for p in out.iterdir()} >= {"report.json", "report.md", "model.yaml", "residuals.png", "allan.png", "evidence.png"}
+    again = tmp_path / "again"
+    assert main(["diagnose", f"recording={path}", f"out={again}", f"model={out / 'model.yaml'}"]) == 0
+    assert json.loads((again / "report.json").read_text())["effects"] == []
+    sim = tmp_path / "sim"
+    assert main(["simulate", f"model={out / 'model.yaml'}", "protocol=oven", f"out={sim}", "metrics=false",
+                 "protocol_params.sample_rate_hz=1"]) == 0
+
+
+def _flat(tmp_path: Path, hours: float, span_c: float) -> Path:
+    t = np.arange(0.0, hours * 3600.0)
+    rng = np.random.default_rng(1)
+    rec = make_recording(t, 25.0 + span_c * t / t[-1], np.zeros_like(t), rng.standard_normal(t.size) * 0.01,
+                         sensor="gyro", sample_rate_hz=1.0, device_id="x")
+    return write_recording(rec, tmp_path / "flat.csv")
+
+
+@pytest.mark.parametrize(("hours", "span", "words"), [
+    (0.2, 10.0, "too short"), (3.0, 0.0, "temperature varies by only"),
+])
+def test_cli_bad_recordings(tmp_path: Path, capsys: pytest.CaptureFixture[str], hours: float, span: float, words: str) -> None:
+    path = _flat(tmp_path, hours, span)
+    code, err = _cli([f"recording={path}", f"out={tmp_path / 'out'}"], capsys)
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_unknown_effect_in_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec, _ = concealed_recording("gyro", None, 5)
+    path = write_recording(rec, tmp_path / "rec.csv")
+    model = tmp_path / "model.yaml"
+    model.write_text("tcbench_model: 1\nsensor: gyro\ncore: {kind: polynomial, centre_c: 20, half_range_c: 10, "
+                     "bias: [0.0], scale_factor: [1.0]}\neffects: {magnetic_creep: {k: 1}}\n")
+    code, err = _cli([f"recording={path}", f"out={tmp_path / 'out'}", f"model={model}"], capsys)
+    assert code == 2 and "magnetic_creep" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_missing_sensor_and_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, err = _cli([f"recording={tmp_path / 'nope.csv'}"], capsys)
+    assert code == 2 and "nope.csv" in err
+    code, err = _cli([], capsys)
+    assert code == 2 and "recording=PATH" in err
+
+
+def test_too_short_api() -> None:
+    t = np.arange(100.0)
+    rec = make_recording(t, t / 10, np.zeros_like(t), np.random.default_rng(0).standard_normal(100),
+                         sensor="gyro", sample_rate_hz=1.0, device_id="x")
+    with pytest.raises(DiagnosisDataError, match="too short"):
+        diagnose(rec)
