@@ -47,3 +47,22 @@ def test_deterministic_and_bad_input() -> None:
                        ((t[:50], temp[:50], r[:50]), "100")]:
         with pytest.raises(ValueError, match=word):
             locate(*args, None)
+
+
+def test_known_coloured_noise_is_not_a_mismatch() -> None:
+    t, temp = _profile()
+    rng = np.random.default_rng(3)
+    kernel = np.ones(120) / np.sqrt(120)  # slow noise, like a smoothed thermometer seen through a slope
+    slow = np.convolve(rng.standard_normal(N + 119), kernel, mode="valid") * 0.6
+    r = rng.standard_normal(N) + slow
+    assert locate(t, temp, r, 1.0)  # a white-noise test takes it for a mismatch
+    model = np.convolve(np.random.default_rng(4).standard_normal(N + 119), kernel, mode="valid") * 0.6
+    assert not locate(t, temp, r, 1.0, coloured=model)
+
+
+def test_bursts_get_no_allan_finding() -> None:
+    t = np.concatenate([k * 300.0 + np.arange(0, 60.0, 0.5) for k in range(60)])
+    temp = 25.0 - t / 3600.0
+    rng = np.random.default_rng(5)
+    r = rng.standard_normal(t.size) + np.repeat(rng.standard_normal(60) * 0.05, 120)
+    assert not any(m.what.startswith("low-frequency") for m in locate(t, temp, r, 1.0))

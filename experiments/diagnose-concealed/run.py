@@ -75,6 +75,13 @@ def confusion(df: pd.DataFrame) -> pd.DataFrame:
     return table.reindex(index=order, columns=cols, fill_value=0)
 
 
+def markdown_table(table: pd.DataFrame) -> str:
+    head = ["hidden \\ named", *map(str, table.columns)]
+    rows = [[str(i), *(str(v) if v else "" for v in r)] for i, r in zip(table.index, table.to_numpy(), strict=True)]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in rows]) + "\n"
+
+
 def plot_confusion(table: pd.DataFrame, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(1.0 + 0.75 * table.shape[1], 0.9 + 0.45 * table.shape[0]))
     ax.imshow(table.to_numpy(), cmap="Blues")
@@ -147,7 +154,7 @@ def main() -> None:
     df = pd.DataFrame(rows)
     df.to_csv(out / "results.csv", index=False, float_format="%.6g")
     table = confusion(df)
-    (out / "confusion.md").write_text(table.to_markdown() + "\n")
+    (out / "confusion.md").write_text(markdown_table(table))
     plot_confusion(table, out / "confusion.png")
     text = summary(df, elapsed)
     (out / "summary.md").write_text(text)

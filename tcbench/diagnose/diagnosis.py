@@ -23,12 +23,15 @@ from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.explain import explain
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
 from tcbench.diagnose.signals import DiagnosisData, prepare
-from tcbench.diagnose.thermometer import propagated_noise
+from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
 log = logging.getLogger(__name__)
 FALSE_ALARM = 0.01  # of the mismatch scan and of the flicker test
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
+TIME_EFFECTS = ("warmup", "aging_drift")  # what a slow random excursion of the bias can mimic
+FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every power-on and ageing keeps "
+                "its sign, a flicker excursion does neither")
 
 
 @dataclass
@@ -53,6 +56,7 @@ class Diagnosis:
     recording: str
     baseline: dict[str, Any]
     mismatch: list[Mismatch]
+    remaining: list[Mismatch]
     effects: list[dict[str, Any]]
     final: dict[str, Any]
     noise: dict[str, float]
@@ -68,19 +72,24 @@ class Diagnosis:
 
     @property
     def verdict(self) -> str:
-        """One line: nothing missing, or which effects."""
+        """One line: nothing missing, which effects, and whether a mismatch remains unexplained."""
+        rest = ("a mismatch remains that no effect of the library explains on this recording "
+                f"({len(self.remaining)} region(s) or band(s), see remaining_mismatch)")
         if not self.effects:
+            if self.remaining:
+                return f"no effect of the library found, but {rest}"
             return "nothing missing: the residual of the starting model is consistent with its noise"
         named = ", ".join(self.effect_ids)
         pairs = "; ".join(f"{c['effects'][0]} cannot be told from {c['effects'][1]}" for c in self.confusable)
-        return f"missing: {named}" + (f" ({pairs})" if pairs else "")
+        return f"missing: {named}" + (f" ({pairs})" if pairs else "") + (f"; {rest}" if self.remaining else "")
 
     def to_json(self) -> dict[str, Any]:
         """``report.json``: plain JSON data."""
         return {
             "sensor": self.sensor, "unit": self.unit, "recording": self.recording,
             "verdict": self.verdict, "baseline": self.baseline,
-            "mismatch": [m.to_dict() for m in self.mismatch], "effects": self.effects,
+            "mismatch": [m.to_dict() for m in self.mismatch],
+            "remaining_mismatch": [m.to_dict() for m in self.remaining], "effects": self.effects,
             "final": self.final, "noise": self.noise,
             "candidates": [_evidence_json(e) for e in self.candidates],
             "confusable": self.confusable,
@@ -153,6 +162,21 @@ def _flicker(
     return ex, float(excess[ex.first_over:].max() / FLICKER_FLOOR)
 
 
+def _flicker_evidence(allan: AllanExcess | None, b: float | None, declared: bool) -> Evidence:
+    """How ``bias_instability`` fared; for a kept one ``gain`` is the Allan ratio at the first
+    flagged tau and ``threshold`` its bound."""
+    effect = "bias_instability"
+    if declared:
+        return Evidence(effect, "in the model", reason="declared in the starting model")
+    if allan is None:
+        return Evidence(effect, "not identifiable", reason="no Allan deviation: the recording is too short or made of bursts")
+    if b is None or allan.first_over is None:
+        return Evidence(effect, "rejected", reason="the residual's Allan deviation follows the white-noise line")
+    k = allan.first_over
+    return Evidence(effect, "kept", float(allan.adev[k] / allan.white[k]), float(allan.bound[k]),
+                    reason=f"Allan deviation above the white line from tau = {allan.tau_s[k]:.4g} s")
+
+
 def diagnose(
     rec: Recording,
     *,
@@ -172,8 +196,9 @@ def diagnose(
     att = attribute(designer, base, threshold=threshold)
     n = data.n
     before, after = att.base_fit.heldout_residual, att.final_fit.heldout_residual
-    mismatch = locate(data.t_s, data.temp_c, before, data.white_sigma, FALSE_ALARM)
-    allan_before, _ = _flicker(data, before, propagated_noise(designer, att.base, att.base_fit.beta))
+    thermo_before = propagated_noise(designer, att.base, att.base_fit.beta)
+    mismatch = locate(data.t_s, data.temp_c, before, data.white_sigma, FALSE_ALARM, coloured=thermo_before)
+    allan_before, _ = _flicker(data, before, thermo_before)
     allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
     if b is not None and len(att.final.ids) > len(base.ids):
         rechecked = recheck_with_flicker(att, b)
@@ -181,37 +206,29 @@ def diagnose(
             att = rechecked
             after = att.final_fit.heldout_residual
             allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
+    thermo_after = propagated_noise(designer, att.final, att.final_fit.beta)
+    remaining = locate(data.t_s, data.temp_c, after, data.white_sigma, FALSE_ALARM, coloured=thermo_after)
+    if b is not None:  # flicker is named: its slow excess is explained, not a remaining mismatch
+        remaining = [m for m in remaining if not m.what.startswith("low-frequency")]
     core, fitted = _physical(att)
     found = [e for e in att.final.ids if e not in base.ids]
     evidence = att.evidence
-    for effect in found:
-        evidence[effect].reason = "dropping it costs more held-out error than chance allows"
-    effects_out = [
-        {"id": e, "params": fitted[e],
-         "evidence": {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold)},
-         "explanation": explain(e, fitted[e], data.unit),
-         **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})}
-        for e in found
-    ]
-    if "bias_instability" in declared:
-        evidence["bias_instability"] = Evidence("bias_instability", "in the model", reason="declared in the starting model")
-    elif allan_after is None:
-        evidence["bias_instability"] = Evidence("bias_instability", "not identifiable",
-                                                reason="no Allan deviation: the recording is too short or made of bursts")
-    elif b is None:
-        evidence["bias_instability"] = Evidence("bias_instability", "rejected",
-                                                reason="the residual's Allan deviation follows the white-noise line")
-    else:
-        k = allan_after.first_over
-        assert k is not None
-        ratio = float(allan_after.adev[k] / allan_after.white[k])
-        evidence["bias_instability"] = Evidence("bias_instability", "kept", ratio, float(allan_after.bound[k]),
-                                                reason=f"Allan deviation above the white line from tau = {allan_after.tau_s[k]:.4g} s")
+    effects_out = []
+    for e in found:
+        evidence[e].reason = "dropping it costs more held-out error than chance allows"
+        ev = {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold),
+              "robust_wald": round(float(evidence[e].wald), 2)}
+        effects_out.append({"id": e, "params": fitted[e], "evidence": ev, "explanation": explain(e, fitted[e], data.unit),
+                            **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})})
+    evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared)
+    confusable = [{"effects": [a, b_], "test": test} for a, b_, test in att.confusions if a in found]
+    if b is not None and "bias_instability" not in declared:
         effects_out.append({
             "id": "bias_instability", "params": {"b": b},
-            "evidence": {"allan_ratio": ratio, "bound": float(allan_after.bound[k]), "tau_s": float(allan_after.tau_s[k])},
+            "evidence": {"allan_ratio": evidence["bias_instability"].gain, "bound": evidence["bias_instability"].threshold},
             "explanation": explain("bias_instability", {"b": b}, data.unit)})
         fitted["bias_instability"] = {"b": b}
+        confusable += [{"effects": [e, "bias_instability"], "test": FLICKER_TEST} for e in found if e in TIME_EFFECTS]
     for effect, params in declared.items():
         fitted.setdefault(effect, dict(params))
     fitted["white_noise"] = {"density": data.white_sigma / np.sqrt(data.sample_rate_hz)}
@@ -220,12 +237,13 @@ def diagnose(
         sensor=data.sensor, unit=data.unit, recording=name,
         baseline={"rmse_fit": _rmse(att.base_fit.sse_fit, n), "rmse_heldout": _rmse(att.base_fit.sse_heldout, n),
                   "model": ["minimal", *base.ids]},
-        mismatch=mismatch, effects=effects_out,
+        mismatch=mismatch, remaining=remaining, effects=effects_out,
         final={"rmse_fit": _rmse(att.final_fit.sse_fit, n), "rmse_heldout": _rmse(att.final_fit.sse_heldout, n),
                "model": ["minimal", *att.final.ids]},
-        noise={"white_sigma": data.white_sigma, "samples": n, "folds": att.k},
+        noise={"white_sigma": data.white_sigma, "thermometer_sigma_c": thermometer_sigma(designer),
+               "samples": n, "folds": att.k},
         candidates=[evidence[e] for e in (*DETERMINISTIC, "bias_instability") if e in evidence],
-        confusable=[{"effects": [a, b_], "test": test} for a, b_, test in att.confusions if a in found],
+        confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
     )

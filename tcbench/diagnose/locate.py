@@ -232,10 +232,13 @@ def _lag1(r: np.ndarray) -> float:
 
 def _group_tests(
     t: np.ndarray, temp: np.ndarray, r: np.ndarray, alpha: float, band_c: float,
-    rate_eps_c_per_s: float, rate_window_s: float,
+    rate_eps_c_per_s: float, rate_window_s: float, inflation: float = 1.0,
 ) -> list[Mismatch]:
+    """Heating vs cooling and soak vs ramp; ``inflation`` (>= 1) is the variance of a window
+    mean over its white-noise value, from known coloured noise, when it exceeds lag-1's."""
     rate = _rate_c_per_s(t, temp, rate_window_s)
     rho = _lag1(r)
+    rho = max(rho, (inflation - 1.0) / (inflation + 1.0))  # (1 - rho) / (1 + rho) = 1 / inflation
     z_thr = float(norm.isf(alpha / 2.0))
     tests = (
         ("heating vs cooling", rate > rate_eps_c_per_s, rate < -rate_eps_c_per_s),
@@ -292,8 +295,13 @@ def allan_excess(
     return AllanExcess(ad.tau_s, ad.adev, white, np.sqrt(bound), int(over[0]) if over.size else None)
 
 
-def _frequency_band(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool) -> list[Mismatch]:
-    ex = allan_excess(t, r, sigma, alpha, estimated)
+def _frequency_band(
+    t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool, coloured: np.ndarray | None = None
+) -> list[Mismatch]:
+    dt = np.diff(t)
+    if dt.max() > 5.0 * np.median(dt):  # bursts: an Allan deviation across gaps means nothing
+        return []
+    ex = allan_excess(t, r, sigma, alpha, estimated, coloured)
     if ex is None or ex.first_over is None:
         return []
     k = ex.first_over
@@ -312,6 +320,7 @@ def locate(
     band_c: float = 5.0,
     rate_eps_c_per_s: float = 0.05 / 60.0,
     rate_window_s: float = 60.0,
+    coloured: np.ndarray | None = None,
 ) -> list[Mismatch]:
     """Departures of ``residual`` (any unit) from white noise of per-sample sigma ``white_sigma``
     (same unit; None: estimated robustly), at time ``t_s`` (s) and temperature ``temp_c`` (°C).
@@ -320,7 +329,9 @@ def locate(
     ``window_s`` is the time-scan window, ``band_c`` the temperature bin, ``rate_eps_c_per_s``
     (°C/s, default 0.05 °C/min) the dT/dt that separates soak from ramp, dT/dt taken over
     ``rate_window_s``. Findings come in family order: time spans, temperature bands, heating vs
-    cooling, soak vs ramp, frequency band. Raises ValueError for non-finite values, unequal
+    cooling, soak vs ramp, frequency band. ``coloured`` is one realisation of a known non-white
+    noise in the residual (e.g. a thermometer's, carried through the model): the scans widen
+    sigma by its variance over a window, the frequency test adds its Allan variance. Raises ValueError for non-finite values, unequal
     lengths, fewer than 100 samples or non-increasing ``t_s``.
     """
     t, temp, r = _check(t_s, temp_c, residual, white_sigma, false_alarm)
@@ -329,9 +340,14 @@ def locate(
     if not sigma > 0:
         raise ValueError("residual has zero white-noise sigma (constant first differences)")
     alpha = _sidak(false_alarm, N_FAMILIES)
+    scan_sigma = sigma
+    if coloured is not None:
+        window = np.floor((t - t[0]) / window_s).astype(np.int64)
+        sums, counts = np.bincount(window, coloured), np.bincount(window)
+        scan_sigma = float(np.sqrt(sigma**2 + np.mean(sums**2) / np.mean(counts)))
     return [
-        *_time_spans(t, r, sigma, alpha, window_s),
-        *_temperature_bands(t, temp, r, sigma, alpha, band_c),
-        *_group_tests(t, temp, r, alpha, band_c, rate_eps_c_per_s, rate_window_s),
-        *_frequency_band(t, r, sigma, alpha, estimated),
+        *_time_spans(t, r, scan_sigma, alpha, window_s),
+        *_temperature_bands(t, temp, r, scan_sigma, alpha, band_c),
+        *_group_tests(t, temp, r, alpha, band_c, rate_eps_c_per_s, rate_window_s, (scan_sigma / sigma) ** 2),
+        *_frequency_band(t, r, sigma, alpha, estimated, coloured),
     ]

@@ -107,6 +107,14 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     else:
         out.append("No region departs from white noise.")
     out.append("")
+    if d.remaining:
+        out += ["## What remains after the refit", "",
+                ("The final model's held-out residual still departs from noise here; no effect of the library "
+                 "explains it beyond chance on this recording:"), ""]
+        out += _table(["from (h)", "to (h)", "what", "statistic", "threshold"],
+                      ([_g((m.t_start_s - t0) / 3600.0, 3), _g((m.t_end_s - t0) / 3600.0, 3), m.what,
+                        _g(m.statistic, 3), _g(m.threshold, 3)] for m in d.remaining))
+        out.append("")
 
     out += ["## Effects found", ""]
     if not d.effects:
