@@ -37,7 +37,8 @@ FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every 
 @dataclass
 class Series:
     """Per-sample arrays behind the plots: time, thermometer (smoothed), the held-out residual of
-    the starting and of the final model, and their Allan deviations against the white line."""
+    the starting and of the final model, and the Allan deviations of their in-sample residuals
+    against the white (plus thermometer) noise line."""
 
     t_s: np.ndarray
     temp_c: np.ndarray
@@ -198,14 +199,17 @@ def diagnose(
     before, after = att.base_fit.heldout_residual, att.final_fit.heldout_residual
     thermo_before = propagated_noise(designer, att.base, att.base_fit.beta)
     mismatch = locate(data.t_s, data.temp_c, before, data.white_sigma, FALSE_ALARM, coloured=thermo_before)
-    allan_before, _ = _flicker(data, before, thermo_before)
-    allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
+    # The Allan test reads the in-sample residual: a held-out one carries each fold's
+    # coefficient error, constant over its 15-min blocks, which looks like slow noise.
+    allan_before, _ = _flicker(data, att.base_fit.residual, thermo_before)
+    allan_after, b = _flicker(data, att.final_fit.residual, propagated_noise(designer, att.final, att.final_fit.beta))
     if b is not None and len(att.final.ids) > len(base.ids):
         rechecked = recheck_with_flicker(att, b)
         if rechecked is not att:
             att = rechecked
             after = att.final_fit.heldout_residual
-            allan_after, b = _flicker(data, after, propagated_noise(designer, att.final, att.final_fit.beta))
+            allan_after, b = _flicker(data, att.final_fit.residual,
+                                      propagated_noise(designer, att.final, att.final_fit.beta))
     thermo_after = propagated_noise(designer, att.final, att.final_fit.beta)
     remaining = locate(data.t_s, data.temp_c, after, data.white_sigma, FALSE_ALARM, coloured=thermo_after)
     if b is not None:  # flicker is named: its slow excess is explained, not a remaining mismatch
