@@ -134,3 +134,18 @@ def test_too_short_api() -> None:
                          sensor="gyro", sample_rate_hz=1.0, device_id="x")
     with pytest.raises(DiagnosisDataError, match="too short"):
         diagnose(rec)
+
+
+def test_one_way_steps_without_soak_cannot_separate_lag_from_rate() -> None:
+    """Steps down held one minute each: the lag never shows its tail in a soak, so the report
+    must say a gradient term would do as well, and name the test that would tell."""
+    from tcbench.sensors.simulate import simulate_recording
+
+    others = ("temperature_cubic", "temperature_rate", "bias_instability", "quantisation")
+    rec = simulate_recording("gyro", "oven", 1, 2, effects={"thermal_lag": {"tau_s": 400.0}}, without=others,
+                             sample_rate_hz=1.0, hold_s=60.0, room_s=600.0)
+    d = diagnose(rec)
+    assert d.effect_ids == ["thermal_lag"]
+    pairs = {tuple(c["effects"]): c["test"] for c in d.confusable}
+    assert "soak" in pairs[("thermal_lag", "temperature_rate")]
+    assert "cannot be told from temperature_rate" in d.verdict
