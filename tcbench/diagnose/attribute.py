@@ -2,15 +2,19 @@
 
 Each round tries every effect not yet in the model at every value of its grid, scoring
 
-    gain = (SSE_heldout(model) - SSE_heldout(model + effect)) / sigma^2 - 2 * extra parameters
+    gain = (SSE_heldout(model) - SSE_heldout(model + effect)) / v - 2 * extra parameters
 
-(``sigma`` the per-sample white noise; the held-out SSE comes from blocked cross-validation, the
+(the held-out SSE from blocked cross-validation; ``v`` the variance of the noise along the
+added signal: white output noise plus the thermometer's noise carried through the model; the
 ``2`` per parameter is Akaike's penalty). The effect with the largest gain is kept when its gain
-exceeds ``threshold``, which is calibrated on recordings with nothing missing
-(``experiments/diagnose-concealed/calibrate.py``), and its nonlinear parameter is then refined
-between its grid neighbours. After the forward pass each kept effect must still earn its
-place (dropping it must cost more than the threshold). Pairs that look alike (PHYSICS.md §3)
-are tested by swapping one for the other: when the swap costs less than the threshold the
+exceeds ``threshold`` and a Wald statistic with a variance robust to slow noise (cluster scores
+with Bartlett-weighted neighbours, never above the known-noise Wald) exceeds
+``wald_threshold``; both are checked on recordings with nothing missing
+(``experiments/diagnose-concealed/calibrate.py``). Its nonlinear parameter is then refined
+between its grid neighbours. After the forward pass each kept effect must still earn its place,
+and when the residual turns out to hold flicker, :func:`recheck_with_flicker` tests the kept
+effects again with that flicker in the noise model. Pairs that look alike (PHYSICS.md §3) are
+tested by swapping one for the other: when the swap costs less than the threshold the
 recording cannot tell them apart, and the report says which test would.
 """
 
