@@ -27,7 +27,7 @@ NSGA-II reference code of Deb, Pratap, Agarwal & Meyarivan, IEEE TEC 6(2), 2002)
   ``y' = y + delta_q (hi - lo)``; ``delta_q`` lies in ``[-delta1, delta2]``, so ``y'`` stays in
   the bounds. Each variable mutates with probability ``mutation_prob`` (default ``1/d``).
 
-Survival (the choice stated in the brief):
+Survival:
 
 - *One objective*: generational replacement with elitism. The ``elite`` best parents survive
   unchanged and ``population - elite`` children replace the others, so a generation costs
