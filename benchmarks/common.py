@@ -53,6 +53,7 @@ class BestRun(Run, Protocol):
 
 R = TypeVar("R", bound=Run)
 B = TypeVar("B", bound=BestRun)
+T = TypeVar("T")
 
 
 # --- command line ---------------------------------------------------------------------------
@@ -309,6 +310,26 @@ def best_time_s(fn: Callable[[], object], repeats: int) -> float:
         fn()
         best = min(best, time.perf_counter() - t0)
     return best
+
+
+def wall_times_s(fn: Callable[[], T], repeats: int) -> tuple[list[float], T]:
+    """All ``repeats`` wall times of ``fn()`` (s) and its last return value."""
+    times: list[float] = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        value = fn()
+        times.append(time.perf_counter() - t0)
+    return times, value
+
+
+def blas_threads() -> str:
+    """``library version (api) N threads`` for every thread pool loaded (threadpoolctl)."""
+    from threadpoolctl import threadpool_info
+
+    return "; ".join(
+        f"{p['internal_api']} {p.get('version')} ({p['user_api']}) {p['num_threads']} threads"
+        for p in threadpool_info()
+    )
 
 
 def objective_seconds(fn: Callable[[Any], object], x: Any, calls: int, repeats: int) -> float:

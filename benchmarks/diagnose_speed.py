@@ -12,12 +12,19 @@ flicker test) and the report (JSON, markdown, model.yaml, three plots) separatel
 from __future__ import annotations
 
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
-from common import add_json, command_line, environment, environment_line, parser_for, write_json
-from threadpoolctl import threadpool_info
+from common import (
+    add_json,
+    blas_threads,
+    command_line,
+    environment,
+    environment_line,
+    parser_for,
+    wall_times_s,
+    write_json,
+)
 
 DEFAULT_JSON = Path(__file__).with_name("diagnose_speed.json")
 HOURS = 15.0
@@ -47,22 +54,16 @@ def main() -> None:
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.report import write_report
 
-    blas = ", ".join(f"{i['internal_api']} {i['version']} ({i['num_threads']} threads)" for i in threadpool_info())
+    blas = blas_threads()
     env = environment("scipy")
     print(f"Command: `{command_line()}`\n\n{environment_line(env, 'scipy ' + str(env['scipy']))} BLAS: {blas}.\n")
     print("| recording | samples | diagnose (s) | report (s) | found |\n|---|---:|---:|---:|---|")
     results = {}
     for sensor in ("msra", "gyro"):
         rec = recording(sensor)
-        times, report_times = [], []
-        for _ in range(args.repeats):
-            t0 = time.perf_counter()
-            d = diagnose(rec, name=f"{sensor} 15 h")
-            times.append(time.perf_counter() - t0)
-            with tempfile.TemporaryDirectory() as tmp:
-                t0 = time.perf_counter()
-                write_report(d, Path(tmp) / "out")
-                report_times.append(time.perf_counter() - t0)
+        times, d = wall_times_s(lambda rec=rec, sensor=sensor: diagnose(rec, name=f"{sensor} 15 h"), args.repeats)
+        with tempfile.TemporaryDirectory() as tmp:
+            report_times, _ = wall_times_s(lambda d=d, tmp=tmp: write_report(d, Path(tmp) / "out"), args.repeats)
         results[sensor] = {"samples": int(rec.time_s.size), "diagnose_s": min(times), "report_s": min(report_times),
                            "all_diagnose_s": times, "found": d.effect_ids}
         print(f"| {sensor} | {rec.time_s.size} | {min(times):.1f} | {min(report_times):.1f} | {', '.join(d.effect_ids) or 'nothing'} |")

@@ -25,14 +25,13 @@ Usage::
 from __future__ import annotations
 
 import statistics
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import antropy
 import numpy as np
 from common import (
     add_json,
+    blas_threads,
     command_line,
     environment,
     environment_line,
@@ -40,10 +39,10 @@ from common import (
     progress,
     table_head,
     table_row,
+    wall_times_s,
     write_json,
 )
 from EntropyHub import FuzzEn
-from threadpoolctl import threadpool_info
 
 from tcbench.signal.entropy import fuzzy_entropy, permutation_entropy, sample_entropy
 
@@ -55,17 +54,6 @@ def make_signal(n: int, seed: int = 0) -> np.ndarray:
     """Unit white noise plus a linear drift from 0 to :data:`DRIFT`, float64."""
     rng = np.random.default_rng(seed)
     return rng.standard_normal(n) + np.linspace(0.0, DRIFT, n)
-
-
-def median_time_s(fn: Callable[[], float], repeats: int) -> tuple[float, list[float], float]:
-    """Median and all of ``repeats`` wall times of ``fn()``, and its last value."""
-    times = []
-    value = float("nan")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        value = float(fn())
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), times, value
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -94,9 +82,11 @@ def main(argv: list[str] | None = None) -> int:
     ]
     rows = []
     for name, peer, peer_repeats, ours, theirs in cases:
-        t_ours, ours_all, v_ours = median_time_s(ours, args.repeats)
+        ours_all, v_ours = wall_times_s(ours, args.repeats)
+        t_ours = statistics.median(ours_all)
         progress(f"{name}: tcbench {t_ours:.4f} s")
-        t_peer, peer_all, v_peer = median_time_s(theirs, peer_repeats)
+        peer_all, v_peer = wall_times_s(theirs, peer_repeats)
+        t_peer = statistics.median(peer_all)
         progress(f"{name}: {peer} {t_peer:.4f} s")
         rows.append({
             "entropy": name, "peer": peer, "tcbench_s": t_ours, "peer_s": t_peer,
@@ -107,8 +97,7 @@ def main(argv: list[str] | None = None) -> int:
         })
 
     env = environment("antropy", "EntropyHub", "numba", "threadpoolctl")
-    pools = [{k: p.get(k) for k in ("user_api", "internal_api", "num_threads", "version")}
-             for p in threadpool_info()]
+    blas = blas_threads() or "none"
     command = command_line(argv)
     print(f"## Entropy vs antropy and EntropyHub ({args.samples} samples)\n")
     print(f"Command: `{command}`\n")
@@ -127,7 +116,6 @@ def main(argv: list[str] | None = None) -> int:
             f"{r['ratio_peer_over_tcbench']:.1f}x", f"{r['tcbench_value']:.6f}",
             f"{r['abs_diff']:.1e}",
         ]))
-    blas = ", ".join(f"{p['internal_api']} {p['num_threads']} threads" for p in pools) or "none"
     print(f"\nBLAS thread pools (threadpoolctl): {blas}. All three tcbench entropies are "
           "single-threaded numpy.\n")
     print(environment_line(env, f"antropy {env['antropy']} (numba {env['numba']}), "
@@ -135,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     write_json(args.json, {
         "benchmark": "entropy_vs_peers", "samples": args.samples, "seed": 0, "drift": DRIFT,
         "repeats": args.repeats, "peer_repeats": args.peer_repeats, "command": command,
-        "environment": env, "threadpools": pools, "rows": rows,
+        "environment": env, "threadpools": blas, "rows": rows,
     })
     return 0
 

@@ -27,13 +27,13 @@ Usage::
 from __future__ import annotations
 
 import statistics
-import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 from common import (
     add_json,
+    blas_threads,
     command_line,
     environment,
     environment_line,
@@ -42,9 +42,9 @@ from common import (
     progress,
     table_head,
     table_row,
+    wall_times_s,
     write_json,
 )
-from threadpoolctl import threadpool_info
 from vmdpy import VMD
 
 from tcbench.signal.vmd import vmd
@@ -78,24 +78,6 @@ def run_vmdpy(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
     return u[order], omega[-1][order], int(omega.shape[0])
 
 
-def median_time_s(fn: Callable[[], object], repeats: int) -> float:
-    """Median of ``repeats`` wall times of ``fn()``."""
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
-
-
-def blas_threads() -> str:
-    """``library (api) N threads`` for every thread pool numpy loaded."""
-    return "; ".join(
-        f"{p['internal_api']} {p.get('version')} ({p['user_api']}) {p['num_threads']} threads"
-        for p in threadpool_info()
-    )
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = parser_for(__doc__)
     parser.add_argument("--samples", type=int, default=20_000)
@@ -124,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     seconds = {}
     for name, fn in runs.items():
-        seconds[name] = median_time_s(fn, args.repeats)
+        seconds[name] = statistics.median(wall_times_s(fn, args.repeats)[0])
         progress(f"{name}: median {seconds[name]:.3f} s")
     peaks = {}
     for name, fn in runs.items():  # memory in a separate pass: tracing slows the calls down

@@ -24,7 +24,6 @@ deviation (:mod:`tcbench.diagnose.attribute`).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
@@ -160,5 +159,3 @@ def grid_values(effect: str) -> list[float | None]:
     """Values of the nonlinear parameter searched for ``effect`` (``[None]`` if it has none)."""
     return list(GRIDS[effect]) if effect in GRIDS else [None]
 
-
-Scorer = Callable[[Model], float]

@@ -153,9 +153,6 @@ def _flicker(
 ) -> tuple[AllanExcess | None, float | None]:
     """Allan test of a residual against white noise plus the ``thermometer`` noise the model
     inherits; the flicker coefficient ``b`` when it flattens above both."""
-    dt = np.diff(data.t_s)
-    if dt.max() > 1.5 * np.median(dt):  # bursts: no Allan deviation across the gaps
-        return None, None
     ex = allan_excess(data.t_s, residual, data.white_sigma, FALSE_ALARM, estimated=True, coloured=thermometer)
     if ex is None or ex.first_over is None:
         return ex, None

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 from scipy.stats import chi2, norm
 
+from tcbench.diagnose.signals import segments
 from tcbench.signal.allan import allan_deviation
 
 MIN_SAMPLES = 100
@@ -273,12 +274,13 @@ def allan_excess(
     coloured: np.ndarray | None = None,
 ) -> AllanExcess | None:
     """The frequency-band test (module doc) at level ``alpha``; None when the residual is too
-    short for tau >= 10 samples at N / 10. ``coloured`` is a known non-white noise (one
+    short for tau >= 10 samples at N / 10, or made of bursts (an Allan deviation across gaps
+    means nothing). ``coloured`` is a known non-white noise (one
     realisation, per sample) whose Allan variance is added to the white line."""
     n = r.size
     fs = (n - 1) / (t[-1] - t[0])
     m_max = min(n // 10, (n - 1) // 2)
-    if m_max < MIN_ALLAN_M:
+    if m_max < MIN_ALLAN_M or segments(t)[-1] > 0:
         return None
     m = MIN_ALLAN_M * 2 ** np.arange(int(np.log2(m_max / MIN_ALLAN_M)) + 1)
     ad = allan_deviation(r, fs, m / fs)
@@ -298,9 +300,6 @@ def allan_excess(
 def _frequency_band(
     t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool, coloured: np.ndarray | None = None
 ) -> list[Mismatch]:
-    dt = np.diff(t)
-    if dt.max() > 5.0 * np.median(dt):  # bursts: an Allan deviation across gaps means nothing
-        return []
     ex = allan_excess(t, r, sigma, alpha, estimated, coloured)
     if ex is None or ex.first_over is None:
         return []
