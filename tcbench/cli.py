@@ -179,6 +179,10 @@ def cmd_list(argv: list[str]) -> int:
     print("tasks (compensation):")
     for key, eid in MSRA_ENV_IDS.items():
         print(f"  {eid:26s} task={key:14s} MSRA {'four-position runs -40..60 °C' if 'full' in key else 'zero-bias runs at room temperature'}")
+    print(f"  {'tcbench/Gyro-DriftNoise-v0':26s} task=gyro_driftnoise seed 001 parallel model on gyro oven runs "
+          "(decomposition, denoiser, drift learner; bandwidth kept)")
+    print(f"  {'tcbench/Gyro-VMDTuning-v0':26s} task=gyro_vmdtuning VMD [k, alpha] against fuzzy and permutation "
+          "entropy (2 objectives)")
     print("optimisers:")
     for name, entry in registry.available().items():
         kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective), ("multi", entry.cls.multi_objective)) if ok)

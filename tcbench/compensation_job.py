@@ -16,7 +16,8 @@ from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.compensation.validate import learner_of
 from tcbench.config import validate
-from tcbench.runner import CompensationResult, run_compensation
+from tcbench.runner import CompensationResult, VMDTuning, run_compensation
+from tcbench.tasks import is_gyro
 
 log = logging.getLogger(__name__)
 
@@ -31,19 +32,27 @@ def compensation_task_key(task: dict[str, Any]) -> str:
     return key
 
 
-def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any]) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``poly3``, ``IFA-BP-gd``, ``random-BP-lm`` ..."""
+def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
+    """Leaderboard name: ``raw``, ``oracle``, ``poly3``, ``IFA-BP-gd``, ``random-BP-lm`` ...; for
+    the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``."""
     if learner.get("label"):
         return str(learner["label"])
     name = str(learner["name"])
-    if name in BASELINES:
-        return name
-    if name == "poly":
-        return f"poly{learner.get('degree', 3)}"
-    opt = str(optimiser.get("label") or optimiser["name"])
-    prefix = "random" if opt == "none" else opt.upper()
-    label = f"{prefix}-{name.upper() if name == 'bp' else name}"
-    return f"{label}-{learner['training']}" if learner.get("training") else label
+    if name in BASELINES or name == "poly":
+        label = f"poly{learner.get('degree', 3)}" if name == "poly" else name
+    else:
+        opt = str(optimiser.get("label") or optimiser["name"])
+        prefix = "random" if opt == "none" else opt.upper()
+        label = f"{prefix}-{name.upper() if name == 'bp' else name}"
+        label = f"{label}-{learner['training']}" if learner.get("training") else label
+    if task is None or not is_gyro(str(task.get("name"))) or name == "oracle":
+        return label
+    decomposition = task.get("decomposition", "vmd")
+    front = {"vmd": "MOVMD" if task.get("k") is None or task.get("alpha") is None else "VMD",
+             "emd": "EMD", "none": ""}[decomposition]
+    front = "-".join(p for p in (front, {"tfpf": "TFPF", "wavelet": "WTD", "none": ""}[task.get("denoise", "tfpf")]) if p)
+    back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
+    return "+".join(p for p in (front, back) if p) or "raw"
 
 
 def score_document(score: Score) -> dict[str, Any]:
@@ -51,18 +60,24 @@ def score_document(score: Score) -> dict[str, Any]:
     return {
         "protocol": score.protocol,
         "conventions": CONVENTIONS[score.protocol],
-        "train_rmse_ug": score.train_rmse_ug,
+        score.train_key: score.train_rmse,
         "recordings": [{"name": r.name, "before": r.before, "after": r.after} for r in score.recordings],
         "summary": score.summary(),
     }
 
 
-def figures(score: Score, history_loss: list[float] | None, where: Path, title: str) -> list[Path]:
-    """The paper's figures for this run: Fig. 7 (zero bias) or Figs. 8-10 (full temperature)."""
+def figures(score: Score, history_loss: list[float] | None, where: Path, title: str,
+            tuning: VMDTuning | None = None) -> list[Path]:
+    """The paper's figures for this run: Fig. 7 (zero bias) or Figs. 8-10 (full temperature) of
+    seed 000; Figs. 11-14 and 17-19 of seed 001 (gyro)."""
     from tcbench.compensation import plots as cplots
 
     paths = []
-    for i, r in enumerate(score.recordings, start=1):
+    if score.protocol == "gyro":
+        from tcbench.gyro.plots import run_figures
+
+        paths = run_figures(score, tuning, where, title)
+    for i, r in enumerate(score.recordings if score.protocol != "gyro" else [], start=1):
         if r.nodes_before is not None and r.nodes_after is not None:
             paths.append(cplots.four_position_before_after(
                 where / f"fig8_test{i}.png", r.nodes_before, r.nodes_after, f"{title}: test {i} ({r.name})"))
@@ -74,6 +89,27 @@ def figures(score: Score, history_loss: list[float] | None, where: Path, title: 
     if history_loss and len(history_loss) > 1:
         paths.append(cplots.training_curve(where / "training_curve.png", history_loss, f"{title}: training"))
     return paths
+
+
+def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:
+    """CSV artifacts of a gyro run: the Allan deviation before and after per test record
+    (``allan_test<i>.csv``: tau_s, adev_before_dph, adev_after_dph) and the VMD tuning's
+    non-dominated set (``vmd_front.csv``)."""
+    files = []
+    for i, r in enumerate(result.score.recordings, start=1):
+        before, after = getattr(r, "allan_before", None), getattr(r, "allan_after", None)
+        if before is None or after is None:
+            continue
+        path = where / f"allan_test{i}.csv"
+        np.savetxt(path, np.column_stack([before.tau_s, before.adev * 3600.0, after.adev * 3600.0]),
+                   delimiter=",", header="tau_s,adev_before_dph,adev_after_dph", comments="")
+        files.append(path)
+    if result.tuning is not None:
+        path = where / "vmd_front.csv"
+        np.savetxt(path, np.column_stack([result.tuning.front_x, result.tuning.front_f]), delimiter=",",
+                   header="k,alpha,mean_fuzzy_entropy,mean_permutation_entropy", comments="")
+        files.append(path)
+    return files
 
 
 def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
@@ -90,7 +126,7 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
     from tcbench.job import sweep_id_from_hydra
 
     sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
-    tkey, method = compensation_task_key(c["task"]), compensation_label(learner, c["optimiser"])
+    tkey, method = compensation_task_key(c["task"]), compensation_label(learner, c["optimiser"], c["task"])
     name = f"{method}-{tkey}-s{c['seed']}"
     if c["tracking"].get("resume"):
         done = tracking.finished_run(c)
@@ -108,7 +144,9 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
             result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
             summary = result.score.summary()
             primary = PRIMARY[result.score.protocol]
-            values = summary | {
+            tuned = {"vmd_k": float(result.tuning.k), "vmd_alpha": result.tuning.alpha,
+                     "seconds_tuning": result.tuning.seconds} if result.tuning else {}
+            values = summary | tuned | {
                 "final_error": summary[primary], "search_evaluations": result.search_evaluations,
                 "init_loss": result.init_loss, "seconds_search": result.seconds_search,
                 "seconds_train": result.seconds_train,
@@ -129,8 +167,10 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
                         nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
                         nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
                         files.append(where / f"nodes_test{i}.csv")
+                files += gyro_tables(result, where)
                 if c["tracking"]["plots"]:
-                    files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}")
+                    files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}",
+                                     result.tuning)
                 for f in files:
                     run.log_artifact(f)
     except Exception as exc:  # recorded as FAILED by job_run; the sweep goes on
@@ -138,6 +178,6 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
         log.debug("%s", traceback.format_exc())
         return None
     s = result.score.summary()
-    log.info("%s: %s %.4g (raw %.4g), training RMSE %.3g µg", name, primary, s[primary], s[f"raw_{primary}"],
-             s["train_rmse_ug"])
+    log.info("%s: %s %.4g (raw %.4g), %s %.3g", name, primary, s[primary], s[f"raw_{primary}"],
+             result.score.train_key, s[result.score.train_key])
     return result

@@ -19,7 +19,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
-from tcbench.tasks import is_compensation, task_class
+from tcbench.tasks import GyroVMDTuningEnv, is_compensation, is_gyro, task_class
 
 
 class ConfigError(ValueError):
@@ -52,6 +52,42 @@ class MSRATaskConfig:
     train_on: str = "positions"
     rate_window_s: float = 120.0
     bias_form: str = "plus"
+
+
+@dataclass
+class GyroTuningTaskConfig:
+    """VMD tuning on a gyro oven record (see :class:`tcbench.tasks.GyroVMDTuningEnv`)."""
+
+    name: str = MISSING
+    device_seed: int = 0
+    recordings_seed: int = 0
+    train_files: list | None = None
+    sample_rate_hz: float = 10.0
+    hold_s: float = 3600.0
+    tuning_samples: int = 2048
+
+
+@dataclass
+class GyroTaskConfig(GyroTuningTaskConfig):
+    """The gyro drift/noise task (see :class:`tcbench.tasks.GyroDriftNoiseEnv`); ``tuner`` and
+    ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]`` when they are null."""
+
+    n_train: int = 1
+    n_test: int = 1
+    test_files: list | None = None
+    decomposition: str = "vmd"
+    k: int | None = None
+    alpha: float | None = None
+    tuner: str = "mopso"
+    tuning_budget: int = 440
+    denoise: str = "tfpf"
+    tfpf_window: int = 31
+    noise_above: float = 0.5
+    drift_below: float = 0.15
+    inputs: str = "t_rate"
+    rate_window_s: float = 120.0
+    learner_block_s: float = 10.0
+    bandwidth_amplitude_dps: float = 0.005
 
 
 @dataclass
@@ -114,19 +150,30 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(f"seed must be >= 0, got {c['seed']}")
     if c["budget"] < 1:
         raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
-    if is_compensation(str(c["task"].get("name"))):
+    name = str(c["task"].get("name"))
+    if is_compensation(name):
         from tcbench.compensation.validate import validate_compensation
 
-        validate_compensation(c, checked_task(c["task"], MSRATaskConfig))
+        validate_compensation(c, checked_task(c["task"], GyroTaskConfig if is_gyro(name) else MSRATaskConfig))
         return
     if c.get("learner"):
         raise ConfigError(f"learner={c['learner'].get('name')}: learners apply to compensation tasks "
-                          f"(msra_fulltemp, msra_zerobias), not to task {c['task'].get('name')}")
-    task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
+                          f"(msra_fulltemp, msra_zerobias, gyro_driftnoise), not to task {c['task'].get('name')}")
     try:
-        env = task_class(c["task"]["name"])(function=c["task"]["name"], budget=c["budget"], **task)
+        if is_gyro(name):
+            task = {k: v for k, v in checked_task(c["task"], GyroTuningTaskConfig).items() if k != "name"}
+            env = GyroVMDTuningEnv(budget=c["budget"], **task)
+        else:
+            task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
+            env = task_class(name)(function=name, budget=c["budget"], **task)
     except (KeyError, ValueError) as exc:
         raise ConfigError(f"task: {exc}") from None
+    check_optimiser(c, env, name)
+
+
+def check_optimiser(c: dict[str, Any], env: Any, task_name: str) -> None:
+    """The job's optimiser against ``env``: known, valid parameters, the right number of
+    objectives, a budget of at least one generation; ConfigError naming the key otherwise."""
     opt = dict(c["optimiser"])
     name = opt.pop("name", None)
     opt.pop("label", None)  # leaderboard name, not a parameter
@@ -139,9 +186,9 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(f"optimiser {name}: {exc}") from None
     m = getattr(env, "n_objectives", 1)
     if m > 1 and not cls.multi_objective:
-        raise ConfigError(f"optimiser {name} is single-objective; task {c['task']['name']} has {m} objectives")
+        raise ConfigError(f"optimiser {name} is single-objective; task {task_name} has {m} objectives")
     if m == 1 and not cls.single_objective:
-        raise ConfigError(f"optimiser {name} is multi-objective only; task {c['task']['name']} has one objective")
+        raise ConfigError(f"optimiser {name} is multi-objective only; task {task_name} has one objective")
     if c["budget"] < params.population:
         raise ConfigError(
             f"budget of {c['budget']} evaluations is smaller than one generation "

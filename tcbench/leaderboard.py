@@ -149,13 +149,16 @@ def is_multiobjective(runs: pd.DataFrame) -> bool:
     return "hypervolume" in runs and bool(runs["hypervolume"].notna().any())
 
 
-def one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
+def one_run_per_job(runs: pd.DataFrame, keys: tuple[str, ...] = ("task", "method", "config_hash", "seed")
+                    ) -> pd.DataFrame:
     """Keep one run per job (task, method, config, seed): the latest FINISHED one, else the
-    latest attempt, so a resumed or repeated sweep does not count a seed twice."""
+    latest attempt, so a resumed or repeated sweep does not count a seed twice. ``keys`` without
+    ``config_hash`` keeps one run per method and seed even when configs sharing a method name differ
+    (e.g. the gyro oracle, the same whatever the pipeline settings beside it)."""
     if runs.empty:
         return runs
     order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
-    keys = ["task", "method", "config_hash", "seed"]
+    keys = list(keys)
     return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
 
 

@@ -42,7 +42,7 @@ def test_population_is_evaluated_in_one_batch_per_generation(monkeypatch) -> Non
     assert calls == [10] + [1, 9] * 10
 
 
-@pytest.mark.parametrize("optimiser", ["fa", "ifa", "bas", "ga", "pso"])
+@pytest.mark.parametrize("optimiser", ["fa", "ifa", "bas", "ga", "pso", "sa"])
 def test_every_single_objective_optimiser_initialises_bp(optimiser: str) -> None:
     result = run_compensation(TASK, {"name": "bp", "training": "lm", "epochs": 20}, {"name": optimiser}, 200, 1)
     assert result.search_evaluations <= 200 and np.isfinite(result.init_loss)

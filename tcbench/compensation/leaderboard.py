@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench.compensation.scoring import FULLTEMP_METRICS, PRIMARY, ROOMTEMP_METRICS
+from tcbench.compensation.scoring import METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.leaderboard import (
     failed_lines,
     markdown_table,
@@ -28,10 +28,13 @@ from tcbench.leaderboard import (
 )
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
-PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp"}
-METRICS = {"fulltemp": FULLTEMP_METRICS, "roomtemp": ROOMTEMP_METRICS}
+PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp", "gyro_driftnoise": "gyro"}
+METRICS = METRIC_NAMES
 SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
-         "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug"}
+         "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug", "drift_dph": "drift_dph",
+         "arw_deg_per_sqrt_h": "arw", "bias_instability_dph": "bi_dph", "rms_error_dph": "rms_dph",
+         "bandwidth_hz": "bw_hz"}
+NO_GAIN = ("halfg_error_ug", "bandwidth_hz")  # no raw value (probe), or not a figure to improve
 
 
 @dataclass
@@ -66,7 +69,8 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     for method, g in runs.groupby("method", sort=True):
         ok = g[g["status"] == "FINISHED"]
         row: dict[str, object] = {"method": method, "runs": len(g), "failed": int(len(g) - len(ok))}
-        best = ok.loc[ok["train_rmse_ug"].idxmin()] if ok["train_rmse_ug"].notna().any() else None
+        train = TRAIN_RMSE[protocol]
+        best = ok.loc[ok[train].idxmin()] if train in ok and ok[train].notna().any() else None
         for m in metrics:
             x = ok[m].to_numpy(float) if m in ok else np.array([])
             low, high = bootstrap_median_ci(x)
@@ -75,9 +79,9 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             row[f"ci95_{s}"] = f"{low:.3g}–{high:.3g}" if np.isfinite(low) else "–"
             row[f"best_by_train_{s}"] = float(best[m]) if best is not None else np.nan
             raw = ok[f"raw_{m}"].to_numpy(float) if f"raw_{m}" in ok else np.array([])
-            if m != "halfg_error_ug":  # the probe has no raw value
+            if m not in NO_GAIN:
                 row[f"gain_{s}"] = float(np.median(raw) / row[f"median_{s}"]) if raw.size and row[f"median_{s}"] else np.nan
-        row["median_train_rmse_ug"] = float(ok["train_rmse_ug"].median()) if "train_rmse_ug" in ok else np.nan
+        row[f"median_{train}"] = float(ok[train].median()) if train in ok else np.nan
         rows.append(row)
         values[method] = pd.Series(ok[primary].to_numpy(float), index=ok["seed"].to_numpy()) if primary in ok else pd.Series(dtype=float)
     table = pd.DataFrame(rows)
@@ -98,6 +102,8 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
     oracle = table.loc[table["method"] == "oracle", primary]
     if oracle.empty:
         return [""] * len(table)
+    if protocol == "gyro":
+        return _gyro_notes(table)
     limit = float(oracle.iloc[0])
     notes = []
     for row in table.itertuples(index=False):
@@ -108,10 +114,41 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
     return notes
 
 
+MSRA_KEY = (
+    "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
+    "physical limit); poly3 = bias and scale factor cubic in temperature (least squares). p_vs_next = Wilcoxon "
+    "signed-rank p-value of the primary metric against the next row, paired by seed. note: a median below the "
+    "oracle's is not physics — such a method has learned the trained acceleration levels, which its ±0.5 g "
+    "probe error (halfg) shows.")
+GYRO_KEY = (
+    "Methods are named by their pipeline: MOVMD = MOPSO-tuned VMD with sample-entropy classes (noise modes "
+    "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition), then "
+    "the drift learner (BAS-elman = BAS-initialised Elman on [T, dT/dt]; (T) = temperature input only); "
+    "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
+    "limit). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by "
+    "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
+    "says how much of a real rate input the method throws away with the noise.")
+
+
+def _gyro_notes(table: pd.DataFrame) -> list[str]:
+    """Flag a gyro method whose ARW is below the oracle's (noise untouched): it smooths the
+    output, and its bandwidth kept says how much of a real rate input it throws away."""
+    oracle = table.loc[table["method"] == "oracle"].iloc[0]
+    notes = []
+    for row in table.itertuples(index=False):
+        parts = []
+        if row.method != "oracle" and row.median_arw < 0.9 * oracle["median_arw"]:
+            parts.append(f"ARW below the physical limit by filtering: bandwidth {row.median_bw_hz:.3g} Hz")
+        if row.method != "oracle" and row.median_drift_dph < 0.9 * oracle["median_drift_dph"]:
+            parts.append("drift below the oracle's: the flicker of the soak means is smoothed too")
+        notes.append("; ".join(parts))
+    return notes
+
+
 def boards(runs: pd.DataFrame) -> list[CompensationBoard]:
     """One board per compensation task in ``runs`` (one run per job)."""
     out = []
-    for task, g in one_run_per_job(runs).groupby("task", sort=True):
+    for task, g in one_run_per_job(runs, ("task", "method", "seed")).groupby("task", sort=True):
         protocol = PROTOCOL_OF_TASK[str(g["task_name"].iloc[0])]
         out.append(CompensationBoard(str(task), protocol, summarise(g, protocol), g))
     return out
@@ -152,21 +189,22 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
     _plot(board, paths["png"])
     primary = PRIMARY[board.protocol]
     failed = board.runs[board.runs["status"] != "FINISHED"]
-    conv = ("sf = scale-factor variation std/mean over the temperature nodes (ppm); bias = bias variation "
-            "std over the nodes (µg), eq. 12 plus form" if board.protocol == "fulltemp" else
-            "zb30/zb20/zb0 = zero-bias stability (1σ of 10 s means) from 30 min, 20 min and 0 min after "
-            "power-on (µg)")
+    conv = {
+        "fulltemp": "sf = scale-factor variation std/mean over the temperature nodes (ppm); bias = bias "
+                    "variation std over the nodes (µg), eq. 12 plus form",
+        "roomtemp": "zb30/zb20/zb0 = zero-bias stability (1σ of 10 s means) from 30 min, 20 min and 0 min "
+                    "after power-on (µg)",
+        "gyro": "drift_dph = residual drift over temperature, std of the 5-min soak means (°/h); arw = σ(1 s)/60 "
+                "(°/√h); bi_dph = Allan minimum / 0.664 (°/h); rms_dph = RMS error against the true rate "
+                "(°/h); bw_hz = bandwidth kept, the −3 dB frequency of the whole method measured by "
+                "injecting a multi-sine rate (Nyquist when nothing is lost)",
+    }[board.protocol]
     lines = [
         f"# Compensation leaderboard: {board.task}", "",
         f"Source: {source}. Metrics are means over the test recordings; {conv}.",
         f"Rows are ordered by the median of {primary} over restarts (seeds); ci95 = bootstrap 95 % "
         "interval of that median; best_by_train = the run with the smallest training RMSE (the paper's "
-        "\"best of 30\" selection); gain = raw / median. raw = no compensation; oracle = the simulator's "
-        "own model at the true die temperature (noise alone: the physical limit); poly3 = bias and scale "
-        "factor cubic in temperature (least squares). p_vs_next = Wilcoxon signed-rank p-value of "
-        f"{primary} against the next row, paired by seed. note: a median below the oracle's is not "
-        "physics — such a method has learned the trained acceleration levels, which its ±0.5 g probe "
-        "error (halfg) shows.", "",
+        "\"best of 30\" selection); gain = raw / median. " + (GYRO_KEY if board.protocol == "gyro" else MSRA_KEY), "",
         markdown_table(board.table), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
     write_board_files(lines + failed_lines(failed), board.table, paths)

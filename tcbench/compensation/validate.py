@@ -10,6 +10,7 @@ import yaml
 
 from tcbench.compensation.data import TaskDataError, file_data
 from tcbench.compensation.methods import BASELINES
+from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.optimisers.protocol import make_params
@@ -30,8 +31,9 @@ def learner_of(c: dict[str, Any]) -> dict[str, Any]:
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
     """Learner, optimiser and task of a compensation job; raise ConfigError naming the key."""
-    from tcbench.tasks.msra_env import MSRACompensationEnv
+    from tcbench.tasks import GyroDriftNoiseEnv, MSRACompensationEnv, is_gyro
 
+    gyro = is_gyro(str(task["name"]))
     learner = learner_of(c)
     name = str(learner.pop("name", None))
     learner.pop("label", None)
@@ -47,16 +49,24 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
             raise _error(f"learner {text}" if text.startswith(f"{name}") else f"learner {name}: {text}") from None
     kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
     try:
-        env = MSRACompensationEnv(task["name"], None if name in BASELINES else name, learner,
-                                  budget=c["budget"], **kwargs)
+        if gyro:
+            env: Any = GyroDriftNoiseEnv(None if name in BASELINES else name, learner, budget=c["budget"], **kwargs)
+        else:
+            env = MSRACompensationEnv(task["name"], None if name in BASELINES else name, learner,
+                                      budget=c["budget"], **kwargs)
     except ValueError as exc:
         raise _error(f"task {task['name']}: {exc}") from None
     if kwargs.get("train_files"):
         try:
-            file_data(env.protocol, list(kwargs["train_files"]), list(kwargs["test_files"]),
-                      env.train_on, env.rate_window_s)
+            if gyro:
+                file_gyro_data(list(kwargs["train_files"]), list(kwargs["test_files"]))
+            else:
+                file_data(env.protocol, list(kwargs["train_files"]), list(kwargs["test_files"]),
+                          env.train_on, env.rate_window_s)
         except TaskDataError as exc:
             raise _error(str(exc)) from None
+    if gyro and env.needs_tuning:
+        _check_tuner(task)
     opt = dict(c["optimiser"])
     oname = str(opt.pop("name", None))
     opt.pop("label", None)
@@ -78,3 +88,19 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
         ocls(env.lower, env.upper, c["budget"], np.random.default_rng(0), params)
     except ValueError as exc:
         raise _error(f"optimiser {oname}: {exc}") from None
+
+
+def _check_tuner(task: dict[str, Any]) -> None:
+    """The gyro task's VMD tuner: a registered multi-objective optimiser with a budget of at
+    least one generation."""
+    name = str(task.get("tuner", "mopso"))
+    try:
+        cls = optimisers.get(name)
+    except optimisers.UnknownOptimiserError as exc:
+        raise _error(f"task.tuner: {exc}") from None
+    if not cls.multi_objective:
+        raise _error(f"task.tuner: optimiser {name} is single-objective; VMD tuning has 2 objectives")
+    population = make_params(cls, {}).population
+    if int(task.get("tuning_budget", 440)) < population:
+        raise _error(f"task.tuning_budget: {task.get('tuning_budget')} evaluations is smaller than one "
+                     f"generation of {name} (population {population})")

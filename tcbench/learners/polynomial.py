@@ -8,6 +8,10 @@ Two forms, chosen by the task (``form="auto"`` is a placeholder the task must re
   the prediction inverts the model, ``target = (output - b(T)) / K(T)``.
 - ``bias``: ``target = b(x0)``, a polynomial of ``degree`` in the first input column (the
   temperature); any other input column (e.g. the temperature rate) is ignored.
+- ``bias_rate``: inputs ``[T, dT/dt]``, ``target = b(T) + r(T) dT/dt`` with ``b`` of ``degree``
+  and ``r`` of ``degree - 1`` in ``T``: the first-order expansion of a bias seen through a thermal
+  lag (``b(T - tau dT/dt) ~ b(T) - tau b'(T) dT/dt``, so ``r`` has the degree of ``b'``) plus a
+  gradient term constant in ``T``.
 
 Everything is solved in the normalised [-1, 1] units of :class:`~tcbench.learners.base.Scaler`
 (an affine change of units keeps both model forms), so the temperature is on [-1, 1] over the
@@ -16,7 +20,8 @@ conditioned up to degree 6.
 
 **Flat parameter vector** (:meth:`PolynomialModel.get_params`), Chebyshev coefficients of
 increasing order in normalised units: ``inverse``: ``b_0..b_d`` then ``K_0..K_d``
-(``2 (d + 1)`` values); ``bias``: ``b_0..b_d`` (``d + 1`` values). It exists only after
+(``2 (d + 1)`` values); ``bias``: ``b_0..b_d`` (``d + 1`` values); ``bias_rate``: ``b_0..b_d`` then
+``r_0..r_{d-1}`` (``2 d + 1`` values, ``r`` in normalised rate units). It exists only after
 :meth:`PolynomialModel.fit`, which also fixes the normalisation it refers to.
 """
 
@@ -31,7 +36,7 @@ from numpy.polynomial import chebyshev
 
 from tcbench.learners.base import FitHistory, Learner, LearnerParams
 
-FORMS = ("auto", "inverse", "bias")
+FORMS = ("auto", "inverse", "bias", "bias_rate")
 MAX_DEGREE = 6
 AUTO_ERROR = "poly: form 'auto' must be resolved by the task; set form=inverse or form=bias"
 
@@ -42,7 +47,8 @@ class PolynomialParams(LearnerParams):
 
     degree: degree of the temperature polynomials b(T) and K(T), 1..6.
     form: "inverse" (inputs [output, temperature] -> applied input), "bias" (temperature ->
-        output bias) or "auto" (the task chooses; fitting with "auto" is an error).
+        output bias), "bias_rate" ([temperature, rate] -> bias) or "auto" (the task chooses;
+        fitting with "auto" is an error).
     """
 
     degree: int = 3
@@ -94,13 +100,20 @@ class PolynomialModel(Learner):
         form = self.settings.form
         if form == "auto":
             raise ValueError(AUTO_ERROR)
-        if form == "inverse" and self.n_inputs != 2:
-            raise ValueError(f"poly: form 'inverse' takes 2 inputs [output, temperature], got {self.n_inputs}")
+        if form in ("inverse", "bias_rate") and self.n_inputs != 2:
+            raise ValueError(f"poly: form {form!r} takes 2 inputs, got {self.n_inputs}")
         return form
 
     def _basis(self, temp_scaled: np.ndarray) -> np.ndarray:
         """Chebyshev basis T_0..T_d of the normalised temperature, shape (n, d + 1)."""
         return chebyshev.chebvander(temp_scaled, self.settings.degree)
+
+    def _design(self, x: np.ndarray, form: str) -> np.ndarray:
+        """Least-squares design of the bias forms: ``b`` basis, then ``rate x`` the ``r`` basis."""
+        basis = self._basis(x[:, 0])
+        if form == "bias":
+            return basis
+        return np.hstack([basis, basis[:, :-1] * x[:, 1:2]])
 
     def fit(self, inputs: np.ndarray, targets: np.ndarray, init: np.ndarray | None = None) -> FitHistory:
         """One least-squares solve in normalised units; ``init`` is ignored (closed form).
@@ -115,12 +128,13 @@ class PolynomialModel(Learner):
             design = np.hstack([basis, basis * y[:, None]])
             rhs = x[:, 0]
         else:
-            design = self._basis(x[:, 0])
+            design = self._design(x, form)
             rhs = y
         coef, _, rank, _ = np.linalg.lstsq(design, rhs, rcond=None)
         if rank < design.shape[1]:
             why = ("the target must vary at each temperature" if form == "inverse"
-                   else "need more distinct temperatures than the degree")
+                   else "need more distinct temperatures than the degree"
+                   + (" and a temperature rate that varies" if form == "bias_rate" else ""))
             raise ValueError(f"poly: form {form!r} of degree {self.settings.degree} is not determined "
                              f"by the training data ({why})")
         self._coef, self._form = coef, form
@@ -134,7 +148,7 @@ class PolynomialModel(Learner):
             basis = self._basis(x[:, 1])
             half = coef.size // 2
             return (x[:, 0] - basis @ coef[:half]) / (basis @ coef[half:])
-        return self._basis(x[:, 0]) @ coef
+        return self._design(x, self._form) @ coef
 
     def predict(self, inputs: np.ndarray) -> np.ndarray:
         self._fitted()

@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
+from tcbench.tasks.gyro_env import ENV_ID as GYRO_DRIFTNOISE_ID
+from tcbench.tasks.gyro_env import GyroDriftNoiseEnv
+from tcbench.tasks.gyro_vmd_env import ENV_ID as GYRO_VMDTUNING_ID
+from tcbench.tasks.gyro_vmd_env import GyroVMDTuningEnv
 from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
 from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
 from tcbench.tasks.msra_env import ENV_IDS as MSRA_ENV_IDS
@@ -11,6 +15,7 @@ from tcbench.tasks.multiobjective import PROBLEMS
 from tcbench.tasks.registration import register_tasks
 
 ENV_VERSION = "v0"
+GYRO_ENV_IDS = {"gyro_driftnoise": GYRO_DRIFTNOISE_ID, "gyro_vmdtuning": GYRO_VMDTUNING_ID}
 
 
 def env_id(function_key: str) -> str:
@@ -28,31 +33,46 @@ def register_msra_envs() -> None:
     register_tasks(MSRA_ENV_IDS, MSRA_ENV_IDS.__getitem__, "tcbench.tasks.msra_env:MSRACompensationEnv", "task")
 
 
+def register_gyro_envs() -> None:
+    """Register the gyro drift/noise and VMD tuning tasks (idempotent)."""
+    register_tasks(["gyro_driftnoise"], GYRO_ENV_IDS.__getitem__, "tcbench.tasks.gyro_env:GyroDriftNoiseEnv", None)
+    register_tasks(["gyro_vmdtuning"], GYRO_ENV_IDS.__getitem__, "tcbench.tasks.gyro_vmd_env:GyroVMDTuningEnv", None)
+
+
 def is_compensation(name: str) -> bool:
-    """True for the sensor compensation tasks (``msra_fulltemp``, ``msra_zerobias``)."""
-    return name.lower() in MSRA_ENV_IDS
+    """True for the sensor compensation tasks (``msra_fulltemp``, ``msra_zerobias``,
+    ``gyro_driftnoise``)."""
+    return name.lower() in MSRA_ENV_IDS or name.lower() == "gyro_driftnoise"
+
+
+def is_gyro(name: str) -> bool:
+    """True for the gyro tasks (``gyro_driftnoise``, ``gyro_vmdtuning``)."""
+    return name.lower() in GYRO_ENV_IDS
 
 
 def is_multiobjective(name: str) -> bool:
-    """True for the multi-objective problems (ZDT1-3, DTLZ2)."""
-    return name.lower() in PROBLEMS
+    """True for the multi-objective tasks (ZDT1-3, DTLZ2, gyro_vmdtuning)."""
+    return name.lower() in PROBLEMS or name.lower() == "gyro_vmdtuning"
 
 
 def task_id(name: str) -> str:
     """Gymnasium id of any task by its config name (``rastrigin``, ``zdt1``, ...)."""
-    if is_compensation(name):
+    if name.lower() in MSRA_ENV_IDS:
         return MSRA_ENV_IDS[name.lower()]
-    return mo_env_id(name) if is_multiobjective(name) else env_id(name)
+    if is_gyro(name):
+        return GYRO_ENV_IDS[name.lower()]
+    return mo_env_id(name) if name.lower() in PROBLEMS else env_id(name)
 
 
 def task_class(name: str) -> type[FunctionEnv] | type[MultiObjectiveEnv]:
-    """The env class serving a task name."""
-    return MultiObjectiveEnv if is_multiobjective(name) else FunctionEnv
+    """The env class serving a function or multi-objective problem name."""
+    return MultiObjectiveEnv if name.lower() in PROBLEMS else FunctionEnv
 
 
 register_envs()
 register_mo_envs()
 register_msra_envs()
+register_gyro_envs()
 
 __all__ = [
     "FUNCTIONS",
@@ -60,15 +80,20 @@ __all__ = [
     "PROBLEMS",
     "BudgetExceededError",
     "FunctionEnv",
+    "GYRO_ENV_IDS",
+    "GyroDriftNoiseEnv",
+    "GyroVMDTuningEnv",
     "MSRACompensationEnv",
     "MultiObjectiveEnv",
     "ObjectiveFunction",
     "env_id",
     "get_function",
     "is_compensation",
+    "is_gyro",
     "is_multiobjective",
     "mo_env_id",
     "register_envs",
+    "register_gyro_envs",
     "register_mo_envs",
     "register_msra_envs",
     "task_class",

@@ -38,6 +38,24 @@ MO_ENV_VERSION = "v0"
 _MERGE_CHUNK = 256
 
 
+def record_front(env: Any, x: np.ndarray, f: np.ndarray) -> None:
+    """Count evaluations ``x`` (n, d) with objectives ``f`` (n, m) on ``env`` and merge the finite
+    ones into its non-dominated set (``front_x``, ``front_f``), updating ``hypervolume``
+    against ``env.ref_point`` when the set changed."""
+    finite = np.all(np.isfinite(f), axis=1)
+    env.nonfinite += int(np.count_nonzero(~finite))
+    env.evaluations += f.shape[0]
+    x, f = x[finite], f[finite]
+    changed = False
+    for start in range(0, f.shape[0], _MERGE_CHUNK):
+        chunk = slice(start, start + _MERGE_CHUNK)
+        old = env.front_f
+        env.front_x, env.front_f = merge_front(env.front_x, old, x[chunk], f[chunk])
+        changed |= not np.array_equal(old, env.front_f)
+    if changed:
+        env.hypervolume = hypervolume(env.front_f, env.ref_point)
+
+
 class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
     """Minimise the objectives of ``function`` in ``dim`` variables within ``budget`` evaluations.
 
@@ -133,18 +151,7 @@ class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
         return obs, reward, False, truncated, self._info()
 
     def _record(self, x: np.ndarray, f: np.ndarray) -> None:
-        finite = np.all(np.isfinite(f), axis=1)
-        self.nonfinite += int(np.count_nonzero(~finite))
-        self.evaluations += f.shape[0]
-        x, f = x[finite], f[finite]
-        changed = False
-        for start in range(0, f.shape[0], _MERGE_CHUNK):
-            chunk = slice(start, start + _MERGE_CHUNK)
-            old = self.front_f
-            self.front_x, self.front_f = merge_front(self.front_x, old, x[chunk], f[chunk])
-            changed |= not np.array_equal(old, self.front_f)
-        if changed:
-            self.hypervolume = hypervolume(self.front_f, self.ref_point)
+        record_front(self, x, f)
 
     def _info(self) -> dict[str, Any]:
         return {

@@ -41,14 +41,15 @@ ENV_IDS = {"msra_zerobias": "tcbench/MSRA-ZeroBias-v0", "msra_fulltemp": "tcbenc
 BIAS_FORMS = ("plus", "printed")
 
 
-def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.random.Generator) -> Learner:
-    """A registered learner for a 2-input task; a ``form: auto`` parameter takes the task's form."""
+def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.random.Generator,
+                 n_inputs: int = 2) -> Learner:
+    """A registered learner with ``n_inputs`` inputs; a ``form: auto`` parameter takes the task's form."""
     cls = learners.get(name)
     values = dict(params or {})
     fields = {f.name for f in dataclasses.fields(cls.Params)}
     if "form" in fields and values.get("form", "auto") == "auto":
         values["form"] = form
-    return cls(2, values, rng)
+    return cls(n_inputs, values, rng)
 
 
 class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):

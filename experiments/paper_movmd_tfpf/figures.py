@@ -1,0 +1,137 @@
+"""Seed 001 Fig. 19 beside tcbench's reproduction: the table of every method with the bandwidth it
+keeps, the verdict on the paper's claim over the restarts, and the Allan curves on one axis.
+
+Reads the finished gyro runs of one sweep from MLflow and writes ``fig19.md``, ``fig19.csv`` and
+``fig19_allan.png`` into ``--out``. Per method: the median over restarts (seeds) and, for the
+Allan figure, the curve of the run whose ARW is the median one.
+
+    python experiments/paper_movmd_tfpf/figures.py --experiment paper-movmd-tfpf --sweep ID --out DIR
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from tcbench import tracking
+from tcbench.compensation import leaderboard as board
+from tcbench.gyro.plots import allan_methods_figure
+from tcbench.leaderboard import markdown_table, one_run_per_job
+from tcbench.signal.allan import AllanDeviation
+
+PAPER = {"raw": (0.531076, 32.7364), "MOVMD-TFPF+BAS-elman-adam": (5.22502e-3, 0.140403)}  # Fig. 19
+PAPER_METHOD = "MOVMD-TFPF+BAS-elman-adam"
+COLUMNS = ("arw_deg_per_sqrt_h", "bias_instability_dph", "drift_dph", "rms_error_dph", "bandwidth_hz")
+
+
+def _table(runs: pd.DataFrame) -> pd.DataFrame:
+    rows = []
+    for method, g in runs.groupby("method"):
+        row: dict[str, object] = {"method": method, "runs": len(g)}
+        for c in COLUMNS:
+            row[c] = float(g[c].median())
+        paper = PAPER.get(str(method))
+        row["paper_arw"], row["paper_bi_dph"] = paper if paper else (np.nan, np.nan)
+        rows.append(row)
+    raw = next(r for r in rows if r["method"] == "raw")
+    rows.append({"method": "raw (seed 001, Fig. 19)", "runs": np.nan, "arw_deg_per_sqrt_h": PAPER["raw"][0],
+                 "bias_instability_dph": PAPER["raw"][1]})
+    rows.append({"method": f"{PAPER_METHOD} (seed 001, Fig. 19)", "runs": np.nan,
+                 "arw_deg_per_sqrt_h": PAPER[PAPER_METHOD][0], "bias_instability_dph": PAPER[PAPER_METHOD][1]})
+    table = pd.DataFrame(rows)
+    table["arw_gain"] = raw["arw_deg_per_sqrt_h"] / table["arw_deg_per_sqrt_h"]
+    table["bi_gain"] = raw["bias_instability_dph"] / table["bias_instability_dph"]
+    paper_rows = table["method"].str.endswith("(seed 001, Fig. 19)")
+    table.loc[paper_rows, "arw_gain"] = PAPER["raw"][0] / table.loc[paper_rows, "arw_deg_per_sqrt_h"]
+    table.loc[paper_rows, "bi_gain"] = PAPER["raw"][1] / table.loc[paper_rows, "bias_instability_dph"]
+    return table.sort_values("drift_dph", na_position="last").drop(columns=["paper_arw", "paper_bi_dph"])
+
+
+def _verdict(runs: pd.DataFrame, oracle: pd.Series) -> list[str]:
+    mine = runs[runs["method"] == PAPER_METHOD]
+    raw = runs[runs["method"] == "raw"].iloc[0]
+    if mine.empty:
+        return ["The paper's method has no finished run in this sweep: nothing to compare."]
+    arw_gain = raw["arw_deg_per_sqrt_h"] / mine["arw_deg_per_sqrt_h"]
+    bi_gain = raw["bias_instability_dph"] / mine["bias_instability_dph"]
+    paper_arw, paper_bi = PAPER["raw"][0] / PAPER[PAPER_METHOD][0], PAPER["raw"][1] / PAPER[PAPER_METHOD][1]
+    n = len(mine)
+    lines = [
+        f"**Claim (Fig. 19): ARW 0.531 → 5.2e-3 (×{paper_arw:.0f}) and bias stability 32.7 → 0.14 °/h "
+        f"(×{paper_bi:.0f}).** Over {n} restarts of the same pipeline here: ARW ×{arw_gain.median():.1f} "
+        f"(range {arw_gain.min():.1f}–{arw_gain.max():.1f}), bias instability ×{bi_gain.median():.1f} "
+        f"(range {bi_gain.min():.1f}–{bi_gain.max():.1f}); {int((arw_gain >= paper_arw).sum())} of {n} reach the "
+        f"paper's ARW factor and {int((bi_gain >= paper_bi).sum())} of {n} its bias-stability factor: "
+        + ("**reproduced**." if (arw_gain >= paper_arw).all() and (bi_gain >= paper_bi).all() else
+           "**not reproduced** at the paper's size."),
+        f"**What the gains are made of.** The oracle — the simulator's true drift removed, the noise "
+        f"untouched — has ARW {oracle['arw_deg_per_sqrt_h']:.3g} °/√h and bias instability "
+        f"{oracle['bias_instability_dph']:.3g} °/h: that is as low as any temperature compensation can go. "
+        f"The paper's pipeline reaches a median ARW of {mine['arw_deg_per_sqrt_h'].median():.3g} °/√h and bias "
+        f"instability {mine['bias_instability_dph'].median():.3g} °/h by keeping only "
+        f"{mine['bandwidth_hz'].median():.3g} Hz of bandwidth (the raw output keeps "
+        f"{raw['bandwidth_hz']:.3g} Hz): the ARW and bias-instability gains beyond the oracle's are an "
+        "artefact of filtering — a real rate input faster than that bandwidth is removed with the noise.",
+        f"**Temperature compensation proper** (residual drift over temperature, std of the soak means): "
+        f"raw {raw['drift_dph']:.3g} °/h, oracle {oracle['drift_dph']:.3g} °/h, the paper's pipeline "
+        f"{mine['drift_dph'].median():.3g} °/h (median; range {mine['drift_dph'].min():.3g}–"
+        f"{mine['drift_dph'].max():.3g}).",
+    ]
+    return lines
+
+
+def _allan_curves(client, runs: pd.DataFrame, where: Path) -> dict[str, AllanDeviation]:  # type: ignore[no-untyped-def]
+    curves: dict[str, AllanDeviation] = {}
+    raw_done = False
+    for method, g in runs.groupby("method"):
+        pick = g.iloc[(g["arw_deg_per_sqrt_h"] - g["arw_deg_per_sqrt_h"].median()).abs().argsort().iloc[0]]
+        path = Path(client.download_artifacts(pick["run_id"], "allan_test1.csv", str(where)))
+        d = np.loadtxt(path, delimiter=",", skiprows=1)
+        if not raw_done:
+            curves["raw"] = AllanDeviation(d[:, 0], d[:, 1] / 3600.0, np.zeros(len(d)), np.nan, 0)
+            raw_done = True
+        if method != "raw":
+            curves[str(method)] = AllanDeviation(d[:, 0], d[:, 2] / 3600.0, np.zeros(len(d)), np.nan, 0)
+    return curves
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--experiment", default="paper-movmd-tfpf")
+    p.add_argument("--sweep", default=None)
+    p.add_argument("--out", type=Path, required=True)
+    args = p.parse_args()
+    client = tracking.client()
+    runs = one_run_per_job(board.load_runs(client, [args.experiment], args.sweep), ("task", "method", "seed"))
+    runs = runs[runs["status"] == "FINISHED"]
+    oracle = runs[runs["method"] == "oracle"].iloc[0]
+    table = _table(runs)
+    args.out.mkdir(parents=True, exist_ok=True)
+    table.to_csv(args.out / "fig19.csv", index=False)
+    with tempfile.TemporaryDirectory() as tmp:
+        curves = _allan_curves(client, runs, Path(tmp))
+    bw = runs.groupby("method")["bandwidth_hz"].median()
+    allan_methods_figure(args.out / "fig19_allan.png", curves, "Fig. 19: Allan deviation of every method (test run)",
+                         annotations={m: f"bw {bw[m]:.2g} Hz" for m in curves if m in bw})
+    lines = [
+        "# Seed 001 Fig. 19 beside tcbench", "",
+        "Simulated 14 h oven runs of gyro 0 at 10 Hz (one to train, one to test; `bash "
+        "experiments/paper_movmd_tfpf/run.sh`). Medians over restarts; ARW = σ(1 s)/60 in °/√h (seed 001 "
+        "prints °/h/√Hz for a value that only fits its bias stability as °/√h, PHYSICS.md §5); bias "
+        "instability = Allan minimum / 0.664 (°/h); drift = std of the 5-min soak means (°/h); rms = RMS "
+        "error against the true rate (°/h); bandwidth = −3 dB frequency of the whole method, measured by "
+        "injecting a multi-sine rate into the test run (5 Hz = Nyquist: nothing lost). Gains are raw / "
+        "method (the paper's rows: its raw / its result).", "",
+        markdown_table(table), "", *[f"{line}\n" for line in _verdict(runs, oracle)],
+        "![Allan deviation of every method](fig19_allan.png)", "",
+    ]
+    (args.out / "fig19.md").write_text("\n".join(lines))
+    print(f"wrote {args.out / 'fig19.md'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,220 @@
+"""The gyro drift/noise compensation stage as a gymnasium environment (seed 001 §3.4-§4).
+
+Two oven runs of one gyro, one to train and one to test (§4.1). ``reset`` decomposes the
+training record with the task's pipeline (VMD with ``[k, alpha]``, sample-entropy classes, see
+:mod:`tcbench.gyro.pipeline`) and builds the learner's training set: block means of
+``[T, dT/dt]`` (or ``[T]``) against the drift part. The action is a candidate vector of the
+learner's initial weights and thresholds (or a batch ``(n, d)``); the observation its training
+error (eq. 3 in normalised units; eq. 36's MSE up to the factor 2), which BAS, PSO, FA ...
+minimise to initialise the learner (BAS-Elman, §3.4.4). :meth:`GyroDriftNoiseEnv.score` trains
+the learner from the best vector and runs the whole pipeline on the test record, scoring it
+before and after with the bandwidth it keeps (:mod:`tcbench.gyro.scoring`).
+
+With ``k``/``alpha`` unset the VMD parameters come from ``reset(options={"k": .., "alpha": ..})``:
+``tcbench run`` first tunes them on ``tcbench/Gyro-VMDTuning-v0`` (MOPSO by default, §3.2).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from tcbench.compensation.data import TaskDataError
+from tcbench.compensation.oracle import oracle_inverse
+from tcbench.compensation.scoring import Score
+from tcbench.gyro.cache import cached_front
+from tcbench.gyro.data import GyroData, check_settings
+from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
+from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
+from tcbench.learners.base import FitHistory, Learner
+from tcbench.tasks.function_env import as_batch, check_budget
+from tcbench.tasks.gyro_vmd_env import load_gyro_data
+from tcbench.tasks.msra_env import make_learner
+
+ENV_ID = "tcbench/Gyro-DriftNoise-v0"
+BASELINES = ("raw", "oracle")
+PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
+
+
+class GyroDriftNoiseEnv(gym.Env[np.ndarray, np.ndarray]):
+    """Search a drift learner's initial parameters on a gyro oven task.
+
+    learner, learner_params: the registered learner (default Elman) and its parameters; None for
+        an env that only scores the baselines (``raw``: the pipeline without a drift learner;
+        ``oracle``: the simulator's true drift removed, noise untouched).
+    budget: candidate evaluations per episode.
+    device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s: the simulated oven
+        runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks).
+    train_files, test_files: schema-v1 gyro recordings instead.
+    decomposition, k, alpha, denoise, tfpf_window, noise_above, drift_below, inputs,
+        rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.gyro.pipeline.PipelineConfig`);
+        ``k``/``alpha`` None: set by ``reset(options=...)`` after tuning.
+    bandwidth_amplitude_dps: amplitude of each injected sine of the bandwidth test (deg/s).
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, learner: str | None = "elman", learner_params: dict[str, Any] | None = None,
+                 budget: int = 1000, device_seed: int = 0, recordings_seed: int = 0, n_train: int = 1,
+                 n_test: int = 1, train_files: list[str] | None = None, test_files: list[str] | None = None,
+                 sample_rate_hz: float = 10.0, hold_s: float = 3600.0, decomposition: str = "vmd",
+                 k: int | None = None, alpha: float | None = None, denoise: str = "tfpf", tfpf_window: int = 31,
+                 noise_above: float = 0.5, drift_below: float = 0.15, inputs: str = "t_rate",
+                 rate_window_s: float = 120.0, learner_block_s: float = 10.0,
+                 bandwidth_amplitude_dps: float = 0.005, **_: Any) -> None:
+        if int(budget) != budget or budget < 1:
+            raise ValueError(f"budget must be a positive integer, got {budget}")
+        for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
+            if int(value) != value or value < 0:
+                raise ValueError(f"{name} must be a non-negative integer, got {value}")
+        if (train_files is None) != (test_files is None):
+            raise ValueError("give both train_files and test_files, or neither")
+        if not (np.isfinite(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
+            raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
+        try:
+            check_settings(sample_rate_hz, hold_s, n_train, n_test)
+        except TaskDataError as exc:
+            raise ValueError(str(exc)) from None
+        pipeline = {"decomposition": decomposition, "denoise": denoise, "tfpf_window": tfpf_window,
+                    "noise_above": noise_above, "drift_below": drift_below, "inputs": inputs,
+                    "rate_window_s": rate_window_s, "learner_block_s": learner_block_s}
+        self.config = PipelineConfig(**pipeline, **({"k": k} if k is not None else {}),
+                                     **({"alpha": alpha} if alpha is not None else {}))
+        self.needs_tuning = decomposition == "vmd" and (k is None or alpha is None)
+        self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), int(recordings_seed)
+        self.n_train, self.n_test = int(n_train), int(n_test)
+        self.train_files, self.test_files = train_files, test_files
+        self.sample_rate_hz, self.hold_s = float(sample_rate_hz), float(hold_s)
+        self.amplitude_dps = float(bandwidth_amplitude_dps)
+        self.learner_name, self.learner_params = learner, dict(learner_params or {})
+        self.learner: Learner | None = None
+        if learner is not None:
+            self.learner = self._make_learner(np.random.default_rng(0))
+        searchable = self.learner is not None and self.learner.searchable
+        self.dim = self.learner.n_params if searchable else 1
+        low, high = self.learner.init_bounds() if searchable else (-1.0, 1.0)
+        self.lower, self.upper = np.full(self.dim, float(low)), np.full(self.dim, float(high))
+        self.action_space = gym.spaces.Box(self.lower, self.upper, dtype=np.float64)
+        self.observation_space = gym.spaces.Box(0.0, np.inf, shape=(1,), dtype=np.float64)
+        self.f_opt, self.target_precision = 0.0, 0.0
+        self.data: GyroData | None = None
+        self.pipeline: ParallelPipeline | None = None
+        self._x = self._y = None
+        self._reset_counters()
+
+    def _make_learner(self, rng: np.random.Generator) -> Learner:
+        form = "bias_rate" if self.config.inputs == "t_rate" else "bias"
+        return make_learner(str(self.learner_name), self.learner_params, form, rng, self.config.n_inputs)
+
+    def tuning_kwargs(self) -> dict[str, Any]:
+        """Arguments of the ``tcbench/Gyro-VMDTuning-v0`` env that tunes this task's VMD."""
+        return {"device_seed": self.device_seed, "recordings_seed": self.recordings_seed,
+                "train_files": self.train_files, "sample_rate_hz": self.sample_rate_hz, "hold_s": self.hold_s}
+
+    # -- episode ---------------------------------------------------------------------------
+    def _reset_counters(self) -> None:
+        self.evaluations = 0
+        self.best_f = np.inf
+        self.best_x = np.full(self.dim, np.nan)
+        self.nonfinite = 0
+
+    def _front(self, y: np.ndarray) -> FrontEnd:
+        assert self.data is not None
+        return cached_front(y, self.data.sample_rate_hz, self.config)
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        opts = dict(options or {})
+        if "k" in opts or "alpha" in opts:
+            self.config = dataclasses.replace(self.config, k=int(opts.get("k", self.config.k)),
+                                              alpha=float(opts.get("alpha", self.config.alpha)))
+            self.needs_tuning = False
+        if self.needs_tuning:
+            raise ValueError("VMD k and alpha are unset: give task.k and task.alpha, or tune them first "
+                             "(tcbench run does, on tcbench/Gyro-VMDTuning-v0)")
+        self.data = load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
+                                   self.sample_rate_hz, self.hold_s, self.n_train, self.n_test)
+        self.pipeline = ParallelPipeline(self.config)
+        learner_rng = np.random.default_rng(int(self.np_random.integers(0, 2**63 - 1)))
+        if self.learner_name is not None:
+            self.learner = self._make_learner(learner_rng)
+            sets = [self.pipeline.training_set(r.time_s, r.temperature_c, self._front(r.output))
+                    for r in (tr.recording for tr in self.data.train)]
+            self._x = np.concatenate([s[0] for s in sets])
+            self._y = np.concatenate([s[1] for s in sets])
+            if self.learner.searchable:
+                self.learner.scale_to(self._x, self._y)
+        self._reset_counters()
+        return np.array([np.inf]), self._info()
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
+        if self.data is None:
+            raise RuntimeError("call reset() before step()")
+        if self.learner is None or not self.learner.searchable:
+            raise TypeError(f"learner {self.learner_name!r} has no initial parameters to search")
+        x2, single = as_batch(action, self.dim)
+        check_budget(self.evaluations, x2.shape[0], self.budget)
+        f = np.asarray(self.learner.loss_batch(x2, self._x, self._y), dtype=np.float64)
+        finite = np.isfinite(f)
+        self.nonfinite += int(np.count_nonzero(~finite))
+        ranked = np.where(finite, f, np.inf)
+        i = int(np.argmin(ranked))
+        if ranked[i] < self.best_f:
+            self.best_f, self.best_x = float(ranked[i]), x2[i].copy()
+        self.evaluations += len(f)
+        reward: np.ndarray | float = float(-f[0]) if single else -f
+        return f, reward, False, self.evaluations >= self.budget, self._info()
+
+    def _info(self) -> dict[str, Any]:
+        return {
+            "best_f": self.best_f, "best_x": self.best_x.copy(), "evaluations": self.evaluations,
+            "budget": self.budget, "lower": self.lower.copy(), "upper": self.upper.copy(),
+            "f_opt": self.f_opt, "target_hit_at": None, "nonfinite": self.nonfinite,
+        }
+
+    # -- final scorer ----------------------------------------------------------------------
+    def _pipeline_method(self, t: np.ndarray, temp: np.ndarray) -> Method:
+        pipe = self.pipeline
+        assert pipe is not None
+        return lambda y: pipe.apply(t, temp, y, front=self._front(y)).output
+
+    def _score_pipeline(self, train_rmse: float, bandwidth: bool = True) -> Score:
+        assert self.data is not None and self.pipeline is not None
+        recs = []
+        for tr in self.data.test:
+            r = tr.recording
+            parts = self.pipeline.apply(r.time_s, r.temperature_c, r.output, front=self._front(r.output))
+            recs.append(score_record(tr, self._pipeline_method(r.time_s, r.temperature_c), self.amplitude_dps,
+                                     parts, bandwidth))
+        return Score("gyro", recs, train_rmse, extra={"k": self.config.k, "alpha": self.config.alpha,
+                                                       "classes": [p.parts.classes for p in recs]})
+
+    def score(self, init: np.ndarray | None = None, bandwidth: bool = True) -> tuple[Score, FitHistory]:
+        """Train the learner on the training record from ``init`` (None: its own random start)
+        and score the whole pipeline on the test record(s), before and after."""
+        if self.data is None or self.learner is None or self.pipeline is None or self._x is None:
+            raise RuntimeError("call reset() on an env with a learner before score()")
+        history = self.learner.fit(self._x, self._y, init=init)
+        self.pipeline.learner = self.learner
+        train_rmse = float(np.sqrt(np.mean((self.learner.predict(self._x) - self._y) ** 2)) * DPS_TO_DPH)
+        return self._score_pipeline(train_rmse, bandwidth), history
+
+    def score_baseline(self, which: str, bandwidth: bool = True) -> Score:
+        """``raw`` (the pipeline without drift compensation: the recorded output itself for the
+        serial pipeline without a denoiser) or ``oracle`` (the simulator's truth)."""
+        if self.data is None or self.pipeline is None:
+            raise RuntimeError("call reset() before score_baseline()")
+        if which == "raw":
+            self.pipeline.learner = None
+            return self._score_pipeline(float("nan"), bandwidth)
+        if which != "oracle":
+            raise ValueError(f"unknown baseline {which!r}; known: {', '.join(BASELINES)}")
+        if not self.data.has_truth:
+            raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
+        recs = [score_record(tr, lambda y, tr=tr: oracle_inverse(y, tr.truth), self.amplitude_dps,
+                             None, bandwidth) for tr in self.data.test]
+        return Score("gyro", recs)
