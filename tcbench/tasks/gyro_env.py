@@ -30,7 +30,7 @@ from tcbench.gyro.data import GyroData, check_settings
 from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.learners.base import FitHistory, Learner
-from tcbench.tasks.function_env import as_batch, check_budget
+from tcbench.tasks.weight_search import WeightSearch
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.msra_env import make_learner
 
@@ -39,7 +39,7 @@ BASELINES = ("raw", "oracle")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
-class GyroDriftNoiseEnv(gym.Env[np.ndarray, np.ndarray]):
+class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     """Search a drift learner's initial parameters on a gyro oven task.
 
     learner, learner_params: the registered learner (default Elman) and its parameters; None for
@@ -115,12 +115,6 @@ class GyroDriftNoiseEnv(gym.Env[np.ndarray, np.ndarray]):
                 "train_files": self.train_files, "sample_rate_hz": self.sample_rate_hz, "hold_s": self.hold_s}
 
     # -- episode ---------------------------------------------------------------------------
-    def _reset_counters(self) -> None:
-        self.evaluations = 0
-        self.best_f = np.inf
-        self.best_x = np.full(self.dim, np.nan)
-        self.nonfinite = 0
-
     def _front(self, y: np.ndarray) -> FrontEnd:
         assert self.data is not None
         return cached_front(y, self.data.sample_rate_hz, self.config)
@@ -150,31 +144,6 @@ class GyroDriftNoiseEnv(gym.Env[np.ndarray, np.ndarray]):
                 self.learner.scale_to(self._x, self._y)
         self._reset_counters()
         return np.array([np.inf]), self._info()
-
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
-        if self.data is None:
-            raise RuntimeError("call reset() before step()")
-        if self.learner is None or not self.learner.searchable:
-            raise TypeError(f"learner {self.learner_name!r} has no initial parameters to search")
-        x2, single = as_batch(action, self.dim)
-        check_budget(self.evaluations, x2.shape[0], self.budget)
-        f = np.asarray(self.learner.loss_batch(x2, self._x, self._y), dtype=np.float64)
-        finite = np.isfinite(f)
-        self.nonfinite += int(np.count_nonzero(~finite))
-        ranked = np.where(finite, f, np.inf)
-        i = int(np.argmin(ranked))
-        if ranked[i] < self.best_f:
-            self.best_f, self.best_x = float(ranked[i]), x2[i].copy()
-        self.evaluations += len(f)
-        reward: np.ndarray | float = float(-f[0]) if single else -f
-        return f, reward, False, self.evaluations >= self.budget, self._info()
-
-    def _info(self) -> dict[str, Any]:
-        return {
-            "best_f": self.best_f, "best_x": self.best_x.copy(), "evaluations": self.evaluations,
-            "budget": self.budget, "lower": self.lower.copy(), "upper": self.upper.copy(),
-            "f_opt": self.f_opt, "target_hit_at": None, "nonfinite": self.nonfinite,
-        }
 
     # -- final scorer ----------------------------------------------------------------------
     def _pipeline_method(self, t: np.ndarray, temp: np.ndarray) -> Method:

@@ -34,7 +34,7 @@ from tcbench.compensation.data import (
 from tcbench.compensation.scoring import Score, score_outputs
 from tcbench.learners import registry as learners
 from tcbench.learners.base import FitHistory, Learner
-from tcbench.tasks.function_env import as_batch, check_budget
+from tcbench.tasks.weight_search import WeightSearch
 
 TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp"}
 ENV_IDS = {"msra_zerobias": "tcbench/MSRA-ZeroBias-v0", "msra_fulltemp": "tcbench/MSRA-FullTemp-v0"}
@@ -52,7 +52,7 @@ def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.ra
     return cls(n_inputs, values, rng)
 
 
-class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):
+class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     """Search a learner's initial parameters on an MSRA compensation task.
 
     Parameters
@@ -129,12 +129,6 @@ class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):
         self._reset_counters()
 
     # -- episode ---------------------------------------------------------------------------
-    def _reset_counters(self) -> None:
-        self.evaluations = 0
-        self.best_f = np.inf
-        self.best_x = np.full(self.dim, np.nan)
-        self.nonfinite = 0
-
     def _load(self) -> MSRAData:
         if self.train_files is not None and self.test_files is not None:
             return file_data(self.protocol, list(self.train_files), list(self.test_files), self.train_on,
@@ -157,31 +151,6 @@ class MSRACompensationEnv(gym.Env[np.ndarray, np.ndarray]):
                 self.learner.scale_to(self._x, self._y)
         self._reset_counters()
         return np.array([np.inf]), self._info()
-
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray | float, bool, bool, dict[str, Any]]:
-        if self.data is None:
-            raise RuntimeError("call reset() before step()")
-        if self.learner is None or not self.learner.searchable:
-            raise TypeError(f"learner {self.learner_name!r} has no initial parameters to search")
-        x2, single = as_batch(action, self.dim)
-        check_budget(self.evaluations, x2.shape[0], self.budget)
-        f = np.asarray(self.learner.loss_batch(x2, self._x, self._y), dtype=np.float64)
-        finite = np.isfinite(f)
-        self.nonfinite += int(np.count_nonzero(~finite))
-        ranked = np.where(finite, f, np.inf)
-        i = int(np.argmin(ranked))
-        if ranked[i] < self.best_f:
-            self.best_f, self.best_x = float(ranked[i]), x2[i].copy()
-        self.evaluations += len(f)
-        reward: np.ndarray | float = float(-f[0]) if single else -f
-        return f, reward, False, self.evaluations >= self.budget, self._info()
-
-    def _info(self) -> dict[str, Any]:
-        return {
-            "best_f": self.best_f, "best_x": self.best_x.copy(), "evaluations": self.evaluations,
-            "budget": self.budget, "lower": self.lower.copy(), "upper": self.upper.copy(),
-            "f_opt": self.f_opt, "target_hit_at": None, "nonfinite": self.nonfinite,
-        }
 
     # -- final scorer ----------------------------------------------------------------------
     def score(self, init: np.ndarray | None = None) -> tuple[Score, FitHistory]:
