@@ -29,6 +29,8 @@ def compensation_task_key(task: dict[str, Any]) -> str:
     key = f"{task['name']}-dev{task.get('device_seed', 0)}"
     if task.get("recordings_seed", 0) != 0:
         key += f"-rec{task.get('recordings_seed')}"
+    for effect, params in sorted((task.get("effects") or {}).items()):
+        key += "-" + "-".join(f"{effect}.{p}={v:g}" for p, v in sorted(params.items()))
     return key
 
 

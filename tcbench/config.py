@@ -65,6 +65,7 @@ class GyroTuningTaskConfig:
     sample_rate_hz: float = 10.0
     hold_s: float = 3600.0
     tuning_samples: int = 2048
+    effects: dict | None = None
 
 
 @dataclass

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import json
 import logging
 import time
 from dataclasses import dataclass, field
@@ -199,9 +200,9 @@ class VMDTuning:
 
 
 @functools.lru_cache(maxsize=4)
-def _tune(kwargs: tuple[tuple[str, Any], ...], tuner: str, budget: int, samples: int, progress: bool) -> VMDTuning:
+def _tune(env_kwargs_json: str, tuner: str, budget: int, samples: int, progress: bool) -> VMDTuning:
     t0 = time.perf_counter()
-    env = tasks.GyroVMDTuningEnv(budget=budget, tuning_samples=samples, **dict(kwargs))
+    env = tasks.GyroVMDTuningEnv(budget=budget, tuning_samples=samples, **json.loads(env_kwargs_json))
     env.reset(seed=0)
     opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), {}, 2)
     ask_tell(opt, env, budget, progress)
@@ -212,12 +213,12 @@ def _tune(kwargs: tuple[tuple[str, Any], ...], tuner: str, budget: int, samples:
 
 def tune_vmd(env_kwargs: dict[str, Any], tuner: str = "mopso", budget: int = 440, samples: int = 2048,
              progress: bool = False) -> VMDTuning:
-    """Tune VMD's ``[k, alpha]`` on ``tcbench/Gyro-VMDTuning-v0`` with the multi-objective
-    optimiser ``tuner`` (its default parameters: MOPSO's are seed 001's) within ``budget``
-    evaluations. The tuning's random stream is fixed (seed 0): the tuned decomposition is a
-    property of the training record, shared by every restart of the learner (and remembered)."""
-    key = tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in env_kwargs.items()))
-    return _tune(key, str(tuner), int(budget), int(samples), bool(progress))
+    """Tune VMD's ``[k, alpha]`` on ``tcbench/Gyro-VMDTuning-v0`` (built from ``env_kwargs``) with
+    the multi-objective optimiser ``tuner`` (its default parameters: MOPSO's are seed 001's)
+    within ``budget`` evaluations. The tuning's random stream is fixed (seed 0): the tuned
+    decomposition is a property of the training record, shared by every restart of the learner
+    (and remembered for the process)."""
+    return _tune(json.dumps(env_kwargs, sort_keys=True), str(tuner), int(budget), int(samples), bool(progress))
 
 
 @dataclass

@@ -207,3 +207,15 @@ def test_poly_bias_rate_recovers_a_lagged_bias() -> None:
     bias_only = PolynomialModel(2, {"degree": 3, "form": "bias"})
     bias_only.fit(np.column_stack([temp, rate]), bias)
     assert np.abs(bias_only.predict(np.column_stack([temp, rate])) - bias).max() > 0.01
+
+
+def test_device_effects_change_the_simulated_gyro() -> None:
+    low = {"bias_instability": {"b": 3.0 / 3600.0}}  # 3 deg/h of flicker instead of ~33
+    env = _env("poly", decomposition="none", denoise="none", effects=low)
+    s = env.score(bandwidth=False)[0].summary()
+    assert s["drift_dph"] * 5 < s["raw_drift_dph"]  # with little flicker the drift is what is left
+    assert env.data.train[0].recording.meta.extra["effect_changes"] == low
+    with pytest.raises(ValueError, match="unknown effect 'nosuch'"):
+        GyroDriftNoiseEnv("poly", effects={"nosuch": {"b": 1.0}})
+    with pytest.raises(ValueError, match="has no parameter q"):
+        GyroVMDTuningEnv(effects={"bias_instability": {"q": 1.0}})

@@ -11,6 +11,7 @@ bursts) or an uneven clock is refused with one line naming the file.
 from __future__ import annotations
 
 import functools
+import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -57,11 +58,28 @@ def recording_key(tr: TaskRecording) -> str:
 
 
 @functools.lru_cache(maxsize=4)
-def _simulated(device_seed: int, seed: int, sample_rate: float, hold_s: float) -> TaskRecording:
+def _simulated(device_seed: int, seed: int, sample_rate: float, hold_s: float, effects_json: str) -> TaskRecording:
     params = {"sample_rate_hz": sample_rate, "hold_s": hold_s, "room_s": hold_s}
-    rec = simulate_recording("gyro", "oven", device_seed, seed, **params)
-    truth = simulate_truth("gyro", "oven", device_seed, seed, **params)
+    effects = json.loads(effects_json)
+    rec = simulate_recording("gyro", "oven", device_seed, seed, effects, **params)
+    truth = simulate_truth("gyro", "oven", device_seed, seed, effects, **params)
     return TaskRecording(f"dev{device_seed}-seed{seed}", rec, truth)
+
+
+def check_effects(effects: dict[str, dict[str, float]] | None) -> dict[str, dict[str, float]]:
+    """Effect changes ``{id: {param: value}}`` of the device (PHYSICS.md §3, output units deg/s);
+    :class:`TaskDataError` naming an unknown effect or parameter."""
+    from tcbench.sensors.devices import unit
+
+    if not effects:
+        return {}
+    if not isinstance(effects, dict) or not all(isinstance(v, dict) for v in effects.values()):
+        raise TaskDataError(f"effects must map effect ids to {{parameter: value}}, got {effects!r}")
+    try:
+        unit("gyro", 0).model.with_effects(effects)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise TaskDataError(f"effects: {str(exc).strip(chr(39))}") from None
+    return {str(k): {str(p): float(v) for p, v in d.items()} for k, d in effects.items()}
 
 
 def check_settings(sample_rate: float, hold_s: float, n_train: int, n_test: int) -> None:
@@ -76,14 +94,17 @@ def check_settings(sample_rate: float, hold_s: float, n_train: int, n_test: int)
 
 
 def simulated_gyro_data(device_seed: int, recordings_seed: int, n_train: int = 1, n_test: int = 1,
-                        sample_rate: float = 10.0, hold_s: float = 3600.0) -> GyroData:
-    """``n_train + n_test`` simulated oven runs of gyro ``device_seed``; the first train."""
+                        sample_rate: float = 10.0, hold_s: float = 3600.0,
+                        effects: dict[str, dict[str, float]] | None = None) -> GyroData:
+    """``n_train + n_test`` simulated oven runs of gyro ``device_seed`` (its effects changed by
+    ``effects``, see :func:`check_effects`); the first ``n_train`` train."""
     check_settings(sample_rate, hold_s, n_train, n_test)
-    recs = [_simulated(int(device_seed), recording_seed(recordings_seed, i), float(sample_rate), float(hold_s))
-            for i in range(n_train + n_test)]
+    changes = json.dumps(check_effects(effects), sort_keys=True)
+    recs = [_simulated(int(device_seed), recording_seed(recordings_seed, i), float(sample_rate), float(hold_s),
+                       changes) for i in range(n_train + n_test)]
     return GyroData(recs[:n_train], recs[n_train:], "simulated",
                     {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed),
-                     "sample_rate_hz": float(sample_rate), "hold_s": float(hold_s)})
+                     "sample_rate_hz": float(sample_rate), "hold_s": float(hold_s), "effects": json.loads(changes)})
 
 
 def load_gyro_file(path: str, role: str) -> TaskRecording:

@@ -26,7 +26,7 @@ from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.oracle import oracle_inverse
 from tcbench.compensation.scoring import Score
 from tcbench.gyro.cache import cached_front
-from tcbench.gyro.data import GyroData, check_settings
+from tcbench.gyro.data import GyroData, check_effects, check_settings
 from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.learners.base import FitHistory, Learner
@@ -53,6 +53,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.gyro.pipeline.PipelineConfig`);
         ``k``/``alpha`` None: set by ``reset(options=...)`` after tuning.
     bandwidth_amplitude_dps: amplitude of each injected sine of the bandwidth test (deg/s).
+    effects: changes of the simulated device's effects, ``{id: {param: value}}`` in deg/s units
+        (e.g. ``{"bias_instability": {"b": 8.3e-4}}`` for 3 deg/h of flicker).
     """
 
     metadata = {"render_modes": []}
@@ -64,7 +66,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  k: int | None = None, alpha: float | None = None, denoise: str = "tfpf", tfpf_window: int = 31,
                  noise_above: float = 0.5, drift_below: float = 0.15, inputs: str = "t_rate",
                  rate_window_s: float = 120.0, learner_block_s: float = 10.0,
-                 bandwidth_amplitude_dps: float = 0.005, **_: Any) -> None:
+                 bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
+                 **_: Any) -> None:
         if int(budget) != budget or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
@@ -76,6 +79,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
         try:
             check_settings(sample_rate_hz, hold_s, n_train, n_test)
+            self.effects = check_effects(effects)
         except TaskDataError as exc:
             raise ValueError(str(exc)) from None
         pipeline = {"decomposition": decomposition, "denoise": denoise, "tfpf_window": tfpf_window,
@@ -112,7 +116,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     def tuning_kwargs(self) -> dict[str, Any]:
         """Arguments of the ``tcbench/Gyro-VMDTuning-v0`` env that tunes this task's VMD."""
         return {"device_seed": self.device_seed, "recordings_seed": self.recordings_seed,
-                "train_files": self.train_files, "sample_rate_hz": self.sample_rate_hz, "hold_s": self.hold_s}
+                "train_files": self.train_files, "sample_rate_hz": self.sample_rate_hz, "hold_s": self.hold_s,
+                "effects": self.effects}
 
     # -- episode ---------------------------------------------------------------------------
     def _front(self, y: np.ndarray) -> FrontEnd:
@@ -131,7 +136,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError("VMD k and alpha are unset: give task.k and task.alpha, or tune them first "
                              "(tcbench run does, on tcbench/Gyro-VMDTuning-v0)")
         self.data = load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
-                                   self.sample_rate_hz, self.hold_s, self.n_train, self.n_test)
+                                   self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects)
         self.pipeline = ParallelPipeline(self.config)
         learner_rng = np.random.default_rng(int(self.np_random.integers(0, 2**63 - 1)))
         if self.learner_name is not None:

@@ -17,7 +17,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from tcbench.gyro.data import GyroData, file_gyro_data, simulated_gyro_data
+from tcbench.compensation.data import TaskDataError
+from tcbench.gyro.data import GyroData, check_effects, file_gyro_data, simulated_gyro_data
 from tcbench.gyro.tuning import ALPHA_RANGE, K_RANGE, REF_POINT, compromise, decode, tuning_window, vmd_objectives
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.mo_env import record_front
@@ -27,11 +28,11 @@ ENV_ID = "tcbench/Gyro-VMDTuning-v0"
 
 def load_gyro_data(device_seed: int, recordings_seed: int, train_files: list[str] | None,
                    test_files: list[str] | None, sample_rate_hz: float, hold_s: float,
-                   n_train: int = 1, n_test: int = 1) -> GyroData:
-    """Simulated oven runs, or the files when ``train_files`` is given."""
+                   n_train: int = 1, n_test: int = 1, effects: dict[str, dict[str, float]] | None = None) -> GyroData:
+    """Simulated oven runs (the device's ``effects`` changed), or the files when ``train_files`` is given."""
     if train_files:
         return file_gyro_data(list(train_files), list(test_files or train_files))
-    return simulated_gyro_data(device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s)
+    return simulated_gyro_data(device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s, effects)
 
 
 class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -40,14 +41,16 @@ class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
     device_seed, recordings_seed: the simulated gyro and its runs (the first one is tuned on);
     train_files: schema-v1 gyro recordings instead (the first is tuned on);
     sample_rate_hz, hold_s: the simulated oven run's rate and soak length;
-    tuning_samples: length of the window the entropies are computed on.
+    tuning_samples: length of the window the entropies are computed on;
+    effects: changes of the simulated device's effects, ``{id: {param: value}}`` (deg/s units).
     """
 
     metadata = {"render_modes": []}
 
     def __init__(self, budget: int = 440, device_seed: int = 0, recordings_seed: int = 0,
                  train_files: list[str] | None = None, sample_rate_hz: float = 10.0, hold_s: float = 3600.0,
-                 tuning_samples: int = 2048, **_: Any) -> None:
+                 tuning_samples: int = 2048, effects: dict[str, dict[str, float]] | None = None,
+                 **_: Any) -> None:
         if int(budget) != budget or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
@@ -57,6 +60,10 @@ class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
         self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), int(recordings_seed)
         self.train_files, self.sample_rate_hz, self.hold_s = train_files, float(sample_rate_hz), float(hold_s)
         self.tuning_samples = int(tuning_samples)
+        try:
+            self.effects = check_effects(effects)
+        except TaskDataError as exc:
+            raise ValueError(str(exc)) from None
         self.dim, self.n_objectives = 2, 2
         self.lower = np.array([K_RANGE[0], ALPHA_RANGE[0]])
         self.upper = np.array([K_RANGE[1], ALPHA_RANGE[1]])
@@ -79,7 +86,7 @@ class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
         super().reset(seed=seed)
         if self.signal is None:
             data = load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, None,
-                                  self.sample_rate_hz, self.hold_s)
+                                  self.sample_rate_hz, self.hold_s, effects=self.effects)
             self.signal = tuning_window(data.train[0].recording.output, self.tuning_samples)
         self._reset_counters()
         return np.full(2, np.inf), self._info()
