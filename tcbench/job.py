@@ -15,13 +15,18 @@ import yaml
 from tcbench import plots
 from tcbench.config import as_dict, validate
 from tcbench.runner import RunResult, run_optimisation
-from tcbench.tasks import is_compensation
+from tcbench.tasks import is_compensation, is_gyro
 
 log = logging.getLogger(__name__)
 
 
 def task_key(task: dict[str, Any]) -> str:
-    """Leaderboard key of a task config, e.g. ``rastrigin-2d`` or ``rastrigin-10d-shifted``."""
+    """Leaderboard key of a task config, e.g. ``rastrigin-2d`` or ``rastrigin-10d-shifted``
+    (``gyro_vmdtuning-dev0`` for the VMD tuning of a gyro)."""
+    if is_gyro(str(task["name"])):
+        from tcbench.compensation_job import compensation_task_key
+
+        return compensation_task_key(task)
     key = f"{task['name']}-{task['dim']}d"
     if task.get("shift"):
         key += "-shifted"

@@ -55,3 +55,15 @@ def test_bad_gyro_settings_exit_2_with_one_line(workdir: Path) -> None:
         assert out.returncode == 2, (arg, out.stderr)
         assert words in out.stderr and "Traceback" not in out.stderr
         assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_vmd_tuning_runs_with_mopso_from_its_experiment(workdir: Path) -> None:
+    out = tcbench("run", "experiment=movmd_tuning", *SMALL, "task.tuning_samples=256", "budget=80", cwd=workdir)
+    assert out.returncode == 0, out.stderr
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    (run,) = client.search_runs([client.get_experiment_by_name("tcbench").experiment_id])
+    assert run.data.tags["tcbench.task"] == "gyro_vmdtuning-dev0" and run.data.tags["tcbench.method"] == "mopso"
+    assert run.data.metrics["hypervolume"] > 0 and run.data.metrics["evaluations"] == 80
+    assert "front.csv" in {a.path for a in client.list_artifacts(run.info.run_id)}
+    single = tcbench("run", "task=gyro_vmdtuning", "optimiser=pso", cwd=workdir)
+    assert single.returncode == 2 and "single-objective" in single.stderr
