@@ -82,13 +82,15 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
     kinds = [leaderboard.load_runs(client, [experiment], sweep), comp_board.load_runs(client, [experiment], sweep)]
     runs = pd.concat([k for k in kinds if not k.empty], ignore_index=True) if any(not k.empty for k in kinds) else kinds[0]
     failed = runs[runs["status"] != "FINISHED"] if len(runs) else runs
+    running = int((failed["status"] == "RUNNING").sum()) if len(failed) else 0
     print(
         f"tcbench: {len(runs)} run{'s' if len(runs) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
         f"(experiment {experiment!r}, sweep {sweep}): {len(runs) - len(failed)} finished, "
-        f"{len(failed)} failed",
+        f"{len(failed)} failed" + (f" ({running} still RUNNING: another process on this sweep id, or "
+                                   "killed without a trace)" if running else ""),
     )
     for r in failed.itertuples():
-        print(f"  FAILED {r.method} on {r.task} seed {r.seed}: {r.error_message}")
+        print(f"  {r.status} {r.method} on {r.task} seed {r.seed}: {r.error_message}")
     missing = (expected - len(runs)) if expected is not None else 0
     if missing > 0:
         print(f"  {missing} job{'s' if missing != 1 else ''} left no run in MLflow "

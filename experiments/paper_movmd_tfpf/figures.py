@@ -99,6 +99,22 @@ def _allan_curves(client, runs: pd.DataFrame, where: Path) -> dict[str, AllanDev
     return curves
 
 
+def _paper_figures(client, task: str, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
+    """Copy the seed's figures (Figs. 11-14, 17-19) of the paper's method's median run (by
+    drift) into ``out/<task>/``; markdown lines that show them."""
+    mine = runs[runs["method"] == PAPER_METHOD]
+    if mine.empty:
+        return []
+    pick = mine.iloc[(mine["drift_dph"] - mine["drift_dph"].median()).abs().argsort().iloc[0]]
+    where = out / task
+    where.mkdir(parents=True, exist_ok=True)
+    names = sorted(a.path for a in client.list_artifacts(pick["run_id"]) if a.path.startswith("fig"))
+    for name in names:
+        client.download_artifacts(pick["run_id"], name, str(where))
+    return [f"Figures of the paper's method, restart {int(pick['seed'])} (the median by drift): "
+            + ", ".join(f"[{n.split('_')[0]}]({task}/{n})" for n in names) + ".", ""]
+
+
 def _section(client, task: str, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
     oracle = runs[runs["method"] == "oracle"].iloc[0]
     table = _table(runs)
@@ -110,7 +126,8 @@ def _section(client, task: str, runs: pd.DataFrame, out: Path) -> list[str]:  # 
     allan_methods_figure(png, curves, f"Fig. 19 on {task}: Allan deviation of every method (test run)",
                          annotations={m: f"bw {bw[m]:.2g} Hz" for m in curves if m in bw})
     return [f"## {task}", "", markdown_table(table), "", *[f"{line}\n" for line in _verdict(runs, oracle)],
-            f"![Allan deviation of every method on {task}]({png.name})", ""]
+            f"![Allan deviation of every method on {task}]({png.name})", "",
+            *_paper_figures(client, task, runs, out)]
 
 
 def main() -> None:
