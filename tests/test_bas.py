@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import optimiser_runs
 import pytest
 
 from tcbench.optimisers.bas import (
@@ -25,20 +26,11 @@ from tcbench.tasks.functions import rastrigin, sphere
 
 
 def _make(dim=2, budget=100, seed=0, params=None, lower=-5.12, upper=5.12):
-    lo, hi = np.full(dim, lower), np.full(dim, upper)
-    return BeetleAntennaeSearch(lo, hi, budget, np.random.default_rng(seed), params or {})
+    return optimiser_runs.make(BeetleAntennaeSearch, dim, budget, seed, params, lower, upper)
 
 
 def _run(fn, dim=2, budget=100, seed=0, params=None, lower=-5.12, upper=5.12):
-    opt = _make(dim, budget, seed, params, lower, upper)
-    asked = 0
-    while not opt.done:
-        x = opt.ask()
-        assert 0 < len(x) <= opt.remaining
-        assert np.all(x >= opt.lower) and np.all(x <= opt.upper)
-        asked += len(x)
-        opt.tell(x, fn(x))
-    return opt, asked
+    return optimiser_runs.run(BeetleAntennaeSearch, fn, dim, budget, seed, params, lower, upper)
 
 
 # -- eq. 30 ----------------------------------------------------------------------------------

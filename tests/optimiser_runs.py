@@ -1,0 +1,29 @@
+"""Driving an ask/tell optimiser to the end of its budget, checking the protocol on the way."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+
+def make(cls: type, dim: int = 2, budget: int = 100, seed: int = 0, params: dict[str, Any] | None = None,
+         lower: float = -5.12, upper: float = 5.12) -> Any:
+    """An optimiser of class ``cls`` on the box ``[lower, upper]^dim``."""
+    lo, hi = np.full(dim, lower), np.full(dim, upper)
+    return cls(lo, hi, budget, np.random.default_rng(seed), params or {})
+
+
+def run(cls: type, fn: Callable[[np.ndarray], np.ndarray], dim: int = 2, budget: int = 100, seed: int = 0,
+        params: dict[str, Any] | None = None, lower: float = -5.12, upper: float = 5.12) -> tuple[Any, int]:
+    """Ask/tell until done, asserting every ask fits the budget and the box; (optimiser, asked)."""
+    opt = make(cls, dim, budget, seed, params, lower, upper)
+    asked = 0
+    while not opt.done:
+        x = opt.ask()
+        assert 0 < len(x) <= opt.remaining
+        assert np.all(x >= opt.lower) and np.all(x <= opt.upper)
+        asked += len(x)
+        opt.tell(x, fn(x))
+    return opt, asked
