@@ -17,8 +17,8 @@ def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
 
 
 def test_tuned_bas_elman_job_is_tracked_with_the_seed_figures(workdir: Path) -> None:
-    out = tcbench("run", "task=gyro_driftnoise", *SMALL, "task.tuning_budget=80", "task.tuning_samples=256",
-                  "learner=elman", "learner.hidden=4", "learner.epochs=20", "optimiser=bas", "budget=40", cwd=workdir)
+    out = tcbench("run", "experiment=movmd_tfpf", *SMALL, "task.tuning_budget=80", "task.tuning_samples=256",
+                  "learner.hidden=4", "learner.epochs=20", "budget=40", cwd=workdir)
     assert out.returncode == 0, out.stderr
     client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     (run,) = client.search_runs([client.get_experiment_by_name("tcbench").experiment_id])
