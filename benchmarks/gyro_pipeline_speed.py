@@ -18,7 +18,15 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from common import add_json, blas_threads, command_line, environment, environment_line, parser_for, write_json
+from common import (
+    add_json,
+    blas_threads,
+    command_line,
+    environment,
+    environment_line,
+    parser_for,
+    write_json,
+)
 
 DEFAULT_JSON = Path(__file__).with_name("gyro_pipeline_speed.json")
 TARGET_S = 300.0

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
+from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
 from tcbench.tasks.gyro_env import ENV_ID as GYRO_DRIFTNOISE_ID
 from tcbench.tasks.gyro_env import GyroDriftNoiseEnv
 from tcbench.tasks.gyro_vmd_env import ENV_ID as GYRO_VMDTUNING_ID
 from tcbench.tasks.gyro_vmd_env import GyroVMDTuningEnv
-from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
 from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
 from tcbench.tasks.msra_env import ENV_IDS as MSRA_ENV_IDS
 from tcbench.tasks.msra_env import MSRACompensationEnv
@@ -76,11 +76,11 @@ register_gyro_envs()
 
 __all__ = [
     "FUNCTIONS",
+    "GYRO_ENV_IDS",
     "MSRA_ENV_IDS",
     "PROBLEMS",
     "BudgetExceededError",
     "FunctionEnv",
-    "GYRO_ENV_IDS",
     "GyroDriftNoiseEnv",
     "GyroVMDTuningEnv",
     "MSRACompensationEnv",

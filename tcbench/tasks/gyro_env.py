@@ -30,9 +30,9 @@ from tcbench.gyro.data import GyroData, check_effects, check_settings
 from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.learners.base import FitHistory, Learner
-from tcbench.tasks.weight_search import WeightSearch
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.msra_env import make_learner
+from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = "tcbench/Gyro-DriftNoise-v0"
 BASELINES = ("raw", "oracle")

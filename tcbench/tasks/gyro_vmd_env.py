@@ -18,8 +18,21 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.compensation.data import TaskDataError
-from tcbench.gyro.data import GyroData, check_effects, file_gyro_data, simulated_gyro_data
-from tcbench.gyro.tuning import ALPHA_RANGE, K_RANGE, REF_POINT, compromise, decode, tuning_window, vmd_objectives
+from tcbench.gyro.data import (
+    GyroData,
+    check_effects,
+    file_gyro_data,
+    simulated_gyro_data,
+)
+from tcbench.gyro.tuning import (
+    ALPHA_RANGE,
+    K_RANGE,
+    REF_POINT,
+    compromise,
+    decode,
+    tuning_window,
+    vmd_objectives,
+)
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.mo_env import record_front
 
