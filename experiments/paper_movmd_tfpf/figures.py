@@ -123,7 +123,7 @@ def _section(client, task: str, runs: pd.DataFrame, out: Path) -> list[str]:  # 
         curves = _allan_curves(client, runs, Path(tmp))
     bw = runs.groupby("method")["bandwidth_hz"].median()
     png = out / f"fig19_allan_{task}.png"
-    allan_methods_figure(png, curves, f"Fig. 19 on {task}: Allan deviation of every method (test run)",
+    allan_methods_figure(png, curves, f"Fig. 19: Allan deviation of every method (test run)\n{task}",
                          annotations={m: f"bw {bw[m]:.2g} Hz" for m in curves if m in bw})
     return [f"## {task}", "", markdown_table(table), "", *[f"{line}\n" for line in _verdict(runs, oracle)],
             f"![Allan deviation of every method on {task}]({png.name})", "",
