@@ -4,7 +4,7 @@
 # the simulated 14 h, 10 Hz oven runs of gyro 0 (one to train, one to test); then regenerate
 # leaderboards/paper-movmd-tfpf/ with the comparison table and the Allan curves of every method.
 # Usage (from the repository root, with tcbench installed): bash experiments/paper_movmd_tfpf/run.sh
-# About 70 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
+# About 30 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 here=experiments/paper_movmd_tfpf
