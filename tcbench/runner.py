@@ -258,8 +258,8 @@ def run_compensation(
     env_seed, rng = seed_streams(seed)
     tuning = None
     if getattr(env, "needs_tuning", False):
-        tuning = tune_vmd(env.tuning_kwargs(), task.get("tuner") or "mopso", task.get("tuning_budget") or 440,
-                          task.get("tuning_samples") or 2048, progress)
+        tuning = tune_vmd(env.tuning_kwargs(), env.tuning["tuner"], env.tuning["budget"], env.tuning["samples"],
+                          progress)
     env.reset(seed=env_seed, options={"k": tuning.k, "alpha": tuning.alpha} if tuning else None)
     trace = Trace()
     if baseline:

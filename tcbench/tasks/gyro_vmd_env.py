@@ -62,8 +62,7 @@ class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
 
     def __init__(self, budget: int = 440, device_seed: int = 0, recordings_seed: int = 0,
                  train_files: list[str] | None = None, sample_rate_hz: float = 10.0, hold_s: float = 3600.0,
-                 tuning_samples: int = 2048, effects: dict[str, dict[str, float]] | None = None,
-                 **_: Any) -> None:
+                 tuning_samples: int = 2048, effects: dict[str, dict[str, float]] | None = None) -> None:
         if int(budget) != budget or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
