@@ -74,12 +74,23 @@ def figures(score: Score, history_loss: list[float] | None, where: Path, title: 
     seed 000; Figs. 11-14 and 17-19 of seed 001 (gyro)."""
     from tcbench.compensation import plots as cplots
 
-    paths = []
     if score.protocol == "gyro":
         from tcbench.gyro.plots import run_figures
 
         paths = run_figures(score, tuning, where, title)
-    for i, r in enumerate(score.recordings if score.protocol != "gyro" else [], start=1):
+    else:
+        paths = _msra_figures(score, where, title)
+    if history_loss and len(history_loss) > 1:
+        paths.append(cplots.training_curve(where / "training_curve.png", history_loss, f"{title}: training"))
+    return paths
+
+
+def _msra_figures(score: Score, where: Path, title: str) -> list[Path]:
+    """Seed 000's Fig. 7 (zero bias) or Figs. 8-9 (full temperature) per test recording."""
+    from tcbench.compensation import plots as cplots
+
+    paths = []
+    for i, r in enumerate(score.recordings, start=1):
         if r.nodes_before is not None and r.nodes_after is not None:
             paths.append(cplots.four_position_before_after(
                 where / f"fig8_test{i}.png", r.nodes_before, r.nodes_after, f"{title}: test {i} ({r.name})"))
@@ -88,8 +99,6 @@ def figures(score: Score, history_loss: list[float] | None, where: Path, title: 
         elif r.t_s is not None:
             paths.append(cplots.zero_bias_before_after(
                 where / f"fig7_test{i}.png", r.t_s, r.before_ug, r.after_ug, f"{title}: test {i} ({r.name})"))
-    if history_loss and len(history_loss) > 1:
-        paths.append(cplots.training_curve(where / "training_curve.png", history_loss, f"{title}: training"))
     return paths
 
 
