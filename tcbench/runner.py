@@ -15,6 +15,7 @@ from tqdm.auto import tqdm
 
 import tcbench.tasks as tasks
 from tcbench.compensation.scoring import Score
+from tcbench.gyro.tuning import compromise, decode
 from tcbench.learners.base import FitHistory
 from tcbench.metrics.multiobjective import igd
 from tcbench.optimisers import registry
@@ -188,12 +189,14 @@ def run_optimisation(
 @dataclass(frozen=True)
 class VMDTuning:
     """Outcome of the multi-objective VMD tuning of a gyro task (seed 001 §3.2): the chosen
-    ``[k, alpha]``, the non-dominated set, every evaluated objective pair and the cost."""
+    ``[k, alpha]``, the non-dominated set and the chosen point's objectives, every evaluated
+    objective pair and the cost."""
 
     k: int
     alpha: float
     front_x: np.ndarray
     front_f: np.ndarray
+    chosen_f: np.ndarray
     evaluated_f: np.ndarray
     evaluations: int
     seconds: float
@@ -206,9 +209,10 @@ def _tune(env_kwargs_json: str, tuner: str, budget: int, samples: int, progress:
     env.reset(seed=0)
     opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), {}, 2)
     ask_tell(opt, env, budget, progress)
-    k, alpha = env.chosen()
-    return VMDTuning(k, alpha, env.front_x, env.front_f, np.concatenate(env.evaluated_f), env.evaluations,
-                     time.perf_counter() - t0)
+    i = compromise(env.front_x, env.front_f)
+    k, alpha = decode(env.front_x[i])
+    return VMDTuning(k, alpha, env.front_x, env.front_f, env.front_f[i], np.concatenate(env.evaluated_f),
+                     env.evaluations, time.perf_counter() - t0)
 
 
 def tune_vmd(env_kwargs: dict[str, Any], tuner: str = "mopso", budget: int = 440, samples: int = 2048,

@@ -328,10 +328,8 @@ def run_figures(score: Any, tuning: Any, where: Path, title: str) -> list[Path]:
         head = f"{title}: test {i} ({r.name})"
         parts = r.parts
         if parts is not None and parts.modes is not None:
-            fs = 1.0 / float(np.median(np.diff(r.t_s)))
-            modes = parts.modes
-            freqs = np.array([_centre_frequency_hz(u, fs) for u in modes])
-            paths.append(modes_figure(where / f"fig12_modes_test{i}.png", r.t_s, modes, freqs,
+            freqs = _centre_frequencies_hz(parts.modes, 1.0 / float(np.median(np.diff(r.t_s))))
+            paths.append(modes_figure(where / f"fig12_modes_test{i}.png", r.t_s, parts.modes, freqs,
                                       parts.classes.label, head))
             paths.append(entropy_classes_figure(where / f"fig13_entropy_test{i}.png", parts.classes, head))
             if np.any(parts.mixed_part):
@@ -347,17 +345,14 @@ def run_figures(score: Any, tuning: Any, where: Path, title: str) -> list[Path]:
                                           {"raw": r.allan_before, "this method": r.allan_after}, head,
                                           annotations={"this method": f"bandwidth {bw:.3g} Hz"} if bw else None))
     if tuning is not None:
-        chosen = tuning.front_f[np.flatnonzero((tuning.front_x[:, 1] == tuning.alpha)
-                                               & (np.rint(tuning.front_x[:, 0]) == tuning.k))[:1]]
-        paths.append(pareto_figure(where / "fig11_pareto.png", tuning.front_f, tuning.evaluated_f,
-                                   chosen[0] if len(chosen) else None, title=f"{title}: VMD tuning",
-                                   front_x=tuning.front_x))
+        paths.append(pareto_figure(where / "fig11_pareto.png", tuning.front_f, tuning.evaluated_f, tuning.chosen_f,
+                                   title=f"{title}: VMD tuning", front_x=tuning.front_x))
     return paths
 
 
-def _centre_frequency_hz(mode: np.ndarray, fs_hz: float) -> float:
-    """Power-weighted mean frequency of ``mode`` (Hz), as VMD's eq. 5 defines a centre."""
-    power = np.abs(np.fft.rfft(mode)) ** 2
-    freqs = np.fft.rfftfreq(mode.size, 1.0 / fs_hz)
-    total = power.sum()
-    return float((freqs * power).sum() / total) if total > 0 else 0.0
+def _centre_frequencies_hz(modes: np.ndarray, fs_hz: float) -> np.ndarray:
+    """Power-weighted mean frequency of each mode (Hz), as VMD's eq. 5 defines a centre."""
+    power = np.abs(np.fft.rfft(modes, axis=1)) ** 2
+    freqs = np.fft.rfftfreq(modes.shape[1], 1.0 / fs_hz)
+    total = power.sum(axis=1)
+    return np.where(total > 0, power @ freqs / np.where(total > 0, total, 1.0), 0.0)
