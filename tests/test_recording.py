@@ -52,6 +52,9 @@ EXPECTED = {
     "missing_field.csv": ("missing_field.csv", "row 2: 4 fields, the header has 5"),
     "empty_cell.csv": ("empty_cell.csv", "row 2, column 'input': empty cell"),
     "not_parquet.parquet": ("not_parquet.parquet", "not a readable Parquet file"),
+    "kelvin_temperature.csv": ("kelvin_temperature.csv", "row 1, column 'temperature_c': 298.15 degC is not "
+                               "plausible for a sensor recording (expected -100..200 degC) (kelvin?)"),
+    "absurd_rate.csv": ("absurd_rate.csv", "row 3, column 'output': 35000 deg/s is not plausible for a gyro"),
 }
 
 
@@ -85,11 +88,12 @@ def test_valid_corpus_file():
 
 
 def _awkward_recording(n: int = 200, seed: int = 1, sensor: str = "msra") -> Recording:
-    """Floats that stress the text round trip: random bit patterns, subnormals, -0.0, huge values."""
+    """Floats that stress the text round trip: random mantissa bits at every exponent from the
+    subnormals up to the plausible range's end (the schema refuses larger), -0.0, 1/3, 0.1."""
     rng = np.random.default_rng(seed)
-    bits = rng.integers(0, 2**63, size=n, dtype=np.int64).view(np.float64)
-    bits[~np.isfinite(bits)] = 1.0
-    bits[:6] = [-0.0, 5e-324, 1.7976931348623157e308, 1 / 3, 0.1, -2.2250738585072014e-308]
+    mantissa, _ = np.frexp(rng.integers(1, 2**63, size=n, dtype=np.int64).view(np.float64))
+    bits = np.ldexp(np.where(np.isfinite(mantissa), mantissa, 0.75), rng.integers(-1074, 10, size=n))
+    bits[:6] = [-0.0, 5e-324, 999.9999999999999, 1 / 3, 0.1, -2.2250738585072014e-308]
     time_s = np.arange(n) / 50.0 + rng.uniform(0, 1e-4, n)
     position = rng.choice(np.array(["+0g", "+1g", "-0g", "-1g", None], dtype=object), n) if sensor == "msra" else None
     return make_recording(time_s, rng.normal(25, 10, n), bits, rng.normal(0, 1e3, n), sensor=sensor,
@@ -121,7 +125,7 @@ def test_round_trip_is_exact(tmp_path, suffix, sensor):
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=1, max_size=20))
+@given(st.lists(st.floats(min_value=-100.0, max_value=200.0, allow_nan=False), min_size=1, max_size=20))
 def test_csv_round_trip_any_finite_float(values):
     n = len(values)
     rec = make_recording(np.arange(n) / 10.0, values, values[::-1], values, sensor="gyro", sample_rate_hz=10.0,
@@ -177,6 +181,24 @@ def test_overwrite_is_atomic(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         write_recording(_awkward_recording(n=20, seed=2), path)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_directory_is_named_as_such(tmp_path):
+    folder = tmp_path / "run.csv"
+    folder.mkdir()
+    with pytest.raises(RecordingError, match="is a directory, not a recording") as info:
+        read_recording(folder)
+    assert str(info.value).startswith(str(folder))
+
+
+def test_plausible_ranges_are_checked_when_made_too():
+    t = np.arange(4) * 0.1
+    with pytest.raises(RecordingError, match="row 3, column 'output': 2e.06 Hz is not plausible for a msra"):
+        make_recording(t, np.full(4, 25.0), np.zeros(4), np.array([0.0, 0.0, 2e6, 0.0]), sensor="msra",
+                       sample_rate_hz=10.0, device_id="m")
+    ok = make_recording(t, np.full(4, 200.0), np.full(4, 1000.0), np.full(4, -1e6), sensor="msra",
+                        sample_rate_hz=10.0, device_id="m")  # the bounds themselves are plausible
+    assert ok.temperature_c.max() == 200.0
 
 
 def test_unsupported_suffix(tmp_path):

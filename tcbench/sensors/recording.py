@@ -176,6 +176,8 @@ def read_recording(path: str | Path) -> Recording:
     """
     path, name = Path(path), str(path)
     with _in_file(name):
+        if path.is_dir():
+            raise RecordingError("is a directory, not a recording (give the .csv or .parquet file inside it)")
         fmt = _format(path)
         if not path.is_file():
             raise RecordingError("no such file")

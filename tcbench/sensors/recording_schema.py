@@ -185,8 +185,35 @@ def _check_units(units: Any, sensor: str) -> dict[str, str]:
     return {c: units[c] for c in NUMERIC_COLUMNS}
 
 
+# Plausible ranges of each column in its schema unit, beyond which a value is a unit mistake
+# (kelvin labelled degC, mdps labelled deg/s, ...) rather than a measurement: test chambers run
+# -70..+180 degC; MEMS gyros measure up to a few thousand deg/s; accelerometers up to a few
+# hundred g; an MSRA's output is a frequency difference well below its ~30 kHz resonance.
+PLAUSIBLE = {
+    "temperature_c": (-100.0, 200.0, "degC"),
+    "gyro": {"input": (-20000.0, 20000.0, "deg/s"), "output": (-20000.0, 20000.0, "deg/s")},
+    "msra": {"input": (-1000.0, 1000.0, "g"), "output": (-1.0e6, 1.0e6, "Hz")},
+}
+
+
+def _check_plausible(data: pd.DataFrame, sensor: str | None, table: str | None) -> None:
+    """Every value within :data:`PLAUSIBLE` for its column's unit; the first outside names file,
+    row and column."""
+    ranges = {"temperature_c": PLAUSIBLE["temperature_c"], **(PLAUSIBLE.get(sensor or "", {}))}
+    for column, (low, high, unit) in ranges.items():
+        x = data[column].to_numpy(dtype=np.float64)
+        bad = (x < low) | (x > high)
+        if bad.any():
+            i = int(np.argmax(bad))
+            hint = " (kelvin?)" if column == "temperature_c" and 173.0 <= x[i] <= 473.0 else ""
+            raise RecordingError(f"{x[i]:g} {unit} is not plausible for a {sensor or 'sensor'} recording "
+                                 f"(expected {low:g}..{high:g} {unit}){hint}", file=table, row=i + 1, column=column)
+
+
 def _check_consistency(data: pd.DataFrame, meta: RecordingMeta, table: str | None, side: str | None) -> None:
-    """Sidecar against table: sample rate vs the median time step, positions only for MSRA."""
+    """Sidecar against table: plausible values for the units, sample rate vs the median time
+    step, positions only for MSRA."""
+    _check_plausible(data, meta.sensor, table)
     if meta.sensor == "gyro" and "position" in data:
         given = data["position"].notna().to_numpy()
         if given.any():
