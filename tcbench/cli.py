@@ -60,7 +60,7 @@ def _run_sweep(args: list[str]) -> Plan | None:
         if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
             from tcbench import tracking
 
-            tracking.experiment_id(tracking.client(checked.tracking_uri), checked.experiment)
+            tracking.prepare_store(checked.tracking_uri, checked.experiment)
     saved = sys.argv
     sys.argv = ["tcbench", *args]
     try:

@@ -62,6 +62,34 @@ def experiment_id(c: MlflowClient, name: str) -> str:
         return found.experiment_id
 
 
+@contextmanager
+def store_lock(uri: str | None = None) -> Iterator[None]:
+    """Exclusive lock on a local SQLite store (a ``<db>.lock`` file beside it) while held; a no-op
+    for other stores. MLflow creates or upgrades a SQLite store's tables the first time a client
+    touches it, and two processes doing so at once collide (``table ... already exists``)."""
+    resolved = tracking_uri(uri)
+    if not resolved.startswith("sqlite:///"):
+        yield
+        return
+    import fcntl
+
+    db = Path(resolved[len("sqlite:///"):])
+    db.parent.mkdir(parents=True, exist_ok=True)
+    with open(db.with_name(db.name + ".lock"), "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def prepare_store(uri: str | None, experiment: str) -> str:
+    """Create or upgrade the store and the experiment once, under :func:`store_lock`, before any
+    job of a sweep starts; the experiment's id."""
+    with store_lock(uri):
+        return experiment_id(client(uri), experiment)
+
+
 def flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
     """``{"a": {"b": 1}}`` -> ``{"a.b": "1"}``: a nested config as MLflow params."""
     out: dict[str, str] = {}

@@ -1,0 +1,23 @@
+"""Several sweeps started at once on a fresh tracking store: all of them are recorded."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import mlflow
+
+
+def test_three_sweeps_at_once_on_a_fresh_store(workdir: Path) -> None:
+    procs = [subprocess.Popen([sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "optimiser=pso",
+                               "budget=40", f"seed={i * 2},{i * 2 + 1}", f"hydra.sweep.dir=multirun/s{i}"],
+                              cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for i in range(3)]
+    outs = [p.communicate(timeout=300) for p in procs]
+    for p, (_, err) in zip(procs, outs, strict=True):
+        assert p.returncode == 0, err[-2000:]
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    runs = client.search_runs([client.get_experiment_by_name("tcbench").experiment_id])
+    assert sorted(int(r.data.tags["tcbench.seed"]) for r in runs) == list(range(6))
+    assert all(r.info.status == "FINISHED" for r in runs)
