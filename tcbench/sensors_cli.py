@@ -139,11 +139,14 @@ def metrics(args: list[str]) -> int:
 def _report(path: Path, rec: Any, out: Path, scale_factor: float | None, track: TrackingConfig,
             tags: dict[str, Any]) -> None:
     from tcbench.metrics.report import analyse
+    from tcbench.staging import moved, staged_dir
 
     try:
-        report = analyse(rec, out, scale_factor)
+        with staged_dir(out) as tmp:  # a recording the metrics cannot serve leaves nothing behind
+            report = analyse(rec, tmp, scale_factor)
     except ValueError as exc:
         raise CommandError(f"{path}: {exc}") from None
+    report.files = moved(report.files, tmp, out)
     width = max(len(k) for k in report.metrics)
     print(f"\nmetrics of {path.name} ({rec.meta.sensor}, {rec.meta.device_id}):")
     for key, value in report.metrics.items():

@@ -134,3 +134,43 @@ def test_cli_effect_arguments(workdir: Path) -> None:
     assert "bias_instability" not in meta["extra"]["device"]["effects"]
     bad = tcbench("simulate", "effects.hysteresis.colour=1", "out=rec2", cwd=workdir)
     assert bad.returncode == 2 and "has no parameter colour" in bad.stderr
+
+
+def _generated_bad_files(where: Path) -> dict[str, str]:
+    """Malformed recordings the corpus folder does not hold, made here: name -> expected words."""
+    gyro_side = ('{"schema_version": 1, "sensor": "gyro", "units": {"time_s": "s", "temperature_c": "degC", '
+                 '"input": "deg/s", "output": "deg/s"}, "sample_rate_hz": 10.0, "device_id": "g"}')
+    files = {
+        "inf.csv": ("time_s,temperature_c,input,output\n0.0,25.0,0.0,inf\n0.1,25.0,0.0,1.0\n", "is not finite"),
+        "semicolons.csv": ("time_s;temperature_c;input;output\n0.0;25.0;0.0;1.0\n", "missing column"),
+        "one_row.csv": ("time_s,temperature_c,input,output\n0.0,25.0,0.0,1.0\n", ""),
+        "kelvin.csv": ("time_s,temperature_c,input,output\n0.0,300.0,0.0,1.0\n0.1,300.0,0.0,1.0\n", "kelvin"),
+    }
+    for name, (text, _) in files.items():
+        (where / name).write_text(text)
+        (where / name).with_suffix(".json").write_text(gyro_side)
+    (where / "garbage.csv").write_bytes(np.random.default_rng(0).bytes(300))
+    (where / "folder.csv").mkdir()
+    return {**{k: v for k, (_, v) in files.items()}, "garbage.csv": "not UTF-8", "folder.csv": "is a directory",
+            "missing.csv": "no such file"}
+
+
+def test_cli_metrics_refuses_every_malformed_kind(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The whole corpus plus the kinds made here: exit 2, one line naming the file, nothing
+    written (in process: the command's own entry point, one call per file)."""
+    from tcbench.cli import main
+
+    bad = workdir / "bad"
+    bad.mkdir()
+    expected = _generated_bad_files(bad)
+    cases = [(MALFORMED / p.name, "") for p in sorted(MALFORMED.iterdir())
+             if p.suffix in (".csv", ".parquet") and p.name != "valid.csv"]
+    cases += [(bad / name, words) for name, words in expected.items()]
+    assert len(cases) >= 20
+    for path, words in cases:
+        code = main(["metrics", str(path), "out=report", "tracking.enabled=false"])
+        err = capsys.readouterr().err
+        lines = err.strip().splitlines()
+        assert code == 2, (path.name, err)
+        assert len(lines) == 1 and path.stem in lines[0] and words in lines[0], (path.name, err)
+        assert not (workdir / "report").exists() and not list(workdir.glob(".report*"))

@@ -8,9 +8,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import shutil
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +15,7 @@ from tcbench.diagnose.diagnosis import Diagnosis
 from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.model_file import parse_model, write_model
 from tcbench.diagnose.plots import write_plots
+from tcbench.staging import staged_dir
 
 
 def _plain(value: Any) -> Any:
@@ -36,18 +34,10 @@ def _plain(value: Any) -> Any:
 def write_report(diag: Diagnosis, out: str | Path) -> dict[str, Path]:
     """Write the report files into ``out`` (created if needed); returns name -> path."""
     out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
-    try:
+    with staged_dir(out) as tmp:
         (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
         write_model(parse_model(_plain(diag.model), "model.yaml"), tmp / "model.yaml")
         plots = write_plots(diag, tmp)
         (tmp / "report.md").write_text(render_markdown(diag, plots))
-        out.mkdir(exist_ok=True)
-        written = {}
-        for item in sorted(tmp.iterdir()):
-            os.replace(item, out / item.name)
-            written[item.name] = out / item.name
-        return written
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        names = sorted(item.name for item in tmp.iterdir())
+    return {name: out / name for name in names}
