@@ -65,7 +65,7 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
     ("args", "message"),
     [
         (["task=nope"], "unknown task 'nope'; known: ackley, "),
-        (["optimiser=nope"], "unknown optimiser 'nope'; known: bas, fa, "),
+        (["optimiser=nope"], "unknown optimiser 'nope'; known: bas, "),
         (["seed=abc"], "seed: Value 'abc'"),
         (["seed=-1"], "seed must be >= 0"),
         (["budget=5"], "smaller than one generation"),
