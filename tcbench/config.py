@@ -70,8 +70,9 @@ class GyroTuningTaskConfig:
 
 @dataclass
 class GyroTaskConfig(GyroTuningTaskConfig):
-    """The gyro drift/noise task (see :class:`tcbench.tasks.GyroDriftNoiseEnv`); ``tuner`` and
-    ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]`` when they are null."""
+    """The gyro drift/noise task (see :class:`tcbench.tasks.GyroDriftNoiseEnv`); ``tuner``,
+    ``tuner_params`` and ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]``
+    when they are null."""
 
     n_train: int = 1
     n_test: int = 1
@@ -80,6 +81,7 @@ class GyroTaskConfig(GyroTuningTaskConfig):
     k: int | None = None
     alpha: float | None = None
     tuner: str = "mopso"
+    tuner_params: dict | None = None
     tuning_budget: int = 440
     denoise: str = "tfpf"
     tfpf_window: int = 31

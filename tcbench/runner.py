@@ -203,11 +203,12 @@ class VMDTuning:
 
 
 @functools.lru_cache(maxsize=4)
-def _tune(env_kwargs_json: str, tuner: str, budget: int, samples: int, progress: bool) -> VMDTuning:
+def _tune(env_kwargs_json: str, tuner: str, params_json: str, budget: int, samples: int,
+          progress: bool) -> VMDTuning:
     t0 = time.perf_counter()
     env = tasks.GyroVMDTuningEnv(budget=budget, tuning_samples=samples, **json.loads(env_kwargs_json))
     env.reset(seed=0)
-    opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), {}, 2)
+    opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), json.loads(params_json), 2)
     ask_tell(opt, env, budget, progress)
     i = compromise(env.front_x, env.front_f)
     k, alpha = decode(env.front_x[i])
@@ -216,13 +217,14 @@ def _tune(env_kwargs_json: str, tuner: str, budget: int, samples: int, progress:
 
 
 def tune_vmd(env_kwargs: dict[str, Any], tuner: str = "mopso", budget: int = 440, samples: int = 2048,
-             progress: bool = False) -> VMDTuning:
+             progress: bool = False, tuner_params: dict[str, Any] | None = None) -> VMDTuning:
     """Tune VMD's ``[k, alpha]`` on ``tcbench/Gyro-VMDTuning-v0`` (built from ``env_kwargs``) with
-    the multi-objective optimiser ``tuner`` (its default parameters: MOPSO's are seed 001's)
-    within ``budget`` evaluations. The tuning's random stream is fixed (seed 0): the tuned
+    the multi-objective optimiser ``tuner`` (``tuner_params``, or its defaults) within ``budget``
+    evaluations. The tuning's random stream is fixed (seed 0): the tuned
     decomposition is a property of the training record, shared by every restart of the learner
     (and remembered for the process)."""
-    return _tune(json.dumps(env_kwargs, sort_keys=True), str(tuner), int(budget), int(samples), bool(progress))
+    return _tune(json.dumps(env_kwargs, sort_keys=True), str(tuner), json.dumps(tuner_params or {}, sort_keys=True),
+                 int(budget), int(samples), bool(progress))
 
 
 @dataclass
@@ -263,7 +265,7 @@ def run_compensation(
     tuning = None
     if getattr(env, "needs_tuning", False):
         tuning = tune_vmd(env.tuning_kwargs(), env.tuning["tuner"], env.tuning["budget"], env.tuning["samples"],
-                          progress)
+                          progress, env.tuning["params"])
     env.reset(seed=env_seed, options={"k": tuning.k, "alpha": tuning.alpha} if tuning else None)
     trace = Trace()
     if baseline:

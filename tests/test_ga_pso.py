@@ -21,6 +21,7 @@ from tcbench.optimisers.ga import (
     polynomial_mutation,
     sbx,
     sbx_spread,
+    tournament_pairs,
 )
 from tcbench.optimisers.pso import (
     PSOParams,
@@ -116,6 +117,37 @@ def test_tournament_picks_the_better() -> None:
     rank, crowd = np.array([0, 0, 1]), np.array([1.0, np.inf, 5.0])
     pairs = np.array([[0, 1], [1, 0], [2, 0], [0, 0], [0, 2]])
     assert binary_tournament(pairs, rank, crowd).tolist() == [1, 1, 0, 0, 0]
+
+
+def test_permutation_tournaments_enter_everyone_twice() -> None:
+    """NSGA-II code's tselect: N children take 2N tournaments from two shuffles, so every
+    individual meets exactly two rivals and never itself; with replacement some miss out."""
+    rng = np.random.default_rng(0)
+    pairs = tournament_pairs(40, 40, rng)
+    assert pairs.shape == (40, 2)
+    assert np.bincount(pairs.ravel(), minlength=40).tolist() == [2] * 40
+    assert np.all(pairs[:, 0] != pairs[:, 1])
+    odd = tournament_pairs(7, 5, rng)  # 10 contestants from two shuffles of 7: nobody thrice
+    assert odd.shape == (5, 2) and np.bincount(odd.ravel(), minlength=7).max() <= 2
+    uniform = tournament_pairs(40, 40, rng, "random")
+    assert np.bincount(uniform.ravel(), minlength=40).min() == 0  # 80 draws leave someone out
+
+
+def test_permutation_tournaments_beat_uniform_on_sphere() -> None:
+    """The selection change the NSGA-II code makes: over 12 seeds on 30-D sphere (20 000
+    evaluations) the median best falls (measured 0.042 -> 0.033 over 20 seeds)."""
+    def median_best(how: str) -> float:
+        best = []
+        for seed in range(12):
+            opt = GeneticAlgorithm(np.full(30, -5.12), np.full(30, 5.12), 20000, np.random.default_rng(seed),
+                                   {"population": 100, "tournament": how})
+            while not opt.done:
+                x = opt.ask()
+                opt.tell(x, sphere(x))
+            best.append(opt.best.f)
+        return float(np.median(best))
+
+    assert median_best("permutation") < 0.9 * median_best("random")
 
 
 # A small hand-made population: front 0 = (0,5) (1,3) (3,1) (4,0); (2,4) is dominated by (1,3)

@@ -50,7 +50,8 @@ def test_baselines_make_a_leaderboard_with_the_bandwidth(workdir: Path) -> None:
 
 def test_bad_gyro_settings_exit_2_with_one_line(workdir: Path) -> None:
     for arg, words in (("task.tuner=bas", "single-objective"), ("task.denoise=kalman", "denoise"),
-                       ("task.nosuch=1", "task.nosuch")):
+                       ("task.nosuch=1", "task.nosuch"), ("task.tuner=ga", "task.tuner_params=null"),
+                       ("task.tuner_params={bound_velocity:bounce}", "bound_velocity")):
         out = tcbench("run", "task=gyro_driftnoise", arg, cwd=workdir)
         assert out.returncode == 2, (arg, out.stderr)
         assert words in out.stderr and "Traceback" not in out.stderr

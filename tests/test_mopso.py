@@ -322,6 +322,31 @@ def test_converges_on_zdt1(seed: int) -> None:
     assert f[:, 0].max() - f[:, 0].min() > 0.8
 
 
+def test_default_reaches_095_of_the_zdt1_front() -> None:
+    """The default wall rule (velocity zeroed at a bound) reaches a hypervolume ratio >= 0.95 on
+    ZDT1 (d = 30, 10^4 evaluations; median of 8 seeds, measured 0.953 over 30); Coello's
+    reverse rule stays near 0.83 because the Pareto set lies on the bound x2..x30 = 0."""
+    import gymnasium as gym
+
+    import tcbench.tasks  # noqa: F401 - registers the envs
+
+    def median_ratio(params: dict) -> float:
+        ratios = []
+        for seed in range(8):
+            env = gym.make("tcbench/ZDT1-v0", budget=10_000).unwrapped
+            env.reset(seed=seed)
+            opt = MOPSO(env.lower, env.upper, 10_000, np.random.default_rng(seed), params, n_objectives=2)
+            while not opt.done:
+                x = opt.ask()
+                f, *_, info = env.step(x)
+                opt.tell(x, f)
+            ratios.append(info["hypervolume_ratio"])
+        return float(np.median(ratios))
+
+    assert median_ratio({}) >= 0.95
+    assert median_ratio({"bound_velocity": "reverse"}) < 0.9
+
+
 # -- configuration and misuse ----------------------------------------------------------------
 def test_rejects_single_objective() -> None:
     with pytest.raises(ValueError, match="multi-objective only"):

@@ -100,7 +100,11 @@ def _check_tuner(task: dict[str, Any]) -> None:
         raise _error(f"task.tuner: {exc}") from None
     if not cls.multi_objective:
         raise _error(f"task.tuner: optimiser {name} is single-objective; VMD tuning has 2 objectives")
-    population = make_params(cls, {}).population
+    try:
+        population = make_params(cls, dict(task.get("tuner_params") or {})).population
+    except (TypeError, ValueError) as exc:
+        hint = " (task.tuner_params=null takes its defaults)" if "has no parameter" in str(exc) else ""
+        raise _error(f"task.tuner_params: {exc}{hint}") from None
     if int(task.get("tuning_budget", 440)) < population:
         raise _error(f"task.tuning_budget: {task.get('tuning_budget')} evaluations is smaller than one "
                      f"generation of {name} (population {population})")

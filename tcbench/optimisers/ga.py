@@ -3,10 +3,15 @@
 Operators (Deb, *Multi-Objective Optimization using Evolutionary Algorithms*, 2001, and the
 NSGA-II reference code of Deb, Pratap, Agarwal & Meyarivan, IEEE TEC 6(2), 2002):
 
-- **Binary tournament selection.** Two individuals drawn uniformly with replacement; the one with
-  the lower objective value wins (single objective), or the lower non-domination rank and, at
-  equal rank, the larger crowding distance (several objectives). A tie goes to the first drawn,
-  which is itself a random choice.
+- **Binary tournament selection.** The contestants come from random permutations of the
+  population, consecutive entries meeting, as in the NSGA-II reference code (``tselect``: two
+  shuffles per generation, so each individual enters exactly two tournaments and the best one
+  always wins two parents' places); the one with the lower objective value wins (single
+  objective), or the lower non-domination rank and, at equal rank, the larger crowding distance
+  (several objectives). A tie goes to the first of the pair, itself a random choice.
+  ``tournament="random"`` draws contestants uniformly with replacement instead (the earlier
+  default); on 30-D sphere the permutations lowered the median after 20 000 evaluations from
+  0.042 to 0.033 (``benchmarks/RESULTS.md``, GA section).
 - **Simulated binary crossover (SBX)**, Deb & Agrawal, Complex Systems 9, 1995, in the *bounded*
   form of the NSGA-II code: for parents ``y1 < y2`` in ``[lo, hi]`` and one ``u ~ U[0, 1)`` per
   variable, ``beta = 1 + 2 (y1 - lo) / (y2 - y1)`` (``(hi - y2)`` for the upper child),
@@ -55,6 +60,7 @@ from tcbench.optimisers.pareto import dominates
 from tcbench.optimisers.protocol import Optimiser, OptimiserParams
 
 _SAME = 1e-14  # parents closer than this in a variable are not crossed there (NSGA-II code)
+TOURNAMENTS = ("permutation", "random")
 
 
 @dataclass(frozen=True)
@@ -69,6 +75,8 @@ class GAParams(OptimiserParams):
     eta_m: polynomial-mutation distribution index, >= 0; larger makes smaller steps.
     elite: best parents copied unchanged into the next generation (one objective only), in
         [0, population - 1].
+    tournament: how contestants are drawn, ``"permutation"`` (NSGA-II code) or ``"random"``
+        (uniform with replacement).
     """
 
     population: int = 40
@@ -78,9 +86,12 @@ class GAParams(OptimiserParams):
     mutation_prob: float | None = None
     eta_m: float = 20.0
     elite: int = 2
+    tournament: str = "permutation"
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.tournament not in TOURNAMENTS:
+            raise ValueError(f"tournament must be one of {', '.join(TOURNAMENTS)}, got {self.tournament!r}")
         if not 0 <= self.crossover_prob <= 1:
             raise ValueError(f"crossover_prob must be in [0, 1], got {self.crossover_prob}")
         if not 0 < self.crossover_var_prob <= 1:
@@ -181,6 +192,18 @@ def polynomial_mutation(
     delta_q = np.where(low, val**e - 1.0, 1.0 - val**e)
     out = np.clip(y + delta_q * width, lower, upper)  # clip: rounding only
     return out if mutate is None else np.where(mutate, out, y)
+
+
+def tournament_pairs(n_pop: int, n_tournaments: int, rng: np.random.Generator,
+                     how: str = "permutation") -> np.ndarray:
+    """Contestant index pairs (n_tournaments, 2): consecutive entries of as many random
+    permutations of ``range(n_pop)`` as needed (``"permutation"``), or uniform draws with
+    replacement (``"random"``)."""
+    if how == "random":
+        return rng.integers(0, n_pop, size=(n_tournaments, 2))
+    shuffles = -(-2 * n_tournaments // n_pop)
+    order = rng.permuted(np.tile(np.arange(n_pop), (shuffles, 1)), axis=1)
+    return order.reshape(-1)[: 2 * n_tournaments].reshape(n_tournaments, 2)
 
 
 def binary_tournament(
@@ -284,7 +307,7 @@ class GeneticAlgorithm(Optimiser):
         """``n`` children of the current population: tournament, SBX, polynomial mutation."""
         p, d = self.params, self.dim
         pairs = -(-n // 2)
-        draws = self.rng.integers(0, len(self.x), size=(2 * pairs, 2))
+        draws = tournament_pairs(len(self.x), 2 * pairs, self.rng, p.tournament)
         if self.n_objectives == 1:
             parents = binary_tournament(draws, self.fitness)
         else:

@@ -152,7 +152,10 @@ class TemperatureCubic(Effect):
     c3_per_c3: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
-        return self.c3_per_c3 * (s.temp_die_c - s.ref_c) ** 3
+        cube = s.temp_die_c - s.ref_c
+        cube **= 3
+        cube *= self.c3_per_c3
+        return cube
 
 
 @dataclass(frozen=True)
@@ -242,10 +245,10 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
 def apply_effects(
     base: np.ndarray, effects: list[Effect], s: Signals, rng: np.random.Generator
 ) -> np.ndarray:
-    """Add the ``output`` terms to ``base`` and apply the ``final`` stage, in list order, each
-    effect drawing from its own child stream of ``rng``."""
+    """Add the ``output`` terms to ``base`` (in place: pass a fresh array) and apply the ``final``
+    stage, in list order, each effect drawing from its own child stream of ``rng``."""
     streams = rng.spawn(len(effects)) if effects else []
-    y = base.copy()
+    y = base
     for effect, stream in zip(effects, streams, strict=True):
         if effect.stage == "output":
             y += effect.term(s, stream)

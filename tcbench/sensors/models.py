@@ -20,8 +20,15 @@ from tcbench.sensors.protocols import Profile
 DPH = 1.0 / 3600.0  # deg/s per deg/h
 
 
+def _temperature_rate(temp_c: np.ndarray, dt_s: float) -> np.ndarray:
+    """dT/dt per sample; a constant temperature gives a broadcast zero, not a full array."""
+    if temp_c.size < 2 or temp_c.strides == (0,) or np.ptp(temp_c) == 0.0:
+        return np.broadcast_to(np.float64(0.0), temp_c.shape)
+    return np.gradient(temp_c, dt_s)
+
+
 def _signals(profile: Profile, ref_c: float) -> fx.Signals:
-    rate = np.gradient(profile.temp_c, profile.dt_s) if profile.t_s.size > 1 else np.zeros(1)
+    rate = _temperature_rate(profile.temp_c, profile.dt_s)
     return fx.Signals(
         t_s=profile.t_s, dt_s=profile.dt_s, temp_meas_c=profile.temp_c,
         temp_die_c=profile.temp_c, temp_rate_c_per_s=rate, accel_g=profile.accel_g,
@@ -152,9 +159,21 @@ class Gyro(SensorModel):
     b2_dph_per_k2: float = 4.0e-3
 
     def core(self, s: fx.Signals) -> np.ndarray:
+        # In place, two full-length temporaries at most; the same floating-point operations, in
+        # the same order, as (1 + sf dT) (W + (b0 + b1 dT + b2 dT dT) DPH).
         dt = s.temp_die_c - self.ref_c
-        bias_dps = (self.b0_dph + self.b1_dph_per_k * dt + self.b2_dph_per_k2 * dt * dt) * DPH
-        return (1.0 + self.sf_ppm_per_k * 1e-6 * dt) * (s.rate_dps + bias_dps)
+        out = self.b1_dph_per_k * dt
+        out += self.b0_dph
+        square = self.b2_dph_per_k2 * dt
+        square *= dt
+        out += square
+        del square
+        out *= DPH
+        out += s.rate_dps
+        dt *= self.sf_ppm_per_k * 1e-6
+        dt += 1.0
+        out *= dt
+        return out
 
 
 def gyro_effects(

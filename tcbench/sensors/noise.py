@@ -14,11 +14,14 @@ from tcbench.sensors.thermal import gauss_markov
 FLICKER_SIGMA_PER_B = 0.605
 _PER_DECADE = 2
 _MAX_STEPS_PER_TC = 40  # a process slower than this many samples is drawn coarser, then interpolated
+_CHUNK = 1 << 18  # samples interpolated at a time, so no full-length time axis is ever built
 
 
 def white(n: int, sigma: float, rng: np.random.Generator) -> np.ndarray:
     """White noise with per-sample standard deviation ``sigma``."""
-    return rng.standard_normal(n) * sigma
+    x = rng.standard_normal(n)
+    x *= sigma
+    return x
 
 
 def random_walk(n: int, dt_s: float, k_per_sqrt_s: float, rng: np.random.Generator) -> np.ndarray:
@@ -33,7 +36,8 @@ def flicker(
 
     A bank of Gauss-Markov processes with correlation times log-spaced two per decade from
     ``max(1 s, 2 dt)`` to ten times ``tau_max_s`` (default: the record length). Slow processes
-    are drawn on a coarser grid and linearly interpolated, which keeps 24 h at 100 Hz fast.
+    are drawn on a coarser grid and linearly interpolated chunk by chunk into the output, which
+    keeps 24 h at 100 Hz fast and its memory at one full-length array (the output) plus chunks.
     """
     duration_s = n * dt_s
     t_hi = 10.0 * (tau_max_s or duration_s)
@@ -42,7 +46,6 @@ def flicker(
     tcs = np.logspace(np.log10(t_lo), np.log10(t_hi), count)
     sigma = FLICKER_SIGMA_PER_B * b
     out = np.zeros(n)
-    t = np.arange(n) * dt_s
     for tc in tcs:
         step = max(1, int(tc / dt_s / _MAX_STEPS_PER_TC))
         if step == 1:
@@ -50,10 +53,21 @@ def flicker(
         else:
             coarse_n = n // step + 2
             coarse = gauss_markov(coarse_n, dt_s * step, tc, sigma, rng)
-            out += np.interp(t, np.arange(coarse_n) * dt_s * step, coarse)
+            coarse_t = np.arange(coarse_n) * dt_s * step
+            for start in range(0, n, _CHUNK):
+                stop = min(start + _CHUNK, n)
+                out[start:stop] += np.interp(np.arange(start, stop) * dt_s, coarse_t, coarse)
     return out
 
 
-def quantise(x: np.ndarray, step: float) -> np.ndarray:
-    """Round to a multiple of ``step`` (counter or ADC resolution); ``step <= 0`` leaves x."""
-    return np.round(x / step) * step if step > 0 else x
+def quantise(x: np.ndarray, step: float, *, in_place: bool = False) -> np.ndarray:
+    """Round to a multiple of ``step`` (counter or ADC resolution); ``step <= 0`` leaves x.
+    ``in_place`` rounds ``x`` itself (no full-length temporary) and returns it."""
+    if step <= 0:
+        return x
+    if not in_place:
+        return np.round(x / step) * step
+    x /= step
+    np.round(x, out=x)
+    x *= step
+    return x

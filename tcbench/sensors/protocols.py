@@ -82,14 +82,14 @@ def _from_segments(
     temp = np.interp(t, t_th, package)
     seg = segment_index(segments, start_c, chamber.ramp_c_per_min, t)
     held = seg >= 0
-    accel = np.zeros_like(t)
-    cross = np.zeros_like(t)
-    rate = np.zeros_like(t)
-    table = np.array([[s.accel_g, s.cross_g, s.rate_dps] for s in segments])
-    accel[held], cross[held], rate[held] = table[seg[held]].T
     # During a ramp the unit already rests in the orientation of the segment it ramps to.
     upcoming = np.minimum.accumulate(np.where(held, seg, len(segments) - 1)[::-1])[::-1]
-    accel[~held], cross[~held], rate[~held] = table[upcoming[~held]].T
+    table = np.array([[s.accel_g, s.cross_g, s.rate_dps] for s in segments])
+    # An input the same in every segment is a read-only broadcast view, not a full array.
+    accel, cross, rate = (
+        np.broadcast_to(column[0], t.shape) if np.all(column == column[0]) else column[upcoming]
+        for column in table.T
+    )
     labels = None
     if any(s.position for s in segments):
         names = np.array([""] + [s.position for s in segments])
@@ -167,10 +167,8 @@ def gyro_oven(
 def gyro_static(
     duration_s: float = 86400.0, temp_c: float = 25.0, sample_rate_hz: float = 100.0
 ) -> Profile:
-    """A long run at rest and constant temperature (for Allan variance)."""
+    """A long run at rest and constant temperature (for Allan variance). The constant columns
+    are read-only broadcast views, so a 24 h run at 100 Hz holds one full-length array (time)."""
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
-    zeros = np.zeros_like(t)
-    return Profile(
-        "static", "gyro", sample_rate_hz, t, np.full_like(t, temp_c), zeros, zeros.copy(),
-        zeros.copy(),
-    )
+    zeros = np.broadcast_to(np.float64(0.0), t.shape)
+    return Profile("static", "gyro", sample_rate_hz, t, np.broadcast_to(np.float64(temp_c), t.shape), zeros, zeros, zeros)

@@ -128,16 +128,19 @@ def make_recording(
     position: np.ndarray | list[str | None] | None = None,
     extra: Mapping[str, Any] | None = None,
 ) -> Recording:
-    """Build and validate a recording from arrays, with the standard units of ``sensor``."""
+    """Build and validate a recording from arrays, with the standard units of ``sensor``.
+
+    Contiguous float64 arrays become the table's columns without a copy (the recording then
+    shares them with the caller); anything else, broadcast views included, is copied once."""
     if sensor not in SENSORS:
         raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
     columns: dict[str, Any] = {"time_s": time_s, "temperature_c": temperature_c, "input": input, "output": output}
-    columns = {k: np.asarray(v, dtype=np.float64).reshape(-1) for k, v in columns.items()}
+    columns = {k: np.ascontiguousarray(v, dtype=np.float64).reshape(-1) for k, v in columns.items()}
     if position is not None:
         columns["position"] = pd.Series(np.asarray(position, dtype=object).reshape(-1), dtype=object)
     meta = RecordingMeta(sensor, dict(STANDARD_UNITS[sensor]), float(sample_rate_hz), device_id,
                          extra=dict(extra or {}))
-    rec = Recording(pd.DataFrame(columns), meta)
+    rec = Recording(pd.DataFrame(columns, copy=False), meta)
     rec.data = _checked(rec, None, None)[0]
     return rec
 

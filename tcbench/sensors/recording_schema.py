@@ -91,7 +91,8 @@ def _check_columns(names: list[str]) -> None:
 
 
 def _normalise(data: pd.DataFrame) -> pd.DataFrame:
-    """Canonical table: columns in schema order, float64 numbers, object positions (str or None)."""
+    """Canonical table: columns in schema order, float64 numbers, object positions (str or None).
+    Float64 columns are shared with ``data``, not copied."""
     _check_columns([str(c) for c in data.columns])
     out = {}
     for c in NUMERIC_COLUMNS:
@@ -100,7 +101,7 @@ def _normalise(data: pd.DataFrame) -> pd.DataFrame:
         out[c] = data[c].to_numpy(dtype=np.float64, na_value=np.nan)
     if "position" in data:
         out["position"] = pd.Series(_positions(data["position"]), dtype=object)
-    return pd.DataFrame(out)
+    return pd.DataFrame(out, copy=False)
 
 
 def _positions(col: pd.Series) -> np.ndarray:
@@ -114,11 +115,12 @@ def _check_table(data: pd.DataFrame) -> None:
     """Row-level checks of a normalised table: rows present, finite numbers, positions, time."""
     if len(data) == 0:
         raise RecordingError("no data rows")
-    values = data[list(NUMERIC_COLUMNS)].to_numpy(dtype=np.float64)
-    bad = ~np.isfinite(values)
-    if bad.any():
-        i, j = divmod(int(np.argmax(bad)), values.shape[1])
-        raise RecordingError(f"{values[i, j]} is not finite", row=i + 1, column=NUMERIC_COLUMNS[j])
+    columns = {c: data[c].to_numpy(dtype=np.float64) for c in NUMERIC_COLUMNS}  # views, column by column
+    rows = [int(np.argmin(np.isfinite(x))) for x in columns.values()]
+    first = [(i, c) for i, (c, x) in zip(rows, columns.items(), strict=True) if not np.isfinite(x[i])]
+    if first:
+        i, c = min(first)  # the first bad row; within it, the first column in schema order
+        raise RecordingError(f"{columns[c][i]} is not finite", row=i + 1, column=c)
     if "position" in data:
         labels = pd.Series(data["position"].to_numpy(dtype=object), dtype=object)
         wrong = ~(labels.isna() | labels.isin(POSITIONS)).to_numpy()
@@ -126,7 +128,7 @@ def _check_table(data: pd.DataFrame) -> None:
             i = int(np.argmax(wrong))
             raise RecordingError(f"{labels[i]!r} is not a position (expected one of {', '.join(POSITIONS)} or empty)",
                                  row=i + 1, column="position")
-    t = values[:, 0]
+    t = columns["time_s"]
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         i = int(back[0])

@@ -78,7 +78,9 @@ def simulate_recording(
     )
     profile = build_profile(sensor, protocol, profile_rng, **protocol_params)
     output = model.simulate(profile, sensor_rng)
-    reading = profile.temp_c + thermometer_rng.standard_normal(profile.t_s.size) * THERMOMETER_NOISE_C
+    reading = thermometer_rng.standard_normal(profile.t_s.size)
+    reading *= THERMOMETER_NOISE_C
+    reading += profile.temp_c
     extra = {
         "protocol": protocol,
         "device_seed": int(device_seed),
@@ -92,7 +94,7 @@ def simulate_recording(
         **profile.info,
     }
     return make_recording(
-        profile.t_s, quantise(reading, THERMOMETER_STEP_C), profile.input, output,
+        profile.t_s, quantise(reading, THERMOMETER_STEP_C, in_place=True), profile.input, output,
         sensor=sensor, sample_rate_hz=profile.sample_rate_hz, device_id=device.device_id,
         position=profile.position, extra=_plain(extra),
     )

@@ -82,7 +82,9 @@ def gauss_markov(
 ) -> np.ndarray:
     """Stationary first-order Gauss-Markov process (std ``sigma``, correlation time ``tau_s``)."""
     a = np.exp(-dt_s / tau_s)
-    drive = rng.standard_normal(n) * sigma * np.sqrt(1.0 - a * a)
+    drive = rng.standard_normal(n)
+    drive *= sigma
+    drive *= np.sqrt(1.0 - a * a)
     x0 = rng.standard_normal() * sigma
     y, _ = lfilter([1.0], [1.0, -a], drive, zi=[a * x0])
     return y

@@ -55,8 +55,9 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     bandwidth_amplitude_dps: amplitude of each injected sine of the bandwidth test (deg/s).
     effects: changes of the simulated device's effects, ``{id: {param: value}}`` in deg/s units
         (e.g. ``{"bias_instability": {"b": 8.3e-4}}`` for 3 deg/h of flicker).
-    tuner, tuning_budget, tuning_samples: the multi-objective search of ``[k, alpha]`` that the
-        runner does before ``reset`` when they are unset (:func:`tcbench.runner.tune_vmd`).
+    tuner, tuner_params, tuning_budget, tuning_samples: the multi-objective search of
+        ``[k, alpha]`` that the runner does before ``reset`` when they are unset
+        (:func:`tcbench.runner.tune_vmd`); ``tuner_params`` None takes the tuner's defaults.
     """
 
     metadata = {"render_modes": []}
@@ -69,7 +70,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  noise_above: float = 0.5, drift_below: float = 0.15, inputs: str = "t_rate",
                  rate_window_s: float = 120.0, learner_block_s: float = 10.0,
                  bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
-                 tuner: str = "mopso", tuning_budget: int = 440, tuning_samples: int = 2048) -> None:
+                 tuner: str = "mopso", tuning_budget: int = 440, tuning_samples: int = 2048,
+                 tuner_params: dict[str, Any] | None = None) -> None:
         if int(budget) != budget or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
@@ -79,7 +81,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError("give both train_files and test_files, or neither")
         if int(tuning_budget) != tuning_budget or tuning_budget < 1:
             raise ValueError(f"tuning_budget must be a positive integer, got {tuning_budget}")
-        self.tuning = {"tuner": str(tuner), "budget": int(tuning_budget), "samples": int(tuning_samples)}
+        self.tuning = {"tuner": str(tuner), "params": dict(tuner_params or {}), "budget": int(tuning_budget),
+                       "samples": int(tuning_samples)}
         if not (np.isfinite(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
             raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
         try:
