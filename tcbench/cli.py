@@ -1,4 +1,4 @@
-"""``tcbench`` command line: run, leaderboard, quickstart, list, simulate, metrics, diagnose."""
+"""``tcbench`` command line: run, leaderboard, quickstart, list, simulate, import, metrics, diagnose."""
 
 from __future__ import annotations
 
@@ -19,6 +19,8 @@ commands:
   quickstart                 FA against IFA on 2-D Rastrigin, 10 seeds each, with a results table
   list                       registered tasks and optimisers
   simulate key=value ...     simulate a recording: sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR
+  import csv=PATH sensor=msra|gyro time=COL[:unit] temperature=COL[:unit] output=COL[:unit] out=DIR
+                             your own CSV as a recording ([input=COL[:unit]] [drop=FLAG_COL] [name=STEM])
   metrics PATH [key=value]   validate a recording and compute the papers' metrics, with plots
   diagnose recording=PATH out=DIR [model=PATH] [sensor=msra|gyro]
                              find the physics a model leaves out; report.json/.md, plots, model.yaml
@@ -212,6 +214,15 @@ def cmd_simulate(argv: list[str]) -> int:
         raise UserError(str(exc)) from None
 
 
+def cmd_import(argv: list[str]) -> int:
+    from tcbench.sensors_cli import CommandError, import_command
+
+    try:
+        return import_command(argv)
+    except CommandError as exc:
+        raise UserError(str(exc)) from None
+
+
 def cmd_metrics(argv: list[str]) -> int:
     from tcbench.sensors_cli import CommandError, metrics
 
@@ -233,7 +244,7 @@ def cmd_diagnose(argv: list[str]) -> int:
 
 COMMANDS = {
     "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
-    "simulate": cmd_simulate, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
+    "simulate": cmd_simulate, "import": cmd_import, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
 }
 
 

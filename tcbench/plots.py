@@ -76,12 +76,27 @@ def band_convergence(
     return path
 
 
-def _block_means(t_s: np.ndarray, y: np.ndarray, block_s: float) -> tuple[np.ndarray, np.ndarray]:
+def _block_means(t_s: np.ndarray, y: np.ndarray, block_s: float,
+                 segment: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     per = max(1, int(round(block_s / float(np.median(np.diff(t_s)))))) if t_s.size > 1 else 1
+    if segment is not None and segment[-1] > 0:  # blocks stay inside segments (a burst shorter: one block)
+        starts = np.flatnonzero(np.diff(segment, prepend=-1))
+        within = np.arange(y.size) - starts[segment - segment[0]]
+        block = np.cumsum(np.diff(segment * (y.size + 1) + within // per, prepend=-1) != 0) - 1
+        n = np.bincount(block)
+        return np.bincount(block, t_s) / n, np.bincount(block, y) / n
     m = y.size // per
     if m == 0:
         return t_s, y
     return t_s[: m * per].reshape(m, per).mean(axis=1), y[: m * per].reshape(m, per).mean(axis=1)
+
+
+def _broken_at_gaps(t_s: np.ndarray, y: np.ndarray, segment: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+    """``t_s`` and ``y`` with a NaN between segments, so a line plot does not bridge the gaps."""
+    if segment is None or t_s.size < 2:
+        return t_s, y
+    gaps = np.flatnonzero(np.diff(segment)) + 1
+    return np.insert(t_s.astype(float), gaps, np.nan), np.insert(y.astype(float), gaps, np.nan)
 
 
 def recording_overview(
@@ -92,13 +107,16 @@ def recording_overview(
     output_label: str,
     title: str,
     max_points: int = 20000,
+    segment: np.ndarray | None = None,
 ) -> Path:
     """Temperature and output against time, and output against temperature with heating,
     cooling and steady spans in different colours, so that loops between them show. The output
-    is drawn raw (light) and as means over ``duration / 1000`` (at least 10 s, dark)."""
+    is drawn raw (light) and as means over ``duration / 1000`` (at least 10 s, dark). With
+    ``segment`` (segment number per sample, bursts with gaps between them) no mean and no raw
+    output line reaches across a gap (the slow thermometer and the means are joined)."""
     duration_s = float(t_s[-1] - t_s[0]) if t_s.size > 1 else 1.0
-    tm, ym = _block_means(t_s, output, max(10.0, duration_s / 1000.0))
-    _, temp_m = _block_means(t_s, temperature_c, max(10.0, duration_s / 1000.0))
+    tm, ym = _block_means(t_s, output, max(10.0, duration_s / 1000.0), segment)
+    _, temp_m = _block_means(t_s, temperature_c, max(10.0, duration_s / 1000.0), segment)
     # rate of the thermometer over +-30 s, robust to its noise and resolution
     rate_c_per_min = np.interp(tm + 30.0, t_s, temperature_c) - np.interp(tm - 30.0, t_s, temperature_c)
     heating, cooling = rate_c_per_min > 0.05, rate_c_per_min < -0.05
@@ -109,9 +127,11 @@ def recording_overview(
     ax_t = fig.add_subplot(grid[0, 0])
     ax_y = fig.add_subplot(grid[1, 0], sharex=ax_t)
     ax_xy = fig.add_subplot(grid[:, 1])
+    seg = None if segment is None or segment[-1] == 0 else segment[::step]
+    t_raw, y_raw = _broken_at_gaps(t_s[::step], output[::step], seg)
     ax_t.plot(t_s[::step] / 3600.0, temperature_c[::step], color="tab:red", lw=0.8)
     ax_t.set(ylabel="thermometer (°C)", title=title)
-    ax_y.plot(t_s[::step] / 3600.0, output[::step], color="tab:blue", lw=0.4, alpha=0.35, label="raw")
+    ax_y.plot(t_raw / 3600.0, y_raw, color="tab:blue", lw=0.4, alpha=0.35, label="raw")
     ax_y.plot(tm / 3600.0, ym, color="navy", lw=0.9, label="block means")
     ax_y.set(xlabel="time (h)", ylabel=output_label)
     ax_y.legend(fontsize=8, loc="best")
@@ -150,6 +170,37 @@ def allan_plot(
     plt.close(fig)
     return path
 
+
+def rate_temperature_plot(
+    path: Path,
+    temperature_c: np.ndarray,
+    output: np.ndarray,
+    points: tuple[np.ndarray, np.ndarray],
+    fit: tuple[float, float],
+    point_label: str,
+    output_label: str,
+    title: str,
+    max_points: int = 20000,
+) -> Path:
+    """Output against temperature: every sample as a faint cloud, the ``points`` (temperature,
+    mean output) as markers and the line ``fit = (slope, intercept)`` through them. The output
+    axis shows the central 99 % of the samples and every point (a few spikes would flatten it)."""
+    step = max(1, temperature_c.size // max_points)
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ax.scatter(temperature_c[::step], output[::step], s=1, color="tab:blue", alpha=0.12, lw=0, label="samples")
+    ax.plot(points[0], points[1], "o", ms=4, color="navy", label=point_label)
+    t_line = np.array([temperature_c.min(), temperature_c.max()])
+    ax.plot(t_line, fit[0] * t_line + fit[1], "-", color="tab:red", lw=1.2, label="least-squares line")
+    low, high = np.percentile(output, [0.5, 99.5])
+    pad = 0.15 * max(high - low, float(np.ptp(points[1])), 1e-12)
+    ax.set_ylim(min(low, points[1].min()) - pad, max(high, points[1].max()) + pad)
+    ax.set(xlabel="thermometer (°C)", ylabel=output_label, title=title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, markerscale=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
 
 def front_plot(
     path: Path, fronts: Mapping[str, np.ndarray], true_front: np.ndarray, title: str

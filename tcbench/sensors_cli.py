@@ -1,4 +1,4 @@
-"""``tcbench simulate`` and ``tcbench metrics``: recordings from the command line."""
+"""``tcbench simulate``, ``tcbench metrics`` and ``tcbench import``: recordings from the command line."""
 
 from __future__ import annotations
 
@@ -133,6 +133,64 @@ def metrics(args: list[str]) -> int:
         raise CommandError(str(exc)) from None
     out = Path(cfg.out) if cfg.out else path.with_name(f"{path.stem}_metrics")
     _report(path, rec, out, cfg.scale_factor_hz_per_g, cfg.tracking, {"kind": "metrics"})
+    return 0
+
+
+@dataclass
+class ImportConfig:
+    """``tcbench import`` arguments: the CSV, the sensor kind, the column map (``time=COL[:unit]``
+    ...), rows to drop (``drop=flag`` or ``drop=a,b``: rows where a column is nonzero) and the
+    output directory; ``name`` is the recording's stem (default: the CSV's)."""
+
+    csv: str = ""
+    sensor: str = ""
+    time: str = ""
+    temperature: str = ""
+    output: str = ""
+    input: str | None = None
+    drop: str | None = None
+    out: str = ""
+    name: str | None = None
+    device_id: str | None = None
+    sample_rate_hz: float | None = None
+
+
+def import_command(args: list[str]) -> int:
+    from tcbench.sensors.importer import import_csv, save
+    from tcbench.sensors.recording import RecordingError
+
+    if args and "=" not in args[0]:
+        args = [f"csv={args[0]}", *args[1:]]
+    cfg: ImportConfig = parse(args, ImportConfig)
+    needed = [k for k in ("csv", "sensor", "time", "temperature", "output", "out") if not getattr(cfg, k)]
+    if needed:
+        raise CommandError(f"missing {needed[0]}=; usage: tcbench import csv=PATH sensor=msra|gyro time=COL[:unit] "
+                           "temperature=COL[:unit] output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR")
+    columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, "output": cfg.output}
+    if cfg.input:
+        columns["input"] = cfg.input
+    drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
+    csv = Path(cfg.csv)
+    stem = cfg.name or csv.stem
+    if "/" in stem or stem in {".", ".."}:
+        raise CommandError(f"name must be a file name without a directory, got {stem!r}")
+    try:
+        rec = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
+                         sample_rate_hz=cfg.sample_rate_hz)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    except OSError as exc:
+        raise CommandError(f"{csv}: cannot read the file ({exc.strerror or exc})") from None
+    try:
+        path = save(rec, cfg.out, stem)
+    except (RecordingError, OSError) as exc:
+        raise CommandError(f"{cfg.out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})") from None
+    source, seg = rec.meta.extra["source"], rec.meta.extra["segments"]
+    n_drop = source["rows_dropped"]
+    dropped = f", {n_drop} row{'s' * (n_drop != 1)} dropped where {' or '.join(drop)} is nonzero" if drop else ""
+    kind = f"in {seg['count']} segments " if seg["count"] > 1 else ""
+    print(f"tcbench: wrote {path} ({len(rec.data)} samples {kind}at {rec.meta.sample_rate_hz:g} Hz{dropped}) "
+          f"and its sidecar {path.with_suffix('.json')}")
     return 0
 
 

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from scipy.stats import chi2, norm
 
-from tcbench.diagnose.signals import segments
+from tcbench.sensors.segments import segments
 from tcbench.signal.allan import allan_deviation
 
 MIN_SAMPLES = 100

@@ -18,6 +18,7 @@ from scipy.signal import lfilter, savgol_filter
 
 from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
+from tcbench.sensors.segments import segments
 
 MAD_TO_SIGMA = 1.4826
 GRID_S = 1.0  # clock of the lag filter and the play operator
@@ -46,13 +47,6 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.nd
     slope = np.where(ok, (stx - st * sx / n) / np.where(ok, var, 1.0), 0.0)
     value = sx / n + slope * (t0 - st / n)
     return value, slope
-
-
-def segments(t_s: np.ndarray) -> np.ndarray:
-    """Segment number per sample: a new segment starts after a gap of more than five median
-    sample intervals (a logger's bursts)."""
-    dt = np.diff(t_s)
-    return np.concatenate(([0], np.cumsum(dt > 5.0 * np.median(dt))))
 
 
 def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:

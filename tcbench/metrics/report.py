@@ -4,8 +4,13 @@
   variation over temperature (seed 000 Table 2).
 - MSRA otherwise (a 0 g run): zero-bias stability after 30 min, 20 min and from zero start
   (seed 000 Table 1), and its Allan read-offs.
-- Gyroscope: Allan read-offs (seed 001) and, when the run reaches 60 and -40 degC, the drift
-  between those soaks.
+- Gyroscope: Allan read-offs (seed 001), when the run reaches 60 and -40 degC the drift
+  between those soaks, and the output against temperature with a fitted line (slope, its
+  standard error and r), plotted as ``rate_vs_temperature.png``.
+
+A recording made of bursts with gaps between them (segments, :mod:`tcbench.sensors.segments`)
+has its Allan deviation taken within the segments and averaged over them, so the gaps never
+count as samples; a gyro's rate-against-temperature points are then the segment means.
 """
 
 from __future__ import annotations
@@ -23,7 +28,8 @@ from tcbench import plots
 from tcbench.metrics import accelerometer as acc
 from tcbench.metrics import gyro
 from tcbench.sensors.recording import Recording
-from tcbench.signal.allan import AllanDeviation, allan_deviation, noise_parameters
+from tcbench.sensors.segments import segments
+from tcbench.signal.allan import AllanDeviation, allan_deviation, allan_deviation_segments, noise_parameters
 
 log = logging.getLogger(__name__)
 DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G = 200.0
@@ -37,6 +43,7 @@ class Report:
     conventions: list[str]
     nodes: pd.DataFrame | None = None
     files: dict[str, Path] = field(default_factory=dict)
+    details: dict[str, Any] = field(default_factory=dict)  # further JSON-ready results for metrics.json
 
 
 def _scale_factor(rec: Recording, override: float | None) -> float:
@@ -81,30 +88,61 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
         return Report(metrics, conventions, nodes, files)
     sf = _scale_factor(rec, scale_factor)
     metrics = acc.zero_bias_table(rec.time_s, rec.output, sf)
-    ad = allan_deviation(rec.output / sf * 1e6, rec.meta.sample_rate_hz or 1.0, "octave")
+    seg = segments(rec.time_s)
+    if seg[-1] == 0:
+        ad = allan_deviation(rec.output / sf * 1e6, rec.meta.sample_rate_hz or 1.0, "octave")
+    else:
+        ad = allan_deviation_segments(rec.output / sf * 1e6, rec.meta.sample_rate_hz or 1.0, seg)
+        metrics["segments"] = float(seg[-1] + 1)
     p = noise_parameters(ad)
     metrics |= {"bias_instability_ug": p.bias_instability, "scale_factor_hz_per_g": sf}
     if out is not None:
         files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev, _allan_lines(ad), "µg", "MSRA zero-bias Allan deviation")
     conventions = ["zero-bias stability: 1 sigma (ddof=1) of non-overlapping 10 s means of output/scale factor, "
                    "from 30 min, 20 min and 0 min after power-on (micro-g)"]
+    if seg[-1] > 0:
+        conventions.append(f"{seg[-1] + 1} segments (gaps > 5 median sample intervals): Allan variance within each "
+                           "segment, pooled over the segments, tau up to half the median segment")
     return Report(metrics, conventions, None, files)
 
 
 def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     fs = rec.meta.sample_rate_hz or 1.0 / float(np.median(np.diff(rec.time_s)))
-    ad, metrics = gyro.allan_summary(rec.output, fs)
+    seg = segments(rec.time_s)
+    n_seg = int(seg[-1]) + 1
+    ad, metrics = gyro.allan_summary(rec.output, fs, seg if n_seg > 1 else None)
     conventions = ["ARW in deg/sqrt(h) (seed 001's 'deg/h/sqrt(Hz)' read as deg/sqrt(h)); bias instability = "
                    "Allan minimum / 0.664 in deg/h; read-offs over tau <= T/10"]
+    details: dict[str, Any] = {}
+    if n_seg > 1:
+        metrics["segments"] = float(n_seg)
+        conventions.append(f"{n_seg} segments (gaps > 5 median sample intervals): Allan variance within each "
+                           "segment, pooled over the segments, tau up to half the median segment; T is the time "
+                           "inside the segments")
+        details["segments"] = {"count": n_seg, "sample_rate_hz": fs,
+                               "samples": np.bincount(seg).tolist()}
     temp = rec.temperature_c
     if temp.max() >= 59.5 and temp.min() <= -39.5:
         metrics["drift_60_to_m40_dps"] = gyro.drift_dps(rec.time_s, temp, rec.output)
         conventions.append("drift: mean output over the last 10 min of the 60 degC soak minus that of the -40 degC soak")
+    fit = gyro.rate_vs_temperature(temp, rec.output, seg)
+    if fit is not None:
+        metrics |= fit.metrics()
+        details["rate_vs_temperature"] = fit.as_dict()
+        conventions.append(f"rate vs temperature: least-squares line through {fit.temperature_c.size} {fit.method} "
+                           "(mean output at mean temperature); slope in deg/s per degC with its standard error")
     if out is not None:
+        title = "gyro Allan deviation" + (f" (within {n_seg} segments)" if n_seg > 1 else "")
         files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev * 3600.0,
                                           {k: (v[0] * 3600.0, v[1], v[2]) for k, v in _allan_lines(ad).items()},
-                                          "°/h", "gyro Allan deviation")
-    return Report(metrics, conventions, None, files)
+                                          "°/h", title)
+        if fit is not None:
+            files["rate_vs_temperature"] = plots.rate_temperature_plot(
+                out / "rate_vs_temperature.png", temp, rec.output, (fit.temperature_c, fit.output_dps),
+                (fit.slope_dps_per_c, fit.intercept_dps), f"{fit.method} ({fit.temperature_c.size})", "rate (°/s)",
+                f"{rec.meta.device_id}: {fit.slope_dps_per_c:+.4g} ± {fit.slope_stderr_dps_per_c:.2g} °/s per °C, "
+                f"r = {fit.r:.3f}")
+    return Report(metrics, conventions, None, files, details)
 
 
 def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None = None) -> Report:
@@ -119,11 +157,12 @@ def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None 
         files["overview"] = plots.recording_overview(
             out / "overview.png", rec.time_s, rec.temperature_c, rec.output, f"output ({unit})",
             f"{rec.meta.device_id}: {rec.meta.extra.get('protocol', '') if rec.meta.extra else ''}",
+            segment=segments(rec.time_s),
         )
     report = _msra(rec, scale_factor, out, files) if sensor == "msra" else _gyro(rec, out, files)
     if out is not None:
         payload: dict[str, Any] = {"device_id": rec.meta.device_id, "sensor": sensor,
-                                   "metrics": report.metrics, "conventions": report.conventions}
+                                   "metrics": report.metrics, "conventions": report.conventions, **report.details}
         report.files["metrics"] = out / "metrics.json"
         report.files["metrics"].write_text(json.dumps(payload, indent=2))
     return report

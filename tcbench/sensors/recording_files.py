@@ -10,7 +10,7 @@ import csv
 import json
 import os
 import secrets
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -42,8 +42,8 @@ def _load_json(path: Path) -> Any:
         raise RecordingError("invalid JSON: not UTF-8 text") from None
 
 
-def _read_header(path: Path) -> list[str]:
-    """Column names from the first line of a CSV file."""
+def _header_names(path: Path) -> list[str]:
+    """Column names from the first line of a CSV file, whatever they are."""
     with path.open("rb") as f:
         line = f.readline()
     try:
@@ -52,7 +52,12 @@ def _read_header(path: Path) -> list[str]:
         raise RecordingError("the header is not UTF-8 text") from None
     if not text:
         raise RecordingError("empty file (no header)")
-    names = [c.strip() for c in next(csv.reader([text]))]
+    return [c.strip() for c in next(csv.reader([text]))]
+
+
+def _read_header(path: Path) -> list[str]:
+    """Column names from the first line of a CSV file, checked against the schema."""
+    names = _header_names(path)
     _check_columns(names)
     return names
 
@@ -87,10 +92,26 @@ def _arrow_csv(path: Path, names: list[str], types: dict[str, pa.DataType]) -> p
     )
 
 
-def _diagnose_csv(path: Path, names: list[str]) -> None:
-    """Raise the first structural or cell problem of a CSV table; return if none is found."""
+def _diagnose_csv(path: Path, names: list[str], numeric: Sequence[str] = NUMERIC_COLUMNS) -> None:
+    """Raise the first structural or cell problem (in the ``numeric`` columns) of a CSV table;
+    return if none is found."""
     raw = path.read_bytes()
     complete = raw.endswith(b"\n")
+    _check_fields(raw, names)
+    text = _arrow_csv(path, names, dict.fromkeys(names, pa.string()))
+    first: tuple[int, int, str] | None = None
+    for j, c in enumerate(numeric):
+        cells = text[c].combine_chunks().fill_null("")
+        i, problem = _first_bad_cell(cells, last_is_cut=not complete)
+        if problem and (first is None or i < first[0]):
+            first = (i, j, problem)
+    if first is not None:
+        raise RecordingError(first[2], row=first[0] + 1, column=numeric[first[1]])
+
+
+def _check_fields(raw: bytes, names: list[str]) -> None:
+    """Raise at the first line of the CSV text ``raw`` below the header that is blank, cut short
+    or has a number of fields other than the header's."""
     fields = _fields_per_line(raw)[1:]
     wrong = np.flatnonzero(fields != len(names))
     if wrong.size:
@@ -98,18 +119,9 @@ def _diagnose_csv(path: Path, names: list[str]) -> None:
         n = int(fields[i])
         if n == 0:
             raise RecordingError("blank line", row=i + 1)
-        if i == fields.size - 1 and n < len(names) and not complete:
+        if i == fields.size - 1 and n < len(names) and not raw.endswith(b"\n"):
             raise RecordingError(f"truncated last line ({n} of {len(names)} fields)", row=i + 1)
         raise RecordingError(f"{n} fields, the header has {len(names)}", row=i + 1)
-    text = _arrow_csv(path, names, dict.fromkeys(names, pa.string()))
-    first: tuple[int, int, str] | None = None
-    for j, c in enumerate(NUMERIC_COLUMNS):
-        cells = text[c].combine_chunks().fill_null("")
-        i, problem = _first_bad_cell(cells, last_is_cut=not complete)
-        if problem and (first is None or i < first[0]):
-            first = (i, j, problem)
-    if first is not None:
-        raise RecordingError(first[2], row=first[0] + 1, column=NUMERIC_COLUMNS[first[1]])
 
 
 def _fields_per_line(raw: bytes) -> np.ndarray:

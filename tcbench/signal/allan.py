@@ -124,6 +124,22 @@ def _second_difference_sum(theta: np.ndarray, m: int, buf: np.ndarray) -> float:
     return total
 
 
+def _checked_rate(rate: np.ndarray, fs_hz: float) -> tuple[np.ndarray, float]:
+    """``rate`` as a 1-D finite float64 array of at least 3 samples and ``fs_hz`` > 0, or ValueError."""
+    rate = np.asarray(rate, dtype=np.float64)
+    if rate.ndim != 1:
+        raise ValueError(f"rate must be 1-D, got shape {rate.shape}")
+    if rate.size < 3:
+        raise ValueError(f"rate needs at least 3 samples, got {rate.size}")
+    if not np.isfinite(rate).all():
+        i = int(np.flatnonzero(~np.isfinite(rate))[0])
+        raise ValueError(f"rate must be finite: rate[{i}] = {rate[i]}")
+    fs_hz = float(fs_hz)
+    if not (np.isfinite(fs_hz) and fs_hz > 0.0):
+        raise ValueError(f"fs_hz must be a finite number > 0, got {fs_hz}")
+    return rate, fs_hz
+
+
 def allan_deviation(
     rate: np.ndarray, fs_hz: float, taus: np.ndarray | str = "octave"
 ) -> AllanDeviation:
@@ -136,23 +152,53 @@ def allan_deviation(
     Raises ValueError for a non-1-D, shorter than 3 or non-finite ``rate`` (naming the first bad
     index), a non-positive ``fs_hz`` or a tau outside [1, (N - 1) // 2] samples.
     """
-    rate = np.asarray(rate, dtype=np.float64)
-    if rate.ndim != 1:
-        raise ValueError(f"rate must be 1-D, got shape {rate.shape}")
-    if rate.size < 3:
-        raise ValueError(f"rate needs at least 3 samples, got {rate.size}")
-    if not np.isfinite(rate).all():
-        i = int(np.flatnonzero(~np.isfinite(rate))[0])
-        raise ValueError(f"rate must be finite: rate[{i}] = {rate[i]}")
-    fs_hz = float(fs_hz)
-    if not (np.isfinite(fs_hz) and fs_hz > 0.0):
-        raise ValueError(f"fs_hz must be a finite number > 0, got {fs_hz}")
-
+    rate, fs_hz = _checked_rate(rate, fs_hz)
     m = _averaging_factors(taus, fs_hz, (rate.size - 1) // 2)
     theta = _angle(rate, 1.0 / fs_hz)
     buf = np.empty(min(_BLOCK, theta.size))
     sums = np.array([_second_difference_sum(theta, int(mj), buf) for mj in m])
     n_terms = theta.size - 2 * m
+    tau_s = m / fs_hz
+    adev = np.sqrt(sums / (2.0 * tau_s**2 * n_terms))
+    for a in (tau_s, adev, n_terms):
+        a.setflags(write=False)
+    return AllanDeviation(tau_s=tau_s, adev=adev, n_terms=n_terms, fs_hz=fs_hz, n_samples=rate.size)
+
+
+def allan_deviation_segments(rate: np.ndarray, fs_hz: float, segment: np.ndarray) -> AllanDeviation:
+    """Overlapping Allan deviation of a rate recorded in segments (bursts with gaps between them).
+
+    ``segment`` numbers the segment of every sample (non-decreasing, as
+    :func:`tcbench.sensors.segments.segments` gives). The second differences are taken inside each
+    segment only, never across a gap, and pooled: at each tau ``sigma^2 = sum of all segments'
+    squared second differences / (2 tau^2 total n_terms)``, the Allan variance averaged over the
+    segments weighted by their number of terms. Octave taus run up to half the median segment
+    length (m <= (N_median - 1) // 2); a segment shorter than 2m + 1 samples skips that tau.
+    ``n_samples`` of the result is the total number of samples, so the read-offs' default limit
+    T/10 counts the time inside the segments. With one segment this is :func:`allan_deviation`.
+    """
+    from tcbench.sensors.segments import bounds
+
+    rate, fs_hz = _checked_rate(rate, fs_hz)
+    segment = np.asarray(segment)
+    if segment.shape != rate.shape:
+        raise ValueError(f"segment must number every sample: shape {segment.shape} against rate {rate.shape}")
+    starts, stops = bounds(segment)
+    lengths = stops - starts
+    m_max = (int(np.median(lengths)) - 1) // 2
+    if m_max < 1:
+        raise ValueError(f"segments of {int(np.median(lengths))} samples (median) are too short for an Allan "
+                         "deviation: it needs at least 3 samples per segment")
+    m = 2 ** np.arange(int(np.log2(m_max)) + 1)
+    sums = np.zeros(m.size)
+    n_terms = np.zeros(m.size, dtype=np.int64)
+    buf = np.empty(min(_BLOCK, int(lengths.max()) + 1))
+    for start, stop in zip(starts, stops, strict=True):
+        fits = m[m <= (stop - start - 1) // 2]  # a prefix of m
+        theta = _angle(rate[start:stop], 1.0 / fs_hz)
+        for j, mj in enumerate(fits):
+            sums[j] += _second_difference_sum(theta, int(mj), buf)
+            n_terms[j] += theta.size - 2 * mj
     tau_s = m / fs_hz
     adev = np.sqrt(sums / (2.0 * tau_s**2 * n_terms))
     for a in (tau_s, adev, n_terms):

@@ -1,0 +1,242 @@
+"""Bring your own data: a CSV table with columns of any name and common units, as a schema-v1 recording.
+
+A column map names the file's column for each schema column, with the unit after a colon
+(``sensor_time_ms:ms``, ``gyro_x_rads:rad/s``); without a unit the column is taken to be in the
+schema unit. Values are converted to the schema units (:data:`UNITS`), rows can be dropped where
+a flag column is nonzero, and the result goes through every check of the schema
+(:func:`~tcbench.sensors.recording.make_recording`: finite values, strictly increasing time,
+plausible values for the unit, sample rate). Every problem raises :class:`RecordingError` in one
+line naming the CSV file and, where it applies, its row (data rows counted from 1 below the
+header, as in the file, dropped rows included) and its column (the file's name for it).
+
+Gaps in the clock are kept: a recording of bursts is split into segments
+(:mod:`tcbench.sensors.segments`), listed in the sidecar's ``extra.segments`` (first row in the
+recording, samples, start and stop time of each), and the sample rate is the rate inside the
+segments (to six significant digits).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pcsv
+
+from tcbench.sensors.recording import (
+    NUMERIC_COLUMNS,
+    SENSORS,
+    STANDARD_UNITS,
+    Recording,
+    RecordingError,
+    make_recording,
+    write_recording,
+)
+from tcbench.sensors.recording_files import _check_fields, _diagnose_csv, _header_names
+from tcbench.sensors.segments import GAP_FACTOR, bounds, segments, within_rate_hz
+from tcbench.staging import staged_dir
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A unit and its conversion to the schema unit: ``schema = value * mul / div + offset``."""
+
+    mul: float = 1.0
+    div: float = 1.0
+    offset: float = 0.0
+
+    def to_schema(self, x: np.ndarray) -> np.ndarray:
+        """``x`` in the schema unit (an identity leaves the values bit for bit)."""
+        y = x * self.mul if self.mul != 1.0 else x
+        y = y / self.div if self.div != 1.0 else y
+        return y + self.offset if self.offset else y
+
+
+_RATE = {"deg/s": Unit(), "dps": Unit(), "rad/s": Unit(180.0, math.pi), "mdeg/s": Unit(1.0, 1e3),
+         "mdps": Unit(1.0, 1e3), "deg/h": Unit(1.0, 3600.0)}
+UNITS: dict[str, dict[str, Unit]] = {  # schema unit -> accepted units of a file's column
+    "s": {"s": Unit(), "ms": Unit(1.0, 1e3), "us": Unit(1.0, 1e6), "ns": Unit(1.0, 1e9), "min": Unit(60.0),
+          "h": Unit(3600.0)},
+    "degC": {"degC": Unit(), "K": Unit(offset=-273.15), "degF": Unit(5.0, 9.0, -160.0 / 9.0)},
+    "deg/s": _RATE,
+    "Hz": {"Hz": Unit(), "mHz": Unit(1.0, 1e3), "kHz": Unit(1e3)},
+    "g": {"g": Unit(), "mg": Unit(1.0, 1e3), "m/s^2": Unit(1.0, 9.80665), "m/s2": Unit(1.0, 9.80665)},
+}
+REQUIRED = ("time_s", "temperature_c", "output")
+
+
+@dataclass(frozen=True)
+class Column:
+    """One schema column taken from a file's column ``name`` in ``unit``."""
+
+    target: str
+    name: str
+    unit: str
+
+    def describe(self) -> str:
+        """``name [unit]`` as the sidecar records it."""
+        return f"{self.name} [{self.unit}]"
+
+
+def parse_column(target: str, spec: str, sensor: str, available: Sequence[str]) -> Column:
+    """The file column and unit of ``spec`` (``name`` or ``name:unit``) for schema column
+    ``target``; a name that exists in the file as written wins over splitting at its last colon."""
+    schema_unit = STANDARD_UNITS[sensor][target]
+    name, unit = spec, schema_unit
+    if spec not in available and ":" in spec:
+        name, unit = spec.rsplit(":", 1)
+    accepted = UNITS[schema_unit]
+    if unit not in accepted:
+        raise RecordingError(f"unknown unit {unit!r} for {target} of a {sensor} recording "
+                             f"(accepted: {', '.join(accepted)})", column=name)
+    if name not in available:
+        raise RecordingError(f"no column {name!r} (for {target}); the file has: "
+                             f"{', '.join(map(str, available))}")
+    return Column(target, name, unit)
+
+
+def _read(path: Path, used: Sequence[str], header: Sequence[str]) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The ``used`` columns of a CSV file as float64 (empty cells NaN) and a mask of the empty
+    cells (rows x ``used``), read with pyarrow; a line with the wrong number of fields, a blank
+    line or a cell that is not a number is located as the schema's reader does."""
+    try:
+        table = pcsv.read_csv(
+            path,
+            read_options=pcsv.ReadOptions(column_names=list(header), skip_rows=1),
+            parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+            convert_options=pcsv.ConvertOptions(column_types=dict.fromkeys(used, pa.float64()),
+                                                include_columns=list(used), null_values=[""],
+                                                strings_can_be_null=True, quoted_strings_can_be_null=False),
+        )
+    except pa.ArrowInvalid as exc:
+        _diagnose_csv(path, list(header), list(used))
+        raise RecordingError(f"cannot parse the table ({str(exc).splitlines()[0]})") from None
+    empty = np.zeros((table.num_rows, len(used)), dtype=bool)
+    if any(table[c].null_count for c in used):  # an empty cell, or a short or blank line
+        _check_fields(path.read_bytes(), list(header))
+        empty = np.column_stack([table[c].is_null().to_numpy(zero_copy_only=False) for c in used])
+    return {c: table[c].to_numpy() for c in used}, empty
+
+
+def _check_filled(empty: np.ndarray, used: Sequence[str], keep: np.ndarray) -> None:
+    """Raise at the first empty cell (rows x ``used`` mask) of the kept rows."""
+    kept = empty[keep]
+    if kept.any():
+        i, j = divmod(int(np.argmax(kept)), kept.shape[1])
+        raise RecordingError("empty cell", row=int(np.flatnonzero(keep)[i]) + 1, column=used[j])
+
+
+def _dropped(raw: Mapping[str, np.ndarray], drop: Sequence[str], n_rows: int) -> np.ndarray:
+    """Rows to drop: where any ``drop`` column is nonzero (an empty or NaN flag is an error)."""
+    out = np.zeros(n_rows, dtype=bool)
+    for name in drop:
+        flag = raw[name]
+        unset = np.isnan(flag)
+        if unset.any():
+            raise RecordingError("a drop= column needs a number in every row (nonzero drops the row, 0 keeps it)",
+                                 row=int(np.argmax(unset)) + 1, column=name)
+        out |= flag != 0
+    return out
+
+
+def _in_csv(err: RecordingError, file: str, rows: np.ndarray, columns: Mapping[str, Column],
+            table: Mapping[str, np.ndarray], sensor: str) -> RecordingError:
+    """A schema error about the converted ``table``, told in the CSV's terms: its file, its row
+    numbers (in the message too) and its column names, with the conversion behind a value."""
+    def row(n: int) -> int:
+        return int(rows[n - 1]) if 1 <= n <= rows.size else n
+
+    col = columns.get(err.column or "")
+    problem = re.sub(r"\brow (\d+)", lambda m: f"row {row(int(m.group(1)))}", err.problem)
+    unit = STANDARD_UNITS[sensor][col.target] if col is not None else None
+    if col is not None and err.row and col.unit != unit and np.isfinite(table[col.target][err.row - 1]):
+        problem += f" (after converting {col.unit} to {unit})"
+    return RecordingError(problem, file=file, row=row(err.row) if err.row else None,
+                          column=col.name if col is not None else err.column)
+
+
+def import_csv(
+    path: str | Path,
+    sensor: str,
+    columns: Mapping[str, str],
+    *,
+    drop: Sequence[str] = (),
+    device_id: str | None = None,
+    sample_rate_hz: float | None = None,
+) -> Recording:
+    """A schema-v1 recording from the CSV table at ``path``.
+
+    ``columns`` maps ``time_s``, ``temperature_c``, ``output`` and optionally ``input`` to a
+    file column, ``name`` or ``name:unit`` (:data:`UNITS`); a missing ``input`` is 0. Rows where a
+    ``drop`` column is nonzero are left out before any check. ``device_id`` defaults to the
+    file's stem, ``sample_rate_hz`` to the rate inside the segments (one over the median
+    interval). Raises :class:`RecordingError` naming the file, row and column.
+    """
+    path = Path(path)
+    name = str(path)
+    if sensor not in SENSORS:
+        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    unknown = [k for k in columns if k not in NUMERIC_COLUMNS]
+    if unknown:
+        raise RecordingError(f"unknown schema column {unknown[0]!r} (expected {', '.join(NUMERIC_COLUMNS)})")
+    missing = [k for k in REQUIRED if not columns.get(k)]
+    if missing:
+        raise RecordingError(f"say which column holds {missing[0]} ({', '.join(REQUIRED)} are required)")
+    try:
+        if path.is_dir():
+            raise RecordingError("is a directory, not a CSV file")
+        if not path.is_file():
+            raise RecordingError("no such file")
+        header = _header_names(path)
+        spec = {k: parse_column(k, v, sensor, header) for k, v in columns.items() if v}
+        for flag in drop:
+            if flag not in header:
+                raise RecordingError(f"no column {flag!r} (for drop); the file has: {', '.join(header)}")
+        used = list(dict.fromkeys([c.name for c in spec.values()] + list(drop)))
+        twice = [c for c in used if header.count(c) > 1]
+        if twice:
+            raise RecordingError(f"the header names column {twice[0]!r} more than once")
+        raw, empty = _read(path, used, header)
+        keep = ~_dropped(raw, drop, empty.shape[0])
+        _check_filled(empty, used, keep)
+        rows = np.flatnonzero(keep) + 1
+        table = {c.target: UNITS[STANDARD_UNITS[sensor][c.target]][c.unit].to_schema(raw[c.name][keep])
+                 for c in spec.values()}
+    except RecordingError as err:
+        raise err.located(name) from None
+    table.setdefault("input", np.zeros(rows.size))
+    if rows.size < 2:
+        after = f" left after dropping {int((~keep).sum())}" if (~keep).any() else ""
+        raise RecordingError(f"{rows.size} data row{'s' * (rows.size != 1)}{after}; a recording needs at least two",
+                             file=name)
+    t = table["time_s"]
+    clock_ok = bool(np.isfinite(t).all() and (np.diff(t) > 0).all())  # else the schema's check names the row
+    seg = segments(t) if clock_ok else np.zeros(t.size, dtype=np.int64)
+    starts, stops = bounds(seg)
+    extra = {
+        "source": {"file": path.name, "columns": {k: c.describe() for k, c in spec.items()},
+                   **({"input": "0 (no column given)"} if "input" not in spec else {}),
+                   "drop": list(drop), "rows_read": int(keep.size), "rows_dropped": int((~keep).sum())},
+        "segments": {"count": int(starts.size), "gap_factor": GAP_FACTOR, "first_rows": (starts + 1).tolist(),
+                     "samples": (stops - starts).tolist(), "start_s": t[starts].tolist(),
+                     "stop_s": t[stops - 1].tolist()},
+    }
+    try:
+        rate = float(sample_rate_hz) if sample_rate_hz is not None else (
+            float(f"{within_rate_hz(t, seg):.6g}") if clock_ok else math.nan)
+        return make_recording(table["time_s"], table["temperature_c"], table["input"], table["output"],
+                              sensor=sensor, sample_rate_hz=rate, device_id=device_id or path.stem, extra=extra)
+    except RecordingError as err:
+        raise _in_csv(err, name, rows, spec, table, sensor) from None
+
+
+def save(rec: Recording, out: str | Path, stem: str) -> Path:
+    """Write ``rec`` as ``out/<stem>.csv`` and its sidecar, all or nothing (``out`` is not even
+    created when writing fails)."""
+    with staged_dir(out) as tmp:
+        write_recording(rec, tmp / f"{stem}.csv")
+    return Path(out) / f"{stem}.csv"
