@@ -26,6 +26,7 @@ import numpy as np
 from common import (
     add_json,
     best_time_s,
+    blas_threads,
     command_line,
     parser_for,
     peak_mib,
@@ -101,6 +102,8 @@ def main(argv: list[str] | None = None) -> int:
         f"Signal: white noise (sigma {WHITE_SIGMA}/sample) + rate random walk "
         f"(K = {RRW_K}/sqrt(s)) at {FS_HZ:g} Hz, seed 0; best of {args.repeats} runs.\n"
     )
+    print(f"BLAS as the process starts (default thread settings, nothing forced): {blas_threads()}. "
+          "Equal work: both compute the same statistic at the same m values.\n")
     print("\n".join(table_head(
         ["taus", "n taus", "tcbench (s)", "allantools (s)", "ratio allantools/tcbench",
          "max rel. diff", "tcbench peak (MiB)", "allantools peak (MiB)"],
