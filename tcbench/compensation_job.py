@@ -179,7 +179,7 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
                         nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
                         files.append(where / f"nodes_test{i}.csv")
                 files += gyro_tables(result, where)
-                if c["tracking"]["plots"]:
+                if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
                     files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}",
                                      result.tuning)
                 for f in files:

@@ -101,7 +101,7 @@ class TrackingConfig:
     uri: str | None = None  # None: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd
     experiment: str = "tcbench"
     sweep_id: str | None = None  # None: derived from the multirun sweep directory
-    plots: bool = True
+    plots: bool | None = None  # None: for single runs and compensation runs, not optimisation sweeps
     resume: bool = False  # skip jobs whose config and seed already FINISHED in this experiment
 
 

@@ -118,7 +118,7 @@ def run_job(cfg: Any) -> RunResult | None:
                     np.savetxt(front, result.front_f, delimiter=",", header=",".join(
                         f"f{i + 1}" for i in range(result.n_objectives)), comments="")
                     run.log_artifact(front)
-                if c["tracking"]["plots"]:
+                if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
                     png = plots.run_convergence(
                         Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
                         result.f_opt, f"{method} on {tkey}, seed {c['seed']}",

@@ -238,8 +238,7 @@ def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tag
         params = {"sensor": rec.meta.sensor, "sample_rate_hz": rec.meta.sample_rate_hz,
                   "protocol": extra.get("protocol"), "device_seed": extra.get("device_seed"),
                   "seed": extra.get("seed"), "samples": len(rec.data)}
-        for key, value in tracking.flatten(params).items():
-            client.log_param(run_id, key, value)
+        handle.log_params(tracking.flatten(params))
         handle.log_metrics({k: v for k, v in report.metrics.items() if v == v})
         for file in report.files.values():
             handle.log_artifact(file)
@@ -247,6 +246,7 @@ def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tag
             sidecar = Path(tmp) / "sidecar.json"
             sidecar.write_text(OmegaConf.to_yaml(OmegaConf.create(extra)) if extra else "{}")
             handle.log_artifact(sidecar)
+        handle.flush()
     except BaseException:
         client.set_terminated(run_id, status="FAILED")
         raise

@@ -8,6 +8,7 @@ directory). MLflow's telemetry is off unless ``MLFLOW_DISABLE_TELEMETRY`` is set
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -20,7 +21,7 @@ from typing import Any
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
 
 import mlflow  # noqa: E402
-from mlflow.entities import Metric, Param, RunStatus  # noqa: E402
+from mlflow.entities import Metric, Param, RunStatus, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 import tcbench  # noqa: E402
@@ -110,8 +111,10 @@ def config_hash(cfg: Mapping[str, Any]) -> str:
     return hashlib.sha256(blob).hexdigest()[:16]
 
 
+@functools.cache
 def git_commit() -> str:
-    """Commit of the tcbench source tree, or ``unknown`` outside a git checkout."""
+    """Commit of the tcbench source tree, or ``unknown`` outside a git checkout (asked once per
+    process)."""
     src = Path(tcbench.__file__).resolve().parent
     try:
         out = subprocess.run(
@@ -137,39 +140,60 @@ def finished_run(cfg: Mapping[str, Any]) -> str | None:
 
 
 class JobRun:
-    """Handle on an active MLflow run that knows how to log a tcbench job."""
+    """Handle on an active MLflow run that knows how to log a tcbench job. Params, metrics and
+    tags are kept until :meth:`flush` (called when the job ends, finished or failed) and sent in
+    as few ``log_batch`` calls as MLflow's limits allow, each one a database transaction."""
 
     def __init__(self, c: MlflowClient, run_id: str) -> None:
         self.client = c
         self.run_id = run_id
+        self._params: list[Param] = []
+        self._metrics: list[Metric] = []
+        self._tags: list[RunTag] = []
+
+    def log_params(self, params: Mapping[str, str]) -> None:
+        self._params += [Param(k, str(v)[:6000]) for k, v in params.items()]
 
     def log_series(self, name: str, values: list[float], steps: list[int]) -> None:
-        """Log ``values`` of metric ``name`` at ``steps`` in batches."""
+        """Log ``values`` of metric ``name`` at ``steps``."""
         ts = mlflow.utils.time.get_current_time_millis()
-        metrics = [Metric(name, float(v), ts, int(s)) for v, s in zip(values, steps, strict=True)]
-        for i in range(0, len(metrics), _BATCH):
-            self.client.log_batch(self.run_id, metrics=metrics[i : i + _BATCH])
+        self._metrics += [Metric(name, float(v), ts, int(s)) for v, s in zip(values, steps, strict=True)]
 
     def log_metrics(self, values: Mapping[str, float]) -> None:
         ts = mlflow.utils.time.get_current_time_millis()
-        metrics = [Metric(k, float(v), ts, 0) for k, v in values.items()]
-        self.client.log_batch(self.run_id, metrics=metrics)
+        self._metrics += [Metric(k, float(v), ts, 0) for k, v in values.items()]
 
     def log_artifact(self, path: Path) -> None:
         self.client.log_artifact(self.run_id, str(path))
 
     def set_tag(self, key: str, value: str) -> None:
-        self.client.set_tag(self.run_id, key, value)
+        self._tags.append(RunTag(key, value))
+
+    def flush(self) -> None:
+        """Send what was logged: MLflow takes at most 1000 metrics, 100 params and 100 tags in
+        one batch."""
+        params, metrics, tags = self._params, self._metrics, self._tags
+        self._params, self._metrics, self._tags = [], [], []
+        while params or metrics or tags:
+            self.client.log_batch(self.run_id, metrics=metrics[:_BATCH], params=params[:100], tags=tags[:100])
+            params, metrics, tags = params[100:], metrics[_BATCH:], tags[100:]
+
+
+@functools.cache
+def _experiment_id(uri: str, name: str) -> str:
+    return experiment_id(client(uri), name)
 
 
 @contextmanager
 def job_run(
     cfg: Mapping[str, Any], run_name: str, tags: Mapping[str, str]
 ) -> Iterator[JobRun]:
-    """Open a run for one job; mark it FAILED (with the error as a tag) if the body raises."""
+    """Open a run for one job; mark it FAILED (with the error as a tag) if the body raises.
+    What the body logs is sent when it ends (:meth:`JobRun.flush`)."""
     track = cfg["tracking"]
-    c = client(track.get("uri"))
-    exp = experiment_id(c, track["experiment"])
+    uri = tracking_uri(track.get("uri"))
+    c = client(uri)
+    exp = _experiment_id(uri, track["experiment"])
     all_tags = {
         f"{TAG_PREFIX}version": tcbench.__version__,
         f"{TAG_PREFIX}git_commit": git_commit(),
@@ -178,14 +202,13 @@ def job_run(
     }
     run = c.create_run(exp, run_name=run_name, tags=all_tags)
     handle = JobRun(c, run.info.run_id)
-    params = flatten(cfg)
-    items = [Param(k, v[:6000]) for k, v in params.items()]
-    for i in range(0, len(items), 100):
-        c.log_batch(run.info.run_id, params=items[i : i + 100])
+    handle.log_params(flatten(cfg))
     try:
         yield handle
     except BaseException as exc:
-        c.set_tag(run.info.run_id, f"{TAG_PREFIX}error", f"{type(exc).__name__}: {exc}"[:4900])
+        handle.set_tag(f"{TAG_PREFIX}error", f"{type(exc).__name__}: {exc}"[:4900])
+        handle.flush()
         c.set_terminated(run.info.run_id, status=RunStatus.to_string(RunStatus.FAILED))
         raise
+    handle.flush()
     c.set_terminated(run.info.run_id, status="FINISHED")

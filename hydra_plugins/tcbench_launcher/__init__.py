@@ -1,0 +1,1 @@
+"""tcbench's Hydra sweeper and launcher (see :mod:`.launcher`)."""

@@ -1,0 +1,190 @@
+"""tcbench's Hydra sweeper and launcher (a Hydra plugin: Hydra only loads plugins from the
+``hydra_plugins`` package): a sweep composes its config once per combination of
+non-seed values, not once (twice) per job.
+
+Hydra's basic sweeper composes every job's config to check it, and its basic launcher composes it
+again before running it: about 0.15 s per compose, which is most of a small job's cost. The jobs
+of a tcbench sweep usually differ only in ``seed``, so here the jobs are grouped by their other
+overrides, each group's config is composed (and so checked) once, and every job gets a copy with
+its own seed and job number.
+
+- :class:`GroupingSweeper` is Hydra's basic sweeper (same ``params`` and batching) checking one
+  config per group.
+- :class:`GroupedLauncher` runs the jobs in this process (``n_jobs: 1``, the default) or in
+  ``n_jobs`` worker processes, each importing tcbench once and keeping its MLflow client for all
+  the jobs it runs. Every job still gets its folder ``<sweep dir>/<subdir>`` with
+  ``.hydra/config.yaml`` and ``.hydra/overrides.yaml``; the job's log goes to the console, and
+  everything else it records goes to MLflow as before. ``tracking.plots: null`` becomes false for
+  the jobs of an optimisation sweep (a convergence PNG per run costs more than the run; the
+  leaderboard draws them over seeds) and true for compensation sweeps. A job that raises is reported after the
+  sweep as Hydra's launchers do (tracked jobs are recorded FAILED and the sweep goes on).
+
+Both are the defaults of ``tcbench run`` (``hydra/sweeper: tcbench``, ``hydra/launcher: tcbench``);
+``hydra/launcher=joblib`` or ``submitit_slurm`` still work as before.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import copy
+import hashlib
+import logging
+import multiprocessing
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+from hydra.core.utils import JobReturn, JobStatus, setup_globals
+from hydra.plugins.launcher import Launcher
+from hydra.types import HydraContext, TaskFunction
+from omegaconf import DictConfig, OmegaConf, open_dict
+
+from tcbench.tasks import is_compensation
+
+log = logging.getLogger(__name__)
+
+
+def split_seed(overrides: Sequence[str]) -> tuple[tuple[str, ...], str | None]:
+    """A job's overrides without its ``seed=`` one, and that seed's value (None if absent)."""
+    rest = tuple(o for o in overrides if not o.startswith("seed="))
+    seeds = [o.split("=", 1)[1] for o in overrides if o.startswith("seed=")]
+    return rest, (seeds[-1] if seeds else None)
+
+
+def groups(job_overrides: Sequence[Sequence[str]]) -> dict[tuple[str, ...], list[int]]:
+    """Job indices by their overrides without the seed, in first-seen order."""
+    out: dict[tuple[str, ...], list[int]] = {}
+    for i, overrides in enumerate(job_overrides):
+        out.setdefault(split_seed(overrides)[0], []).append(i)
+    return out
+
+
+class GroupingSweeper(BasicSweeper):
+    """Hydra's basic sweeper, checking one composed config per group of jobs that differ only in
+    their seed (the launcher composes the same configs again)."""
+
+    def validate_batch_is_legal(self, batch: Sequence[Sequence[str]]) -> None:
+        firsts = [batch[idx[0]] for idx in groups(batch).values()]
+        super().validate_batch_is_legal(firsts)
+
+
+class GroupedLauncher(Launcher):
+    """Runs a sweep's jobs from one composed config per group; see the module docstring."""
+
+    def __init__(self, n_jobs: int = 1) -> None:
+        if int(n_jobs) != n_jobs or n_jobs < 1:
+            raise ValueError(f"hydra.launcher.n_jobs must be a positive integer, got {n_jobs}")
+        self.n_jobs = int(n_jobs)
+        self.config: DictConfig | None = None
+        self.hydra_context: HydraContext | None = None
+        self.task_function: TaskFunction | None = None
+
+    def setup(self, *, hydra_context: HydraContext, task_function: TaskFunction, config: DictConfig) -> None:
+        self.config = config
+        self.hydra_context = hydra_context
+        self.task_function = task_function
+
+    def launch(self, job_overrides: Sequence[Sequence[str]], initial_job_idx: int) -> Sequence[JobReturn]:
+        assert self.config is not None and self.hydra_context is not None
+        setup_globals()
+        sweep_dir = Path(str(self.config.hydra.sweep.dir))
+        sweep_dir.mkdir(parents=True, exist_ok=True)
+        sweep_id = hashlib.sha256(str(sweep_dir.resolve()).encode()).hexdigest()[:12]
+        jobs: list[tuple[int, list[str], dict[str, Any], str]] = []
+        for indices in groups(job_overrides).values():
+            composed = self.hydra_context.config_loader.load_sweep_config(self.config, list(job_overrides[indices[0]]))
+            hydra_cfg = composed.hydra
+            task = {key: _resolved(composed, key) for key in composed if key != "hydra"}
+            track = task.setdefault("tracking", {})
+            if not track.get("sweep_id"):
+                track["sweep_id"] = sweep_id
+            if track.get("plots") is None:  # one convergence PNG per run of an optimisation sweep is
+                track["plots"] = is_compensation(str(task["task"]["name"]))  # noise: the leaderboard draws them
+            for i in indices:
+                num = initial_job_idx + i
+                overrides = list(job_overrides[i])
+                seed = split_seed(overrides)[1]
+                cfg = copy.deepcopy(task)
+                if seed is not None:
+                    cfg["seed"] = int(seed)
+                with open_dict(hydra_cfg):
+                    hydra_cfg.job.num = num
+                    hydra_cfg.job.id = num
+                out = sweep_dir / str(OmegaConf.select(hydra_cfg, "sweep.subdir"))
+                _write_job_dir(out, str(hydra_cfg.output_subdir) if hydra_cfg.output_subdir else None, cfg, overrides)
+                jobs.append((num, overrides, cfg, str(out)))
+        jobs.sort(key=lambda j: j[0])
+        log.info("Launching %d jobs (%d configs composed) %s", len(jobs), len(groups(job_overrides)),
+                 "in this process" if self.n_jobs == 1 else f"on {self.n_jobs} worker processes")
+        if self.n_jobs == 1 or len(jobs) == 1:
+            outcomes = [_run_one(cfg) for _, _, cfg, _ in jobs]
+        else:
+            outcomes = _run_parallel([cfg for _, _, cfg, _ in jobs], self.n_jobs)
+        returns = []
+        for (_, overrides, cfg, out), (ok, value) in zip(jobs, outcomes, strict=True):
+            ret = JobReturn(overrides=overrides, cfg=OmegaConf.create(cfg), working_dir=out,
+                            task_name=str(self.config.hydra.job.name),
+                            status=JobStatus.COMPLETED if ok else JobStatus.FAILED)
+            ret.return_value = value
+            returns.append(ret)
+        return returns
+
+
+def _resolved(cfg: DictConfig, key: str) -> Any:
+    """``cfg[key]`` as plain, resolved data (interpolations resolved against the whole config)."""
+    node = cfg._get_node(key)
+    return OmegaConf.to_container(node, resolve=True) if OmegaConf.is_config(node) else cfg[key]
+
+
+def _write_job_dir(out: Path, subdir: str | None, cfg: dict[str, Any], overrides: list[str]) -> None:
+    """The job's folder with its resolved config and overrides, as Hydra writes them."""
+    out.mkdir(parents=True, exist_ok=True)
+    if subdir is None:
+        return
+    meta = out / subdir
+    meta.mkdir(parents=True, exist_ok=True)
+    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+    (meta / "config.yaml").write_text(yaml.dump(cfg, Dumper=dumper, sort_keys=False))
+    (meta / "overrides.yaml").write_text(yaml.dump(overrides, Dumper=dumper))
+
+
+def _run_one(cfg: dict[str, Any]) -> tuple[bool, Any]:
+    """Run one job's config; (True, result) or (False, the exception)."""
+    from tcbench.job import run_job
+
+    try:
+        return True, run_job(cfg)
+    except Exception as exc:  # reported by the sweeper after the batch, as Hydra's launchers do
+        log.error("job with seed %s raised %s: %s", cfg.get("seed"), type(exc).__name__, exc)
+        return False, exc
+
+
+def _worker_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
+    ok, value = _run_one(cfg)
+    return ok, (None if ok else _picklable(value))
+
+
+def _picklable(exc: BaseException) -> BaseException:
+    import pickle
+
+    try:
+        pickle.dumps(exc)
+        return exc
+    except Exception:  # noqa: BLE001 - any unpicklable exception is sent as its text
+        return RuntimeError(f"{type(exc).__name__}: {exc}")
+
+
+def _worker_init() -> None:
+    logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
+
+
+def _run_parallel(configs: list[dict[str, Any]], n_jobs: int) -> list[tuple[bool, Any]]:
+    """Run the configs on ``n_jobs`` fresh worker processes (spawned: no inherited database
+    connections), results in order."""
+    context = multiprocessing.get_context("spawn")
+    workers = min(n_jobs, len(configs), os.cpu_count() or n_jobs)
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init) as pool:
+        return list(pool.map(_worker_job, configs))

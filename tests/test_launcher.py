@@ -1,0 +1,104 @@
+"""tcbench's sweeper and launcher (hydra_plugins/tcbench_launcher): one compose per combination
+of non-seed values, every job run once with its own seed and folder, in one process or in
+worker processes, and the per-run convergence PNG left to the leaderboard in a sweep."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mlflow
+import pytest
+import yaml
+from hydra_plugins.tcbench_launcher import launcher
+from test_parallel import check_runs, tcbench
+
+
+def test_jobs_are_grouped_by_everything_but_the_seed() -> None:
+    jobs = [["optimiser=fa", "seed=0"], ["optimiser=ifa", "seed=0"], ["seed=1", "optimiser=fa"],
+            ["optimiser=ifa", "seed=1"], ["optimiser=ga"]]
+    assert launcher.groups(jobs) == {("optimiser=fa",): [0, 2], ("optimiser=ifa",): [1, 3], ("optimiser=ga",): [4]}
+    assert launcher.split_seed(["a=1", "seed=7"]) == (("a=1",), "7")
+    assert launcher.split_seed(["a=1"]) == (("a=1",), None)
+
+
+def compose_counter(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:
+    """Record every config Hydra composes for a sweep's jobs."""
+    from hydra._internal.config_loader_impl import ConfigLoaderImpl
+
+    calls: list[list[str]] = []
+    original = ConfigLoaderImpl.load_sweep_config
+
+    def counted(self, master_config, sweep_overrides):  # type: ignore[no-untyped-def]
+        calls.append(list(sweep_overrides))
+        return original(self, master_config, sweep_overrides)
+
+    monkeypatch.setattr(ConfigLoaderImpl, "load_sweep_config", counted)
+    return calls
+
+
+@pytest.mark.parametrize("launcher_args, composes", [([], 4), (["hydra/sweeper=basic", "hydra/launcher=basic"], 12)])
+def test_one_compose_per_group_and_every_job_once(workdir: Path, monkeypatch, launcher_args, composes) -> None:
+    """6 jobs in 2 groups: the sweeper checks and the launcher composes one config per group
+    (2 + 2), where Hydra's basic pair composes each job twice (6 + 6); the runs are the same."""
+    from tcbench.cli import main
+
+    calls = compose_counter(monkeypatch)
+    code = main(["run", "-m", "task=sphere", "task.dim=2", "budget=60", "optimiser=fa,ifa", "seed=range(3)",
+                 "tracking.experiment=grouped", *launcher_args])
+    assert code == 0
+    assert len(calls) == composes
+    check_runs(mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}"), "grouped",
+               {(o, s) for o in ("fa", "ifa") for s in range(3)})
+    configs = sorted(workdir.glob("multirun/*/*/*/.hydra/config.yaml"))
+    assert len(configs) == 6
+    seen = set()
+    for path in configs:
+        cfg = yaml.safe_load(path.read_text())
+        overrides = yaml.safe_load(path.with_name("overrides.yaml").read_text())
+        assert f"seed={cfg['seed']}" in overrides and f"optimiser={cfg['optimiser']['name']}" in overrides
+        seen.add((cfg["optimiser"]["name"], cfg["seed"]))
+    assert len(seen) == 6
+
+
+def test_two_worker_processes_record_every_run_once(workdir: Path) -> None:
+    out = tcbench("run", "-m", "task=sphere", "task.dim=2", "budget=60", "optimiser=fa", "seed=range(6)",
+                  "tracking.experiment=workers", "hydra.launcher.n_jobs=2", cwd=workdir)
+    assert out.returncode == 0, out.stderr
+    assert "on 2 worker processes" in out.stderr + out.stdout
+    check_runs(mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}"), "workers", {("fa", s) for s in range(6)})
+
+
+def test_an_untracked_job_that_raises_fails_the_sweep(workdir: Path, capsys) -> None:
+    """Without tracking nothing records a failure, so the sweep must raise it after running the
+    other jobs (as Hydra's launchers do): the command exits non-zero."""
+    from test_tracking import Exploding
+
+    from tcbench.cli import main
+    from tcbench.optimisers import register
+
+    register("exploding", Exploding)
+    with pytest.raises(SystemExit) as exited:  # Hydra reports the job's error and exits
+        main(["run", "-m", "task=sphere", "task.dim=2", "budget=200", "seed=range(2)", "tracking.enabled=false",
+              "optimiser=fa", "optimiser.name=fa,exploding"])
+    assert exited.value.code not in (0, None)
+    assert "boom in generation 2" in capsys.readouterr().err
+
+
+def test_sweeps_leave_the_convergence_png_to_the_leaderboard(workdir: Path) -> None:
+    """``tracking.plots: null``: a single run logs its convergence PNG, the runs of a sweep do not
+    (unless ``tracking.plots=true``)."""
+    assert tcbench("run", "task=sphere", "task.dim=2", "budget=60", "tracking.experiment=one", cwd=workdir).returncode == 0
+    assert tcbench("run", "-m", "task=sphere", "task.dim=2", "budget=60", "seed=range(2)", "tracking.experiment=many",
+                   cwd=workdir).returncode == 0
+    assert tcbench("run", "-m", "task=sphere", "task.dim=2", "budget=60", "seed=range(2)", "tracking.experiment=asked",
+                   "tracking.plots=true", cwd=workdir).returncode == 0
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+
+    def pngs(experiment: str) -> list[int]:
+        exp = client.get_experiment_by_name(experiment)
+        return [sum(a.path.endswith(".png") for a in client.list_artifacts(r.info.run_id))
+                for r in client.search_runs([exp.experiment_id])]
+
+    assert pngs("one") == [1]
+    assert pngs("many") == [0, 0]
+    assert pngs("asked") == [1, 1]
