@@ -6,5 +6,5 @@ import numpy as np
 
 
 def library_seed(rng: np.random.Generator) -> int:
-    """A 31-bit integer seed for a library that takes one (cma, optuna, scipy, pymoo)."""
+    """A 31-bit integer seed for a library that takes one (cma, nevergrad, optuna, scipy, pymoo)."""
     return int(rng.integers(1, 2**31 - 1))
