@@ -120,8 +120,9 @@ def plan(args: list[str]) -> Plan:
         if multirun:
             first = [f"{k}={v[0]}" for k, v in sweeps.items()]
             base = _compose(fixed + first, hydra_cfg=True)
+            given = {o.get_key_element() for o in parsed}  # the command line wins over the config's params
             for key, value in (base.hydra.sweeper.get("params") or {}).items():
-                if key not in sweeps:
+                if key not in given:
                     (o,) = parser.parse_overrides([f"{key}={value}"])
                     vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
                     sweeps[key] = [str(v) for v in vals]
