@@ -19,7 +19,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
-from tcbench.tasks import GyroVMDTuningEnv, is_compensation, is_gyro, task_class
+from tcbench.tasks import GyroVMDTuningEnv, is_bbob, is_compensation, is_gyro, task_class
 
 
 class ConfigError(ValueError):
@@ -36,6 +36,18 @@ class TaskConfig:
     target_precision: float = 1e-8
     lower: float | None = None
     upper: float | None = None
+
+
+@dataclass
+class BBOBTaskConfig:
+    """A BBOB function from ioh (see :class:`tcbench.tasks.bbob_env.BBOBEnv`)."""
+
+    name: str = MISSING
+    function: int = 1
+    dim: int = 5
+    instance: int = 1
+    target_precision: float = 1e-8
+    stop_at_target: bool = True
 
 
 @dataclass
@@ -103,6 +115,7 @@ class TrackingConfig:
     sweep_id: str | None = None  # None: derived from the multirun sweep directory
     plots: bool | None = None  # None: for single runs and compensation runs, not optimisation sweeps
     resume: bool = False  # skip jobs whose config and seed already FINISHED in this experiment
+    ioh_dir: str | None = None  # also write each run in IOHprofiler's format under this folder
 
 
 @dataclass
@@ -154,6 +167,12 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     if c["budget"] < 1:
         raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
     name = str(c["task"].get("name"))
+    ioh_dir = c.get("tracking", {}).get("ioh_dir")
+    if ioh_dir is not None and not str(ioh_dir).strip():
+        raise ConfigError("tracking.ioh_dir: give a folder, or null for no IOHprofiler log")
+    if ioh_dir and is_compensation(name):
+        raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are written for optimisation tasks, "
+                          f"not for task {name}")
     if is_compensation(name):
         from tcbench.compensation.validate import validate_compensation
 
@@ -166,11 +185,19 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         if is_gyro(name):
             task = {k: v for k, v in checked_task(c["task"], GyroTuningTaskConfig).items() if k != "name"}
             env = GyroVMDTuningEnv(budget=c["budget"], **task)
+        elif is_bbob(name):
+            from tcbench.tasks.bbob_env import BBOBEnv
+
+            task = {k: v for k, v in checked_task(c["task"], BBOBTaskConfig).items() if k != "name"}
+            env = BBOBEnv(budget=c["budget"], **task)
         else:
             task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
             env = task_class(name)(function=name, budget=c["budget"], **task)
     except (KeyError, ValueError) as exc:
         raise ConfigError(f"task: {exc}") from None
+    if ioh_dir and getattr(env, "n_objectives", 1) > 1:
+        raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are for one objective; task {name} has "
+                          f"{env.n_objectives}")
     check_optimiser(c, env, name)
 
 

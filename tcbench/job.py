@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import logging
 import tempfile
 import traceback
@@ -15,18 +16,21 @@ import yaml
 from tcbench import plots
 from tcbench.config import as_dict, validate
 from tcbench.runner import RunResult, run_optimisation
-from tcbench.tasks import is_compensation, is_gyro
+from tcbench.tasks import is_bbob, is_compensation, is_gyro
 
 log = logging.getLogger(__name__)
 
 
 def task_key(task: dict[str, Any]) -> str:
     """Leaderboard key of a task config, e.g. ``rastrigin-2d`` or ``rastrigin-10d-shifted``
-    (``gyro_vmdtuning-dev0`` for the VMD tuning of a gyro)."""
+    (``gyro_vmdtuning-dev0`` for the VMD tuning of a gyro, ``bbob-f03-5d`` for BBOB f3 in 5-D,
+    whose instances play the part of seeds)."""
     if is_gyro(str(task["name"])):
         from tcbench.compensation_job import compensation_task_key
 
         return compensation_task_key(task)
+    if is_bbob(str(task["name"])):
+        return f"bbob-f{task.get('function')!s:0>2}-{task.get('dim')}d"
     key = f"{task['name']}-{task['dim']}d"
     if task.get("shift"):
         key += "-shifted"
@@ -70,6 +74,17 @@ def result_metrics(result: RunResult) -> dict[str, float]:
     return metrics
 
 
+def ioh_folder(c: dict[str, Any]) -> Path | None:
+    """Where a job writes its IOHprofiler log (``tracking.ioh_dir``), or None:
+    ``<ioh_dir>/<method>/<task key>-s<seed>-<hash of the job's config>``."""
+    root = (c.get("tracking") or {}).get("ioh_dir")
+    if not root:
+        return None
+    content = {k: v for k, v in c.items() if k not in {"tracking", "progress"}}
+    digest = hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()[:8]
+    return Path(root) / method_label(c["optimiser"]) / f"{task_key(c['task'])}-s{c['seed']}-{digest}"
+
+
 def run_job(cfg: Any) -> RunResult | None:
     """Run one configured job. Tracked jobs that raise are recorded FAILED and return None."""
     c = as_dict(cfg)
@@ -78,9 +93,10 @@ def run_job(cfg: Any) -> RunResult | None:
 
         return run_compensation_job(c)  # type: ignore[return-value]
     optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
+    ioh = {"ioh_folder": ioh_folder(c), "algorithm": method_label(c["optimiser"])}
     if not c["tracking"]["enabled"]:
         validate(c)
-        return run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"])
+        return run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"], **ioh)
 
     from tcbench import tracking
 
@@ -102,7 +118,7 @@ def run_job(cfg: Any) -> RunResult | None:
     try:
         with tracking.job_run(c, f"{method}-{tkey}-s{c['seed']}", tags) as run:
             validate(c)
-            result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"])
+            result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"], **ioh)
             t = result.trace
             multi = result.n_objectives > 1
             run.log_series("hv_gap" if multi else "best_f", t.best_f, t.evaluations)

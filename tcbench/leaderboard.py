@@ -8,7 +8,8 @@ and a failed run at its full budget) / (number of successful runs); infinite whe
 Rank orders methods by success rate (higher first), then ERT, then median final error.
 ``ci95_low``/``ci95_high``: percentile-bootstrap 95 % interval of the median error over seeds;
 ``p_vs_next``: two-sided Wilcoxon signed-rank p-value of the final errors of this method and
-the next-ranked one, paired by seed (finished runs both have; NaN below 6 shared seeds).
+the next-ranked one, paired by seed (and BBOB instance; finished runs both have; NaN below 6
+shared seeds).
 """
 
 from __future__ import annotations
@@ -75,6 +76,7 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
             "task": t.get("tcbench.task"),
             "method": t.get("tcbench.method"),
             "seed": int(t.get("tcbench.seed", -1)),
+            "instance": int(p.get("task.instance") or 0),  # BBOB: runs pair by (instance, seed)
             "sweep": t.get("tcbench.sweep_id"),
             "config_hash": t.get("tcbench.config_hash"),
             "start_time": r.info.start_time,
@@ -108,7 +110,8 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     for method, g in runs.groupby("method", sort=True):
         ok = g["status"] == "FINISHED"
         err = g.loc[ok, "final_error"].to_numpy(float)
-        errors[method] = pd.Series(err, index=g.loc[ok, "seed"].to_numpy())
+        pairs = g.loc[ok, ["instance", "seed"]] if "instance" in g else g.loc[ok, ["seed"]]
+        errors[method] = pd.Series(err, index=pd.MultiIndex.from_frame(pairs))
         hit = (g["target_hit"] & ok).to_numpy(bool)
         evals = np.where(ok, g["evaluations"].fillna(0), g["budget"]).astype(float)
         q25, q50, q75 = np.percentile(err, [25, 50, 75]) if err.size else (np.nan,) * 3

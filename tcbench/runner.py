@@ -6,7 +6,9 @@ import functools
 import json
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -132,21 +134,27 @@ class _Progress:
             t.mean_f.append(_population_mean(opt))
 
 
-def ask_tell(opt: Optimiser, env: Any, budget: int, progress: bool) -> tuple[_Progress, dict[str, Any]]:
-    """Run ``opt`` on ``env`` until it is done: ``X = ask(); F = step(X); tell(X, F)``, one
-    batch per ask; the per-generation record and the last step's ``info``."""
+def ask_tell(opt: Optimiser, env: Any, budget: int, progress: bool,
+             on_step: Callable[[np.ndarray, np.ndarray], None] | None = None) -> tuple[_Progress, dict[str, Any]]:
+    """Run ``opt`` on ``env`` until it is done or the env terminates the episode (a task that
+    stops at its target): ``X = ask(); F = step(X); tell(X, F)``, one batch per ask, each batch
+    also handed to ``on_step(X, F)``; the per-generation record and the last step's ``info``."""
     recorder = _Progress(env)
     info: dict[str, Any] = {}
     last_generation = -1
     with tqdm(total=budget, disable=not progress, unit="eval", leave=False) as bar:
         while not opt.done:
             x = checked_batch(opt, opt.ask(), env)
-            f, _, _, _, info = env.step(x)
+            f, _, terminated, _, info = env.step(x)
+            if on_step is not None:
+                on_step(x, f)
             opt.tell(x, f)
             bar.update(len(f))
-            if opt.generation != last_generation:
+            if opt.generation != last_generation or terminated:
                 last_generation = opt.generation
                 recorder.record(opt, info)
+            if terminated:
+                break
     return recorder, info
 
 
@@ -156,15 +164,27 @@ def run_optimisation(
     budget: int,
     seed: int,
     progress: bool = False,
+    ioh_folder: str | Path | None = None,
+    algorithm: str | None = None,
 ) -> RunResult:
-    """Minimise ``task`` with ``optimiser`` (configs as mappings) under ``budget`` and ``seed``."""
+    """Minimise ``task`` with ``optimiser`` (configs as mappings) under ``budget`` and ``seed``;
+    with ``ioh_folder``, also write the run there in IOHprofiler's format under the name
+    ``algorithm`` (default: the optimiser's name)."""
     env = make_task(task, budget)
     env_seed, rng = seed_streams(seed)
     env.reset(seed=env_seed)
     params = {k: v for k, v in optimiser.items() if k != "name"}
     n_objectives = getattr(env, "n_objectives", 1)
     opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, params, n_objectives)
-    recorder, info = ask_tell(opt, env, budget, progress)
+    ioh_log = None
+    if ioh_folder is not None:
+        from tcbench.iohprofiler import RunLogger, problem_meta
+
+        ioh_log = RunLogger(ioh_folder, problem_meta(env, seed), algorithm or optimiser["name"],
+                            json.dumps(params, sort_keys=True, default=str), seed, {"budget": budget})
+    recorder, info = ask_tell(opt, env, budget, progress, ioh_log.record if ioh_log else None)
+    if ioh_log is not None:
+        ioh_log.close()
     if env.nonfinite:
         log.warning("%d evaluations returned NaN or inf; they were treated as worst", env.nonfinite)
     common = {

@@ -19,6 +19,17 @@ def test_jobs_are_grouped_by_everything_but_the_seed() -> None:
     assert launcher.groups(jobs) == {("optimiser=fa",): [0, 2], ("optimiser=ifa",): [1, 3], ("optimiser=ga",): [4]}
     assert launcher.split_seed(["a=1", "seed=7"]) == (("a=1",), "7")
     assert launcher.split_seed(["a=1"]) == (("a=1",), None)
+    assert launcher.split_seed(["seed=${task.instance}"]) == (("seed=${task.instance}",), None)
+
+
+def test_a_seed_from_an_interpolation_is_composed(workdir: Path) -> None:
+    from tcbench.cli import main
+
+    code = main(["run", "-m", "task=sphere", "task.dim=2", "budget=60", "optimiser=fa,ifa", "seed=${budget}",
+                 "tracking.experiment=interp"])
+    assert code == 0
+    paths = sorted(workdir.glob("multirun/*/*/*/.hydra/config.yaml"))
+    assert [yaml.safe_load(p.read_text())["seed"] for p in paths] == [60, 60]
 
 
 def compose_counter(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:

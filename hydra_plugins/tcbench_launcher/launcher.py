@@ -47,10 +47,16 @@ from tcbench.tasks import is_compensation
 log = logging.getLogger(__name__)
 
 
+def _literal_seed(override: str) -> bool:
+    return override.startswith("seed=") and override[5:].lstrip("-").isdigit()
+
+
 def split_seed(overrides: Sequence[str]) -> tuple[tuple[str, ...], str | None]:
-    """A job's overrides without its ``seed=`` one, and that seed's value (None if absent)."""
-    rest = tuple(o for o in overrides if not o.startswith("seed="))
-    seeds = [o.split("=", 1)[1] for o in overrides if o.startswith("seed=")]
+    """A job's overrides without its ``seed=<integer>`` one, and that seed (None if absent). A
+    seed given any other way (``seed='${task.instance}'``) stays with the overrides, so it is
+    composed and resolved like any other value."""
+    rest = tuple(o for o in overrides if not _literal_seed(o))
+    seeds = [o[5:] for o in overrides if _literal_seed(o)]
     return rest, (seeds[-1] if seeds else None)
 
 

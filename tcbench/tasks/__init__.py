@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from tcbench.tasks.bbob_env import ENV_ID as BBOB_ID
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
 from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
 from tcbench.tasks.gyro_env import ENV_ID as GYRO_DRIFTNOISE_ID
@@ -39,6 +40,16 @@ def register_gyro_envs() -> None:
     register_tasks(["gyro_vmdtuning"], GYRO_ENV_IDS.__getitem__, "tcbench.tasks.gyro_vmd_env:GyroVMDTuningEnv", None)
 
 
+def register_bbob_env() -> None:
+    """Register the BBOB task (ioh's functions 1-24, idempotent)."""
+    register_tasks(["bbob"], lambda _: BBOB_ID, "tcbench.tasks.bbob_env:BBOBEnv", None)
+
+
+def is_bbob(name: str) -> bool:
+    """True for the BBOB task (``bbob``: ioh's functions 1-24)."""
+    return name.lower() == "bbob"
+
+
 def is_compensation(name: str) -> bool:
     """True for the sensor compensation tasks (``msra_fulltemp``, ``msra_zerobias``,
     ``gyro_driftnoise``)."""
@@ -61,6 +72,8 @@ def task_id(name: str) -> str:
         return MSRA_ENV_IDS[name.lower()]
     if is_gyro(name):
         return GYRO_ENV_IDS[name.lower()]
+    if is_bbob(name):
+        return BBOB_ID
     return mo_env_id(name) if name.lower() in PROBLEMS else env_id(name)
 
 
@@ -73,8 +86,10 @@ register_envs()
 register_mo_envs()
 register_msra_envs()
 register_gyro_envs()
+register_bbob_env()
 
 __all__ = [
+    "BBOB_ID",
     "FUNCTIONS",
     "GYRO_ENV_IDS",
     "MSRA_ENV_IDS",
@@ -88,10 +103,12 @@ __all__ = [
     "ObjectiveFunction",
     "env_id",
     "get_function",
+    "is_bbob",
     "is_compensation",
     "is_gyro",
     "is_multiobjective",
     "mo_env_id",
+    "register_bbob_env",
     "register_envs",
     "register_gyro_envs",
     "register_mo_envs",
