@@ -12,6 +12,7 @@ from tcbench.optimisers.firefly_moves import (
     attractiveness,
     brighter_mask,
     move_towards,
+    pull_layout,
     squared_distances,
 )
 from tcbench.optimisers.ifa import (
@@ -53,6 +54,67 @@ def test_eq5_closed_form_equals_sequential_moves() -> None:
                 want[i] = want[i] + coef[i, j] * (x[j] - want[i]) + next(noise)
     want[0] = x[0] + (draws.random((1, d)) - 0.5) * alpha  # the brightest walks randomly
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def sequential_moves(x, coef, step, rng):
+    """Eq. 5 firefly by firefly, pull by pull: the random steps of the moves in (i, j) row-major
+    order, then one step for each firefly that moves toward nobody, in row order."""
+    n, d = x.shape
+    noise = iter((rng.random((int(np.count_nonzero(coef)), d)) - 0.5) * step)
+    want = x.copy()
+    for i in range(n):
+        for j in range(n):
+            if coef[i, j] > 0:
+                want[i] = want[i] + coef[i, j] * (x[j] - want[i]) + next(noise)
+    for i in np.flatnonzero(~(coef > 0).any(axis=1)):
+        want[i] = x[i] + (rng.random((1, d))[0] - 0.5) * step
+    return want
+
+
+@pytest.mark.parametrize("lone_rows", [[0], [0, 1], [0, 3, 5], [2, 6]])
+def test_eq5_closed_form_with_any_pattern_of_pulls(lone_rows) -> None:
+    """Random subsets of brighter fireflies (IFA) and fireflies that follow nobody anywhere in
+    the population: still the sequential chain, steps drawn in the same order."""
+    rng = np.random.default_rng(5)
+    n, d = 7, 4
+    x = rng.normal(size=(n, d))
+    step = np.array([0.1, 0.2, 0.3, 0.4])
+    coef = np.tril(rng.uniform(0.1, 0.9, (n, n)), -1) * (rng.random((n, n)) < 0.6)
+    coef[:, 0] = np.where(np.arange(n) > 0, 0.5, 0.0)  # every row but the first has a pull
+    coef[lone_rows] = 0.0
+    got = move_towards(x, coef, step, np.random.default_rng(11))
+    want = sequential_moves(x, coef, step, np.random.default_rng(11))
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("mask", "moving", "starts"),
+    [
+        (np.tri(4, k=-1, dtype=bool), [1, 2, 3], [0, 1, 3]),  # everyone brighter (FA)
+        (np.array([[0, 0, 0, 0], [0, 0, 0, 0], [1, 1, 0, 0], [1, 1, 1, 0]], dtype=bool),
+         [2, 3], [0, 2]),  # the two brightest tie: neither pulls the other
+        (np.array([[0, 0, 0, 0], [1, 0, 0, 0], [0, 0, 0, 0], [1, 1, 1, 0]], dtype=bool),
+         [1, 3], [0, 1]),  # a lone firefly between movers
+    ],
+)
+def test_pull_layout(mask, moving, starts) -> None:
+    layout = pull_layout(mask)
+    rows = np.arange(len(mask))
+    assert layout.pulls == mask.sum()
+    np.testing.assert_array_equal(rows[layout.moving], moving)
+    np.testing.assert_array_equal(rows[layout.lone], np.setdiff1d(rows, moving))
+    assert layout.n_lone == len(mask) - len(moving)
+    np.testing.assert_array_equal(layout.starts, starts)
+
+
+def test_scalar_step_gives_the_same_bits_as_a_uniform_per_axis_step() -> None:
+    rng = np.random.default_rng(2)
+    x = rng.uniform(-5, 5, (12, 6))
+    f = np.sort(rng.normal(size=12))
+    coef = np.where(brighter_mask(f), attractiveness(squared_distances(x), 1.0, 0.05), 0.0)
+    a = move_towards(x, coef, 0.37, np.random.default_rng(4))
+    b = move_towards(x, coef, np.full(6, 0.37), np.random.default_rng(4))
+    np.testing.assert_array_equal(a, b)
 
 
 def test_eq6_adaptive_step() -> None:

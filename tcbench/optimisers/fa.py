@@ -75,6 +75,8 @@ class FireflyAlgorithm(Optimiser):
         super().__init__(*args, **kwargs)
         self.width = self.upper - self.lower
         self.alpha = self.params.alpha0 * (self.width if self.params.alpha_relative else 1.0)
+        if np.ndim(self.alpha) and np.all(self.alpha == self.alpha[0]):
+            self.alpha = float(self.alpha[0])  # the same step on every axis, kept as a scalar
         self.x = np.empty((0, self.dim))
         self.fitness = np.empty(0)
 
@@ -82,27 +84,31 @@ class FireflyAlgorithm(Optimiser):
         limit = self.params.max_generations
         return limit is not None and self.generation >= limit
 
-    def moved(self, follow: np.ndarray) -> np.ndarray:
-        """The population after one round of moves, firefly i pulled by j where ``follow[i, j]``
-        (and j is brighter); positions clamped to the domain (eq. 11)."""
+    def moved(self, follow: np.ndarray | None = None) -> np.ndarray:
+        """The population after one round of moves, firefly i pulled by every brighter j, or only
+        by those with ``follow[i, j]`` when ``follow`` is given; positions clamped to the domain
+        (eq. 11)."""
         p = self.params
         beta = attractiveness(squared_distances(self.x), p.beta0, p.gamma, p.beta_min)
-        coef = np.where(follow & brighter_mask(self.fitness), beta, 0.0)
+        pulls = brighter_mask(self.fitness)
+        if follow is not None:
+            pulls &= follow
+        coef = np.where(pulls, beta, 0.0)
         return self.clip(move_towards(self.x, coef, self.alpha, self.rng))
 
     def _ask(self) -> np.ndarray:
         if self.fitness.size == 0:
             return self.uniform(self.params.population)
-        return self.moved(np.ones((len(self.fitness),) * 2, dtype=bool))[: self.remaining]
+        return self.moved()[: self.remaining]
 
     def _tell(self, x: np.ndarray, f: np.ndarray) -> None:
-        if self.fitness.size == 0:
-            self.x, self.fitness = x, f
-        else:
+        if self.fitness.size:
             k = len(f)
-            self.x = np.concatenate([x, self.x[k:]])
-            self.fitness = np.concatenate([f, self.fitness[k:]])
+            if k < len(self.fitness):  # a last, partial generation: the rest stay where they are
+                x = np.concatenate([x, self.x[k:]])
+                f = np.concatenate([f, self.fitness[k:]])
             self.generation += 1
-            self.alpha = self.alpha * self.params.alpha_decay
-        order = np.argsort(self.fitness, kind="stable")
-        self.x, self.fitness = self.x[order], self.fitness[order]
+            if self.params.alpha_decay != 1.0:
+                self.alpha = self.alpha * self.params.alpha_decay
+        order = np.argsort(f, kind="stable")
+        self.x, self.fitness = x[order], f[order]

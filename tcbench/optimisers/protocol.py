@@ -96,6 +96,10 @@ class Optimiser(ABC):
                 f"(population {self.params.population})"
             )
         self.dim = self.lower.size
+        self._finite_bounds = bool(np.isfinite(self.lower).all() and np.isfinite(self.upper).all())
+        # The same interval on every axis: checked and clamped with scalars, which is cheaper.
+        same = np.all(self.lower == self.lower[:1]) and np.all(self.upper == self.upper[:1])
+        self._box = (float(self.lower[0]), float(self.upper[0])) if same and self.dim else None
         self.budget = int(budget)
         self.rng = rng
         self.evaluations = 0
@@ -145,7 +149,13 @@ class Optimiser(ABC):
                 f"{self.name}: ask() returned shape {x.shape}; expected (k, {self.dim}) "
                 f"with 0 < k <= {self.remaining}"
             )
-        if np.any(x < self.lower) or np.any(x > self.upper) or not np.all(np.isfinite(x)):
+        # NaN fails the comparisons (and is the min/max of any array holding it); with finite
+        # bounds they also reject +-inf.
+        if self._box is not None:
+            inside = x.min() >= self._box[0] and x.max() <= self._box[1]
+        else:
+            inside = (x >= self.lower).all() and (x <= self.upper).all()
+        if not inside or not (self._finite_bounds or np.isfinite(x).all()):
             raise ProtocolError(f"{self.name}: ask() returned points outside the bounds")
         self._pending = x
         return x.copy()
@@ -159,17 +169,23 @@ class Optimiser(ABC):
         f = np.asarray(f, dtype=np.float64)
         if self.n_objectives == 1:
             f = f.reshape(-1)
-        if x.shape != self._pending.shape or not np.array_equal(x, self._pending):
+        if x.shape != self._pending.shape or not (x == self._pending).all():
             raise ProtocolError(f"{self.name}: tell() must receive the points of the last ask()")
         want = (x.shape[0],) if self.n_objectives == 1 else (x.shape[0], self.n_objectives)
         if f.shape != want:
             raise ProtocolError(f"{self.name}: tell() got values of shape {f.shape} for {x.shape[0]} points; expected {want}")
         self._pending = None
-        self.nonfinite += int(np.count_nonzero(~np.isfinite(f).reshape(f.shape[0], -1).all(axis=1)))
-        f = worst_if_nonfinite(f)
+        finite = np.isfinite(f)
+        if finite.ndim == 2:
+            finite = finite.all(axis=1)
+        if finite.all():
+            f = f.copy()  # the optimiser keeps its own copy, as worst_if_nonfinite gives
+        else:
+            self.nonfinite += int(finite.size - np.count_nonzero(finite))
+            f = worst_if_nonfinite(f)
         self.evaluations += f.shape[0]
         if self.n_objectives == 1:
-            i = int(np.argmin(f))
+            i = int(f.argmin())
             if f[i] < self._best.f:
                 self._best = Best(x[i].copy(), float(f[i]))
         else:
@@ -197,7 +213,8 @@ class Optimiser(ABC):
     # -- helpers for subclasses ------------------------------------------------------------
     def clip(self, x: np.ndarray) -> np.ndarray:
         """Put points back inside the bounds by clamping each coordinate (seed 000 eq. 11)."""
-        return np.clip(x, self.lower, self.upper)
+        lower, upper = self._box or (self.lower, self.upper)
+        return np.minimum(np.maximum(x, lower), upper)
 
     def uniform(self, n: int) -> np.ndarray:
         """``n`` points drawn uniformly in the bounds."""
