@@ -12,7 +12,8 @@ Measured per command: the wall time of the whole command; the time to the first 
 command's start to the start time MLflow recorded for its first run; and the overhead per job,
 ``(wall - time to first job - N * compute) / N``, where ``compute`` is the median time of one
 run's optimisation measured in this process (``tcbench.runner.run_optimisation``, no tracking).
-Every run must be recorded FINISHED, once.
+Every run must be recorded FINISHED, once. Also: the wall time of ``tcbench --help`` in a fresh
+process (10 calls).
 
 Usage::
 
@@ -52,6 +53,17 @@ def compute_s(runs: int = 20) -> float:
     return statistics.median(times)
 
 
+def help_s(repeats: int = 10) -> list[float]:
+    """Wall times of ``tcbench --help`` in fresh processes."""
+    tcbench = str(Path(sys.executable).with_name("tcbench"))
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        subprocess.run([tcbench, "--help"], capture_output=True, check=True)
+        times.append(time.perf_counter() - t0)
+    return times
+
+
 def sweep(jobs: int, launcher: list[str]) -> dict[str, float]:
     """Run one sweep command in a fresh folder; its wall time, time to first job and run counts."""
     tcbench = str(Path(sys.executable).with_name("tcbench"))
@@ -83,6 +95,7 @@ def main() -> int:
     add_json(parser, DEFAULT_JSON)
     args = parser.parse_args()
     load_start = os.getloadavg()[0]
+    helps = help_s()
     compute = compute_s()
     rows = []
     for label, jobs, launcher in (("tcbench (default)", args.jobs, []),
@@ -107,9 +120,13 @@ def main() -> int:
                          f"{r['overhead_per_job_s']:.3f}", r["finished"], r["distinct_seeds"],
                          "met" if r["first_job_s"] <= TARGET_FIRST_JOB_S else "**not met**",
                          "met" if r["overhead_per_job_s"] <= TARGET_OVERHEAD_S else "**not met**"]))
+    print(f"\n`tcbench --help` in a fresh process: median {statistics.median(helps):.2f} s, "
+          f"range {min(helps):.2f}-{max(helps):.2f} s over {len(helps)} calls (target < 0.5 s: "
+          f"{'met' if statistics.median(helps) < 0.5 else '**not met**'}).")
     ratio = rows[1]["overhead_per_job_s"] / rows[0]["overhead_per_job_s"]
     print(f"\nOverhead per job, Hydra basic / tcbench: {ratio:.1f}x (equal work: the same jobs, one process each).")
-    write_json(args.json, {"compute_s": compute, "load_average_1min": load, "versions": libraries, "rows": rows})
+    write_json(args.json, {"compute_s": compute, "help_s": helps, "load_average_1min": load, "versions": libraries,
+                            "rows": rows})
     return 0
 
 

@@ -171,11 +171,13 @@ def cmd_quickstart(argv: list[str]) -> int:
 
 def cmd_list(argv: list[str]) -> int:
     from tcbench.optimisers import registry
-    from tcbench.tasks import FUNCTIONS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
+    from tcbench.tasks import BBOB_ID, FUNCTIONS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
 
     print("tasks (single objective):")
     for key, fn in FUNCTIONS.items():
         print(f"  {env_id(key):26s} task={key:11s} {fn.title}, domain [{fn.lower:g}, {fn.upper:g}]^d, x*={fn.x_opt:g}")
+    print(f"  {BBOB_ID:26s} task=bbob        COCO's 24 noiseless BBOB functions through ioh (task.function, "
+          "task.dim, task.instance), domain [-5, 5]^d")
     print("tasks (multi-objective):")
     for key, p in PROBLEMS.items():
         print(f"  {mo_env_id(key):26s} task={key:11s} {p.title}, {p.n_objectives} objectives, "

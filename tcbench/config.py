@@ -19,7 +19,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
-from tcbench.tasks import GyroVMDTuningEnv, is_bbob, is_compensation, is_gyro, task_class
+from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
 
 
 class ConfigError(ValueError):
@@ -184,6 +184,8 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     try:
         if is_gyro(name):
             task = {k: v for k, v in checked_task(c["task"], GyroTuningTaskConfig).items() if k != "name"}
+            from tcbench.tasks.gyro_vmd_env import GyroVMDTuningEnv
+
             env = GyroVMDTuningEnv(budget=c["budget"], **task)
         elif is_bbob(name):
             from tcbench.tasks.bbob_env import BBOBEnv

@@ -96,3 +96,27 @@ def test_unknown_command(workdir: Path) -> None:
 def test_leaderboard_without_runs(workdir: Path) -> None:
     out = tcbench("leaderboard", "--experiment", "none", cwd=workdir)
     assert out.returncode == 2 and "no MLflow experiment named none" in out.stderr
+
+
+def test_help_and_import_load_no_heavy_library() -> None:
+    """``tcbench --help`` (and ``import tcbench``, which registers every task) must answer
+    without loading the simulators' or tracking's libraries: the sensor tasks' classes are
+    imported on first use. What it costs in time is measured in benchmarks/sweep_overhead.py."""
+    import subprocess
+    import sys
+
+    heavy = ["scipy", "matplotlib", "mlflow", "pandas", "hydra", "omegaconf", "ioh", "nevergrad", "optuna", "pywt"]
+    code = ("import sys, contextlib, io\n"
+            "from tcbench.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+            "    main(['--help'])\n"
+            "assert 'usage: tcbench' in out.getvalue()\n"
+            "import gymnasium as gym, tcbench\n"
+            "assert 'tcbench/Gyro-DriftNoise-v0' in gym.registry and 'tcbench/BBOB-v0' in gym.registry\n"
+            f"print(sorted({{m.split('.')[0] for m in sys.modules}} & {set(heavy)!r}))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+    import tcbench.tasks
+
+    assert tcbench.tasks.GyroDriftNoiseEnv.__name__ == "GyroDriftNoiseEnv"  # the lazy name resolves

@@ -2,26 +2,27 @@
 
 from __future__ import annotations
 
-from tcbench.tasks.bbob_env import ENV_ID as BBOB_ID
+from typing import Any
+
 from tcbench.tasks.function_env import BudgetExceededError, FunctionEnv
 from tcbench.tasks.functions import FUNCTIONS, ObjectiveFunction, get_function
-from tcbench.tasks.gyro_env import ENV_ID as GYRO_DRIFTNOISE_ID
-from tcbench.tasks.gyro_env import GyroDriftNoiseEnv
-from tcbench.tasks.gyro_vmd_env import ENV_ID as GYRO_VMDTUNING_ID
-from tcbench.tasks.gyro_vmd_env import GyroVMDTuningEnv
+from tcbench.tasks.ids import BBOB_ID, ENV_VERSION, GYRO_ENV_IDS, MSRA_ENV_IDS, env_id
 from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
-from tcbench.tasks.msra_env import ENV_IDS as MSRA_ENV_IDS
-from tcbench.tasks.msra_env import MSRACompensationEnv
 from tcbench.tasks.multiobjective import PROBLEMS
 from tcbench.tasks.registration import register_tasks
 
-ENV_VERSION = "v0"
-GYRO_ENV_IDS = {"gyro_driftnoise": GYRO_DRIFTNOISE_ID, "gyro_vmdtuning": GYRO_VMDTUNING_ID}
+# The sensor tasks' classes pull in simulators, learners and signal processing: imported when
+# first used (``tcbench.tasks.GyroDriftNoiseEnv``), so that ``import tcbench`` stays light.
+_LAZY = {"GyroDriftNoiseEnv": "tcbench.tasks.gyro_env", "GyroVMDTuningEnv": "tcbench.tasks.gyro_vmd_env",
+         "MSRACompensationEnv": "tcbench.tasks.msra_env", "BBOBEnv": "tcbench.tasks.bbob_env"}
 
 
-def env_id(function_key: str) -> str:
-    """Gymnasium id of a function task, e.g. ``tcbench/Rastrigin-v0``."""
-    return f"tcbench/{function_key.capitalize()}-{ENV_VERSION}"
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'tcbench.tasks' has no attribute {name!r}")
 
 
 def register_envs() -> None:
@@ -90,6 +91,8 @@ register_bbob_env()
 
 __all__ = [
     "BBOB_ID",
+    "ENV_VERSION",
+    "BBOBEnv",
     "FUNCTIONS",
     "GYRO_ENV_IDS",
     "MSRA_ENV_IDS",

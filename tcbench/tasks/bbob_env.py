@@ -21,8 +21,9 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.tasks.function_env import FunctionEnv, as_batch, check_budget
+from tcbench.tasks.ids import BBOB_ID
 
-ENV_ID = "tcbench/BBOB-v0"
+ENV_ID = BBOB_ID
 BBOB_FUNCTIONS = range(1, 25)
 BBOB_LOWER, BBOB_UPPER = -5.0, 5.0
 BBOB_MIN_DIM = 2  # ioh refuses BBOB problems in one dimension

@@ -31,10 +31,11 @@ from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
+from tcbench.tasks.ids import GYRO_DRIFTNOISE_ID
 from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
-ENV_ID = "tcbench/Gyro-DriftNoise-v0"
+ENV_ID = GYRO_DRIFTNOISE_ID
 BASELINES = ("raw", "oracle")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 

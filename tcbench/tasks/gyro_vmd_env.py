@@ -34,9 +34,10 @@ from tcbench.gyro.tuning import (
     vmd_objectives,
 )
 from tcbench.tasks.function_env import as_batch, check_budget
+from tcbench.tasks.ids import GYRO_VMDTUNING_ID
 from tcbench.tasks.mo_env import record_front
 
-ENV_ID = "tcbench/Gyro-VMDTuning-v0"
+ENV_ID = GYRO_VMDTUNING_ID
 
 
 def load_gyro_data(device_seed: int, recordings_seed: int, train_files: list[str] | None,

@@ -35,9 +35,10 @@ from tcbench.compensation.scoring import Score, score_outputs
 from tcbench.learners import registry as learners
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.weight_search import WeightSearch
+from tcbench.tasks.ids import MSRA_ENV_IDS
 
 TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp"}
-ENV_IDS = {"msra_zerobias": "tcbench/MSRA-ZeroBias-v0", "msra_fulltemp": "tcbench/MSRA-FullTemp-v0"}
+ENV_IDS = MSRA_ENV_IDS
 BIAS_FORMS = ("plus", "printed")
 
 
