@@ -27,3 +27,13 @@ def run(cls: type, fn: Callable[[np.ndarray], np.ndarray], dim: int = 2, budget:
         asked += len(x)
         opt.tell(x, fn(x))
     return opt, asked
+
+
+def drive(opt: Any, f: Callable[[np.ndarray], np.ndarray]) -> list[np.ndarray]:
+    """Ask/tell ``opt`` on ``f`` until done; every batch it asked, in order."""
+    asked = []
+    while not opt.done:
+        x = opt.ask()
+        asked.append(x)
+        opt.tell(x, f(x))
+    return asked

@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pytest
 from nevergrad.optimization import metamodel
-from optimiser_runs import make, run
+from optimiser_runs import drive, make, run
 from tcbench_peers.nevergrad_opt import NevergradDE, NGOpt
 
 from tcbench import check_optimizer
@@ -23,15 +23,6 @@ from tcbench.runner import run_optimisation
 
 def sphere(x: np.ndarray) -> np.ndarray:
     return np.sum((x - 1.0) ** 2, axis=1)
-
-
-def drive(opt, f) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
-    asked = []
-    while not opt.done:
-        x = opt.ask()
-        asked.append(x)
-        opt.tell(x, f(x))
-    return asked
 
 
 @pytest.mark.parametrize("name", ["ngopt", "ng_de"])

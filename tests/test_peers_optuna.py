@@ -13,7 +13,7 @@ import time
 import numpy as np
 import optuna
 import pytest
-from optimiser_runs import make, run
+from optimiser_runs import drive, make, run
 from tcbench_peers.optuna_tpe import TPE
 
 from tcbench import check_optimizer
@@ -22,15 +22,6 @@ from tcbench.optimisers import available
 
 def sphere(x: np.ndarray) -> np.ndarray:
     return np.sum((x - 1.0) ** 2, axis=1)
-
-
-def drive(opt, f) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
-    asked = []
-    while not opt.done:
-        x = opt.ask()
-        asked.append(x)
-        opt.tell(x, f(x))
-    return asked
 
 
 def test_registered_through_the_entry_point_and_contract() -> None:

@@ -26,19 +26,11 @@ from tcbench import check_optimizer
 from tcbench.optimisers import available
 from tcbench.optimisers.pareto import nondominated
 from tcbench.runner import run_optimisation
+from optimiser_runs import drive
 
 
 def two_spheres(x: np.ndarray) -> np.ndarray:
     return np.stack([np.sum(x**2, axis=1), np.sum((x - 1.0) ** 2, axis=1)], axis=1)
-
-
-def drive(opt, f) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
-    asked = []
-    while not opt.done:
-        x = opt.ask()
-        asked.append(x)
-        opt.tell(x, f(x))
-    return asked
 
 
 def box(d: int) -> tuple[np.ndarray, np.ndarray]:

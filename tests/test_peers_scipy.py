@@ -19,6 +19,7 @@ from tcbench_peers.scipy_opt import DualAnnealing, ScipyDE
 from tcbench import check_optimizer
 from tcbench.optimisers import available
 from tcbench.runner import run_optimisation
+from optimiser_runs import drive
 
 
 def sphere(x: np.ndarray) -> np.ndarray:
@@ -27,15 +28,6 @@ def sphere(x: np.ndarray) -> np.ndarray:
 
 def rastrigin(x: np.ndarray) -> np.ndarray:
     return 10 * x.shape[1] + np.sum(x**2 - 10 * np.cos(2 * np.pi * x), axis=1)
-
-
-def drive(opt, f) -> list[np.ndarray]:  # type: ignore[no-untyped-def]
-    asked = []
-    while not opt.done:
-        x = opt.ask()
-        asked.append(x)
-        opt.tell(x, f(x))
-    return asked
 
 
 def threads_back_to(count: int, wait: float = 2.0) -> bool:
