@@ -29,7 +29,7 @@ from typing import Any
 METHODS = ["fa", "ifa", "ga", "pso", "bas", "sa", "cmaes", "ipop_cmaes", "scipy_de", "dual_annealing",
            "ng_de", "ngopt", "tpe"]
 FUNCTIONS = list(range(1, 25))
-INSTANCES = {5: list(range(1, 16)), 20: list(range(1, 6))}
+INSTANCES = {5: list(range(1, 16)), 20: list(range(1, 4))}
 BUDGET_PER_DIM = 10_000
 # Methods slow per evaluation get a smaller budget so that the sweep fits in about an hour on
 # two cores (experiments/bbob/README.md has the timings): evaluations per dimension ...
