@@ -161,7 +161,7 @@ def cmd_quickstart(argv: list[str]) -> int:
 
     uri = tracking.tracking_uri(checked.tracking_uri)
     print(
-        f"\nRuns (params, per-generation curves, config, convergence plots) are in MLflow at "
+        f"\nRuns (params, per-generation curves, config) are in MLflow at "
         f"{uri}; browse them with\n  mlflow ui --backend-store-uri {uri}\n"
         f"Leaderboard table and plot: {out.resolve()}/\n"
         f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/"
