@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 import yaml
 
-from tcbench import plots
 from tcbench.config import as_dict, validate
 from tcbench.runner import RunResult, run_optimisation
 from tcbench.tasks import is_bbob, is_compensation, is_gyro
@@ -135,6 +134,8 @@ def run_job(cfg: Any) -> RunResult | None:
                         f"f{i + 1}" for i in range(result.n_objectives)), comments="")
                     run.log_artifact(front)
                 if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
+                    from tcbench import plots  # matplotlib only when a run draws
+
                     png = plots.run_convergence(
                         Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
                         result.f_opt, f"{method} on {tkey}, seed {c['seed']}",

@@ -9,19 +9,20 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import gymnasium as gym
 import numpy as np
 from tqdm.auto import tqdm
 
 import tcbench.tasks as tasks
-from tcbench.compensation.scoring import Score
-from tcbench.gyro.tuning import compromise, decode
-from tcbench.learners.base import FitHistory
 from tcbench.metrics.multiobjective import igd
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import Optimiser, ProtocolError
+
+if TYPE_CHECKING:  # the compensation side (simulators, scipy) loads only when a compensation run needs it
+    from tcbench.compensation.scoring import Score
+    from tcbench.learners.base import FitHistory
 
 log = logging.getLogger(__name__)
 
@@ -230,6 +231,8 @@ def _tune(env_kwargs_json: str, tuner: str, params_json: str, budget: int, sampl
     env.reset(seed=0)
     opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), json.loads(params_json), 2)
     ask_tell(opt, env, budget, progress)
+    from tcbench.gyro.tuning import compromise, decode
+
     i = compromise(env.front_x, env.front_f)
     k, alpha = decode(env.front_x[i])
     return VMDTuning(k, alpha, env.front_x, env.front_f, env.front_f[i], np.concatenate(env.evaluated_f),
