@@ -37,3 +37,16 @@ def drive(opt: Any, f: Callable[[np.ndarray], np.ndarray]) -> list[np.ndarray]:
         asked.append(x)
         opt.tell(x, f(x))
     return asked
+
+
+def assert_initialises_bp(optimiser: str, searches: int = 60) -> None:
+    """``optimiser`` searching BP's initial weights on MSRA full-temperature (X-BP): the best of
+    ``searches`` starts beats one random start, and the result compensates."""
+    from tcbench.runner import run_compensation
+
+    task, bp = {"name": "msra_fulltemp"}, {"name": "bp", "training": "lm", "epochs": 20}
+    searched = run_compensation(task, bp, {"name": optimiser}, searches, 0)
+    random = run_compensation(task, bp, {"name": "none"}, searches, 0)
+    assert searched.search_evaluations == searches and random.search_evaluations == 1
+    assert searched.init_loss < random.init_loss
+    assert searched.score.summary()["bias_variation_ug"] < searched.score.summary()["raw_bias_variation_ug"]

@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
+from optimiser_runs import drive
+
 from tcbench.check import check_optimizer
 from tcbench.optimisers.mopso import (
     MOPSO,
@@ -41,12 +43,7 @@ def zdt1(x: np.ndarray) -> np.ndarray:
 
 
 def run(opt: MOPSO, objective=zdt1) -> list[np.ndarray]:
-    asked = []
-    while not opt.done:
-        x = opt.ask()
-        asked.append(x)
-        opt.tell(x, objective(x))
-    return asked
+    return drive(opt, objective)
 
 
 def make(budget: int = 400, seed: int = 0, d: int = 3, **params) -> MOPSO:

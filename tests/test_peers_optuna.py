@@ -13,7 +13,7 @@ import time
 import numpy as np
 import optuna
 import pytest
-from optimiser_runs import drive, make, run
+from optimiser_runs import assert_initialises_bp, drive, make, run
 from tcbench_peers.optuna_tpe import TPE
 
 from tcbench import check_optimizer
@@ -114,14 +114,7 @@ def test_invalid_parameters_are_refused(params: dict, words: str) -> None:
 
 
 def test_tpe_initialises_a_learner() -> None:
-    from tcbench.runner import run_compensation
-
-    task, bp = {"name": "msra_fulltemp"}, {"name": "bp", "training": "lm", "epochs": 20}
-    searched = run_compensation(task, bp, {"name": "tpe"}, 60, 0)
-    random = run_compensation(task, bp, {"name": "none"}, 60, 0)
-    assert searched.search_evaluations == 60 and random.search_evaluations == 1
-    assert searched.init_loss < random.init_loss  # the best of 60 searched starts beats a random one
-    assert searched.score.summary()["bias_variation_ug"] < searched.score.summary()["raw_bias_variation_ug"]
+    assert_initialises_bp("tpe")
 
 
 def test_the_interpreter_exits_promptly_after_an_abandoned_run() -> None:
