@@ -75,16 +75,11 @@ def _run_sweep(args: list[str]) -> Plan | None:
 def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | None = None) -> int:
     """Print how many runs of a sweep finished and failed; 1 if any failed or, when
     ``expected`` is given, if fewer runs than jobs were recorded."""
-    import pandas as pd
-
     from tcbench import leaderboard, tracking
-    from tcbench.compensation import leaderboard as comp_board
 
-    client = tracking.client(uri)
-    kinds = [leaderboard.load_runs(client, [experiment], sweep), comp_board.load_runs(client, [experiment], sweep)]
-    runs = pd.concat([k for k in kinds if not k.empty], ignore_index=True) if any(not k.empty for k in kinds) else kinds[0]
-    failed = runs[runs["status"] != "FINISHED"] if len(runs) else runs
-    running = int((failed["status"] == "RUNNING").sum()) if len(failed) else 0
+    runs = leaderboard.sweep_runs(tracking.client(uri), [experiment], sweep)
+    failed = runs[runs["status"] != "FINISHED"]
+    running = int((failed["status"] == "RUNNING").sum())
     print(
         f"tcbench: {len(runs)} run{'s' if len(runs) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
         f"(experiment {experiment!r}, sweep {sweep}): {len(runs) - len(failed)} finished, "

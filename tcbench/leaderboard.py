@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from tcbench import plots
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 COLUMNS = [
@@ -63,6 +62,16 @@ def search_runs(client, experiments: list[str], kind: str, sweep: str | None = N
         token = page.token
         if not token:
             break
+
+
+def sweep_runs(client, experiments: list[str], sweep: str) -> pd.DataFrame:  # type: ignore[no-untyped-def]
+    """Status, method, task, seed and error of every run of one sweep, optimisation and
+    compensation alike (what the end-of-sweep report needs, without either board's columns)."""
+    rows = [{"status": r.info.status, "method": t.get("tcbench.method"), "task": t.get("tcbench.task"),
+             "seed": int(t.get("tcbench.seed", -1)), "error_message": t.get("tcbench.error", "")}
+            for kind in ("optimisation", "compensation")
+            for r in search_runs(client, experiments, kind, sweep) for t in (r.data.tags,)]
+    return pd.DataFrame(rows, columns=["status", "method", "task", "seed", "error_message"])
 
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -215,6 +224,8 @@ def _front_plot(board: Board, client, path: Path) -> bool:  # type: ignore[no-un
             local = client.download_artifacts(median_run["run_id"], "front.csv", tmp)
             fronts[str(method)] = np.loadtxt(local, delimiter=",", skiprows=1, ndmin=2)
     problem = get_problem(str(done["task_name"].iloc[0]))
+    from tcbench import plots
+
     plots.front_plot(path, fronts, problem.true_front(400), f"{board.task}: final fronts (median-IGD run)")
     return True
 
@@ -250,6 +261,8 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
     multi = is_multiobjective(board.runs)
     curves = step_curves(client, board.runs, "hv_gap" if multi else "best_f", grid)
     if curves:
+        from tcbench import plots
+
         plots.band_convergence(
             paths["png"], curves, board.f_opt,
             f"{board.task}: {'hypervolume gap' if multi else 'best so far'} (median, IQR over seeds)",

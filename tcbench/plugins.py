@@ -5,6 +5,8 @@ A package declares classes under a group in its ``pyproject.toml``::
     [project.entry-points."tcbench.optimisers"]
     de = "my_package.de:DifferentialEvolution"
 
+A name is imported when it is first asked for (:meth:`PluginRegistry.get`), so a run of FA does
+not import every installed plugin's libraries; :meth:`PluginRegistry.available` loads them all.
 An entry point that fails to load (or names the wrong kind of class) is recorded as broken with
 its error and skipped; the others still work.
 """
@@ -13,7 +15,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from importlib.metadata import entry_points
+from importlib.metadata import EntryPoint, entry_points
 from typing import Any, Generic, TypeVar
 
 log = logging.getLogger(__name__)
@@ -41,22 +43,37 @@ class PluginRegistry(Generic[T]):
     def __init__(self, group: str, base: type[T], kind: str,
                  unknown_error: type[UnknownPluginError] = UnknownPluginError) -> None:
         self.group, self.base, self.kind, self.unknown_error = group, base, kind, unknown_error
-        self._entries: dict[str, Entry[T]] | None = None
+        self._points: dict[str, EntryPoint] | None = None
+        self._entries: dict[str, Entry[T]] = {}
         self._broken: dict[str, str] = {}
 
-    def _load(self) -> dict[str, Entry[T]]:
-        if self._entries is None:
-            self._entries = {}
-            for ep in entry_points(group=self.group):
-                package = ep.dist.name if ep.dist is not None else "?"
-                try:
-                    cls = ep.load()
-                    self.check_class(ep.name, cls)
-                except Exception as exc:  # a broken plugin must not take the others down
-                    self._broken[ep.name] = f"{type(exc).__name__}: {exc}"
-                    log.warning("%s plugin %r from %s skipped: %s", self.kind, ep.name, package, exc)
-                    continue
-                self._entries[ep.name] = Entry(cls, package)
+    def _entry_points(self) -> dict[str, EntryPoint]:
+        """The group's entry points by name, not yet imported (a later duplicate name wins)."""
+        if self._points is None:
+            self._points = {ep.name: ep for ep in entry_points(group=self.group)}
+        return self._points
+
+    def _load_one(self, name: str) -> Entry[T] | None:
+        """Import the entry point ``name`` once; ``None`` if there is none or it is broken."""
+        if name in self._entries:
+            return self._entries[name]
+        ep = self._entry_points().get(name)
+        if ep is None or name in self._broken:
+            return None
+        package = ep.dist.name if ep.dist is not None else "?"
+        try:
+            cls = ep.load()
+            self.check_class(name, cls)
+        except Exception as exc:  # a broken plugin must not take the others down
+            self._broken[name] = f"{type(exc).__name__}: {exc}"
+            log.warning("%s plugin %r from %s skipped: %s", self.kind, name, package, exc)
+            return None
+        self._entries[name] = Entry(cls, package)
+        return self._entries[name]
+
+    def _load_all(self) -> dict[str, Entry[T]]:
+        for name in self._entry_points():
+            self._load_one(name)
         return self._entries
 
     def check_class(self, name: str, cls: Any) -> None:
@@ -67,22 +84,27 @@ class PluginRegistry(Generic[T]):
     def register(self, name: str, cls: type[T], package: str = "__main__") -> None:
         """Register ``cls`` under ``name`` for this process (entry points are the lasting way)."""
         self.check_class(name, cls)
-        self._load()[name] = Entry(cls, package)
+        self._entries[name] = Entry(cls, package)
+        self._broken.pop(name, None)
+
+    def names(self) -> list[str]:
+        """Every registered name, without importing any plugin (broken ones included)."""
+        return sorted(set(self._entry_points()) | set(self._entries))
 
     def available(self) -> dict[str, Entry[T]]:
-        """Registered classes by name."""
-        return dict(sorted(self._load().items()))
+        """Registered classes by name (imports every plugin of the group)."""
+        return dict(sorted(self._load_all().items()))
 
     def broken(self) -> dict[str, str]:
-        """Entry points that failed to load, with their error."""
-        self._load()
+        """Entry points that failed to load, with their error (imports every plugin of the group)."""
+        self._load_all()
         return dict(self._broken)
 
     def get(self, name: str) -> type[T]:
         """The class registered as ``name``; :class:`UnknownPluginError` naming the known ones."""
-        entries = self._load()
-        if name not in entries:
-            known = ", ".join(sorted(entries)) or "none"
+        entry = self._load_one(name)
+        if entry is None:
+            known = ", ".join(n for n in self.names() if n not in self._broken) or "none"
             hint = f" (plugin failed to load: {self._broken[name]})" if name in self._broken else ""
             raise self.unknown_error(f"unknown {self.kind} {name!r}{hint}; known: {known}")
-        return entries[name].cls
+        return entry.cls

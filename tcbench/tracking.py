@@ -63,18 +63,23 @@ def experiment_id(c: MlflowClient, name: str) -> str:
         return found.experiment_id
 
 
+def sqlite_path(uri: str | None = None) -> Path | None:
+    """The database file of a local SQLite store; None for any other store."""
+    resolved = tracking_uri(uri)
+    return Path(resolved[len("sqlite:///"):]) if resolved.startswith("sqlite:///") else None
+
+
 @contextmanager
 def store_lock(uri: str | None = None) -> Iterator[None]:
     """Exclusive lock on a local SQLite store (a ``<db>.lock`` file beside it) while held; a no-op
     for other stores. MLflow creates or upgrades a SQLite store's tables the first time a client
     touches it, and two processes doing so at once collide (``table ... already exists``)."""
-    resolved = tracking_uri(uri)
-    if not resolved.startswith("sqlite:///"):
+    db = sqlite_path(uri)
+    if db is None:
         yield
         return
     import fcntl
 
-    db = Path(resolved[len("sqlite:///"):])
     db.parent.mkdir(parents=True, exist_ok=True)
     with open(db.with_name(db.name + ".lock"), "a") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
@@ -87,7 +92,12 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
 def prepare_store(uri: str | None, experiment: str) -> str:
     """Create or upgrade the store and the experiment once, under :func:`store_lock`, before any
     job of a sweep starts; the experiment's id."""
+    db = sqlite_path(uri)
     with store_lock(uri):
+        if db is not None and (not db.exists() or db.stat().st_size == 0):
+            from tcbench.store_template import create_store
+
+            create_store(db)  # a copy of a migrated empty store; MLflow builds it if this fails
         return experiment_id(client(uri), experiment)
 
 

@@ -9,6 +9,18 @@ import pytest
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _cache_dir(tmp_path_factory):  # type: ignore[no-untyped-def]
+    """tcbench's user cache (the MLflow store template) in a folder of this test session."""
+    old = os.environ.get("TCBENCH_CACHE_DIR")
+    os.environ["TCBENCH_CACHE_DIR"] = str(tmp_path_factory.mktemp("tcbench-cache"))
+    yield
+    if old is None:
+        os.environ.pop("TCBENCH_CACHE_DIR", None)
+    else:
+        os.environ["TCBENCH_CACHE_DIR"] = old
+
+
 @pytest.fixture
 def workdir(tmp_path, monkeypatch):
     """Run in an empty directory with no tracking server configured."""

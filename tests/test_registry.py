@@ -42,3 +42,31 @@ def test_register_in_process() -> None:
         x = opt.ask()
         opt.tell(x, x.sum(axis=1))
     assert opt.evaluations == 25 and 0 <= opt.best.f <= 2
+
+
+def test_asking_for_one_optimiser_imports_no_other_plugin() -> None:
+    """A run of FA must not pay for importing cma, nevergrad or optuna (about 2 s): the registry
+    imports an entry point when its name is asked for. The peers plugin is installed in the test
+    environment, so those modules would be loaded by an eager registry."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom tcbench.optimisers import registry\nregistry.get('fa')\n"
+            "assert 'ifa' in registry.REGISTRY.names()\n"
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'cma', 'nevergrad', 'optuna', 'pymoo', 'tcbench_peers'}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
+
+
+def test_a_broken_entry_point_is_named_when_asked_for(monkeypatch: pytest.MonkeyPatch) -> None:
+    from importlib.metadata import EntryPoint
+
+    from tcbench.optimisers.registry import REGISTRY
+
+    broken = EntryPoint("broken-test", "no_such_module_xyz:Thing", "tcbench.optimisers")
+    monkeypatch.setattr(REGISTRY, "_points", {**REGISTRY._entry_points(), "broken-test": broken})
+    with pytest.raises(UnknownOptimiserError, match="'broken-test' .plugin failed to load: ModuleNotFoundError"):
+        get("broken-test")
+    assert "broken-test" in REGISTRY.broken()
+    assert "broken-test" not in available()
+    monkeypatch.setattr(REGISTRY, "_broken", {k: v for k, v in REGISTRY._broken.items() if k != "broken-test"})

@@ -2,17 +2,26 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import mlflow
+import pytest
 
 
-def test_three_sweeps_at_once_on_a_fresh_store(workdir: Path) -> None:
+@pytest.mark.parametrize("cache", ["empty", "unusable"])
+def test_three_sweeps_at_once_on_a_fresh_store(workdir: Path, cache: str) -> None:
+    """``empty``: the three race to build the store template and copy it; ``unusable`` (the cache
+    path is a file): MLflow migrates the store itself, once, under the store lock."""
+    cache_dir = workdir / "cache"
+    if cache == "unusable":
+        cache_dir.write_text("not a folder")
+    env = {**os.environ, "TCBENCH_CACHE_DIR": str(cache_dir)}
     procs = [subprocess.Popen([sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "optimiser=pso",
                                "budget=40", f"seed={i * 2},{i * 2 + 1}", f"hydra.sweep.dir=multirun/s{i}"],
-                              cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                              cwd=workdir, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
              for i in range(3)]
     outs = [p.communicate(timeout=300) for p in procs]
     for p, (_, err) in zip(procs, outs, strict=True):

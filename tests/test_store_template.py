@@ -1,0 +1,84 @@
+"""A new SQLite store is a copy of a cached, migrated empty store: the same database MLflow makes."""
+
+from __future__ import annotations
+
+import sqlite3
+from pathlib import Path
+
+import mlflow
+import pytest
+
+from tcbench import store_template, tracking
+
+
+def _schema_and_rows(db: Path) -> tuple[list[tuple], list[tuple], list[tuple]]:
+    with sqlite3.connect(db) as con:
+        # the clauses of a table's DDL, unordered: MLflow's own migrations order the constraints of
+        # a rebuilt table differently from one process to the next (set iteration)
+        schema = sorted((kind, name, tuple(sorted(c.strip() for c in (sql or "").split(","))))
+                        for kind, name, sql in con.execute("select type, name, sql from sqlite_master"
+                                                           " where name not like 'sqlite_%'"))
+        version = con.execute("select version_num from alembic_version").fetchall()
+        experiments = con.execute("select experiment_id, name, artifact_location, lifecycle_stage from experiments").fetchall()
+    con.close()
+    return schema, version, experiments
+
+
+@pytest.fixture
+def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def test_copy_equals_the_store_mlflow_builds(workdir: Path, cache: Path, tmp_path: Path) -> None:
+    # the template is built from another directory: the copy must still point Default at this one
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    import os
+
+    os.chdir(elsewhere)
+    store_template.ensure_template()
+    os.chdir(workdir)
+    assert store_template.create_store(workdir / "copy.db")
+    mlflow.MlflowClient(f"sqlite:///{workdir / 'direct.db'}").search_experiments()
+    copy, direct = _schema_and_rows(workdir / "copy.db"), _schema_and_rows(workdir / "direct.db")
+    assert copy == direct
+    assert copy[2][0][2] == str(workdir / "mlruns" / "0")
+
+
+def test_prepare_store_uses_the_template_and_leaves_no_temporary_file(workdir: Path, cache: Path) -> None:
+    uri = f"sqlite:///{workdir / 'sub' / 'mlflow.db'}"
+    eid = tracking.prepare_store(uri, "tcbench")
+    assert store_template.template_path().is_file()
+    client = mlflow.MlflowClient(uri)
+    assert client.get_experiment_by_name("tcbench").experiment_id == eid
+    run = client.create_run(eid)
+    client.log_metric(run.info.run_id, "m", 1.5)
+    assert client.get_run(run.info.run_id).data.metrics == {"m": 1.5}
+    assert sorted(p.name for p in (workdir / "sub").iterdir()) == ["mlflow.db", "mlflow.db.lock"]
+
+
+def test_a_broken_template_is_rebuilt(workdir: Path, cache: Path) -> None:
+    template = store_template.ensure_template()
+    template.write_bytes(b"garbage, not SQLite")
+    assert store_template.create_store(workdir / "a.db")
+    assert _schema_and_rows(workdir / "a.db")[1]  # migrated
+    assert _schema_and_rows(template)[1]
+
+
+def test_an_unusable_cache_leaves_the_store_to_mlflow(workdir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (workdir / "cache").write_text("a file where the cache folder should be")
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(workdir / "cache"))
+    assert not store_template.create_store(workdir / "b.db")
+    assert not (workdir / "b.db").exists()
+    uri = f"sqlite:///{workdir / 'b.db'}"
+    eid = tracking.prepare_store(uri, "tcbench")  # MLflow migrates it itself
+    assert mlflow.MlflowClient(uri).get_experiment_by_name("tcbench").experiment_id == eid
+
+
+def test_an_existing_store_is_not_replaced(workdir: Path, cache: Path) -> None:
+    uri = f"sqlite:///{workdir / 'mlflow.db'}"
+    tracking.prepare_store(uri, "first")
+    tracking.prepare_store(uri, "second")
+    names = {e.name for e in mlflow.MlflowClient(uri).search_experiments()}
+    assert {"first", "second"} <= names
