@@ -228,11 +228,19 @@ def front_plot(
     return path
 
 
+def line_styles(n: int) -> list[dict[str, str]]:
+    """``n`` distinct line styles: the ten default colours solid, then dashed, then dotted, then
+    dash-dotted (40 before any repeats)."""
+    dashes = ("-", "--", ":", "-.")
+    return [{"color": f"C{k % 10}", "ls": dashes[k // 10 % len(dashes)]} for k in range(n)]
+
+
 def ecdf_plot(path: Path, evaluations: np.ndarray, curves: Mapping[str, np.ndarray], title: str) -> Path:
     """COCO-style runtime ECDF: fraction of (function, target) pairs solved against evaluations."""
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    for method, frac in sorted(curves.items(), key=lambda kv: -kv[1][-1]):
-        ax.step(evaluations, frac, where="post", label=f"{method} ({frac[-1]:.0%})")
+    ranked = sorted(curves.items(), key=lambda kv: -kv[1][-1])
+    for (method, frac), style in zip(ranked, line_styles(len(ranked)), strict=True):
+        ax.step(evaluations, frac, where="post", **style, label=f"{method} ({frac[-1]:.0%})")
     ax.set_xscale("log")
     ax.set_ylim(0, 1)
     ax.set(xlabel="evaluations", ylabel="fraction of (function, target) pairs", title=title)

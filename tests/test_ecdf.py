@@ -42,3 +42,10 @@ def test_ecdf_plots_from_runs(workdir: Path) -> None:
     runs = leaderboard.load_runs(tracking.client(), ["e"])
     (path,) = write_ecdf_plots(tracking.client(), runs, workdir)
     assert path.name == "ecdf_2d.png" and path.stat().st_size > 5000
+
+
+def test_ecdf_line_styles_are_distinct_beyond_ten_methods() -> None:
+    from tcbench.plots import line_styles
+
+    styles = line_styles(13)  # the BBOB and optimiser-suite boards have 13 methods
+    assert len({(s["color"], s["ls"]) for s in styles}) == 13
