@@ -18,6 +18,7 @@ import logging
 import os
 import shutil
 import sqlite3
+import time
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -129,11 +130,13 @@ def create_store(db: Path) -> bool:
     tmp = db.with_name(f"{db.name}.{os.getpid()}.tmp")
     try:
         shutil.copyfile(template, tmp)
-        with sqlite3.connect(tmp) as con:  # the Default experiment's folder, as MLflow sets it here
+        with sqlite3.connect(tmp) as con:  # the Default experiment as MLflow makes it here and now
             (location,) = con.execute("select artifact_location from experiments where experiment_id = 0").fetchone()
             if Path(location).is_relative_to(built_in):
-                con.execute("update experiments set artifact_location = ? where experiment_id = 0",
-                            (str(Path.cwd() / Path(location).relative_to(built_in)),))
+                location = str(Path.cwd() / Path(location).relative_to(built_in))
+            now_ms = int(time.time() * 1000)
+            con.execute("update experiments set artifact_location = ?, creation_time = ?, last_update_time = ?"
+                        " where experiment_id = 0", (location, now_ms, now_ms))
         con.close()
         os.replace(tmp, db)
     except (OSError, sqlite3.Error, TypeError) as exc:

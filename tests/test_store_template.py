@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sqlite3
+import time
 from pathlib import Path
 
 import mlflow
@@ -37,13 +38,20 @@ def test_copy_equals_the_store_mlflow_builds(workdir: Path, cache: Path, tmp_pat
     import os
 
     os.chdir(elsewhere)
-    store_template.ensure_template()
+    template = store_template.ensure_template()
+    with sqlite3.connect(template) as con:  # as if the template were built long ago
+        con.execute("update experiments set creation_time = 0, last_update_time = 0")
+    con.close()
     os.chdir(workdir)
     assert store_template.create_store(workdir / "copy.db")
     mlflow.MlflowClient(f"sqlite:///{workdir / 'direct.db'}").search_experiments()
     copy, direct = _schema_and_rows(workdir / "copy.db"), _schema_and_rows(workdir / "direct.db")
-    assert copy == direct
+    assert copy == direct  # experiments compared without their times
     assert copy[2][0][2] == str(workdir / "mlruns" / "0")
+    with sqlite3.connect(workdir / "copy.db") as con:
+        (created_ms,) = con.execute("select creation_time from experiments where experiment_id = 0").fetchone()
+    con.close()
+    assert abs(created_ms / 1000 - time.time()) < 60  # not the template's time
 
 
 def test_prepare_store_uses_the_template_and_leaves_no_temporary_file(workdir: Path, cache: Path) -> None:
