@@ -12,7 +12,6 @@ half-built store. If the cache cannot be used, MLflow creates the store itself a
 
 from __future__ import annotations
 
-import fcntl
 import json
 import logging
 import os
@@ -24,6 +23,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from tcbench.filelock import locked
+
 log = logging.getLogger(__name__)
 
 
@@ -34,16 +35,6 @@ def cache_dir() -> Path:
         return Path(explicit)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "tcbench"
-
-
-@contextmanager
-def _locked(path: Path) -> Iterator[None]:
-    with open(path.with_name(path.name + ".lock"), "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def _is_store(path: Path) -> bool:
@@ -112,7 +103,7 @@ def ensure_template() -> Path:
     """The cached empty store, built first if missing or unreadable."""
     template = template_path()
     template.parent.mkdir(parents=True, exist_ok=True)
-    with _locked(template):
+    with locked(template):
         if not _is_store(template):
             _build(template)
     return template

@@ -78,15 +78,10 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
     if db is None:
         yield
         return
-    import fcntl
+    from tcbench.filelock import locked
 
-    db.parent.mkdir(parents=True, exist_ok=True)
-    with open(db.with_name(db.name + ".lock"), "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+    with locked(db):
+        yield
 
 
 def prepare_store(uri: str | None, experiment: str) -> str:

@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tcbench.optimisers import Optimiser, UnknownOptimiserError, available, get, register
+from tcbench.optimisers import (
+    Optimiser,
+    UnknownOptimiserError,
+    available,
+    get,
+    register,
+)
 from tcbench.optimisers.fa import FireflyAlgorithm
 from tcbench.optimisers.ifa import ImprovedFireflyAlgorithm
 

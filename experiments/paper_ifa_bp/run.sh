@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Reproduce seed 000 §3 (Tables 1-2): FA-BP and IFA-BP, 30 trainings each, BP from random
-# weights (GD and LM), the polynomial baseline, raw and the oracle, on both MSRA tasks; then
-# regenerate leaderboards/paper-ifa-bp/ and this folder's tables.
-# Usage (from the repository root, with tcbench installed): bash experiments/paper_ifa_bp/run.sh
+# Reproduce seed 000 §3 (Tables 1-2): FA-BP and IFA-BP, 30 trainings each, beside BP from random
+# weights and from PSO's and CMA-ES's search (GD and LM), the polynomial baseline, raw and the
+# oracle, on both MSRA tasks; then regenerate leaderboards/paper-ifa-bp/ and this folder's tables.
+# Usage (from the repository root, with tcbench and plugins/tcbench-peers installed):
+#   bash experiments/paper_ifa_bp/run.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 here=experiments/paper_ifa_bp
