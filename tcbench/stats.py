@@ -11,8 +11,9 @@ BOOTSTRAP_SEED = 20221  # fixed, so a leaderboard is reproducible from the same 
 def bootstrap_median_ci(
     values: np.ndarray, level: float = 0.95, n_boot: int = 2000, seed: int = BOOTSTRAP_SEED
 ) -> tuple[float, float]:
-    """Percentile-bootstrap confidence interval of the median (NaN for fewer than 2 values)."""
-    x = np.asarray(values, dtype=float)
+    """Percentile-bootstrap confidence interval of the median (NaN for fewer than 2 values); the
+    same for the same values in any order (runs come back from MLflow in the order they ran)."""
+    x = np.sort(np.asarray(values, dtype=float))
     x = x[np.isfinite(x)]
     if x.size < 2:
         return float("nan"), float("nan")

@@ -62,3 +62,9 @@ def test_leaderboard_columns_from_runs() -> None:
     assert np.isnan(table.loc["bad", "p_vs_next"])  # last row has no next
     first = table[table["rank"] == 1].iloc[0]
     assert first["p_vs_next"] == pytest.approx(first["p_vs_next"]) and 0 <= first["p_vs_next"] <= 1
+
+
+def test_bootstrap_interval_ignores_the_order_of_the_values() -> None:
+    values = np.random.default_rng(3).lognormal(size=30)
+    for seed in range(10):  # an order-dependent resampling differs on several of these
+        assert bootstrap_median_ci(values) == bootstrap_median_ci(np.random.default_rng(seed).permutation(values))
