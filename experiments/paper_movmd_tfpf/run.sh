@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Reproduce seed 001 §4 (Fig. 19): the parallel model (MOPSO-tuned VMD, sample-entropy classes,
-# TFPF, BAS-Elman on [T, dT/dt]) over 30 restarts beside its rivals and the honest baselines, on
-# the simulated 14 h, 10 Hz oven runs of gyro 0 (one to train, one to test); then regenerate
-# leaderboards/paper-movmd-tfpf/ with the comparison table and the Allan curves of every method.
-# Usage (from the repository root, with tcbench installed): bash experiments/paper_movmd_tfpf/run.sh
-# About 30 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
+# TFPF, BAS-Elman on [T, dT/dt]) over 30 restarts beside its rivals (among them CMA-ES in BAS's
+# place) and the honest baselines, on the simulated 14 h, 10 Hz oven runs of gyro 0 (one to
+# train, one to test); then regenerate leaderboards/paper-movmd-tfpf/ with the comparison table
+# and the Allan curves of every method.
+# Usage (from the repository root, with tcbench and plugins/tcbench-peers installed):
+#   bash experiments/paper_movmd_tfpf/run.sh
+# About 32 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 here=experiments/paper_movmd_tfpf
@@ -33,6 +35,7 @@ run 5 task.decomposition=emd task.denoise=wavelet learner=bp optimiser=sa "seed=
 run 6 learner=raw optimiser=none
 run 7 learner=bp optimiser=pso 'seed=range(5)'
 wait
+run 14 learner=elman optimiser=cmaes "seed=$seeds"  # CMA-ES (plugins/tcbench-peers) in BAS's place
 # the same device with 3 deg/h of flicker instead of ~33: where temperature drift, not flicker,
 # dominates the soak means, what does each method compensate?
 low=('task.effects={bias_instability:{b:8.3e-4}}')
