@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # BBOB f1-f24 through ioh: every built-in single-objective optimiser and every installed peer,
-# d = 5 (15 instances) and d = 20 (3 instances), 10^4 d evaluations (SA, dual annealing and
+# d = 5 and d = 20 (15 instances each), 10^4 d evaluations (SA, dual annealing and
 # nevergrad DE 10^3 d, NGOpt 50 d, TPE 200 trials: see README.md), IOHprofiler logs per run, then
 # the committed leaderboards/bbob/.
 # Usage (from the repository root, tcbench and plugins/tcbench-peers installed, python on PATH):
