@@ -20,7 +20,7 @@ import sqlite3
 import time
 import uuid
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from pathlib import Path
 
 from tcbench.filelock import locked
@@ -40,7 +40,7 @@ def cache_dir() -> Path:
 def _is_store(path: Path) -> bool:
     """True if ``path`` is a SQLite file holding a migrated MLflow schema."""
     try:
-        with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as con:
+        with closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True)) as con:
             return con.execute("select count(*) from alembic_version").fetchone()[0] == 1
     except sqlite3.Error:
         return False
@@ -100,11 +100,12 @@ def template_path() -> Path:
 
 
 def ensure_template() -> Path:
-    """The cached empty store, built first if missing or unreadable."""
+    """The cached empty store, built first if it or its note of where it was built is missing
+    or unreadable."""
     template = template_path()
     template.parent.mkdir(parents=True, exist_ok=True)
     with locked(template):
-        if not _is_store(template):
+        if not (_is_store(template) and template.with_suffix(".json").is_file()):
             _build(template)
     return template
 

@@ -66,12 +66,16 @@ def test_prepare_store_uses_the_template_and_leaves_no_temporary_file(workdir: P
     assert sorted(p.name for p in (workdir / "sub").iterdir()) == ["mlflow.db", "mlflow.db.lock"]
 
 
-def test_a_broken_template_is_rebuilt(workdir: Path, cache: Path) -> None:
+@pytest.mark.parametrize("damage", ["garbage", "no note"])
+def test_a_broken_template_is_rebuilt(workdir: Path, cache: Path, damage: str) -> None:
     template = store_template.ensure_template()
-    template.write_bytes(b"garbage, not SQLite")
+    if damage == "garbage":
+        template.write_bytes(b"garbage, not SQLite")
+    else:
+        template.with_suffix(".json").unlink()
     assert store_template.create_store(workdir / "a.db")
     assert _schema_and_rows(workdir / "a.db")[1]  # migrated
-    assert _schema_and_rows(template)[1]
+    assert _schema_and_rows(template)[1] and template.with_suffix(".json").is_file()
 
 
 def test_an_unusable_cache_leaves_the_store_to_mlflow(workdir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
