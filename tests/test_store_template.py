@@ -31,18 +31,17 @@ def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path / "cache"
 
 
-def test_copy_equals_the_store_mlflow_builds(workdir: Path, cache: Path, tmp_path: Path) -> None:
+def test_copy_equals_the_store_mlflow_builds(workdir: Path, cache: Path, tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
     # the template is built from another directory: the copy must still point Default at this one
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
-    import os
-
-    os.chdir(elsewhere)
+    monkeypatch.chdir(elsewhere)
     template = store_template.ensure_template()
     with sqlite3.connect(template) as con:  # as if the template were built long ago
         con.execute("update experiments set creation_time = 0, last_update_time = 0")
     con.close()
-    os.chdir(workdir)
+    monkeypatch.chdir(workdir)
     assert store_template.create_store(workdir / "copy.db")
     mlflow.MlflowClient(f"sqlite:///{workdir / 'direct.db'}").search_experiments()
     copy, direct = _schema_and_rows(workdir / "copy.db"), _schema_and_rows(workdir / "direct.db")
