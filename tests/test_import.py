@@ -229,3 +229,24 @@ def test_pan_lsm6dsm_cooling(workdir: Path, capsys: pytest.CaptureFixture[str]) 
                                       "output": "gyro_x_rads_logged:rad/s"}, drop=["spike_flag"])
     dps = read_recording("rec/pan_lsm6dsm_tvac_cooling.csv")
     np.testing.assert_allclose(logged.output, 2.0 * dps.output, rtol=1e-5)
+
+
+def test_metrics_say_when_the_allan_minimum_is_no_floor(tmp_path: Path) -> None:
+    """White rate noise alone: the Allan deviation falls to the last tau read, so the bias
+    instability is only an upper bound and the report says so; with a rate random walk the
+    curve turns up and the minimum is a floor."""
+    t = np.arange(0.0, 3600.0, 0.1)
+    rng = np.random.default_rng(5)
+    white = rng.normal(0.0, 0.05, t.size)
+    walk = white + np.cumsum(rng.normal(0.0, 0.01, t.size))
+    reports = {name: analyse(make_recording(t, np.full(t.size, 25.0), np.zeros(t.size), rate, sensor="gyro",
+                                            sample_rate_hz=10.0, device_id="w"))
+               for name, rate in (("white", white), ("walk", walk))}
+    assert reports["white"].metrics["allan_min_is_interior"] == 0.0
+    assert any("upper bound" in c for c in reports["white"].conventions)
+    assert reports["walk"].metrics["allan_min_is_interior"] == 1.0
+    assert not any("upper bound" in c for c in reports["walk"].conventions)
+    msra = analyse(make_recording(t, np.full(t.size, 25.0), np.zeros(t.size), 30000.0 + white, sensor="msra",
+                                  sample_rate_hz=10.0, device_id="m"))  # the zero-bias report
+    assert msra.metrics["allan_min_is_interior"] == 0.0
+    assert any("upper bound" in c for c in msra.conventions)

@@ -29,7 +29,13 @@ from tcbench.metrics import accelerometer as acc
 from tcbench.metrics import gyro
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
-from tcbench.signal.allan import AllanDeviation, allan_deviation, allan_deviation_segments, noise_parameters
+from tcbench.signal.allan import (
+    AllanDeviation,
+    NoiseParameters,
+    allan_deviation,
+    allan_deviation_segments,
+    noise_parameters,
+)
 
 log = logging.getLogger(__name__)
 DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G = 200.0
@@ -65,6 +71,17 @@ def _allan_lines(ad: AllanDeviation) -> dict[str, tuple[float, float, float]]:
     }
 
 
+def _floor_read(p: NoiseParameters, unit: str, scale: float) -> tuple[dict[str, float], list[str]]:
+    """Whether the Allan minimum is a floor (an interior point) as a 0/1 metric, and a warning
+    line when it is not: then the bias instability read from it is only an upper bound."""
+    metrics = {"allan_min_is_interior": float(p.min_is_interior)}
+    if p.min_is_interior or not np.isfinite(p.adev_min):
+        return metrics, []
+    return metrics, [f"Allan minimum at an end of the taus read ({p.tau_min_s:.3g} s, {p.adev_min * scale:.4g} {unit}): "
+                     "no flicker floor was seen, so the bias instability is only an upper bound; a longer "
+                     "record would show the floor"]
+
+
 def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: dict[str, Path]) -> Report:
     labels = rec.position
     pos = None if labels is None else np.where(labels == None, "", labels).astype(str)  # noqa: E711
@@ -96,6 +113,8 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
         metrics["segments"] = float(seg[-1] + 1)
     p = noise_parameters(ad)
     metrics |= {"bias_instability_ug": p.bias_instability, "scale_factor_hz_per_g": sf}
+    floor, floor_note = _floor_read(p, "µg", 1.0)
+    metrics |= floor
     if out is not None:
         files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev, _allan_lines(ad), "µg", "MSRA zero-bias Allan deviation")
     conventions = ["zero-bias stability: 1 sigma (ddof=1) of non-overlapping 10 s means of output/scale factor, "
@@ -103,7 +122,7 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
     if seg[-1] > 0:
         conventions.append(f"{seg[-1] + 1} segments (gaps > 5 median sample intervals): Allan variance within each "
                            "segment, pooled over the segments, tau up to half the median segment")
-    return Report(metrics, conventions, None, files)
+    return Report(metrics, conventions + floor_note, None, files)
 
 
 def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
@@ -111,8 +130,10 @@ def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     seg = segments(rec.time_s)
     n_seg = int(seg[-1]) + 1
     ad, metrics = gyro.allan_summary(rec.output, fs, seg if n_seg > 1 else None)
+    floor, floor_note = _floor_read(noise_parameters(ad), "°/h", 3600.0)
+    metrics |= floor
     conventions = ["ARW in deg/sqrt(h) (seed 001's 'deg/h/sqrt(Hz)' read as deg/sqrt(h)); bias instability = "
-                   "Allan minimum / 0.664 in deg/h; read-offs over tau <= T/10"]
+                   "Allan minimum / 0.664 in deg/h; read-offs over tau <= T/10", *floor_note]
     details: dict[str, Any] = {}
     if n_seg > 1:
         metrics["segments"] = float(n_seg)
