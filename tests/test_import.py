@@ -250,3 +250,21 @@ def test_metrics_say_when_the_allan_minimum_is_no_floor(tmp_path: Path) -> None:
                                   sample_rate_hz=10.0, device_id="m"))  # the zero-bias report
     assert msra.metrics["allan_min_is_interior"] == 0.0
     assert any("upper bound" in c for c in msra.conventions)
+
+
+def test_msra_zero_bias_rows_that_cannot_be_computed_are_nan_with_the_reason() -> None:
+    rng = np.random.default_rng(6)
+    short_t = np.arange(0.0, 600.0, 1.0)  # 10 min: only the zero-start row has data
+    short = analyse(make_recording(short_t, np.full(short_t.size, 25.0), np.zeros(short_t.size),
+                                   30000.0 + rng.normal(0.0, 0.01, short_t.size), sensor="msra",
+                                   sample_rate_hz=1.0, device_id="s"))
+    assert np.isfinite(short.metrics["zero_start_ug"])
+    assert np.isnan(short.metrics["after_30min_ug"]) and np.isnan(short.metrics["after_20min_ug"])
+    assert sum("not computed" in c for c in short.conventions) == 2
+    # 25 bursts of 5 s at 50 Hz: no 10 s window fits inside a burst, and none may span a gap
+    burst_t = np.concatenate([300.0 * k + np.arange(0.0, 5.0, 0.02) for k in range(25)])
+    bursts = analyse(make_recording(burst_t, np.full(burst_t.size, 25.0), np.zeros(burst_t.size),
+                                    30000.0 + rng.normal(0.0, 0.01, burst_t.size), sensor="msra",
+                                    sample_rate_hz=50.0, device_id="b"))
+    assert np.isnan(bursts.metrics["zero_start_ug"]) and bursts.metrics["segments"] == 25
+    assert np.isfinite(bursts.metrics["bias_instability_ug"])

@@ -24,6 +24,15 @@ def test_zero_bias_stability_by_hand() -> None:
         acc.zero_bias_stability_ug(t, y, 200.0, start_s=35)
 
 
+def test_zero_bias_windows_stay_inside_a_loggers_bursts() -> None:
+    # three bursts of 25 s at 1 Hz, 300 s apart: two full 10 s windows each (means 0 and 200 ug),
+    # then 5 s that make no full window and hold a wild value no window may average in
+    burst = np.concatenate([np.zeros(10), np.full(10, 200e-6 * 200), np.full(5, 1.0 * 200)])
+    y = np.tile(burst, 3)
+    t = np.concatenate([300.0 * k + np.arange(25.0) for k in range(3)])
+    assert acc.zero_bias_stability_ug(t, y, 200.0) == pytest.approx(np.std([0, 200] * 3, ddof=1))
+
+
 def test_zero_bias_table_rows() -> None:
     t = np.arange(5400.0)
     y = 0.2 * np.exp(-t / 1200.0)

@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from tcbench.sensors.segments import bounds, segments, within_rate_hz
+
 POSITION_ORDER = ("+0g", "+1g", "-0g", "-1g")
 
 
@@ -33,28 +35,39 @@ def zero_bias_stability_ug(
     window_s: float = 10.0,
 ) -> float:
     """1 sigma of non-overlapping ``window_s`` means of ``output / scale factor`` from
-    ``start_s`` on, in micro-g (``window_s`` <= one sample gives the raw-sample 1 sigma)."""
+    ``start_s`` on, in micro-g (``window_s`` <= one sample gives the raw-sample 1 sigma).
+
+    A clock with gaps (a logger's bursts, :func:`tcbench.sensors.segments.segments`) has its
+    windows taken inside each segment, so none spans a gap; a segment's last partial window is
+    left out, as is a continuous record's."""
     keep = t_s >= t_s[0] + start_s
     t, y = t_s[keep], output[keep] / scale_factor_per_g
     if t.size < 2:
         raise ValueError(f"no data after {start_s} s to compute zero-bias stability")
-    per = max(1, int(round(window_s / float(np.median(np.diff(t))))))
+    per = max(1, int(round(window_s * within_rate_hz(t))))
+    starts, stops = bounds(segments(t))
+    full = (stops - starts) // per * per  # samples in each segment's complete windows
+    if starts.size > 1:
+        position = np.arange(y.size) - np.repeat(starts, stops - starts)
+        y = y[position < np.repeat(full, stops - starts)]
+    else:
+        y = y[: full[0]]
     m = y.size // per
     if m < 2:
         raise ValueError(f"fewer than two {window_s} s windows after {start_s} s")
-    means = y[: m * per].reshape(m, per).mean(axis=1)
+    means = y.reshape(m, per).mean(axis=1)
     return float(np.std(means, ddof=1) * 1e6)
+
+
+ZERO_BIAS_STARTS_S = {"after_30min_ug": 1800.0, "after_20min_ug": 1200.0, "zero_start_ug": 0.0}
 
 
 def zero_bias_table(
     t_s: np.ndarray, output: np.ndarray, scale_factor_per_g: float, window_s: float = 10.0
 ) -> dict[str, float]:
     """Seed 000 Table 1 rows: stability after 30 min, after 20 min, and from zero start (micro-g)."""
-    return {
-        "after_30min_ug": zero_bias_stability_ug(t_s, output, scale_factor_per_g, 1800.0, window_s),
-        "after_20min_ug": zero_bias_stability_ug(t_s, output, scale_factor_per_g, 1200.0, window_s),
-        "zero_start_ug": zero_bias_stability_ug(t_s, output, scale_factor_per_g, 0.0, window_s),
-    }
+    return {row: zero_bias_stability_ug(t_s, output, scale_factor_per_g, start_s, window_s)
+            for row, start_s in ZERO_BIAS_STARTS_S.items()}
 
 
 def position_blocks(position: np.ndarray) -> pd.DataFrame:

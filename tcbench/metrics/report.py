@@ -104,7 +104,13 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
             nodes.to_csv(files["nodes"], index=False)
         return Report(metrics, conventions, nodes, files)
     sf = _scale_factor(rec, scale_factor)
-    metrics = acc.zero_bias_table(rec.time_s, rec.output, sf)
+    metrics, unstable = {}, []
+    for row, start_s in acc.ZERO_BIAS_STARTS_S.items():
+        try:
+            metrics[row] = acc.zero_bias_stability_ug(rec.time_s, rec.output, sf, start_s)
+        except ValueError as exc:  # a short record, or bursts shorter than a window: NaN, said why
+            metrics[row] = float("nan")
+            unstable.append(f"{row} not computed: {exc} (windows stay inside the clock's segments)")
     seg = segments(rec.time_s)
     if seg[-1] == 0:
         ad = allan_deviation(rec.output / sf * 1e6, rec.meta.sample_rate_hz or 1.0, "octave")
@@ -122,7 +128,7 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
     if seg[-1] > 0:
         conventions.append(f"{seg[-1] + 1} segments (gaps > 5 median sample intervals): Allan variance within each "
                            "segment, pooled over the segments, tau up to half the median segment")
-    return Report(metrics, conventions + floor_note, None, files)
+    return Report(metrics, conventions + floor_note + unstable, None, files)
 
 
 def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
