@@ -46,12 +46,9 @@ def zero_bias_stability_ug(
         raise ValueError(f"no data after {start_s} s to compute zero-bias stability")
     per = max(1, int(round(window_s * within_rate_hz(t))))
     starts, stops = bounds(segments(t))
-    full = (stops - starts) // per * per  # samples in each segment's complete windows
-    if starts.size > 1:
-        position = np.arange(y.size) - np.repeat(starts, stops - starts)
-        y = y[position < np.repeat(full, stops - starts)]
-    else:
-        y = y[: full[0]]
+    lengths = stops - starts
+    position = np.arange(y.size) - np.repeat(starts, lengths)  # index inside its segment
+    y = y[position < np.repeat(lengths // per * per, lengths)]  # complete windows only
     m = y.size // per
     if m < 2:
         raise ValueError(f"fewer than two {window_s} s windows after {start_s} s")
