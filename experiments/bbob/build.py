@@ -45,11 +45,15 @@ NAMES = {"fa": "FA", "ifa": "IFA", "ga": "GA", "pso": "PSO", "bas": "BAS", "sa":
 def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
     """One row per planned run (found or missing) with its hitting evaluations per target; and
     the planned runs that left no log."""
-    rows = {}
+    rows: dict[tuple[str, int, int, int, int], dict] = {}
     for r in read_runs(ioh_dir):
         if r.meta.suite != "BBOB":
             continue
-        key = (r.algorithm, r.meta.function_id, r.meta.dim, r.meta.instance)
+        # A run made at another budget (an earlier grid) is kept on disk but is not this plan's.
+        key = (r.algorithm, r.meta.function_id, r.meta.dim, r.meta.instance, int(r.attributes.get("budget", -1)))
+        if key in rows:
+            raise SystemExit(f"build: two runs of {key[0]} on f{key[1]} {key[2]}-D instance {key[3]} at budget "
+                             f"{key[4]} under {ioh_dir}; remove one")
         rows[key] = {
             "hits": hitting_evaluations(r.evaluations.astype(float), r.raw_y), "evals": r.evals,
             "final": float(r.best_so_far()[-1]),
@@ -60,7 +64,7 @@ def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
             budget = plan["budgets"][m][str(d)]
             for f in plan["functions"]:
                 for i in plan["instances"][str(d)]:
-                    found = rows.get((m, f, d, i))
+                    found = rows.get((m, f, d, i, budget))
                     if found is None:
                         missing.append({"method": m, "function": f, "dim": d, "instance": i})
                         found = {"hits": np.full(TARGETS.size, np.inf), "evals": budget, "final": np.inf}

@@ -31,9 +31,10 @@ METHODS = ["fa", "ifa", "ga", "pso", "bas", "sa", "cmaes", "ipop_cmaes", "scipy_
 FUNCTIONS = list(range(1, 25))
 INSTANCES = {5: list(range(1, 16)), 20: list(range(1, 16))}
 BUDGET_PER_DIM = 10_000
-# Methods slow per evaluation get a smaller budget so that the sweep fits in under two hours on
-# two cores (experiments/bbob/README.md has the timings): evaluations per dimension ...
-REDUCED_BUDGET_PER_DIM = {"sa": 1_000, "dual_annealing": 1_000, "ng_de": 1_000, "ngopt": 50}
+# Methods slow per evaluation get a smaller budget where a full one would not fit in a session on
+# two cores (experiments/bbob/README.md has the timings): evaluations per dimension, per method and
+# dimension ...
+REDUCED_BUDGET_PER_DIM = {"ng_de": {20: 1_000}, "ngopt": {5: 50, 20: 50}}
 # ... or in total, whatever the dimension (TPE's cost per trial grows with the trials so far).
 FIXED_BUDGET = {"tpe": 200}
 # Rough relative cost per run, to start the longest jobs first (balances the pool).
@@ -49,13 +50,27 @@ def parse_ints(text: str) -> list[int]:
     return out
 
 
-def budget(method: str, dim: int, overrides: dict[str, int]) -> int:
-    """Evaluations of one run of ``method`` in ``dim`` dimensions (``overrides``: per dimension)."""
-    if method in overrides:
-        return overrides[method] * dim
+def budget(method: str, dim: int, overrides: dict[tuple[str, int | None], int]) -> int:
+    """Evaluations of one run of ``method`` in ``dim`` dimensions. ``overrides`` maps
+    ``(method, dim)`` or ``(method, None)`` (every dimension) to evaluations per dimension."""
+    for key in ((method, dim), (method, None)):
+        if key in overrides:
+            return overrides[key] * dim
     if method in FIXED_BUDGET:
         return FIXED_BUDGET[method]
-    return REDUCED_BUDGET_PER_DIM.get(method, BUDGET_PER_DIM) * dim
+    return REDUCED_BUDGET_PER_DIM.get(method, {}).get(dim, BUDGET_PER_DIM) * dim
+
+
+def parse_budget(item: str) -> tuple[tuple[str, int | None], int]:
+    """``"sa=1000"`` -> ``(("sa", None), 1000)``; ``"ng_de@20=1000"`` -> ``(("ng_de", 20), 1000)``."""
+    key, sep, value = item.partition("=")
+    method, at, dim = key.partition("@")
+    if not sep or not method.strip() or (at and not dim.strip()):
+        raise ValueError(f"--budget-per-dim {item!r}: expected METHOD=N or METHOD@DIM=N")
+    n = int(value)
+    if n < 1:
+        raise ValueError(f"--budget-per-dim {item!r}: N must be >= 1")
+    return (method.strip(), int(dim) if at else None), n
 
 
 def base_configs(methods: list[str], ioh_dir: Path) -> dict[str, dict[str, Any]]:
@@ -103,9 +118,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dims", default="5,20", help="dimensions")
     ap.add_argument("--instances", action="append", default=[], metavar="DIM:LIST",
                     help="instances of a dimension, e.g. 20:1-5 (default 1-15)")
-    ap.add_argument("--budget-per-dim", action="append", default=[], metavar="METHOD=N",
-                    help=f"evaluations per dimension for a method (default {BUDGET_PER_DIM}; "
-                         f"{', '.join(f'{k} {v}' for k, v in REDUCED_BUDGET_PER_DIM.items())}; "
+    reduced = [f"{m}@{d} {n}" for m, per_dim in REDUCED_BUDGET_PER_DIM.items() for d, n in per_dim.items()]
+    ap.add_argument("--budget-per-dim", action="append", default=[], metavar="METHOD[@DIM]=N",
+                    help=f"evaluations per dimension for a method, in every dimension or in DIM only "
+                         f"(default {BUDGET_PER_DIM}; {', '.join(reduced)}; "
                          f"{', '.join(f'{k} {v} in total' for k, v in FIXED_BUDGET.items())})")
     ns = ap.parse_args(argv)
     from tcbench.config import ConfigError, validate
@@ -118,7 +134,7 @@ def main(argv: list[str] | None = None) -> int:
         for item in ns.instances:
             d, _, spec = item.partition(":")
             instances[int(d)] = parse_ints(spec)
-        overrides = {k: int(v) for k, _, v in (s.partition("=") for s in ns.budget_per_dim)}
+        overrides = dict(parse_budget(item) for item in ns.budget_per_dim)
     except ValueError as exc:
         print(f"sweep: error: {exc}", file=sys.stderr)
         return 2
