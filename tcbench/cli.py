@@ -61,7 +61,13 @@ def _run_sweep(args: list[str]) -> Plan | None:
         print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
         if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
             from tcbench import tracking
+            from tcbench.outputs import folder_problem
 
+            db = tracking.sqlite_path(checked.tracking_uri)
+            if db is not None and db.is_dir():
+                raise UserError(f"tracking store {db} is a folder, not a database file")
+            if db is not None and (problem := folder_problem(db.parent)):
+                raise UserError(f"tracking store {db}: its folder {db.parent} {problem}")
             tracking.prepare_store(checked.tracking_uri, checked.experiment)
     saved = sys.argv
     sys.argv = ["tcbench", *args]
@@ -113,6 +119,10 @@ def cmd_leaderboard(argv: list[str]) -> int:
     ns = ap.parse_args(argv)
     from tcbench import leaderboard, tracking
     from tcbench.compensation import leaderboard as comp_board
+    from tcbench.outputs import folder_problem
+
+    if problem := folder_problem(ns.out):
+        raise UserError(f"--out {ns.out}: {problem}")
 
     experiments = ns.experiment or ["tcbench"]
     client = tracking.client(ns.tracking_uri)

@@ -19,6 +19,7 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
+from tcbench.outputs import folder_problem
 from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
 
 
@@ -173,6 +174,8 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     if ioh_dir and is_compensation(name):
         raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are written for optimisation tasks, "
                           f"not for task {name}")
+    if ioh_dir and (problem := folder_problem(ioh_dir)):
+        raise ConfigError(f"tracking.ioh_dir={ioh_dir}: {problem}")
     if is_compensation(name):
         from tcbench.compensation.validate import validate_compensation
 

@@ -17,6 +17,16 @@ class CommandError(ValueError):
     """A bad argument: reported in one line."""
 
 
+def writable_folder(path: str | Path, key: str = "out") -> Path:
+    """``path`` as an output folder, checked before any work: a :class:`CommandError` naming
+    ``key`` if it cannot be made or written."""
+    from tcbench.outputs import folder_problem
+
+    if problem := folder_problem(path):
+        raise CommandError(f"{key}={path}: {problem}")
+    return Path(path)
+
+
 @dataclass
 class SimulateConfig:
     """``tcbench simulate`` arguments (``key=value``). ``protocol_params.<name>=`` overrides a
@@ -55,7 +65,7 @@ def parse(args: list[str], schema: type) -> Any:
 
 
 def simulate(args: list[str]) -> int:
-    from tcbench.sensors.recording import write_recording
+    from tcbench.sensors.recording import RecordingError, write_recording
     from tcbench.sensors.simulate import protocol_names, simulate_recording
 
     cfg: SimulateConfig = parse(args, SimulateConfig)
@@ -70,7 +80,7 @@ def simulate(args: list[str]) -> int:
         raise CommandError(f"format must be csv or parquet, got {cfg.format!r}")
     if cfg.device_seed < 0 or cfg.seed < 0:
         raise CommandError("device_seed and seed must be non-negative integers")
-    out = Path(cfg.out)
+    out = writable_folder(cfg.out)
     if fitted is not None:
         stem = cfg.name or f"{Path(str(cfg.model)).stem}-{cfg.protocol}-seed{cfg.seed}"
     else:
@@ -81,8 +91,11 @@ def simulate(args: list[str]) -> int:
                                  **cfg.protocol_params)
     except (TypeError, ValueError) as exc:
         raise CommandError(str(exc)) from None
-    out.mkdir(parents=True, exist_ok=True)
-    path = write_recording(rec, out / f"{stem}.{cfg.format}")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        path = write_recording(rec, out / f"{stem}.{cfg.format}")
+    except (RecordingError, OSError) as exc:
+        raise CommandError(f"{out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})") from None
     print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
           f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
     if cfg.metrics:
@@ -131,7 +144,7 @@ def metrics(args: list[str]) -> int:
         rec = read_recording(path)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
-    out = Path(cfg.out) if cfg.out else path.with_name(f"{path.stem}_metrics")
+    out = writable_folder(cfg.out or path.with_name(f"{path.stem}_metrics"))
     _report(path, rec, out, cfg.scale_factor_hz_per_g, cfg.tracking, {"kind": "metrics"})
     return 0
 
@@ -174,6 +187,7 @@ def import_command(args: list[str]) -> int:
     stem = cfg.name or csv.stem
     if "/" in stem or stem in {".", ".."}:
         raise CommandError(f"name must be a file name without a directory, got {stem!r}")
+    writable_folder(cfg.out)
     try:
         rec = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
                          sample_rate_hz=cfg.sample_rate_hz)

@@ -6,7 +6,7 @@ import logging
 from dataclasses import dataclass
 from pathlib import Path
 
-from tcbench.sensors_cli import CommandError, parse
+from tcbench.sensors_cli import CommandError, parse, writable_folder
 
 log = logging.getLogger(__name__)
 
@@ -36,6 +36,7 @@ def diagnose_command(args: list[str]) -> int:
         raise CommandError("recording=PATH is required")
     if cfg.sensor not in (None, "msra", "gyro"):
         raise CommandError(f"sensor must be msra or gyro, got {cfg.sensor!r}")
+    writable_folder(cfg.out)
     try:
         rec = read_recording(cfg.recording)
     except RecordingError as exc:
