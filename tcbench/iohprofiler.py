@@ -28,6 +28,7 @@ import json
 import os
 import shutil
 from collections import defaultdict
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -275,13 +276,18 @@ def read_runs(root: Path | str) -> list[IOHRun]:
 
 
 def merge(root: Path | str, out: Path | str) -> list[Path]:
-    """Gather the runs under ``root`` into ``out/<algorithm>/`` (one ``.json`` per function, one
-    ``.dat`` per dimension), ordered by dimension, instance and seed; the files written."""
+    """Gather the runs under ``root`` into ``out/<algorithm>/`` (see :func:`write_merged`)."""
+    return write_merged(read_runs(root), out)
+
+
+def write_merged(runs: Iterable[IOHRun], out: Path | str) -> list[Path]:
+    """Write ``runs`` into ``out/<algorithm>/`` (one ``.json`` per function, one ``.dat`` per
+    dimension), ordered by dimension, instance and seed; the files written."""
     by_algorithm: dict[str, list[IOHRun]] = defaultdict(list)
-    for run in read_runs(root):
+    for run in runs:
         by_algorithm[run.algorithm].append(run)
     written = []
-    for algorithm, runs in sorted(by_algorithm.items()):
-        runs.sort(key=lambda r: (r.meta.function_id, r.meta.dim, r.meta.instance, r.seed or 0))
-        written += write_runs(Path(out) / algorithm.replace(os.sep, "_"), runs)
+    for algorithm, group in sorted(by_algorithm.items()):
+        group.sort(key=lambda r: (r.meta.function_id, r.meta.dim, r.meta.instance, r.seed or 0))
+        written += write_runs(Path(out) / algorithm.replace(os.sep, "_"), group)
     return written

@@ -24,7 +24,7 @@ import numpy as np
 import pandas as pd
 
 from tcbench.ecdf import TARGETS, ecdf_curves, hitting_evaluations
-from tcbench.iohprofiler import merge, read_runs
+from tcbench.iohprofiler import IOHRun, read_runs, write_merged
 from tcbench.leaderboard import expected_running_time, markdown_table
 
 GROUPS = {
@@ -42,9 +42,10 @@ NAMES = {"fa": "FA", "ifa": "IFA", "ga": "GA", "pso": "PSO", "bas": "BAS", "sa":
          "ng_de": "DE (nevergrad)", "ngopt": "NGOpt", "tpe": "TPE"}
 
 
-def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """One row per planned run (found or missing) with its hitting evaluations per target; and
-    the planned runs that left no log."""
+def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame, list[IOHRun]]:
+    """One row per planned run (found or missing) with its hitting evaluations per target; the
+    planned runs that left no log; and the planned runs found (runs of another grid under
+    ``ioh_dir`` are left out)."""
     rows: dict[tuple[str, int, int, int, int], dict] = {}
     for r in read_runs(ioh_dir):
         if r.meta.suite != "BBOB":
@@ -56,9 +57,9 @@ def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
                              f"{key[4]} under {ioh_dir}; remove one")
         rows[key] = {
             "hits": hitting_evaluations(r.evaluations.astype(float), r.raw_y), "evals": r.evals,
-            "final": float(r.best_so_far()[-1]),
+            "final": float(r.best_so_far()[-1]), "run": r,
         }
-    planned, missing = [], []
+    planned, missing, found_runs = [], [], []
     for m in plan["methods"]:
         for d in plan["dims"]:
             budget = plan["budgets"][m][str(d)]
@@ -68,8 +69,12 @@ def runs_table(ioh_dir: Path, plan: dict) -> tuple[pd.DataFrame, pd.DataFrame]:
                     if found is None:
                         missing.append({"method": m, "function": f, "dim": d, "instance": i})
                         found = {"hits": np.full(TARGETS.size, np.inf), "evals": budget, "final": np.inf}
+                    else:
+                        found = dict(found)
+                        found_runs.append(found.pop("run"))
                     planned.append({"method": m, "function": f, "dim": d, "instance": i, "budget": budget, **found})
-    return pd.DataFrame(planned), pd.DataFrame(missing, columns=["method", "function", "dim", "instance"])
+    return (pd.DataFrame(planned), pd.DataFrame(missing, columns=["method", "function", "dim", "instance"]),
+            found_runs)
 
 
 def hit_at(runs: pd.DataFrame, target: float) -> np.ndarray:
@@ -243,7 +248,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"build: error: {plan_path} not found: run sweep.py first", file=sys.stderr)
         return 2
     plan = json.loads(plan_path.read_text())
-    runs, missing = runs_table(ns.runs / "ioh", plan)
+    runs, missing, found_runs = runs_table(ns.runs / "ioh", plan)
     funcs = per_function(runs)
     solved = solved_table(funcs, runs, missing)
     ns.out.mkdir(parents=True, exist_ok=True)
@@ -298,7 +303,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\n{standing(solved, len(plan['functions']))}\n\nwritten: {ns.out}/README.md, solved.csv, per_function.csv, "
           f"{', '.join(p.name for p in plots)}; missing runs: {len(missing)}")
     if ns.ioh_merged:
-        written = merge(ns.runs / "ioh", ns.ioh_merged)
+        written = write_merged(found_runs, ns.ioh_merged)
         print(f"IOHanalyzer folder: {ns.ioh_merged} ({len(written)} files; upload it zipped)")
     return 0
 
