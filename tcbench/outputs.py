@@ -15,7 +15,7 @@ def folder_problem(path: str | Path) -> str | None:
     which a sub-folder can be made: this is tried (an empty temporary folder, removed at once),
     since permission bits do not tell a read-only mount or a virtual file system apart, nor bind
     the superuser. Nothing is left behind."""
-    target = Path(path).expanduser()
+    target = Path(path)
     probe_in = target
     while not probe_in.exists():
         if probe_in.parent == probe_in:
