@@ -17,14 +17,19 @@ class CommandError(ValueError):
     """A bad argument: reported in one line."""
 
 
-def writable_folder(path: str | Path, key: str = "out") -> Path:
-    """``path`` as an output folder, checked before any work: a :class:`CommandError` naming
-    ``key`` if it cannot be made or written."""
+def writable_folder(path: str | Path) -> Path:
+    """``path`` (an ``out=`` argument) as an output folder, checked before any work: a
+    :class:`CommandError` if it cannot be made or written."""
     from tcbench.outputs import folder_problem
 
     if problem := folder_problem(path):
-        raise CommandError(f"{key}={path}: {problem}")
+        raise CommandError(f"out={path}: {problem}")
     return Path(path)
+
+
+def cannot_write(out: str | Path, exc: Exception) -> CommandError:
+    """The one-line error for a recording that could not be written into ``out``."""
+    return CommandError(f"{out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})")
 
 
 @dataclass
@@ -95,7 +100,7 @@ def simulate(args: list[str]) -> int:
         out.mkdir(parents=True, exist_ok=True)
         path = write_recording(rec, out / f"{stem}.{cfg.format}")
     except (RecordingError, OSError) as exc:
-        raise CommandError(f"{out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})") from None
+        raise cannot_write(out, exc) from None
     print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
           f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
     if cfg.metrics:
@@ -198,7 +203,7 @@ def import_command(args: list[str]) -> int:
     try:
         path = save(rec, cfg.out, stem)
     except (RecordingError, OSError) as exc:
-        raise CommandError(f"{cfg.out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})") from None
+        raise cannot_write(cfg.out, exc) from None
     source, seg = rec.meta.extra["source"], rec.meta.extra["segments"]
     n_drop = source["rows_dropped"]
     dropped = f", {n_drop} row{'s' * (n_drop != 1)} dropped where {' or '.join(drop)} is nonzero" if drop else ""
