@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -258,7 +259,7 @@ def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tag
                   "protocol": extra.get("protocol"), "device_seed": extra.get("device_seed"),
                   "seed": extra.get("seed"), "samples": len(rec.data)}
         handle.log_params(tracking.flatten(params))
-        handle.log_metrics({k: v for k, v in report.metrics.items() if v == v})
+        handle.log_metrics({k: v for k, v in report.metrics.items() if not math.isnan(v)})
         for file in report.files.values():
             handle.log_artifact(file)
         with tempfile.TemporaryDirectory() as tmp:

@@ -103,5 +103,5 @@ def test_gyro_allan_summary_units() -> None:
     arw_deg_sqrt_h = 0.5
     rng = np.random.default_rng(0)
     y = rng.standard_normal(200_000) * arw_deg_sqrt_h / 60 * np.sqrt(fs)
-    _, summary = gyro.allan_summary(y, fs)
+    _, _, summary = gyro.allan_summary(y, fs)
     assert summary["arw_deg_per_sqrt_h"] == pytest.approx(arw_deg_sqrt_h, rel=0.05)

@@ -66,7 +66,7 @@ def arw_at_1s(ad: AllanDeviation) -> float:
 def gyro_metrics(t_s: np.ndarray, temp_c: np.ndarray, output_dps: np.ndarray, true_rate_dps: np.ndarray,
                  fs_hz: float) -> tuple[dict[str, float], AllanDeviation]:
     """Drift, ARW, bias instability and RMS error of one output, and its Allan deviation."""
-    ad, allan = allan_summary(output_dps, fs_hz)
+    ad, _, allan = allan_summary(output_dps, fs_hz)
     values = {
         "drift_dph": residual_drift_dph(t_s, temp_c, output_dps),
         "arw_deg_per_sqrt_h": arw_at_1s(ad),

@@ -16,12 +16,18 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from tcbench.sensors.segments import bounds
-from tcbench.signal.allan import AllanDeviation, allan_deviation, allan_deviation_segments, noise_parameters
+from tcbench.signal.allan import (
+    AllanDeviation,
+    NoiseParameters,
+    allan_deviation,
+    allan_deviation_segments,
+    noise_parameters,
+)
 
 TEMPERATURE_BINS = 20  # bins of a continuous recording's temperature range
 MIN_FIT_POINTS = 3  # a line with a standard error needs three points
@@ -29,8 +35,15 @@ MIN_FIT_SPAN_C = 0.5  # ... spread over at least this much temperature
 BURST_SPAN_FRACTION = 0.1  # segments are bursts when each spans less than this of the range
 
 
-def allan_summary(output_dps: np.ndarray, fs_hz: float,
-                  segment: np.ndarray | None = None) -> tuple[AllanDeviation, dict[str, float]]:
+class AllanSummary(NamedTuple):
+    """An Allan deviation, its read-offs in the input's units and as metrics (see :func:`allan_summary`)."""
+
+    ad: AllanDeviation
+    params: NoiseParameters
+    metrics: dict[str, float]
+
+
+def allan_summary(output_dps: np.ndarray, fs_hz: float, segment: np.ndarray | None = None) -> AllanSummary:
     """Allan deviation (octave taus) and its read-offs in deg/sqrt(h), deg/h, deg/h/sqrt(h).
 
     With ``segment`` (segment number per sample) the Allan variance is taken within the
@@ -40,13 +53,13 @@ def allan_summary(output_dps: np.ndarray, fs_hz: float,
     else:
         ad = allan_deviation_segments(output_dps, fs_hz, segment)
     p = noise_parameters(ad)
-    return ad, {
+    return AllanSummary(ad, p, {
         "arw_deg_per_sqrt_h": p.angle_random_walk * 60.0,
         "bias_instability_dph": p.bias_instability * 3600.0,
         "allan_min_dph": p.adev_min * 3600.0,
         "allan_min_tau_s": p.tau_min_s,
         "rrw_dph_per_sqrt_h": p.rate_random_walk * 3600.0 * 60.0,
-    }
+    })
 
 
 def soak_mean(

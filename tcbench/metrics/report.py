@@ -30,7 +30,6 @@ from tcbench.metrics import gyro
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 from tcbench.signal.allan import (
-    AllanDeviation,
     NoiseParameters,
     allan_deviation,
     allan_deviation_segments,
@@ -62,8 +61,8 @@ def _scale_factor(rec: Recording, override: float | None) -> float:
     return DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G
 
 
-def _allan_lines(ad: AllanDeviation) -> dict[str, tuple[float, float, float]]:
-    p = noise_parameters(ad)
+def _allan_lines(p: NoiseParameters) -> dict[str, tuple[float, float, float]]:
+    """The three noise lines drawn over an Allan plot: (value at tau = 1 s, slope, tau_s = 1)."""
     return {
         "angle random walk (slope -1/2)": (p.angle_random_walk, -0.5, 1.0),
         "bias instability floor (0.664 B)": (p.adev_min, 0.0, 1.0),
@@ -122,7 +121,7 @@ def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: d
     floor, floor_note = _floor_read(p, "µg", 1.0)
     metrics |= floor
     if out is not None:
-        files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev, _allan_lines(ad), "µg", "MSRA zero-bias Allan deviation")
+        files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev, _allan_lines(p), "µg", "MSRA zero-bias Allan deviation")
     conventions = ["zero-bias stability: 1 sigma (ddof=1) of non-overlapping 10 s means of output/scale factor, "
                    "from 30 min, 20 min and 0 min after power-on (micro-g)"]
     if seg[-1] > 0:
@@ -135,8 +134,8 @@ def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     fs = rec.meta.sample_rate_hz or 1.0 / float(np.median(np.diff(rec.time_s)))
     seg = segments(rec.time_s)
     n_seg = int(seg[-1]) + 1
-    ad, metrics = gyro.allan_summary(rec.output, fs, seg if n_seg > 1 else None)
-    floor, floor_note = _floor_read(noise_parameters(ad), "°/h", 3600.0)
+    ad, p, metrics = gyro.allan_summary(rec.output, fs, seg if n_seg > 1 else None)
+    floor, floor_note = _floor_read(p, "°/h", 3600.0)
     metrics |= floor
     conventions = ["ARW in deg/sqrt(h) (seed 001's 'deg/h/sqrt(Hz)' read as deg/sqrt(h)); bias instability = "
                    "Allan minimum / 0.664 in deg/h; read-offs over tau <= T/10", *floor_note]
@@ -161,7 +160,7 @@ def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     if out is not None:
         title = "gyro Allan deviation" + (f" (within {n_seg} segments)" if n_seg > 1 else "")
         files["allan"] = plots.allan_plot(out / "allan.png", ad.tau_s, ad.adev * 3600.0,
-                                          {k: (v[0] * 3600.0, v[1], v[2]) for k, v in _allan_lines(ad).items()},
+                                          {k: (v[0] * 3600.0, v[1], v[2]) for k, v in _allan_lines(p).items()},
                                           "°/h", title)
         if fit is not None:
             files["rate_vs_temperature"] = plots.rate_temperature_plot(
