@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # BBOB f1-f24 through ioh: every built-in single-objective optimiser and every installed peer,
-# d = 5 and d = 20 (15 instances each), 10^4 d evaluations (nevergrad's DE 10^3 d in 20-D,
-# NGOpt 50 d, TPE 200 trials: see README.md), IOHprofiler logs per run, then
+# d = 5 and d = 20 (15 instances each), 10^4 d evaluations (NGOpt 50 d, TPE 200 trials:
+# see README.md), IOHprofiler logs per run, then
 # the committed leaderboards/bbob/.
 # Usage (from the repository root, tcbench and plugins/tcbench-peers installed, python on PATH):
 #   bash experiments/bbob/run.sh                 # the full sweep, TCBENCH_JOBS=2 workers

@@ -34,7 +34,7 @@ BUDGET_PER_DIM = 10_000
 # Methods slow per evaluation get a smaller budget where a full one would not fit in a session on
 # two cores (experiments/bbob/README.md has the timings): evaluations per dimension, per method and
 # dimension ...
-REDUCED_BUDGET_PER_DIM = {"ng_de": {20: 1_000}, "ngopt": {5: 50, 20: 50}}
+REDUCED_BUDGET_PER_DIM = {"ngopt": {5: 50, 20: 50}}
 # ... or in total, whatever the dimension (TPE's cost per trial grows with the trials so far).
 FIXED_BUDGET = {"tpe": 200}
 # Rough relative cost per run, to start the longest jobs first (balances the pool).
