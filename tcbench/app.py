@@ -73,33 +73,32 @@ def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
         raise ConfigError(_explain(exc)) from None
 
 
-def plugin_config_packages() -> list[str]:
-    """``pkg://`` search-path entries of installed plugins' Hydra configs (entry-point group
-    ``tcbench.configs``, each naming a package that holds e.g. ``optimiser/<name>.yaml``)."""
-    from importlib.metadata import entry_points
-
-    return [f"pkg://{ep.value}" for ep in sorted(entry_points(group="tcbench.configs"), key=lambda e: e.name)]
-
-
-def with_plugin_configs(args: list[str]) -> list[str]:
-    """The command line plus a ``hydra.searchpath`` override naming the plugins' configs."""
-    paths = plugin_config_packages()
-    if not paths or any(a.startswith(("hydra.searchpath=", "+hydra.searchpath=")) for a in args):
-        return args
-    return [*args, f"hydra.searchpath=[{','.join(paths)}]"]
-
-
-def overrides_of(args: list[str]) -> list[str]:
-    """The ``key=value`` overrides of a Hydra command line (flags and their values dropped)."""
+def _override_positions(args: list[str]) -> list[int]:
+    """Indices of the ``key=value`` (or ``~key``) overrides in a Hydra command line: not flags,
+    not the value of a flag (``-cn NAME``, ``--cfg job``, ``--info defaults``)."""
     out, skip = [], False
-    for a in args:
+    for i, a in enumerate(args):
         if skip:
             skip = False
         elif a in VALUE_FLAGS:
             skip = True
-        elif not a.startswith("-"):
-            out.append(a)
+        elif not a.startswith("-") and ("=" in a or a.startswith("~")):
+            out.append(i)
     return out
+
+
+def overrides_of(args: list[str]) -> list[str]:
+    """The ``key=value`` overrides of a Hydra command line (flags and their values dropped)."""
+    return [args[i] for i in _override_positions(args)]
+
+
+def with_overrides(args: list[str], extra: list[str]) -> list[str]:
+    """``args`` with the overrides ``extra`` placed right after the user's last override (or at
+    the end): Hydra's parser takes one run of overrides, so ``task=sphere --help x=1`` would
+    reject ``x=1`` as an unrecognised argument."""
+    positions = _override_positions(args)
+    at = positions[-1] + 1 if positions else len(args)
+    return [*args[:at], *extra, *args[at:]]
 
 
 def plan(args: list[str]) -> Plan:

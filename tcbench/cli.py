@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import uuid
 from pathlib import Path
@@ -43,68 +44,115 @@ def _fail(message: str, code: int = 2) -> int:
 
 def _run_sweep(args: list[str]) -> Plan | None:
     """Validate every job, then run them through Hydra; the plan, or None if not checked."""
-    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan, with_plugin_configs
+    from hydra.errors import HydraException
+    from omegaconf.errors import OmegaConfBaseException
+
+    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan, with_overrides
     from tcbench.config import ConfigError
 
-    if not any(a.startswith("tracking.sweep_id=") for a in args):
-        args = [*args, f"tracking.sweep_id={uuid.uuid4().hex[:12]}"]
-    args = with_plugin_configs(args)
+    info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
+    if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
+        args = with_overrides(args, [f"tracking.sweep_id={uuid.uuid4().hex[:12]}"])
     checked: Plan | None = None
     if any(a in CONFIG_SOURCE_FLAGS for a in args):
         print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)
-    elif not any(a in HYDRA_INFO_FLAGS for a in args):
+    elif not info:
         try:
             checked = plan(args)
         except ConfigError as exc:
             raise UserError(str(exc)) from None
-        n = checked.jobs
-        print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
         if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
             from tcbench import tracking
-            from tcbench.outputs import folder_problem
 
-            db = tracking.sqlite_path(checked.tracking_uri)
-            if db is not None and db.is_dir():
-                raise UserError(f"tracking store {db} is a folder, not a database file")
-            if db is not None and (problem := folder_problem(db.parent)):
-                raise UserError(f"tracking store {db}: its folder {db.parent} {problem}")
-            tracking.prepare_store(checked.tracking_uri, checked.experiment)
-    saved = sys.argv
+            try:
+                tracking.check_store(checked.tracking_uri, create=True)
+                tracking.prepare_store(checked.tracking_uri, checked.experiment)
+            except tracking.StoreError as exc:
+                raise UserError(str(exc)) from None
+            if checked.resume and (dead := tracking.mark_dead_runs(checked.tracking_uri, checked.experiment,
+                                                                   checked.sweep_id)):
+                print(f"tcbench: {dead} run{'s' * (dead != 1)} of sweep {checked.sweep_id} left RUNNING by a "
+                      "process that is gone marked KILLED; their jobs run again", file=sys.stderr)
+        n = checked.jobs
+        print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
+    saved, full_error = sys.argv, os.environ.get("HYDRA_FULL_ERROR")
     sys.argv = ["tcbench", *args]
+    os.environ["HYDRA_FULL_ERROR"] = "1"  # Hydra's errors reach us whole instead of as its traceback
     try:
         hydra_main()
+    except OSError as exc:  # a job folder or Hydra's own files cannot be written (a full disk)
+        where = f" {exc.filename}" if exc.filename else ""
+        raise UserError(f"cannot write{where} ({exc.strerror or exc}); nothing more was run") from None
+    except (HydraException, OmegaConfBaseException, ValueError) as exc:  # usage: "Only one of --run, --cfg ..."
+        raise UserError(str(exc).strip().splitlines()[0]) from None
     finally:
         sys.argv = saved
+        if full_error is None:
+            os.environ.pop("HYDRA_FULL_ERROR", None)
+        else:
+            os.environ["HYDRA_FULL_ERROR"] = full_error
     return checked
 
 
 def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | None = None) -> int:
-    """Print how many runs of a sweep finished and failed; 1 if any failed or, when
-    ``expected`` is given, if fewer runs than jobs were recorded."""
+    """Print how the jobs of a sweep ended (the latest run of each job: a resumed sweep's re-run
+    replaces the attempt it repeats); 1 if any job's latest run did not finish or, when
+    ``expected`` is given, if fewer jobs than planned left a run."""
     from tcbench import leaderboard, tracking
 
+    tracking.mark_dead_runs(uri, experiment, sweep, frozenset({os.getpid()}))
     runs = leaderboard.sweep_runs(tracking.client(uri), [experiment], sweep)
-    failed = runs[runs["status"] != "FINISHED"]
+    latest = leaderboard.one_run_per_job(runs)
+    failed = latest[latest["status"] != "FINISHED"]
     running = int((failed["status"] == "RUNNING").sum())
+    repeated = len(runs) - len(latest)
     print(
-        f"tcbench: {len(runs)} run{'s' if len(runs) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
-        f"(experiment {experiment!r}, sweep {sweep}): {len(runs) - len(failed)} finished, "
-        f"{len(failed)} failed" + (f" ({running} still RUNNING: another process on this sweep id, or "
-                                   "killed without a trace)" if running else ""),
+        f"tcbench: {len(latest)} job{'s' if len(latest) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
+        f"(experiment {experiment!r}, sweep {sweep}): {len(latest) - len(failed)} finished, "
+        f"{len(failed)} failed" + (f" ({running} still RUNNING in another live process or on another host)"
+                                   if running else "")
+        + (f"; {repeated} earlier attempt{'s' * (repeated != 1)} replaced by a re-run" if repeated else ""),
     )
     for r in failed.itertuples():
-        print(f"  {r.status} {r.method} on {r.task} seed {r.seed}: {r.error_message}")
-    missing = (expected - len(runs)) if expected is not None else 0
+        print(f"  {r.status} {r.method} on {r.task} seed {r.seed}: {_first_line(r.error_message)}")
+    missing = (expected - len(latest)) if expected is not None else 0
     if missing > 0:
+        from tcbench.job import FAILURES
+
         print(f"  {missing} job{'s' if missing != 1 else ''} left no run in MLflow "
               f"(skipped by resume, or the tracking store failed: see the job logs)")
+        for error in dict.fromkeys(_first_line(f.error) for f in FAILURES):
+            print(f"  a job's error: {error}")
     return 1 if len(failed) or missing > 0 else 0
 
 
-def cmd_run(args: list[str]) -> int:
-    checked = _run_sweep(args)
-    if checked is None or not checked.tracking_enabled:
+def _first_line(text: str) -> str:
+    from tcbench.job import error_line
+
+    return error_line(text)
+
+
+def _failures_report(jobs: int) -> int:
+    """Untracked jobs: print the failures this process saw; 1 if any."""
+    from tcbench.job import FAILURES
+
+    if not FAILURES:
         return 0
+    print(f"tcbench: {len(FAILURES)} of {jobs} job{'s' * (jobs != 1)} failed (tracking off: nothing recorded)")
+    for f in FAILURES:
+        print(f"  FAILED {f.name}: {f.error}")
+    return 1
+
+
+def cmd_run(args: list[str]) -> int:
+    from tcbench.job import FAILURES
+
+    FAILURES.clear()  # this command's jobs only
+    checked = _run_sweep(args)
+    if checked is None:
+        return 1 if FAILURES else 0
+    if not checked.tracking_enabled:
+        return _failures_report(checked.jobs)
     expected = None if checked.resume else checked.jobs
     return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri, expected)
 
@@ -125,7 +173,10 @@ def cmd_leaderboard(argv: list[str]) -> int:
         raise UserError(f"--out {ns.out}: {problem}")
 
     experiments = ns.experiment or ["tcbench"]
-    client = tracking.client(ns.tracking_uri)
+    try:
+        client = tracking.client(tracking.check_store(ns.tracking_uri, create=False))
+    except tracking.StoreError as exc:
+        raise UserError(str(exc)) from None
     try:
         runs = leaderboard.load_runs(client, experiments, ns.sweep)
         comp = comp_board.load_runs(client, experiments, ns.sweep)

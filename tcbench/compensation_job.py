@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import logging
 import tempfile
-import traceback
 from pathlib import Path
 from typing import Any
 
@@ -123,8 +122,15 @@ def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:
     return files
 
 
+def compensation_job_name(c: dict[str, Any]) -> str:
+    """``<method>-<task key>-s<seed>`` of a compensation job, as its MLflow run is named."""
+    learner = learner_of(c)
+    return f"{compensation_label(learner, c['optimiser'], c['task'])}-{compensation_task_key(c['task'])}-s{c['seed']}"
+
+
 def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
-    """Run one compensation job; tracked jobs that raise are recorded FAILED and return None."""
+    """Run one compensation job (None when resume skips it); what it raises, tracked jobs
+    record as FAILED before it propagates (:func:`tcbench.job.run_job` reports it)."""
     learner = learner_of(c)
     c = {**c, "learner": learner}  # the default learner made explicit, so it is logged and hashed
     optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
@@ -149,45 +155,40 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
         "tcbench.seed": str(c["seed"]), "tcbench.task_name": str(c["task"]["name"]),
         "tcbench.kind": "compensation",
     }
-    try:
-        with tracking.job_run(c, name, tags) as run:
-            validate(c)
-            result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
-            summary = result.score.summary()
-            primary = PRIMARY[result.score.protocol]
-            tuned = {"vmd_k": float(result.tuning.k), "vmd_alpha": result.tuning.alpha,
-                     "seconds_tuning": result.tuning.seconds} if result.tuning else {}
-            values = summary | tuned | {
-                "final_error": summary[primary], "search_evaluations": result.search_evaluations,
-                "init_loss": result.init_loss, "seconds_search": result.seconds_search,
-                "seconds_train": result.seconds_train,
-            }
-            run.log_metrics({k: v for k, v in values.items() if not np.isnan(v)})
-            if result.trace.evaluations:
-                run.log_series("init_best_f", result.trace.best_f, result.trace.evaluations)
-            loss = result.history.loss if result.history else None
-            if loss:
-                run.log_series("train_loss", loss, list(range(len(loss))))
-            with tempfile.TemporaryDirectory() as tmp:
-                where = Path(tmp)
-                (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))
-                (where / "scores.json").write_text(json.dumps(score_document(result.score), indent=2))
-                files = [where / "config.yaml", where / "scores.json"]
-                for i, r in enumerate(result.score.recordings, start=1):
-                    if r.nodes_after is not None:
-                        nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
-                        nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
-                        files.append(where / f"nodes_test{i}.csv")
-                files += gyro_tables(result, where)
-                if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
-                    files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}",
-                                     result.tuning)
-                for f in files:
-                    run.log_artifact(f)
-    except Exception as exc:  # recorded as FAILED by job_run; the sweep goes on
-        log.error("job %s failed: %s: %s", name, type(exc).__name__, exc)
-        log.debug("%s", traceback.format_exc())
-        return None
+    with tracking.job_run(c, name, tags) as run:
+        validate(c)
+        result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
+        summary = result.score.summary()
+        primary = PRIMARY[result.score.protocol]
+        tuned = {"vmd_k": float(result.tuning.k), "vmd_alpha": result.tuning.alpha,
+                 "seconds_tuning": result.tuning.seconds} if result.tuning else {}
+        values = summary | tuned | {
+            "final_error": summary[primary], "search_evaluations": result.search_evaluations,
+            "init_loss": result.init_loss, "seconds_search": result.seconds_search,
+            "seconds_train": result.seconds_train,
+        }
+        run.log_metrics({k: v for k, v in values.items() if not np.isnan(v)})
+        if result.trace.evaluations:
+            run.log_series("init_best_f", result.trace.best_f, result.trace.evaluations)
+        loss = result.history.loss if result.history else None
+        if loss:
+            run.log_series("train_loss", loss, list(range(len(loss))))
+        with tempfile.TemporaryDirectory() as tmp:
+            where = Path(tmp)
+            (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))
+            (where / "scores.json").write_text(json.dumps(score_document(result.score), indent=2))
+            files = [where / "config.yaml", where / "scores.json"]
+            for i, r in enumerate(result.score.recordings, start=1):
+                if r.nodes_after is not None:
+                    nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
+                    nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
+                    files.append(where / f"nodes_test{i}.csv")
+            files += gyro_tables(result, where)
+            if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
+                files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}",
+                                 result.tuning)
+            for f in files:
+                run.log_artifact(f)
     s = result.score.summary()
     log.info("%s: %s %.4g (raw %.4g), %s %.3g", name, primary, s[primary], s[f"raw_{primary}"],
              result.score.train_key, s[result.score.train_key])

@@ -167,6 +167,9 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise ConfigError(f"seed must be >= 0, got {c['seed']}")
     if c["budget"] < 1:
         raise ConfigError(f"budget must be a positive number of evaluations, got {c['budget']}")
+    track = c.get("tracking") or {}
+    if track.get("enabled", True) and not str(track.get("experiment") or "").strip():
+        raise ConfigError("tracking.experiment: give the MLflow experiment a name (default: tcbench)")
     name = str(c["task"].get("name"))
     ioh_dir = c.get("tracking", {}).get("ioh_dir")
     if ioh_dir is not None and not str(ioh_dir).strip():
@@ -194,16 +197,43 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
             from tcbench.tasks.bbob_env import BBOBEnv
 
             task = {k: v for k, v in checked_task(c["task"], BBOBTaskConfig).items() if k != "name"}
+            check_job_memory(c, task["dim"])
             env = BBOBEnv(budget=c["budget"], **task)
         else:
             task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
+            check_job_memory(c, task["dim"])
             env = task_class(name)(function=name, budget=c["budget"], **task)
+    except ConfigError:
+        raise
     except (KeyError, ValueError) as exc:
         raise ConfigError(f"task: {exc}") from None
     if ioh_dir and getattr(env, "n_objectives", 1) > 1:
         raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are for one objective; task {name} has "
                           f"{env.n_objectives}")
     check_optimiser(c, env, name)
+
+
+def check_job_memory(c: dict[str, Any], dim: Any) -> None:
+    """Refuse a job whose optimiser's own estimate (:meth:`Optimiser.memory_bytes`) in ``dim``
+    dimensions exceeds what one job may use here (:func:`tcbench.memory.job_budget_bytes`),
+    before the task or the optimiser allocates anything."""
+    from tcbench.memory import ENV, human, job_budget_bytes
+
+    opt = {k: v for k, v in c["optimiser"].items() if k not in {"name", "label"}}
+    name = str(c["optimiser"].get("name"))
+    try:
+        cls = registry.get(name)
+        need = cls.memory_bytes(make_params(cls, opt), int(dim))
+    except (registry.UnknownOptimiserError, TypeError, ValueError):
+        return  # check_optimiser and the task name what is wrong
+    try:
+        budget = job_budget_bytes()
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    if budget is not None and need > budget:
+        raise ConfigError(f"task.dim={dim}: a run of optimiser {name} would need about {human(need)}, more than "
+                          f"the {human(budget)} one job may use here (free memory, or ${ENV}); lower task.dim "
+                          "or the population")
 
 
 def check_optimiser(c: dict[str, Any], env: Any, task_name: str) -> None:

@@ -5,8 +5,10 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import re
 import tempfile
 import traceback
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -84,13 +86,75 @@ def ioh_folder(c: dict[str, Any]) -> Path | None:
     return Path(root) / method_label(c["optimiser"]) / f"{task_key(c['task'])}-s{c['seed']}-{digest}"
 
 
-def run_job(cfg: Any) -> RunResult | None:
-    """Run one configured job. Tracked jobs that raise are recorded FAILED and return None."""
-    c = as_dict(cfg)
-    if is_compensation(str(c["task"].get("name"))):
-        from tcbench.compensation_job import run_compensation_job
+@dataclass(frozen=True)
+class JobFailure:
+    """A job that raised (or called ``sys.exit``): its name and the error, one line."""
 
-        return run_compensation_job(c)  # type: ignore[return-value]
+    name: str
+    error: str
+
+
+# The failures of the jobs run in this process (and, in a sweep's parent, those its workers
+# reported): ``tcbench run`` lists them when no tracking store records them.
+FAILURES: list[JobFailure] = []
+
+
+def error_line(text: str) -> str:
+    """One line of an error's text: the first, or where a database names its error (SQLAlchemy
+    puts "(sqlite3.OperationalError) database or disk is full" below a line about autoflush)."""
+    lines = [ln.strip() for ln in str(text).strip().splitlines() if ln.strip()] or [""]
+    named = next((ln for ln in lines if re.match(r"\(\w+(\.\w+)*(Error|Exception)\)", ln)), None)
+    if named is None:
+        return lines[0]
+    prefix = lines[0].split(":", 1)[0] + ": " if ":" in lines[0] else ""
+    return prefix + named
+
+
+def failed(name: str, exc: BaseException) -> JobFailure:
+    """Log and remember a job's failure; the sweep goes on."""
+    error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+    if isinstance(exc, MemoryError):
+        from tcbench.memory import ENV
+
+        error += f" (more than one job may use here: the memory free when it started, or ${ENV})"
+    failure = JobFailure(name, error_line(error))
+    log.error("job %s failed: %s", name, failure.error)
+    log.debug("%s", traceback.format_exc())
+    FAILURES.append(failure)
+    return failure
+
+
+def job_name(c: dict[str, Any]) -> str:
+    """``<method>-<task key>-s<seed>`` of a job, as its MLflow run is named."""
+    try:
+        if is_compensation(str(c["task"].get("name"))):
+            from tcbench.compensation_job import compensation_job_name
+
+            return compensation_job_name(c)
+        return f"{method_label(c['optimiser'])}-{task_key(c['task'])}-s{c['seed']}"
+    except Exception:  # noqa: BLE001 - a config too broken to name: its failure still needs a name
+        return f"job-s{c.get('seed')}"
+
+
+def run_job(cfg: Any) -> RunResult | JobFailure | None:
+    """Run one configured job: its result, None when resume skipped it, or a :class:`JobFailure`
+    when it raised or called ``sys.exit`` (recorded FAILED when tracked); never raises but for
+    ``KeyboardInterrupt``."""
+    from tcbench import memory
+
+    c = as_dict(cfg)
+    try:
+        with memory.limited(memory.job_budget_bytes()):
+            if is_compensation(str(c["task"].get("name"))):
+                from tcbench.compensation_job import run_compensation_job
+
+                return run_compensation_job(c)  # type: ignore[return-value]
+            return _run_optimisation_job(c)
+    except (Exception, SystemExit) as exc:  # recorded as FAILED by job_run when tracked
+        return failed(job_name(c), exc)
+
+
+def _run_optimisation_job(c: dict[str, Any]) -> RunResult | None:
     optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
     ioh = {"ioh_folder": ioh_folder(c), "algorithm": method_label(c["optimiser"])}
     if not c["tracking"]["enabled"]:
@@ -114,40 +178,35 @@ def run_job(cfg: Any) -> RunResult | None:
         "tcbench.task_name": str(c["task"]["name"]),
         "tcbench.kind": "optimisation",
     }
-    try:
-        with tracking.job_run(c, f"{method}-{tkey}-s{c['seed']}", tags) as run:
-            validate(c)
-            result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"], **ioh)
-            t = result.trace
-            multi = result.n_objectives > 1
-            run.log_series("hv_gap" if multi else "best_f", t.best_f, t.evaluations)
-            run.log_series("igd" if multi else "pop_mean_f", t.mean_f, t.evaluations)
-            run.log_series("generation", [float(g) for g in t.generation], t.evaluations)
-            run.log_metrics(result_metrics(result) | {"f_opt": result.f_opt})
-            with tempfile.TemporaryDirectory() as tmp:
-                cfg_path = Path(tmp) / "config.yaml"
-                cfg_path.write_text(yaml.safe_dump(c, sort_keys=False))
-                run.log_artifact(cfg_path)
-                if multi:
-                    front = Path(tmp) / "front.csv"
-                    np.savetxt(front, result.front_f, delimiter=",", header=",".join(
-                        f"f{i + 1}" for i in range(result.n_objectives)), comments="")
-                    run.log_artifact(front)
-                if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
-                    from tcbench import plots  # matplotlib only when a run draws
+    with tracking.job_run(c, f"{method}-{tkey}-s{c['seed']}", tags) as run:
+        validate(c)
+        result = run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"], **ioh)
+        t = result.trace
+        multi = result.n_objectives > 1
+        run.log_series("hv_gap" if multi else "best_f", t.best_f, t.evaluations)
+        run.log_series("igd" if multi else "pop_mean_f", t.mean_f, t.evaluations)
+        run.log_series("generation", [float(g) for g in t.generation], t.evaluations)
+        run.log_metrics(result_metrics(result) | {"f_opt": result.f_opt})
+        with tempfile.TemporaryDirectory() as tmp:
+            cfg_path = Path(tmp) / "config.yaml"
+            cfg_path.write_text(yaml.safe_dump(c, sort_keys=False))
+            run.log_artifact(cfg_path)
+            if multi:
+                front = Path(tmp) / "front.csv"
+                np.savetxt(front, result.front_f, delimiter=",", header=",".join(
+                    f"f{i + 1}" for i in range(result.n_objectives)), comments="")
+                run.log_artifact(front)
+            if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
+                from tcbench import plots  # matplotlib only when a run draws
 
-                    png = plots.run_convergence(
-                        Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
-                        result.f_opt, f"{method} on {tkey}, seed {c['seed']}",
-                        labels=("hypervolume gap 1 - HV/HV*", "IGD") if multi else None,
-                    )
-                    run.log_artifact(png)
-                if result.nonfinite:
-                    run.set_tag("tcbench.warning", f"{result.nonfinite} NaN/inf evaluations")
-    except Exception as exc:  # recorded as FAILED by job_run; the sweep goes on
-        log.error("job %s failed: %s: %s", f"{method}-{tkey}-s{c['seed']}", type(exc).__name__, exc)
-        log.debug("%s", traceback.format_exc())
-        return None
+                png = plots.run_convergence(
+                    Path(tmp) / "convergence.png", t.evaluations, t.best_f, t.mean_f,
+                    result.f_opt, f"{method} on {tkey}, seed {c['seed']}",
+                    labels=("hypervolume gap 1 - HV/HV*", "IGD") if multi else None,
+                )
+                run.log_artifact(png)
+            if result.nonfinite:
+                run.set_tag("tcbench.warning", f"{result.nonfinite} NaN/inf evaluations")
     log.info(
         "%s on %s seed %d: best %.6g (error %.3g) after %d evaluations",
         method, tkey, c["seed"], result.best_f, result.error, result.evaluations,

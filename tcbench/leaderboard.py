@@ -5,7 +5,10 @@ the final error (best - optimum),
 success rate at the task's target precision, expected running time (ERT) to that target, and a
 rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
 and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
-Rank orders methods by success rate (higher first), then ERT, then median final error.
+Rank orders methods by success rate (higher first), then ERT, then median final error with a
+failed run counted as infinitely bad (a failed run is a failure to reach the target: it counts
+in the success rate, in ERT at its full budget, and in the rank; ``median_error`` and its
+interval are over the finished runs, ``failed`` says how many did not finish).
 ``ci95_low``/``ci95_high``: percentile-bootstrap 95 % interval of the median error over seeds;
 ``p_vs_next``: two-sided Wilcoxon signed-rank p-value of the final errors of this method and
 the next-ranked one, paired by seed (and BBOB instance; finished runs both have; NaN below 6
@@ -22,7 +25,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from tcbench.stats import bootstrap_median_ci, paired_p_value
+from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
 COLUMNS = [
     "rank", "method", "seeds", "failed", "median_best", "median_error", "ci95_low", "ci95_high",
@@ -67,11 +70,13 @@ def search_runs(client, experiments: list[str], kind: str, sweep: str | None = N
 def sweep_runs(client, experiments: list[str], sweep: str) -> pd.DataFrame:  # type: ignore[no-untyped-def]
     """Status, method, task, seed and error of every run of one sweep, optimisation and
     compensation alike (what the end-of-sweep report needs, without either board's columns)."""
+    columns = ["status", "method", "task", "seed", "config_hash", "start_time", "error_message"]
     rows = [{"status": r.info.status, "method": t.get("tcbench.method"), "task": t.get("tcbench.task"),
-             "seed": int(t.get("tcbench.seed", -1)), "error_message": t.get("tcbench.error", "")}
+             "seed": int(t.get("tcbench.seed", -1)), "config_hash": t.get("tcbench.config_hash"),
+             "start_time": r.info.start_time, "error_message": t.get("tcbench.error", "")}
             for kind in ("optimisation", "compensation")
             for r in search_runs(client, experiments, kind, sweep) for t in (r.data.tags,)]
-    return pd.DataFrame(rows, columns=["status", "method", "task", "seed", "error_message"])
+    return pd.DataFrame(rows, columns=columns)
 
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -139,13 +144,14 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
             "median_evals": float(np.median(evals)),
             "median_hv": float(np.median(g.loc[ok, "hypervolume"])) if "hypervolume" in g and ok.any() else np.nan,
             "median_igd": float(np.median(g.loc[ok, "igd"])) if "igd" in g and ok.any() else np.nan,
+            "_rank_error": median_counting_failures(err, int((~ok).sum())),
         })
     table = pd.DataFrame(rows)
     columns = MO_COLUMNS if is_multiobjective(runs) else COLUMNS
     if table.empty:
         return pd.DataFrame(columns=columns)
     table = table.sort_values(
-        ["success_rate", "ert_evals", "median_error"], ascending=[False, True, True],
+        ["success_rate", "ert_evals", "_rank_error", "median_error"], ascending=[False, True, True, True],
         na_position="last",
     ).reset_index(drop=True)
     table.insert(0, "rank", np.arange(1, len(table) + 1))

@@ -24,6 +24,13 @@ def bootstrap_median_ci(
     return float(low), float(high)
 
 
+def median_counting_failures(values: np.ndarray, failed: int) -> float:
+    """Median of ``values`` with ``failed`` more runs counted as infinitely bad: a method that
+    crashed on most seeds cannot rank on the few it finished (NaN when there are no runs)."""
+    x = np.concatenate([np.asarray(values, dtype=float), np.full(int(failed), np.inf)])
+    return float(np.median(x)) if x.size else float("nan")
+
+
 def paired_p_value(a: pd.Series, b: pd.Series) -> float:
     """Two-sided Wilcoxon signed-rank p-value of ``a - b`` over the seeds (index) both have.
 

@@ -11,9 +11,11 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import logging
 import os
+import socket
 import subprocess
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -21,12 +23,16 @@ from typing import Any
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
 
 import mlflow  # noqa: E402
-from mlflow.entities import Metric, Param, RunStatus, RunTag  # noqa: E402
+from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 import tcbench  # noqa: E402
 
 TAG_PREFIX = "tcbench."
+log = logging.getLogger(__name__)
+# MLflow logs every failed database call with its whole traceback before raising it; tcbench
+# reports the error it raises in one line (the run FAILED with it, or the command's error).
+logging.getLogger("mlflow.store.db.utils").setLevel(logging.CRITICAL)
 _BATCH = 1000
 
 
@@ -84,16 +90,90 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
         yield
 
 
+class StoreError(Exception):
+    """The tracking store cannot be used: one line saying why."""
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(getattr(exc, "orig", None) or exc).strip()
+    return text.splitlines()[0][:300] if text else type(exc).__name__
+
+
+def _http_problem(uri: str, timeout_s: float) -> str | None:
+    """Why the MLflow server at ``uri`` cannot be used, asked once with a short timeout (MLflow's
+    own client retries a dead server for minutes), or None."""
+    import urllib.error
+    import urllib.request
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(uri)
+    if not parts.hostname:
+        return "no host in the address"
+    try:
+        port = parts.port or (443 if parts.scheme == "https" else 80)
+        with socket.create_connection((parts.hostname, port), timeout=timeout_s):
+            pass
+    except (OSError, ValueError) as exc:
+        return f"nothing answers at {parts.netloc} ({getattr(exc, 'strerror', None) or exc})"
+    probe = uri.rstrip("/") + "/api/2.0/mlflow/experiments/search?max_results=1"
+    try:
+        with urllib.request.urlopen(probe, timeout=timeout_s) as reply:  # noqa: S310 - http(s) only
+            json.loads(reply.read(1 << 20) or b"{}")
+    except urllib.error.HTTPError as exc:
+        if exc.code in (401, 403):
+            return None  # a server that wants credentials: MLflow's client sends them
+        return f"does not answer as an MLflow server (HTTP {exc.code} for {probe})"
+    except (OSError, ValueError) as exc:
+        return f"does not answer as an MLflow server ({getattr(exc, 'reason', None) or exc})"
+    return None
+
+
+def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str:
+    """The resolved store URI if the store can be used, checked once and quickly; else a
+    :class:`StoreError` with one line. ``create=False`` (reading, e.g. a leaderboard) refuses a
+    local store that does not exist instead of making an empty one."""
+    resolved = tracking_uri(uri)
+    db = sqlite_path(resolved)
+    if db is not None:
+        if db.is_dir():
+            raise StoreError(f"tracking store {db} is a folder, not a database file")
+        if not create and not db.exists():
+            raise StoreError(f"no tracking store at {db}: run a sweep here first, or name the store "
+                             "(MLFLOW_TRACKING_URI, tracking.uri=, --tracking-uri)")
+        from tcbench.outputs import folder_problem
+
+        if create and (problem := folder_problem(db.parent)):
+            raise StoreError(f"tracking store {db}: its folder {db.parent} {problem}")
+        return resolved
+    if resolved.startswith(("http://", "https://")):
+        problem = _http_problem(resolved, timeout_s)
+    else:
+        try:
+            MlflowClient(tracking_uri=resolved).search_experiments(max_results=1)
+            problem = None
+        except Exception as exc:  # noqa: BLE001 - any failure of an unknown store is the user's to fix
+            problem = _first_line(exc)
+    if problem:
+        raise StoreError(f"tracking store {resolved}: {problem}")
+    return resolved
+
+
 def prepare_store(uri: str | None, experiment: str) -> str:
     """Create or upgrade the store and the experiment once, under :func:`store_lock`, before any
-    job of a sweep starts; the experiment's id."""
+    job of a sweep starts; the experiment's id. A :class:`StoreError` if that fails."""
     db = sqlite_path(uri)
-    with store_lock(uri):
-        if db is not None and (not db.exists() or db.stat().st_size == 0):
-            from tcbench.store_template import create_store
+    new = db is not None and not db.exists()
+    try:
+        with store_lock(uri):
+            if db is not None and (not db.exists() or db.stat().st_size == 0):
+                from tcbench.store_template import create_store
 
-            create_store(db)  # a copy of a migrated empty store; MLflow builds it if this fails
-        return experiment_id(client(uri), experiment)
+                create_store(db)  # a copy of a migrated empty store; MLflow builds it if this fails
+            return experiment_id(client(uri), experiment)
+    except Exception as exc:  # noqa: BLE001 - a full disk, a locked or corrupt database, a refused login
+        if new and db is not None:  # a store this call began is not left half-made
+            db.unlink(missing_ok=True)
+        raise StoreError(f"tracking store {tracking_uri(uri)}: cannot be prepared ({_first_line(exc)})") from exc
 
 
 def flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
@@ -189,12 +269,45 @@ def _experiment_id(uri: str, name: str) -> str:
     return experiment_id(client(uri), name)
 
 
+# Called with the id of every job run this process creates (a sweep's worker tells its parent,
+# which can then mark the run FAILED if the worker dies).
+on_run_created: Callable[[str], None] | None = None
+
+
+def _host() -> str:
+    return socket.gethostname()
+
+
+def process_alive(pid: int) -> bool:
+    """Whether a process ``pid`` exists on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def mark_failed(c: MlflowClient, run_id: str, error: str, status: str = "FAILED") -> bool:
+    """Mark a run ended with ``status`` and ``error`` as its ``tcbench.error`` tag; False (and one
+    logged line) if the store cannot be written."""
+    try:
+        c.set_tag(run_id, f"{TAG_PREFIX}error", error[:4900])
+        c.set_terminated(run_id, status=status)
+    except Exception as exc:  # noqa: BLE001 - a full disk or a dead server: say so, do not mask the job's error
+        log.error("run %s could not be marked %s in %s: %s", run_id, status, c.tracking_uri, _first_line(exc))
+        return False
+    return True
+
+
 @contextmanager
 def job_run(
     cfg: Mapping[str, Any], run_name: str, tags: Mapping[str, str]
 ) -> Iterator[JobRun]:
-    """Open a run for one job; mark it FAILED (with the error as a tag) if the body raises.
-    What the body logs is sent when it ends (:meth:`JobRun.flush`)."""
+    """Open a run for one job; mark it FAILED (with the error as a tag) if the body, or sending
+    what it logged, raises. The run carries the host and process id that ran it, so a run left
+    RUNNING by a killed process can be told from one still running (:func:`mark_dead_runs`)."""
     track = cfg["tracking"]
     uri = tracking_uri(track.get("uri"))
     c = client(uri)
@@ -203,17 +316,47 @@ def job_run(
         f"{TAG_PREFIX}version": tcbench.__version__,
         f"{TAG_PREFIX}git_commit": git_commit(),
         f"{TAG_PREFIX}config_hash": config_hash(cfg),
+        f"{TAG_PREFIX}host": _host(),
+        f"{TAG_PREFIX}pid": str(os.getpid()),
         **tags,
     }
     run = c.create_run(exp, run_name=run_name, tags=all_tags)
-    handle = JobRun(c, run.info.run_id)
+    run_id = run.info.run_id
+    if on_run_created is not None:
+        on_run_created(run_id)
+    handle = JobRun(c, run_id)
     handle.log_params(flatten(cfg))
     try:
         yield handle
-    except BaseException as exc:
-        handle.set_tag(f"{TAG_PREFIX}error", f"{type(exc).__name__}: {exc}"[:4900])
         handle.flush()
-        c.set_terminated(run.info.run_id, status=RunStatus.to_string(RunStatus.FAILED))
+    except BaseException as exc:
+        error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        try:
+            handle.flush()
+        except Exception:  # noqa: BLE001 - what the job logged is lost; its failure is still recorded below
+            log.debug("params and metrics of run %s could not be sent", run_id)
+        mark_failed(c, run_id, error)
         raise
-    handle.flush()
-    c.set_terminated(run.info.run_id, status="FINISHED")
+    c.set_terminated(run_id, status="FINISHED")
+
+
+def mark_dead_runs(uri: str | None, experiment: str, sweep_id: str, ended_pids: frozenset[int] = frozenset()) -> int:
+    """Mark ``KILLED`` every RUNNING run of a sweep whose process is gone: it ran on this host and
+    its process no longer exists, or is one of ``ended_pids`` (this process, after its jobs
+    ended). Runs of other hosts, or of live processes, are left alone. The number marked."""
+    c = client(uri)
+    exp = c.get_experiment_by_name(experiment)
+    if exp is None:
+        return 0
+    query = f"tags.`{TAG_PREFIX}sweep_id` = '{sweep_id}' and attributes.status = 'RUNNING'"
+    host, marked = _host(), 0
+    for run in c.search_runs([exp.experiment_id], filter_string=query, max_results=10000):
+        tags = run.data.tags
+        pid = tags.get(f"{TAG_PREFIX}pid", "")
+        if tags.get(f"{TAG_PREFIX}host") != host or not pid.isdigit():
+            continue
+        if int(pid) in ended_pids or not process_alive(int(pid)):
+            how = "ended without marking it" if int(pid) in ended_pids else "killed"
+            marked += mark_failed(c, run.info.run_id, f"process {pid} on {host} {how} (found RUNNING)",
+                                  status="KILLED")
+    return marked

@@ -47,7 +47,7 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
         "tracking.experiment=t", "task.target_precision=1e-2", cwd=workdir,
     )
     assert out.returncode == 0, out.stderr
-    assert "6 runs recorded" in out.stdout and "6 finished, 0 failed" in out.stdout
+    assert "6 jobs recorded" in out.stdout and "6 finished, 0 failed" in out.stdout
     client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     runs = client.search_runs([client.get_experiment_by_name("t").experiment_id])
     assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1
@@ -94,6 +94,7 @@ def test_unknown_command(workdir: Path) -> None:
 
 
 def test_leaderboard_without_runs(workdir: Path) -> None:
+    assert tcbench("run", "budget=20", cwd=workdir).returncode == 0
     out = tcbench("leaderboard", "--experiment", "none", cwd=workdir)
     assert out.returncode == 2 and "no MLflow experiment named none" in out.stderr
 

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from tcbench import leaderboard, tracking
-from tcbench.job import run_job
+from tcbench.job import JobFailure, run_job
 from tcbench.optimisers import register
 from tcbench.optimisers.fa import FireflyAlgorithm
 from tcbench.tasks.function_env import FunctionEnv
@@ -48,8 +48,8 @@ class Exploding(FireflyAlgorithm):
 def test_failed_job_is_recorded_and_counted(workdir: Path) -> None:
     register("exploding", Exploding)
     assert run_job(cfg(seed=0)) is not None
-    assert run_job(cfg(optimiser={"name": "exploding"}, seed=0)) is None
-    assert run_job(cfg(optimiser={"name": "exploding"}, seed=1)) is None
+    assert isinstance(run_job(cfg(optimiser={"name": "exploding"}, seed=0)), JobFailure)
+    assert isinstance(run_job(cfg(optimiser={"name": "exploding"}, seed=1)), JobFailure)
     client = tracking.client()
     runs = leaderboard.load_runs(client, ["t"], "s1")
     assert sorted(runs["status"]) == ["FAILED", "FAILED", "FINISHED"]
@@ -126,6 +126,40 @@ def test_summarise_ranks_and_statistics() -> None:
     assert table.loc["a", "ert_evals"] == np.inf
 
 
+def test_a_method_that_crashes_on_most_seeds_does_not_rank_first() -> None:
+    """A method that failed on 7 of 12 seeds was ranked above FA (0 failed) on the median of the
+    5 it finished: a failed run is a failure to reach the target, in the rank too."""
+    rows = []
+    for method, errors, failed in [("fa", [5.0] * 12, 0), ("crashy", [3.0] * 12, 7)]:
+        for seed, e in enumerate(errors):
+            ok = seed >= failed
+            rows.append({"method": method, "seed": seed, "status": "FINISHED" if ok else "FAILED",
+                         "final_error": e if ok else np.nan, "final_best": e if ok else np.nan,
+                         "target_hit": False, "evaluations": 100.0 if ok else np.nan,
+                         "evals_to_target": np.nan, "budget": 100})
+    table = leaderboard.summarise(pd.DataFrame(rows)).set_index("method")
+    assert table.loc["fa", "rank"] == 1 and table.loc["crashy", "rank"] == 2
+    assert table.loc["crashy", "failed"] == 7 and table.loc["crashy", "median_error"] == 3.0
+
+
+def test_a_compensation_method_that_crashes_on_most_restarts_does_not_rank_first() -> None:
+    from tcbench.compensation.leaderboard import summarise
+    from tcbench.compensation.scoring import METRIC_NAMES as METRICS
+    from tcbench.compensation.scoring import PRIMARY
+
+    protocol = "fulltemp"
+    primary = PRIMARY[protocol]
+    rows = []
+    for method, value, failed in [("steady", 5.0, 0), ("crashy", 3.0, 7)]:
+        for seed in range(12):
+            ok = seed >= failed
+            rows.append({"method": method, "seed": seed, "status": "FINISHED" if ok else "FAILED",
+                         **{m: (value if ok else np.nan) for m in METRICS[protocol]},
+                         f"raw_{primary}": 50.0})
+    table = summarise(pd.DataFrame(rows), protocol).set_index("method")
+    assert table.loc["steady", "rank"] == 1 and table.loc["crashy", "rank"] == 2
+
+
 def test_sweep_goes_on_after_a_failing_job(workdir: Path, capsys) -> None:
     """A multirun in which some jobs raise: they are FAILED in MLflow, the others finish,
     and the command lists the failures and exits 1."""
@@ -138,18 +172,18 @@ def test_sweep_goes_on_after_a_failing_job(workdir: Path, capsys) -> None:
     ])
     out = capsys.readouterr().out
     assert code == 1
-    assert "4 runs recorded" in out and "2 finished, 2 failed" in out
+    assert "4 jobs recorded" in out and "2 finished, 2 failed" in out
     assert out.count("FAILED x on sphere-2d seed") == 2 and "boom in generation 2" in out
 
 
 def test_resume_skips_finished_jobs(workdir: Path) -> None:
     register("exploding", Exploding)
     first = [run_job(cfg(seed=s)) for s in range(2)] + [run_job(cfg(optimiser={"name": "exploding"}, seed=0))]
-    assert first[0] is not None and first[2] is None
+    assert first[0] is not None and isinstance(first[2], JobFailure)
     again = [run_job(cfg(seed=s, tracking__resume=True, tracking__sweep_id="s2")) for s in range(3)]
     assert again[0] is None and again[1] is None and again[2] is not None  # only seed 2 ran
     redo = run_job(cfg(optimiser={"name": "exploding"}, seed=0, tracking__resume=True, tracking__sweep_id="s2"))
-    assert redo is None  # FAILED before, so it was tried again (and failed again)
+    assert isinstance(redo, JobFailure)  # FAILED before, so it was tried again (and failed again)
     runs = leaderboard.load_runs(tracking.client(), ["t"])
     assert len(runs) == 5  # 3 first attempts, 1 new seed, 1 retried failure
     (board,) = leaderboard.boards(runs)

@@ -77,14 +77,13 @@ def base_configs(methods: list[str], ioh_dir: Path) -> dict[str, dict[str, Any]]
     """The composed job config of each method (``task=bbob optimiser=<m>``, tracking off)."""
     from hydra import compose, initialize_config_dir
 
-    from tcbench.app import CONF_DIR, with_plugin_configs
+    from tcbench.app import CONF_DIR
     from tcbench.config import as_dict
 
     out = {}
     with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
         for m in methods:
-            overrides = with_plugin_configs(["task=bbob", f"optimiser={m}", "tracking.enabled=false",
-                                             f"tracking.ioh_dir={ioh_dir}"])
+            overrides = ["task=bbob", f"optimiser={m}", "tracking.enabled=false", f"tracking.ioh_dir={ioh_dir}"]
             out[m] = as_dict(compose("config", overrides=overrides))
     return out
 

@@ -16,8 +16,9 @@ its own seed and job number.
   ``.hydra/config.yaml`` and ``.hydra/overrides.yaml``; the job's log goes to the console, and
   everything else it records goes to MLflow as before. ``tracking.plots: null`` becomes false for
   the jobs of an optimisation sweep (a convergence PNG per run costs more than the run; the
-  leaderboard draws them over seeds) and true for compensation sweeps. A job that raises is reported after the
-  sweep as Hydra's launchers do (tracked jobs are recorded FAILED and the sweep goes on).
+  leaderboard draws them over seeds) and true for compensation sweeps. A job that raises, calls ``sys.exit`` or
+  whose worker dies is recorded FAILED (or, untracked, listed by ``tcbench run`` after the sweep)
+  and the sweep goes on; workers exit with the sweep's main process (:mod:`.pool`).
 
 Both are the defaults of ``tcbench run`` (``hydra/sweeper: tcbench``, ``hydra/launcher: tcbench``);
 ``hydra/launcher=joblib`` or ``submitit_slurm`` still work as before.
@@ -25,11 +26,9 @@ Both are the defaults of ``tcbench run`` (``hydra/sweeper: tcbench``, ``hydra/la
 
 from __future__ import annotations
 
-import concurrent.futures
 import copy
 import hashlib
 import logging
-import multiprocessing
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -42,6 +41,7 @@ from hydra.plugins.launcher import Launcher
 from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf, open_dict
 
+from hydra_plugins.tcbench_launcher.pool import run_jobs
 from tcbench.tasks import is_compensation
 
 log = logging.getLogger(__name__)
@@ -130,10 +130,11 @@ class GroupedLauncher(Launcher):
         else:
             outcomes = _run_parallel([cfg for _, _, cfg, _ in jobs], self.n_jobs)
         returns = []
-        for (_, overrides, cfg, out), (ok, value) in zip(jobs, outcomes, strict=True):
+        for (_, overrides, cfg, out), (_ok, value) in zip(jobs, outcomes, strict=True):
+            # COMPLETED either way: a failed job's JobFailure is no exception for Hydra to raise,
+            # which would end the sweep; tcbench reports the failures after it.
             ret = JobReturn(overrides=overrides, cfg=OmegaConf.create(cfg), working_dir=out,
-                            task_name=str(self.config.hydra.job.name),
-                            status=JobStatus.COMPLETED if ok else JobStatus.FAILED)
+                            task_name=str(self.config.hydra.job.name), status=JobStatus.COMPLETED)
             ret.return_value = value
             returns.append(ret)
         return returns
@@ -146,41 +147,32 @@ def _resolved(cfg: DictConfig, key: str) -> Any:
 
 
 def _write_job_dir(out: Path, subdir: str | None, cfg: dict[str, Any], overrides: list[str]) -> None:
-    """The job's folder with its resolved config and overrides, as Hydra writes them."""
-    out.mkdir(parents=True, exist_ok=True)
-    if subdir is None:
-        return
-    meta = out / subdir
-    meta.mkdir(parents=True, exist_ok=True)
-    dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
-    (meta / "config.yaml").write_text(yaml.dump(cfg, Dumper=dumper, sort_keys=False))
-    (meta / "overrides.yaml").write_text(yaml.dump(overrides, Dumper=dumper))
+    """The job's folder with its resolved config and overrides, as Hydra writes them; an
+    ``OSError`` naming the folder if it cannot be written (a full disk)."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        if subdir is None:
+            return
+        meta = out / subdir
+        meta.mkdir(parents=True, exist_ok=True)
+        dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+        (meta / "config.yaml").write_text(yaml.dump(cfg, Dumper=dumper, sort_keys=False))
+        (meta / "overrides.yaml").write_text(yaml.dump(overrides, Dumper=dumper))
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(out)) from None
 
 
 def _run_one(cfg: dict[str, Any]) -> tuple[bool, Any]:
-    """Run one job's config; (True, result) or (False, the exception)."""
-    from tcbench.job import run_job
+    """Run one job's config; (True, result), or (False, its :class:`~tcbench.job.JobFailure`)."""
+    from tcbench.job import JobFailure, run_job
 
-    try:
-        return True, run_job(cfg)
-    except Exception as exc:  # reported by the sweeper after the batch, as Hydra's launchers do
-        log.error("job with seed %s raised %s: %s", cfg.get("seed"), type(exc).__name__, exc)
-        return False, exc
+    value = run_job(cfg)  # never raises: a failure comes back as a JobFailure
+    return not isinstance(value, JobFailure), value
 
 
 def _worker_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
     ok, value = _run_one(cfg)
-    return ok, (None if ok else _picklable(value))
-
-
-def _picklable(exc: BaseException) -> BaseException:
-    import pickle
-
-    try:
-        pickle.dumps(exc)
-        return exc
-    except Exception:  # noqa: BLE001 - any unpicklable exception is sent as its text
-        return RuntimeError(f"{type(exc).__name__}: {exc}")
+    return ok, (value if not ok else None)
 
 
 def _worker_init() -> None:
@@ -189,8 +181,21 @@ def _worker_init() -> None:
 
 def _run_parallel(configs: list[dict[str, Any]], n_jobs: int) -> list[tuple[bool, Any]]:
     """Run the configs on ``n_jobs`` fresh worker processes (spawned: no inherited database
-    connections), results in order."""
-    context = multiprocessing.get_context("spawn")
+    connections), results in order; a worker that dies fails its job only
+    (:func:`.pool.run_jobs`). The workers' failures join this process's :data:`tcbench.job.FAILURES`."""
+    from tcbench.job import FAILURES, JobFailure, job_name
+
+    def lost(index: int, run_id: str, why: str) -> None:
+        from tcbench import tracking
+
+        tracking.mark_failed(tracking.client((configs[index].get("tracking") or {}).get("uri")), run_id, why)
+
     workers = min(n_jobs, len(configs), os.cpu_count() or n_jobs)
-    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context, initializer=_worker_init) as pool:
-        return list(pool.map(_worker_job, configs))
+    outcomes = run_jobs(configs, workers, _worker_job, init=_worker_init, on_lost_run=lost)
+    for cfg, (ok, value) in zip(configs, outcomes, strict=True):
+        if not ok:
+            if not isinstance(value, JobFailure):
+                value = JobFailure(job_name(cfg), f"{type(value).__name__}: {value}")
+                log.error("job %s failed: %s", value.name, value.error)
+            FAILURES.append(value)
+    return outcomes

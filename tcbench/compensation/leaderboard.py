@@ -4,7 +4,8 @@ Per method: runs (one per seed), failed runs, for each metric the median over re
 bootstrap 95 % interval, the value of the run with the smallest training RMSE ("best of N by
 training RMSE", the paper's selection) and the improvement over the raw output (raw / median).
 Rows are ordered by the median of the task's primary metric (bias variation for full
-temperature, zero-start stability for zero bias); raw and the oracle are deterministic, one run.
+temperature, zero-start stability for zero bias) with a failed run counted as infinitely bad, so a
+method cannot rank on the few restarts it finished; raw and the oracle are deterministic, one run.
 ``p_vs_next``: Wilcoxon signed-rank p-value of the primary metric against the next row, paired
 by seed (NaN below 6 shared seeds). ``note`` flags a method whose median is below the oracle's,
 the physical limit: it cannot be compensating the sensor better than its own noise allows.
@@ -26,7 +27,7 @@ from tcbench.leaderboard import (
     search_runs,
     write_board_files,
 )
-from tcbench.stats import bootstrap_median_ci, paired_p_value
+from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
 PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp", "gyro_driftnoise": "gyro"}
 METRICS = METRIC_NAMES
@@ -82,12 +83,15 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             if m not in NO_GAIN:
                 row[f"gain_{s}"] = float(np.median(raw) / row[f"median_{s}"]) if raw.size and row[f"median_{s}"] else np.nan
         row[f"median_{train}"] = float(ok[train].median()) if train in ok else np.nan
+        row["_rank"] = median_counting_failures(ok[primary].to_numpy(float) if primary in ok else np.array([]),
+                                                int(row["failed"]))  # type: ignore[arg-type]
         rows.append(row)
         values[method] = pd.Series(ok[primary].to_numpy(float), index=ok["seed"].to_numpy()) if primary in ok else pd.Series(dtype=float)
     table = pd.DataFrame(rows)
     if table.empty:
         return table
-    table = table.sort_values(f"median_{SHORT[primary]}", na_position="last").reset_index(drop=True)
+    table = table.sort_values(["_rank", f"median_{SHORT[primary]}"], na_position="last").reset_index(drop=True)
+    table = table.drop(columns="_rank")
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     names = table["method"].tolist()
     table["p_vs_next"] = [paired_p_value(values[a], values[b]) for a, b in zip(names, names[1:], strict=False)] + [np.nan]

@@ -67,6 +67,14 @@ class Optimiser(ABC):
     single_objective: ClassVar[bool] = True  # can minimise one objective
     multi_objective: ClassVar[bool] = False  # can handle n_objectives > 1
 
+    @classmethod
+    def memory_bytes(cls, params: OptimiserParams, dim: int, n_objectives: int = 1) -> int:
+        """A generous estimate of a run's peak memory in ``dim`` dimensions (bytes): 16 float
+        arrays per individual and 64 more of the problem's size, which bounds tcbench's own
+        optimisers (measured: 6-14 per individual). Override where an optimiser holds more,
+        e.g. a ``dim x dim`` covariance; the config check refuses a job that cannot fit."""
+        return 8 * int(dim) * (16 * int(params.population) + 64)
+
     def __init__(
         self,
         lower: np.ndarray,

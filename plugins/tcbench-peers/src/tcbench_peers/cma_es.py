@@ -61,6 +61,13 @@ class CMAES(Optimiser):
     Params: ClassVar[type[OptimiserParams]] = CMAESParams
     restarts: ClassVar[bool] = False
 
+    @classmethod
+    def memory_bytes(cls, params: OptimiserParams, dim: int, n_objectives: int = 1) -> int:
+        """cma keeps a ``dim x dim`` covariance, its eigenvectors and a few copies: about five
+        ``dim x dim`` arrays beside the population."""
+        lam = params.population or 4 + int(3 * math.log(max(dim, 1)))
+        return 8 * int(dim) * (5 * int(dim) + 16 * lam + 64)
+
     def __init__(self, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
         super().__init__(*args, **kwargs)
         p: CMAESParams = self.params  # type: ignore[assignment]

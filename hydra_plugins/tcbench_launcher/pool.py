@@ -1,0 +1,144 @@
+"""Worker processes for a sweep's jobs that survive a worker's death and die with their parent.
+
+``concurrent.futures.ProcessPoolExecutor`` breaks as a whole when one worker dies (a job that
+calls ``os._exit``, the kernel's OOM killer, ``kill -9``): every pending job fails with
+``BrokenProcessPool`` and nobody knows which job was running. Here each worker takes one job at a
+time over its own pipe, so the parent knows which job a dead worker held: that job is reported
+failed (its MLflow run marked FAILED, when it had one), a new worker takes the next job, and the
+sweep goes on. Each worker watches its parent and exits when the parent is gone, so killing the
+sweep's main process leaves no orphan workers behind.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+import signal
+import threading
+from collections import deque
+from collections.abc import Callable, Sequence
+from multiprocessing.connection import Connection, wait
+from typing import Any
+
+log = logging.getLogger(__name__)
+
+Job = Callable[[dict[str, Any]], tuple[bool, Any]]
+
+
+class WorkerDied(RuntimeError):
+    """The worker process running a job ended before the job did."""
+
+
+def _exit_with_parent() -> None:
+    """End this worker as soon as its parent process ends (``kill -9`` of the sweep included)."""
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        parent.join()
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True, name="tcbench-parent-watch").start()
+
+
+def _worker(conn: Connection, job: Job, init: Callable[[], None] | None) -> None:
+    """Worker loop: ``(index, cfg)`` in; ``("run", index, run_id)`` when the job opens its
+    MLflow run and ``("done", index, ok, value)`` out; ``None`` in ends it."""
+    _exit_with_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    if init is not None:
+        init()
+    from tcbench import tracking
+
+    current = [-1]
+    tracking.on_run_created = lambda run_id: conn.send(("run", current[0], run_id))
+    while True:
+        try:
+            task = conn.recv()
+        except EOFError:
+            return
+        if task is None:
+            return
+        current[0], cfg = task
+        ok, value = job(cfg)
+        conn.send(("done", current[0], ok, value))
+
+
+def _died(proc: multiprocessing.process.BaseProcess) -> str:
+    proc.join(1)
+    code = proc.exitcode
+    if code is not None and code < 0:
+        try:
+            return f"killed by signal {signal.Signals(-code).name}"
+        except ValueError:
+            return f"killed by signal {-code}"
+    return f"exited with code {code}"
+
+
+def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
+             init: Callable[[], None] | None = None,
+             on_lost_run: Callable[[int, str, str], None] | None = None) -> list[tuple[bool, Any]]:
+    """Run ``job(cfg)`` for every config on ``n_workers`` spawned processes; the ``(ok, value)``
+    of each, in order. A job whose worker died gets ``(False, WorkerDied(...))`` and, if it had
+    opened an MLflow run, ``on_lost_run(index, run_id, why)`` is called for it."""
+    context = multiprocessing.get_context("spawn")
+    pending = deque(enumerate(configs))
+    results: list[tuple[bool, Any] | None] = [None] * len(configs)
+    busy: dict[Connection, tuple[multiprocessing.process.BaseProcess, int | None, str | None]] = {}
+
+    def start() -> None:
+        parent_end, child_end = context.Pipe()
+        proc = context.Process(target=_worker, args=(child_end, job, init), daemon=True)
+        proc.start()
+        child_end.close()
+        busy[parent_end] = (proc, None, None)
+        give(parent_end)
+
+    def give(conn: Connection) -> None:
+        proc, _, _ = busy[conn]
+        if pending:
+            index, cfg = pending.popleft()
+            conn.send((index, cfg))
+            busy[conn] = (proc, index, None)
+        else:
+            conn.send(None)
+            proc.join()
+            conn.close()
+            del busy[conn]
+
+    try:
+        for _ in range(min(n_workers, len(configs))):
+            start()
+        while busy:
+            sentinels = {proc.sentinel: conn for conn, (proc, _, _) in busy.items()}
+            for ready in wait([*busy, *sentinels]):
+                conn = ready if isinstance(ready, Connection) else sentinels[ready]
+                if conn not in busy:
+                    continue
+                proc, index, run_id = busy[conn]
+                try:
+                    message = conn.recv()
+                except (EOFError, OSError):
+                    message = None
+                if message is not None and message[0] == "run":
+                    busy[conn] = (proc, index, message[2])
+                elif message is not None:
+                    results[message[1]] = (message[2], message[3])
+                    give(conn)
+                else:  # the worker is gone
+                    why = _died(proc)
+                    conn.close()
+                    del busy[conn]
+                    if index is not None:
+                        log.error("the worker running job %d %s; the sweep goes on", index, why)
+                        results[index] = (False, WorkerDied(f"the worker process running the job {why}"))
+                        if run_id is not None and on_lost_run is not None:
+                            on_lost_run(index, run_id, f"WorkerDied: the worker process running the job {why}")
+                    if pending:
+                        start()
+    finally:
+        for proc, _, _ in busy.values():
+            proc.terminate()
+    return [r if r is not None else (False, WorkerDied("the job never ran")) for r in results]

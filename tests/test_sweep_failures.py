@@ -1,0 +1,227 @@
+"""A sweep goes on whatever its jobs do: raise, call ``sys.exit``, kill their worker; with
+tracking or without; and a killed sweep's runs do not stay RUNNING for ever."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from mlflow.tracking import MlflowClient
+
+# An optimiser plugin whose behaviour the task's dimension picks: 2-D works, 3-D calls
+# sys.exit(3), 4-D kills its own process, 5-D raises, 6-D sleeps while $CRASHY_SLEEP is set,
+# 7-D allocates 400 MB.
+CRASHY = (
+    "import os, signal, sys, time\n"
+    "from tcbench.optimisers.fa import FireflyAlgorithm\n"
+    "class Crashy(FireflyAlgorithm):\n"
+    "    name = 'crashy'\n"
+    "    def ask(self):\n"
+    "        d = self.lower.size\n"
+    "        if d == 3:\n"
+    "            sys.exit(3)\n"
+    "        if d == 4:\n"
+    "            os.kill(os.getpid(), signal.SIGKILL)\n"
+    "        if d == 5:\n"
+    "            raise RuntimeError('crashy broke')\n"
+    "        if d == 6 and os.environ.get('CRASHY_SLEEP'):\n"
+    "            time.sleep(600)\n"
+    "        if d == 7:\n"
+    "            import numpy\n"
+    "            numpy.ones(50_000_000)\n"
+    "        return super().ask()\n"
+)
+
+
+@pytest.fixture
+def site(tmp_path: Path) -> Path:
+    """A directory on PYTHONPATH holding the crashing optimiser as an installed plugin."""
+    site = tmp_path / "site"
+    info = site / "crashy_plugin-0.1.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: crashy_plugin\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text("[tcbench.optimisers]\ncrashy = crashy_mod:Crashy\n")
+    (site / "crashy_mod.py").write_text(CRASHY)
+    return site
+
+
+def tcbench(*args: str, cwd: Path, site: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    env.pop("MLFLOW_TRACKING_URI", None)
+    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def statuses(cwd: Path) -> dict[str, list[str]]:
+    """Run status by task key ``sphere-<d>d``."""
+    c = MlflowClient(tracking_uri=f"sqlite:///{cwd / 'mlflow.db'}")
+    exp = c.get_experiment_by_name("tcbench")
+    out: dict[str, list[str]] = {}
+    for r in c.search_runs([exp.experiment_id], max_results=1000):
+        out.setdefault(r.data.tags["tcbench.task"], []).append(r.info.status)
+    return out
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_job_that_exits_or_kills_its_worker_fails_alone(site: Path, tmp_path: Path, workers: int) -> None:
+    """sys.exit(3) used to end the whole sweep (exit 3, 2 of 8 runs recorded); a killed worker
+    ended it with BrokenProcessPool and a run left RUNNING. Every job now leaves a run, the bad
+    ones FAILED, and the command exits 1 after naming them."""
+    dims = "2,3,5" if workers == 1 else "2,3,4,5"  # the SIGKILL case would kill the main process itself
+    run = tcbench("run", "-m", "task=sphere", f"task.dim={dims}", "optimiser=fa", "optimiser.name=crashy",
+                  "seed=range(2)", "budget=60", f"hydra.launcher.n_jobs={workers}", cwd=tmp_path, site=site)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "Traceback" not in run.stderr
+    s = statuses(tmp_path)
+    assert s.pop("sphere-2d") == ["FINISHED", "FINISHED"]
+    assert all(v == ["FAILED", "FAILED"] for v in s.values()), s
+    n = 2 * len(dims.split(","))
+    assert f"{n} jobs recorded" in run.stdout and f"{n - 2} failed" in run.stdout
+    assert "sys.exit(3)" in run.stdout and "RuntimeError: crashy broke" in run.stdout
+    if workers == 2:
+        assert "killed by signal SIGKILL" in run.stdout
+
+
+def test_untracked_failures_are_listed_and_the_sweep_goes_on(site: Path, tmp_path: Path) -> None:
+    """With tracking off a raising job ended the sweep with a traceback."""
+    run = tcbench("run", "-m", "task=sphere", "task.dim=5,2,3", "optimiser=fa", "optimiser.name=crashy",
+                  "seed=0", "budget=60", "tracking.enabled=false", cwd=tmp_path, site=site)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "Traceback" not in run.stderr
+    assert "2 of 3 jobs failed" in run.stdout
+    assert "RuntimeError: crashy broke" in run.stdout and "sys.exit(3)" in run.stdout
+    assert not (tmp_path / "mlflow.db").exists()
+
+
+def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, tmp_path: Path) -> None:
+    """``task.dim=100000000`` grew to 24 GB and was killed by the kernel without a word: a job too
+    big by its optimiser's estimate is refused before it starts, and one that allocates past the
+    budget anyway fails with a MemoryError while the sweep goes on."""
+    env_args = ("run", "task=sphere", "task.dim=100000000", "budget=200")
+    before = tcbench(*env_args, cwd=tmp_path, site=site)
+    assert before.returncode == 2 and "Traceback" not in before.stderr
+    assert "task.dim=100000000: a run of optimiser ifa would need about" in before.stderr
+    os.environ["TCBENCH_JOB_MEMORY_MB"] = "200"
+    try:
+        run = tcbench("run", "-m", "task=sphere", "task.dim=7,2", "optimiser=fa", "optimiser.name=crashy",
+                      "seed=0", "budget=60", cwd=tmp_path, site=site)
+    finally:
+        del os.environ["TCBENCH_JOB_MEMORY_MB"]
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "Traceback" not in run.stderr
+    assert statuses(tmp_path) == {"sphere-7d": ["FAILED"], "sphere-2d": ["FINISHED"]}
+    assert "MemoryError" in run.stdout and "TCBENCH_JOB_MEMORY_MB" in run.stdout
+
+
+def _wait_for(predicate, timeout_s: float) -> bool:  # type: ignore[no-untyped-def]
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if predicate():
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def _children(pid: int) -> set[int]:
+    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True)
+    return {int(p) for p in out.stdout.split()}
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="process groups and pgrep as on Linux")
+def test_killed_sweep_workers_exit_and_resume_marks_dead_runs(site: Path, tmp_path: Path) -> None:
+    """kill -9 of the sweep's main process left its workers (and the resource tracker) alive for
+    ever, and the runs they held RUNNING: every later resume exited 1. Now the workers exit with
+    their parent, and a resume marks the dead runs KILLED and completes the sweep (exit 0)."""
+    env = {k: v for k, v in os.environ.items() if k != "MLFLOW_TRACKING_URI"} | {"PYTHONPATH": str(site)}
+    args = [sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "task.dim=6", "optimiser=fa",
+            "optimiser.name=crashy", "seed=range(4)", "budget=60", "hydra.launcher.n_jobs=2",
+            "tracking.sweep_id=killme"]
+    proc = subprocess.Popen(args, cwd=tmp_path, env=env | {"CRASHY_SLEEP": "1"},
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        def two_running() -> bool:
+            try:
+                return statuses(tmp_path).get("sphere-6d", []).count("RUNNING") == 2
+            except Exception:  # noqa: BLE001 - the store is still being created
+                return False
+
+        assert _wait_for(two_running, 120), "the sweep never had two jobs running"
+        workers = _children(proc.pid)
+        assert len(workers) >= 2
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+        assert _wait_for(lambda: not any(Path(f"/proc/{p}").exists() for p in workers), 20), \
+            "workers outlived the sweep's main process"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert statuses(tmp_path)["sphere-6d"] == ["RUNNING", "RUNNING"]
+    resume = subprocess.run([*args, "tracking.resume=true"], cwd=tmp_path, env=env,
+                            capture_output=True, text=True, timeout=300)
+    s = statuses(tmp_path)["sphere-6d"]
+    assert sorted(s) == ["FINISHED"] * 4 + ["KILLED"] * 2, s
+    assert "2 runs of sweep killme left RUNNING by a process that is gone marked KILLED" in resume.stderr
+    assert resume.returncode == 0, resume.stdout + resume.stderr
+    assert "4 finished, 0 failed; 2 earlier attempts replaced by a re-run" in resume.stdout
+
+
+@pytest.fixture
+def small_disk(tmp_path: Path):  # type: ignore[no-untyped-def]
+    """``mount(size)``: a tmpfs of ``size`` (e.g. ``"1200k"``) under tmp_path; skipped where
+    mounting is not allowed (not root, a container without the capability)."""
+    mounted: list[Path] = []
+
+    def mount(size: str) -> Path:
+        where = tmp_path / f"disk{len(mounted)}"
+        where.mkdir()
+        out = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(where)],
+                             capture_output=True, text=True)
+        if out.returncode != 0:
+            pytest.skip(f"cannot mount a tmpfs here: {out.stderr.strip()}")
+        mounted.append(where)
+        return where
+
+    yield mount
+    for where in mounted:
+        subprocess.run(["umount", "-l", str(where)], capture_output=True)
+
+
+def test_a_full_store_disk_fails_jobs_in_one_line_each(site: Path, tmp_path: Path, small_disk) -> None:  # type: ignore[no-untyped-def]
+    """A full disk under the store ended in 55-126-line tracebacks and left runs RUNNING, later
+    reported as another process's. Now every job ends (FINISHED, FAILED, or no run), each error
+    is one line, and no run is left RUNNING."""
+    disk = small_disk("1200k")  # room for the empty store (about 0.95 MB) and some runs
+    work = tmp_path / "work"
+    work.mkdir()
+    run = tcbench("run", "-m", "task=sphere", "budget=60", "seed=range(40)",
+                  f"tracking.uri=sqlite:///{disk / 'mlflow.db'}", cwd=work, site=site)
+    assert run.returncode == 1, run.stdout + run.stderr
+    assert "Traceback" not in run.stdout + run.stderr
+    assert "database or disk is full" in run.stdout
+    assert "RUNNING" not in run.stdout
+    c = MlflowClient(tracking_uri=f"sqlite:///{disk / 'mlflow.db'}")
+    runs = c.search_runs([c.get_experiment_by_name("tcbench").experiment_id], max_results=100)
+    assert runs and all(r.info.status != "RUNNING" for r in runs)
+
+
+def test_a_store_that_does_not_fit_is_one_line_and_not_left_half_made(site: Path, tmp_path: Path,
+                                                                      small_disk) -> None:  # type: ignore[no-untyped-def]
+    disk = small_disk("500k")
+    run = tcbench("run", "budget=20", f"tracking.uri=sqlite:///{disk / 'mlflow.db'}", cwd=tmp_path, site=site)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "cannot be prepared (database or disk is full)" in run.stderr
+    assert not (disk / "mlflow.db").exists()
+
+
+def test_job_folders_on_a_full_disk_stop_the_sweep_in_one_line(site: Path, small_disk) -> None:  # type: ignore[no-untyped-def]
+    disk = small_disk("100k")
+    run = tcbench("run", "-m", "task=sphere", "budget=20", "seed=range(200)", "tracking.enabled=false",
+                  cwd=disk, site=site)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    (line,) = [ln for ln in run.stderr.splitlines() if ln.startswith("tcbench: error:")]
+    assert "cannot write multirun/" in line and "No space left on device" in line
