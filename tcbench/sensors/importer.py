@@ -234,9 +234,10 @@ def import_csv(
         raise _in_csv(err, name, rows, spec, table, sensor) from None
 
 
-def save(rec: Recording, out: str | Path, stem: str) -> Path:
+def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path] = ()) -> Path:
     """Write ``rec`` as ``out/<stem>.csv`` and its sidecar, all or nothing (``out`` is not even
-    created when writing fails)."""
-    with staged_dir(out) as tmp:
+    created when writing fails); neither may replace one of ``inputs``
+    (:class:`~tcbench.staging.InputOverwriteError`)."""
+    with staged_dir(out, inputs) as tmp:
         write_recording(rec, tmp / f"{stem}.csv")
     return Path(out) / f"{stem}.csv"

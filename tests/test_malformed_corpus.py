@@ -1,0 +1,138 @@
+"""Malformed input through the real command line: import, metrics, diagnose and simulate refuse it
+in one line (exit 2, no traceback) and write or overwrite nothing.
+
+Every case is made inside the test (sparse files for the big ones), none is stored in the repository.
+"""
+
+from __future__ import annotations
+
+import errno
+import hashlib
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tcbench.cli import main
+from tcbench.sensors.recording import make_recording, write_recording
+
+SIM = ["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=100",
+       "protocol_params.sample_rate_hz=1", "tracking.enabled=false"]
+IMPORT = ["import", "sensor=gyro", "time=t:ms", "temperature=temp", "output=rate:mdps"]
+
+
+def snapshot(root: Path) -> dict[str, str]:
+    """Every file and folder under ``root`` with a digest of its content."""
+    return {str(p.relative_to(root)): "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*"))}
+
+
+def refused(capsys: pytest.CaptureFixture[str], root: Path, args: list[str], *names: str) -> str:
+    """Run ``tcbench <args>``; assert exit 2, one ``tcbench: error:`` line naming each of
+    ``names``, no traceback and nothing changed under ``root``; the line."""
+    before = snapshot(root)
+    code = main(args)
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert code == 2, (code, captured.err)
+    assert len(lines) == 1 and lines[0].startswith("tcbench: error: "), captured.err
+    assert "Traceback" not in captured.err + captured.out
+    for name in names:
+        assert name in lines[0], (name, lines[0])
+    assert snapshot(root) == before
+    return lines[0]
+
+
+def log_csv(path: Path, t_ms: np.ndarray | None = None) -> Path:
+    """A small foreign gyro log: a clock in ms, temperature in degC, rate in mdps."""
+    t_ms = np.arange(0.0, 100_000.0, 1000.0) if t_ms is None else t_ms
+    rate = 30.0 + np.sin(np.arange(t_ms.size))
+    rows = "".join(f"{t!r},{25.0 + 0.01 * i!r},{r!r}\n" for i, (t, r) in enumerate(zip(t_ms.tolist(), rate.tolist(), strict=True)))
+    path.write_text("t,temp,rate\n" + rows)
+    return path
+
+
+def recording(path: Path, t_s: np.ndarray | None = None) -> Path:
+    """A small valid gyro recording (1 Hz, 2000 s, warming by 10 degC: enough to diagnose) at ``path``."""
+    t_s = np.arange(2000.0) if t_s is None else t_s
+    rng = np.random.default_rng(0)
+    temp_c = 20.0 + np.linspace(0.0, 10.0, t_s.size)
+    rec = make_recording(t_s, temp_c, np.zeros(t_s.size), 0.01 * temp_c + rng.normal(0.0, 0.01, t_s.size),
+                         sensor="gyro", sample_rate_hz=1.0, device_id="d")
+    return write_recording(rec, path)
+
+
+# -- point 1: never write over an input --------------------------------------------------------
+def test_import_refuses_to_overwrite_its_source(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    log_csv(workdir / "src.csv")
+    refused(capsys, workdir, [*IMPORT, "csv=src.csv", "out=."], "src.csv", "would overwrite the input")
+    (workdir / "sub").mkdir()
+    refused(capsys, workdir, [*IMPORT, "csv=src.csv", "out=sub/..", "name=src"],
+            "src.csv")
+
+
+def test_import_refuses_a_sidecar_over_its_source(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    log_csv(workdir / "log.json")  # a CSV under another suffix: the sidecar log.json would replace it
+    refused(capsys, workdir, [*IMPORT, "csv=log.json", "out=."], "log.json")
+
+
+def test_metrics_and_diagnose_do_not_overwrite_their_inputs(workdir: Path,
+                                                            capsys: pytest.CaptureFixture[str]) -> None:
+    recording(workdir / "metrics.csv")  # its sidecar metrics.json is a name metrics writes
+    refused(capsys, workdir, ["metrics", "metrics.csv", "out=.", "tracking.enabled=false"], "metrics.json")
+    recording(workdir / "rec.csv")
+    (workdir / "model.yaml").write_text("tcbench_model: 1\nsensor: gyro\ncore: {kind: polynomial, centre_c: 25.0, "
+                                        "half_range_c: 50.0, bias: [0.0], scale_factor: [1.0]}\n")
+    refused(capsys, workdir, ["diagnose", "recording=rec.csv", "model=model.yaml", "out=."], "model.yaml")
+
+
+# -- point 2: names stay inside out= --------------------------------------------------------------
+@pytest.mark.parametrize("name", ["{tmp}/x/ESCAPE", "../escape", "", "''", ".", "..", "a\\b", "a/b", "nul\0x"])
+def test_names_stay_inside_out(workdir: Path, capsys: pytest.CaptureFixture[str], name: str) -> None:
+    name = name.format(tmp=workdir.parent)
+    log_csv(workdir / "log.csv")
+    outside = snapshot(workdir.parent)
+    refused(capsys, workdir, [*SIM, f"name={name}", "out=o"], "name=")
+    refused(capsys, workdir, [*IMPORT, "csv=log.csv", f"name={name}", "out=o"], "name=")
+    assert snapshot(workdir.parent) == outside
+
+
+# -- point 8: a full disk --------------------------------------------------------------------------
+def full_disk(monkeypatch: pytest.MonkeyPatch, module: object, name: str) -> None:
+    """Make ``module.name`` (a writer) fail as on a full disk."""
+    def no_space(*args: object, **kwargs: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(module, name, no_space)
+
+
+@pytest.mark.parametrize("writer", ["plots", "table", "json"])
+def test_a_full_disk_is_one_line(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                 monkeypatch: pytest.MonkeyPatch, writer: str) -> None:
+    import matplotlib.figure
+
+    import tcbench.sensors.recording as recording_module
+
+    recording(workdir / "rec.csv")
+    log_csv(workdir / "log.csv")
+    if writer == "plots":
+        full_disk(monkeypatch, matplotlib.figure.Figure, "savefig")
+    elif writer == "table":
+        full_disk(monkeypatch, recording_module, "_write_table")
+    else:
+        full_disk(monkeypatch, Path, "write_text")
+    commands: dict[str, list[str]] = {
+        "simulate": [*SIM, "out=new/o"],
+        "metrics": ["metrics", "rec.csv", "out=m", "tracking.enabled=false"],
+        "import": [*IMPORT, "csv=log.csv", "out=i"],
+        "diagnose": ["diagnose", "recording=rec.csv", "out=d"],
+    }
+    hit: Callable[[str], bool] = {"plots": lambda c: c in {"simulate", "metrics", "diagnose"},
+                                  "table": lambda c: c in {"simulate", "import"},
+                                  "json": lambda c: c in {"simulate", "metrics", "diagnose"}}[writer]
+    for command, args in commands.items():
+        if hit(command):
+            out = args[-2] if command == "metrics" else args[-1]
+            refused(capsys, workdir, args, f"{out}: cannot write", "(No space left on device)")
+
