@@ -182,6 +182,8 @@ def metrics(args: list[str]) -> int:
     if not cfg.recording:
         raise CommandError("say which recording: tcbench metrics recording=PATH")
     scale = cfg.scale_factor_hz_per_g
+    if scale is not None and not (math.isfinite(scale) and scale > 0):
+        raise CommandError(f"scale_factor_hz_per_g: must be a finite number > 0, got {scale:g}")
     path = Path(cfg.recording)
     try:
         rec = read_recording(path)

@@ -136,3 +136,46 @@ def test_a_full_disk_is_one_line(workdir: Path, capsys: pytest.CaptureFixture[st
             out = args[-2] if command == "metrics" else args[-1]
             refused(capsys, workdir, args, f"{out}: cannot write", "(No space left on device)")
 
+
+# -- point 7: simulate's and metrics' parameters ----------------------------------------------------
+@pytest.mark.parametrize(("arg", "key"), [
+    ("protocol_params.duration_s=0", "protocol_params.duration_s"),
+    ("protocol_params.duration_s=-10", "protocol_params.duration_s"),
+    ("protocol_params.duration_s=inf", "protocol_params.duration_s"),
+    ("protocol_params.duration_s=1e12", "protocol_params"),
+    ("protocol_params.sample_rate_hz=0", "protocol_params.sample_rate_hz"),
+    ("protocol_params.sample_rate_hz=-5", "protocol_params.sample_rate_hz"),
+    ("protocol_params.sample_rate_hz=nan", "protocol_params.sample_rate_hz"),
+    ("protocol_params.sample_rate_hz=fast", "protocol_params.sample_rate_hz"),
+    ("protocol_params.sample_rate_hz=true", "protocol_params.sample_rate_hz"),
+    ("protocol_params.sample_rate_hz=0.001", "protocol_params"),  # 100 s at 1 mHz: not two samples
+    ("without=[nosuch]", "without"),
+])
+def test_simulate_refuses_bad_parameters(workdir: Path, capsys: pytest.CaptureFixture[str], arg: str, key: str) -> None:
+    line = refused(capsys, workdir, [*SIM, arg, "out=o"], key)
+    if arg.startswith("without"):
+        assert "white_noise" in line  # the known effects are listed
+
+
+@pytest.mark.parametrize(("protocol", "arg"), [
+    ("oven", "protocol_params.step_c=0"),
+    ("oven", "protocol_params.step_c=1e-9"),
+    ("oven", "protocol_params.hold_s=1e12"),
+    ("oven", "protocol_params.hold_s=-1"),
+    ("fulltemp", "protocol_params.nodes_c=[]"),
+    ("fulltemp", "protocol_params.nodes_c=[1,x]"),
+    ("fulltemp", "protocol_params.chamber=1"),
+    ("roomtemp", "protocol_params.wander_tau_s=nan"),
+])
+def test_simulate_refuses_bad_protocol_parameters(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                  protocol: str, arg: str) -> None:
+    sensor = "gyro" if protocol == "oven" else "msra"
+    key = arg.split("=")[0] if "1e12" not in arg else "protocol_params"
+    refused(capsys, workdir, ["simulate", f"sensor={sensor}", f"protocol={protocol}", arg, "out=o"], key)
+
+
+@pytest.mark.parametrize("value", ["0", "-200", "nan", "inf", "fast"])
+def test_metrics_refuses_a_bad_scale_factor(workdir: Path, capsys: pytest.CaptureFixture[str], value: str) -> None:
+    recording(workdir / "rec.csv")
+    refused(capsys, workdir, ["metrics", "rec.csv", f"scale_factor_hz_per_g={value}", "tracking.enabled=false"],
+            "scale_factor_hz_per_g")
