@@ -179,3 +179,45 @@ def test_metrics_refuses_a_bad_scale_factor(workdir: Path, capsys: pytest.Captur
     recording(workdir / "rec.csv")
     refused(capsys, workdir, ["metrics", "rec.csv", f"scale_factor_hz_per_g={value}", "tracking.enabled=false"],
             "scale_factor_hz_per_g")
+
+
+# -- point 3: clocks that make no sense for the rate --------------------------------------------------
+def schema_csv(path: Path, t_s: np.ndarray) -> Path:
+    """A gyro table in schema columns (no sidecar) with the clock ``t_s``, warming 25 -> 35 degC."""
+    n = t_s.size
+    temp = np.linspace(25.0, 35.0, n)
+    rate = 0.01 * temp + 0.01 * np.sin(np.arange(n))
+    path.write_text("time_s,temperature_c,input,output\n" + "".join(
+        f"{t!r},{c!r},0.0,{r!r}\n" for t, c, r in zip(t_s.tolist(), temp.tolist(), rate.tolist(), strict=True)))
+    return path
+
+
+@pytest.mark.parametrize(("last_s", "words"), [(1e9, "a gap of 1e+09 s after 1 s steps"),
+                                               (1e7, "a gap of 1e+07 s after 1 s steps"),
+                                               (1e300, "1e+300 s is not a plausible time")])
+def test_a_clock_glitch_is_refused_by_every_reader(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                   last_s: float, words: str) -> None:
+    schema_csv(workdir / "glitch.csv", np.append(np.arange(100.0), last_s))
+    for args in (["metrics", "glitch.csv", "tracking.enabled=false"],
+                 ["diagnose", "recording=glitch.csv", "sensor=gyro", "out=d"],
+                 ["import", "csv=glitch.csv", "sensor=gyro", "time=time_s", "temperature=temperature_c",
+                  "output=output", "out=i"]):
+        refused(capsys, workdir, args, "glitch.csv: row 101, column 'time_s'", words)
+
+
+def test_a_logger_in_bursts_is_not_a_glitch(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Ten 30 s bursts at 1 Hz an hour apart (gaps 120 times the data), and one burst a day later."""
+    bursts = [3600.0 * k + np.arange(30.0) for k in range(10)] + [86400.0 + np.arange(30.0)]
+    schema_csv(workdir / "bursts.csv", np.concatenate(bursts))
+    code = main(["import", "csv=bursts.csv", "sensor=gyro", "time=time_s", "temperature=temperature_c",
+                 "output=output", "out=i"])
+    assert code == 0, capsys.readouterr().err
+    assert "in 11 segments" in capsys.readouterr().out
+
+
+def test_diagnose_refuses_an_absurd_filter_grid(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A clock the schema accepts (bursts a day apart for 100 days) but too long for diagnose's
+    1 s filter clock: refused before anything is allocated."""
+    schema_csv(workdir / "long.csv", np.concatenate([86400.0 * k + np.arange(20.0) for k in range(100)]))
+    refused(capsys, workdir, ["diagnose", "recording=long.csv", "sensor=gyro", "out=d"], "long.csv",
+            "filter clock would hold 8.55e+06 samples")
