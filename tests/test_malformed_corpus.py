@@ -8,6 +8,10 @@ from __future__ import annotations
 
 import errno
 import hashlib
+import json
+import os
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -221,3 +225,48 @@ def test_diagnose_refuses_an_absurd_filter_grid(workdir: Path, capsys: pytest.Ca
     schema_csv(workdir / "long.csv", np.concatenate([86400.0 * k + np.arange(20.0) for k in range(100)]))
     refused(capsys, workdir, ["diagnose", "recording=long.csv", "sensor=gyro", "out=d"], "long.csv",
             "filter clock would hold 8.55e+06 samples")
+
+
+# -- point 4: files too big to read whole, read in bounded pieces --------------------------------------
+HEADER = b"time_s,temperature_c,input,output\n"
+BIG_FILES: dict[str, tuple[Callable[[Path], None], tuple[str, ...]]] = {
+    "cell.csv": (lambda p: p.write_bytes(HEADER + b"0,25,0,1\n1,25,0,1\n2,25,0," + b"1" * 50_000_000 + b"\n3,25,0,1\n"),
+                 ("cell.csv: row 3, column 'output'", "a line longer than 1 MiB")),
+    "head.csv": (lambda p: p.write_bytes(b"time_s," + b"x" * 200_000 + b"\n0,1\n"),
+                 ("head.csv:", "the first line is longer than 64 KiB")),
+    "sparse.csv": (lambda p: p.open("wb").truncate(2**31), ("sparse.csv:", "the header holds a NUL byte")),
+    "nul.csv": (lambda p: (p.write_bytes(HEADER), p.open("ab").truncate(2**31)),
+                ("nul.csv: row 1, column 'time_s'", "a NUL byte")),
+}
+RSS_PROBE = """
+import json, resource, sys
+import tcbench.cli, tcbench.diagnose.diagnosis, tcbench.diagnose.report, tcbench.sensors.importer
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+codes = [tcbench.cli.main(args.split()) for args in sys.argv[1:]]
+print(json.dumps({"codes": codes, "growth_mb": (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024}))
+"""
+
+
+@pytest.mark.parametrize("name", list(BIG_FILES))
+def test_big_files_are_judged_from_a_bounded_read(workdir: Path, name: str) -> None:
+    """Each of import, metrics and diagnose refuses the file in one line, naming it (and the row
+    and column where there is one), and its peak memory grows by less than 64 MB, whatever the
+    file's size (2 GiB sparse files among them)."""
+    make, words = BIG_FILES[name]
+    make(workdir / name)
+    before = snapshot_names(workdir)
+    commands = [f"metrics {name} tracking.enabled=false", f"diagnose recording={name} sensor=gyro out=d",
+                f"import csv={name} sensor=gyro time=time_s temperature=temperature_c output=output out=i"]
+    done = subprocess.run([sys.executable, "-c", RSS_PROBE, *commands], cwd=workdir, capture_output=True, text=True,
+                          timeout=120, check=False, env={**os.environ, "MPLBACKEND": "Agg"})
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    lines = done.stderr.strip().splitlines()
+    assert result["codes"] == [2, 2, 2] and len(lines) == 3, done.stderr
+    assert all(line.startswith("tcbench: error: ") and all(w in line for w in words) for line in lines), lines
+    assert result["growth_mb"] < 64, result
+    assert snapshot_names(workdir) == before
+
+
+def snapshot_names(root: Path) -> list[str]:
+    """The files under ``root`` (names only: the big files are not hashed)."""
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*"))
