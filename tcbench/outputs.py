@@ -1,5 +1,8 @@
 """Is an output folder usable? Asked before any work is done, so a long run does not end in a
-traceback at its first write (a read-only disk, a file where a folder should be, a typo'd mount)."""
+traceback at its first write (a read-only disk, a file where a folder should be, a typo'd mount).
+
+Also the checks every command that writes shares: a ``name=`` keeps its files inside the folder,
+no output replaces an input, and a failed write is told in words."""
 
 from __future__ import annotations
 
