@@ -9,6 +9,7 @@ from __future__ import annotations
 import errno
 import hashlib
 import json
+import logging
 import os
 import subprocess
 import sys
@@ -24,6 +25,15 @@ from tcbench.sensors.recording import make_recording, write_recording
 SIM = ["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=100",
        "protocol_params.sample_rate_hz=1", "tracking.enabled=false"]
 IMPORT = ["import", "sensor=gyro", "time=t:ms", "temperature=temp", "output=rate:mdps"]
+
+
+@pytest.fixture(autouse=True)
+def _fresh_logging(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Logging as in a fresh ``tcbench`` process: earlier tests (Hydra runs) can leave handlers
+    on streams pytest has since closed, which would add lines to the captured stderr."""
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "handlers", [])
+    monkeypatch.setattr(root, "level", logging.WARNING)
 
 
 def snapshot(root: Path) -> dict[str, str]:
