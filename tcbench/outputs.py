@@ -1,10 +1,14 @@
 """Is an output folder usable? Asked before any work is done, so a long run does not end in a
-traceback at its first write (a read-only disk, a file where a folder should be, a typo'd mount)."""
+traceback at its first write (a read-only disk, a file where a folder should be, a typo'd mount).
+
+Also the checks every command that writes shares: a ``name=`` keeps its files inside the folder,
+no output replaces an input, and a failed write is told in words."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 
 
@@ -31,3 +35,44 @@ def folder_problem(path: str | Path) -> str | None:
             return f"cannot be written ({reason})"
         return f"cannot be made in {probe_in} ({reason})"
     return None
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot be the stem of files written inside an output folder, or None if it
+    can: it must be a plain file name, so that every write stays inside the folder."""
+    if not name:
+        return "is empty"
+    if "\0" in name:
+        return "holds a NUL character"
+    if "/" in name or "\\" in name or (os.altsep and os.altsep in name):
+        return "must be a file name without a directory (no / or \\)"
+    if name in {".", ".."}:
+        return f"{name!r} is not a file name"
+    return None
+
+
+def same_file(a: str | Path, b: str | Path) -> bool:
+    """True when ``a`` and ``b`` both exist and are the same file (links and ``..`` seen through)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def overwritten_input(targets: Iterable[str | Path], inputs: Iterable[str | Path]) -> tuple[Path, Path] | None:
+    """The first ``(target, input)`` pair where writing ``target`` would replace an input file."""
+    inputs = [Path(p) for p in inputs]
+    for target in targets:
+        for source in inputs:
+            if same_file(target, source):
+                return Path(target), source
+    return None
+
+
+def write_problem(exc: OSError) -> str:
+    """The reason an ``OSError`` of a write gives, in words (``No space left on device``)."""
+    if exc.strerror:
+        return exc.strerror
+    if exc.errno:
+        return os.strerror(exc.errno)
+    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__

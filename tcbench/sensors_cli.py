@@ -12,6 +12,7 @@ from omegaconf import OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
 from tcbench.config import TrackingConfig
+from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
 class CommandError(ValueError):
@@ -28,9 +29,30 @@ def writable_folder(path: str | Path) -> Path:
     return Path(path)
 
 
-def cannot_write(out: str | Path, exc: Exception) -> CommandError:
-    """The one-line error for a recording that could not be written into ``out``."""
-    return CommandError(f"{out}: cannot write the recording ({getattr(exc, 'strerror', None) or exc})")
+def cannot_write(out: str | Path, exc: OSError, what: str = "the recording") -> CommandError:
+    """The one-line error for files that could not be written into ``out`` (a full disk, a
+    read-only mount, a quota)."""
+    from tcbench.outputs import write_problem
+
+    return CommandError(f"out={out}: cannot write {what} ({write_problem(exc)})")
+
+
+def file_stem(name: str, args: list[str], key: str = "name") -> str:
+    """``name`` (the ``key=`` argument) checked as the stem of files written inside ``out=``;
+    an empty ``key=`` in ``args`` is refused too (it would otherwise mean the default)."""
+    from tcbench.outputs import name_problem
+
+    if f"{key}=" in args:
+        name = ""
+    if problem := name_problem(name):
+        raise CommandError(f"{key}={name!r}: {problem}")
+    return name
+
+
+def overwrite_error(exc: Any) -> CommandError:
+    """The one-line error for output that would replace one of the command's inputs."""
+    return CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out= "
+                        "or name=")
 
 
 @dataclass
@@ -61,6 +83,8 @@ def parse(args: list[str], schema: type) -> Any:
     bad = [a for a in args if "=" not in a or a.startswith("=")]
     if bad:
         raise CommandError(f"expected key=value, got {bad[0]!r}")
+    if nul := [a for a in args if "\0" in a]:
+        raise CommandError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
     try:
         cfg = OmegaConf.merge(OmegaConf.structured(schema), OmegaConf.from_dotlist(args))
         return OmegaConf.to_object(cfg)
@@ -87,25 +111,37 @@ def simulate(args: list[str]) -> int:
     if cfg.device_seed < 0 or cfg.seed < 0:
         raise CommandError("device_seed and seed must be non-negative integers")
     out = writable_folder(cfg.out)
-    if fitted is not None:
-        stem = cfg.name or f"{Path(str(cfg.model)).stem}-{cfg.protocol}-seed{cfg.seed}"
+    if cfg.name is not None or "name=" in args:
+        stem = file_stem(cfg.name or "", args)
+    elif fitted is not None:
+        stem = f"{Path(str(cfg.model)).stem}-{cfg.protocol}-seed{cfg.seed}"
     else:
-        stem = cfg.name or f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
+        stem = f"{cfg.sensor}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
     try:
         rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed,
                                  effects=cfg.effects, without=tuple(cfg.without), model=fitted,
                                  **cfg.protocol_params)
     except (TypeError, ValueError) as exc:
         raise CommandError(str(exc)) from None
+    path = out / f"{stem}.{cfg.format}"
+    inputs = [cfg.model] if cfg.model else []
+    report = None
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        path = write_recording(rec, out / f"{stem}.{cfg.format}")
-    except (RecordingError, OSError) as exc:
-        raise cannot_write(out, exc) from None
+        with staged_dir(out, inputs) as tmp:  # the recording and its metrics, all or nothing
+            write_recording(rec, tmp / path.name)
+            if cfg.metrics:
+                report = _analysed(path, rec, tmp / f"{stem}_metrics", None)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc) from None
+    except OSError as exc:
+        raise cannot_write(out, exc, "the recording and its metrics" if cfg.metrics else "the recording") from None
     print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
           f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
-    if cfg.metrics:
-        _report(path, rec, out / f"{stem}_metrics", None, cfg.tracking, {"kind": "simulation", "args": args})
+    if report is not None:
+        report.files = moved(report.files, tmp, out)
+        _show(path, rec, report, cfg.tracking, {"kind": "simulation", "args": args})
     return 0
 
 
@@ -138,20 +174,33 @@ class MetricsConfig:
 
 
 def metrics(args: list[str]) -> int:
-    from tcbench.sensors.recording import RecordingError, read_recording
+    from tcbench.sensors.recording import RecordingError, read_recording, sidecar_path
 
     if args and "=" not in args[0]:
         args = [f"recording={args[0]}", *args[1:]]
     cfg: MetricsConfig = parse(args, MetricsConfig)
     if not cfg.recording:
         raise CommandError("say which recording: tcbench metrics recording=PATH")
+    scale = cfg.scale_factor_hz_per_g
+    if scale is not None and not (math.isfinite(scale) and scale > 0):
+        raise CommandError(f"scale_factor_hz_per_g: must be a finite number > 0, got {scale:g}")
     path = Path(cfg.recording)
     try:
         rec = read_recording(path)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
+    except OSError as exc:
+        raise CommandError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     out = writable_folder(cfg.out or path.with_name(f"{path.stem}_metrics"))
-    _report(path, rec, out, cfg.scale_factor_hz_per_g, cfg.tracking, {"kind": "metrics"})
+    try:
+        with staged_dir(out, [path, sidecar_path(path)]) as tmp:  # a failure leaves nothing behind
+            report = _analysed(path, rec, tmp, scale)
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc) from None
+    except OSError as exc:
+        raise cannot_write(out, exc, "the metrics") from None
+    report.files = moved(report.files, tmp, out)
+    _show(path, rec, report, cfg.tracking, {"kind": "metrics"})
     return 0
 
 
@@ -175,6 +224,7 @@ class ImportConfig:
 
 
 def import_command(args: list[str]) -> int:
+    from tcbench.outputs import overwritten_input
     from tcbench.sensors.importer import import_csv, save
     from tcbench.sensors.recording import RecordingError
 
@@ -190,10 +240,11 @@ def import_command(args: list[str]) -> int:
         columns["input"] = cfg.input
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
-    stem = cfg.name or csv.stem
-    if "/" in stem or stem in {".", ".."}:
-        raise CommandError(f"name must be a file name without a directory, got {stem!r}")
+    stem = file_stem(cfg.name if cfg.name is not None else csv.stem, args)
     writable_folder(cfg.out)
+    targets = [Path(cfg.out) / f"{stem}.csv", Path(cfg.out) / f"{stem}.json"]
+    if clash := overwritten_input(targets, [csv]):
+        raise overwrite_error(InputOverwriteError(*clash))
     try:
         rec = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
                          sample_rate_hz=cfg.sample_rate_hz)
@@ -202,8 +253,12 @@ def import_command(args: list[str]) -> int:
     except OSError as exc:
         raise CommandError(f"{csv}: cannot read the file ({exc.strerror or exc})") from None
     try:
-        path = save(rec, cfg.out, stem)
-    except (RecordingError, OSError) as exc:
+        path = save(rec, cfg.out, stem, inputs=[csv])
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc) from None
+    except OSError as exc:
         raise cannot_write(cfg.out, exc) from None
     source, seg = rec.meta.extra["source"], rec.meta.extra["segments"]
     n_drop = source["rows_dropped"]
@@ -214,17 +269,18 @@ def import_command(args: list[str]) -> int:
     return 0
 
 
-def _report(path: Path, rec: Any, out: Path, scale_factor: float | None, track: TrackingConfig,
-            tags: dict[str, Any]) -> None:
+def _analysed(path: Path, rec: Any, out: Path, scale_factor: float | None) -> Any:
+    """The metrics report of ``rec``, its plots and tables written into ``out``."""
     from tcbench.metrics.report import analyse
-    from tcbench.staging import moved, staged_dir
 
     try:
-        with staged_dir(out) as tmp:  # a recording the metrics cannot serve leaves nothing behind
-            report = analyse(rec, tmp, scale_factor)
+        return analyse(rec, out, scale_factor)
     except ValueError as exc:
         raise CommandError(f"{path}: {exc}") from None
-    report.files = moved(report.files, tmp, out)
+
+
+def _show(path: Path, rec: Any, report: Any, track: TrackingConfig, tags: dict[str, Any]) -> None:
+    """Print a metrics report and log it to MLflow when tracking is on."""
     width = max(len(k) for k in report.metrics)
     print(f"\nmetrics of {path.name} ({rec.meta.sensor}, {rec.meta.device_id}):")
     for key, value in report.metrics.items():

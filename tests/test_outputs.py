@@ -7,11 +7,15 @@ import os
 import subprocess
 import sys
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from tcbench.outputs import folder_problem
+from tcbench.outputs import folder_problem, name_problem, overwritten_input
+from tcbench.sensors.recording import make_recording, write_recording
+from tcbench.staging import InputOverwriteError, staged_dir
 
 
 def listing(root: Path) -> list[str]:
@@ -84,3 +88,84 @@ def test_metrics_refuses_an_unusable_output_folder(workdir: Path) -> None:
     out = tcbench("metrics", str(recording), "out=blocker/m", "tracking.enabled=false", cwd=workdir)
     assert out.returncode == 2 and "out=blocker/m: cannot be made: blocker is not a folder" in out.stderr
     assert "Traceback" not in out.stderr and listing(workdir) == before
+
+
+# -- names, inputs and staging ----------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["", ".", "..", "a/b", "../x", "/tmp/x", "a\\b", "a\0b"])
+def test_names_that_leave_the_folder_are_refused(name: str) -> None:
+    assert name_problem(name) is not None
+
+
+@pytest.mark.parametrize("name", ["run1", "gyro-static-dev0-seed0", ".hidden", "a b", "x.y"])
+def test_plain_names_pass(name: str) -> None:
+    assert name_problem(name) is None
+
+
+def test_an_input_is_found_through_another_spelling(tmp_path: Path) -> None:
+    (tmp_path / "sub").mkdir()
+    src = tmp_path / "src.csv"
+    src.write_text("x\n")
+    (tmp_path / "link.csv").symlink_to(src)
+    assert overwritten_input([tmp_path / "sub" / ".." / "src.csv"], [src]) is not None
+    assert overwritten_input([tmp_path / "link.csv"], [src]) is not None
+    assert overwritten_input([tmp_path / "new.csv", tmp_path / "sub"], [src, tmp_path / "missing"]) is None
+
+
+def test_staging_keeps_inputs_and_leaves_no_folder_it_made(tmp_path: Path) -> None:
+    src = tmp_path / "out" / "a.txt"
+    src.parent.mkdir()
+    src.write_text("input")
+    with pytest.raises(InputOverwriteError), staged_dir(tmp_path / "out", [src]) as tmp:
+        (tmp / "b.txt").write_text("new")
+        (tmp / "a.txt").write_text("new")
+    assert listing(tmp_path) == ["out", "out/a.txt"] and src.read_text() == "input"  # not even b.txt moved
+    with pytest.raises(OSError), staged_dir(tmp_path / "x" / "y" / "out") as tmp:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert listing(tmp_path) == ["out", "out/a.txt"]  # x/ and x/y/ made for the staging are gone
+
+
+def test_staging_merges_folders(tmp_path: Path) -> None:
+    with staged_dir(tmp_path / "out") as tmp:
+        (tmp / "m").mkdir()
+        (tmp / "m" / "old.png").write_text("1")
+        (tmp / "m" / "same.json").write_text("1")
+    with staged_dir(tmp_path / "out") as tmp:
+        (tmp / "m").mkdir()
+        (tmp / "m" / "same.json").write_text("2")
+    assert listing(tmp_path) == ["out", "out/m", "out/m/old.png", "out/m/same.json"]
+    assert (tmp_path / "out" / "m" / "same.json").read_text() == "2"
+
+
+@pytest.fixture
+def small_tmpfs(tmp_path: Path) -> Iterator[Path]:
+    """A 2 MB tmpfs, nearly full (skipped where mounting is not allowed)."""
+    mount = tmp_path / "full"
+    mount.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(mount)], capture_output=True,
+                          check=False)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    try:
+        (mount / "filler").write_bytes(b"\0" * (2 * 1024 * 1024 - 64 * 1024))
+        yield mount
+    finally:
+        subprocess.run(["umount", str(mount)], check=False)
+
+
+def test_a_real_full_disk(workdir: Path, small_tmpfs: Path) -> None:
+    """Simulate, metrics and diagnose into a full tmpfs: one line, exit 2, nothing left there."""
+    t_s = np.arange(2000.0)
+    temp_c = np.linspace(20.0, 30.0, t_s.size)
+    rate_dps = 0.01 * temp_c + np.random.default_rng(0).normal(0.0, 0.01, t_s.size)
+    write_recording(make_recording(t_s, temp_c, 0.0 * t_s, rate_dps, sensor="gyro", sample_rate_hz=1.0,
+                                   device_id="d"), workdir / "rec.csv")
+    before = listing(small_tmpfs)
+    for args in (["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=2000",
+                  "protocol_params.sample_rate_hz=1", "tracking.enabled=false", f"out={small_tmpfs}/o"],
+                 ["metrics", "rec.csv", f"out={small_tmpfs}/m", "tracking.enabled=false"],
+                 ["diagnose", "recording=rec.csv", f"out={small_tmpfs}/d"]):
+        out = tcbench(*args, cwd=workdir)
+        lines = out.stderr.strip().splitlines()
+        assert out.returncode == 2 and len(lines) == 1, out.stderr
+        assert lines[0].startswith("tcbench: error: out=") and "(No space left on device)" in lines[0], lines
+        assert listing(small_tmpfs) == before

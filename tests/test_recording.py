@@ -279,3 +279,37 @@ def test_bom_crlf_and_quoted_csv(tmp_path):
     (tmp_path / "d.csv").write_text("time_s,temperature_c,input,output,time_s\n0,25,0,1.5,0\n")
     with pytest.raises(RecordingError, match=r"d\.csv: duplicate column 'time_s'$"):
         read_recording(tmp_path / "d.csv")
+
+
+# -- bounded reading: the same verdicts read in small pieces ---------------------------------------
+@pytest.mark.parametrize(("row", "line", "end"), [
+    (321, "320,25,0,abc", "\n"),  # not a number
+    (321, "", "\n"),  # blank line
+    (321, "320,25,0", "\n"),  # a field short
+    (400, "399,25,0,1\0", "\n"),  # a NUL byte
+    (500, "499,25,0,1.", "\n"),  # fine
+    (500, "499,25,0,", "\n"),  # empty cell at the end
+    (500, "499,25,0,1.", ""),  # fine without the last newline
+    (500, "499,25,0,1e", ""),  # a number cut short
+    (500, "499,25", ""),  # a line cut short
+])
+def test_pieces_give_the_whole_file_verdict(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, row: int, line: str,
+                                            end: str) -> None:
+    import tcbench.sensors.recording_files as files
+
+    lines = [f"{i},25,0,1" for i in range(500)]
+    lines[row - 1] = line
+    path = tmp_path / "t.csv"
+    path.write_text("time_s,temperature_c,input,output\n" + "\n".join(lines) + end)
+
+    def verdict() -> str:
+        try:
+            read_recording(path)
+        except RecordingError as err:
+            return str(err)
+        return "ok"
+
+    whole = verdict()
+    monkeypatch.setattr(files, "CHUNK_BYTES", 64)
+    assert verdict() == whole
+    assert whole == "ok" or f"row {row}," in whole or f"row {row}:" in whole, whole

@@ -6,7 +6,7 @@ import logging
 from dataclasses import dataclass
 from pathlib import Path
 
-from tcbench.sensors_cli import CommandError, parse, writable_folder
+from tcbench.sensors_cli import CommandError, cannot_write, overwrite_error, parse, writable_folder
 
 log = logging.getLogger(__name__)
 
@@ -28,7 +28,8 @@ def diagnose_command(args: list[str]) -> int:
     from tcbench.diagnose.model_file import ModelFileError, read_model
     from tcbench.diagnose.report import write_report
     from tcbench.diagnose.signals import DiagnosisDataError
-    from tcbench.sensors.recording import read_recording
+    from tcbench.sensors.recording import read_recording, sidecar_path
+    from tcbench.staging import InputOverwriteError
     from tcbench.sensors.recording_schema import RecordingError
 
     cfg: DiagnoseConfig = parse(args, DiagnoseConfig)
@@ -41,6 +42,8 @@ def diagnose_command(args: list[str]) -> int:
         rec = read_recording(cfg.recording)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
+    except OSError as exc:
+        raise CommandError(f"{cfg.recording}: cannot read the file ({exc.strerror or exc})") from None
     sensor = cfg.sensor or rec.meta.sensor
     if sensor is None:
         raise CommandError(f"{cfg.recording}: no sidecar says which sensor this is; give sensor=msra or sensor=gyro")
@@ -59,7 +62,13 @@ def diagnose_command(args: list[str]) -> int:
         diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
-    written = write_report(diag, cfg.out)
+    inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
+    try:
+        written = write_report(diag, cfg.out, inputs)
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc) from None
+    except OSError as exc:
+        raise cannot_write(cfg.out, exc, "the report") from None
     print(f"tcbench: {diag.verdict}")
     print(f"  baseline RMSE held-out {diag.baseline['rmse_heldout']:.4g} {diag.unit}, final "
           f"{diag.final['rmse_heldout']:.4g} {diag.unit}, white noise {diag.noise['white_sigma']:.4g} {diag.unit}")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -31,10 +32,11 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def write_report(diag: Diagnosis, out: str | Path) -> dict[str, Path]:
-    """Write the report files into ``out`` (created if needed); returns name -> path."""
+def write_report(diag: Diagnosis, out: str | Path, inputs: Sequence[str | Path] = ()) -> dict[str, Path]:
+    """Write the report files into ``out`` (created if needed), none of them over one of
+    ``inputs``; returns name -> path."""
     out = Path(out)
-    with staged_dir(out) as tmp:
+    with staged_dir(out, inputs) as tmp:
         (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
         write_model(parse_model(_plain(diag.model), "model.yaml"), tmp / "model.yaml")
         plots = write_plots(diag, tmp)

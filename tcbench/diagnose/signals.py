@@ -22,6 +22,7 @@ from tcbench.sensors.segments import segments
 
 MAD_TO_SIGMA = 1.4826
 GRID_S = 1.0  # clock of the lag filter and the play operator
+MAX_GRID_SAMPLES = 5_000_000  # that clock over the recording: 58 days at 1 s
 
 
 class DiagnosisDataError(ValueError):
@@ -78,8 +79,19 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
     return value, rate
 
 
+def check_grid(t_s: np.ndarray, grid_s: float = GRID_S) -> None:
+    """Refuse a recording whose span on a uniform clock of ``grid_s`` would exceed
+    :data:`MAX_GRID_SAMPLES`, before anything is allocated."""
+    n = (float(t_s[-1]) - float(t_s[0])) / grid_s if t_s.size else 0.0
+    if not n <= MAX_GRID_SAMPLES:
+        raise DiagnosisDataError(
+            f"the recording spans {n * grid_s:.3g} s: its {grid_s:g} s filter clock would hold {n:.3g} samples, more "
+            f"than the {MAX_GRID_SAMPLES:.0e} a diagnosis allocates (split it into shorter recordings)")
+
+
 def on_grid(t_s: np.ndarray, x: np.ndarray, fn, grid_s: float = GRID_S) -> np.ndarray:  # type: ignore[no-untyped-def]
     """Apply ``fn(x_grid, grid_s)`` to ``x`` resampled on a uniform clock, read back at ``t_s``."""
+    check_grid(t_s, grid_s)
     grid = np.arange(t_s[0], t_s[-1] + grid_s, grid_s)
     return np.interp(t_s, grid, fn(np.interp(grid, t_s, x), grid_s))
 
@@ -157,6 +169,7 @@ def prepare(
         raise DiagnosisDataError(
             f"recording too short to identify anything: {t.size} samples over {t[-1] - t[0]:.0f} s "
             f"(need at least {min_samples} samples over {min_duration_s:.0f} s)")
+    check_grid(t)
     span = float(np.ptp(temp))
     if span < min_span_c:
         raise DiagnosisDataError(

@@ -36,7 +36,7 @@ from tcbench.sensors.recording import (
     make_recording,
     write_recording,
 )
-from tcbench.sensors.recording_files import _check_fields, _diagnose_csv, _header_names
+from tcbench.sensors.recording_files import CHUNK_BYTES, _check_fields, _diagnose_csv, _header_names, _scan_text
 from tcbench.sensors.segments import GAP_FACTOR, bounds, segments, within_rate_hz
 from tcbench.staging import staged_dir
 
@@ -106,7 +106,7 @@ def _read(path: Path, used: Sequence[str], header: Sequence[str]) -> tuple[dict[
     try:
         table = pcsv.read_csv(
             path,
-            read_options=pcsv.ReadOptions(column_names=list(header), skip_rows=1),
+            read_options=pcsv.ReadOptions(column_names=list(header), skip_rows=1, block_size=CHUNK_BYTES),
             parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
             convert_options=pcsv.ConvertOptions(column_types=dict.fromkeys(used, pa.float64()),
                                                 include_columns=list(used), null_values=[""],
@@ -117,7 +117,7 @@ def _read(path: Path, used: Sequence[str], header: Sequence[str]) -> tuple[dict[
         raise RecordingError(f"cannot parse the table ({str(exc).splitlines()[0]})") from None
     empty = np.zeros((table.num_rows, len(used)), dtype=bool)
     if any(table[c].null_count for c in used):  # an empty cell, or a short or blank line
-        _check_fields(path.read_bytes(), list(header))
+        _check_fields(path, list(header))
         empty = np.column_stack([table[c].is_null().to_numpy(zero_copy_only=False) for c in used])
     return {c: table[c].to_numpy() for c in used}, empty
 
@@ -192,6 +192,7 @@ def import_csv(
         if not path.is_file():
             raise RecordingError("no such file")
         header = _header_names(path)
+        _scan_text(path, header)
         spec = {k: parse_column(k, v, sensor, header) for k, v in columns.items() if v}
         for flag in drop:
             if flag not in header:
@@ -234,9 +235,10 @@ def import_csv(
         raise _in_csv(err, name, rows, spec, table, sensor) from None
 
 
-def save(rec: Recording, out: str | Path, stem: str) -> Path:
+def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path] = ()) -> Path:
     """Write ``rec`` as ``out/<stem>.csv`` and its sidecar, all or nothing (``out`` is not even
-    created when writing fails)."""
-    with staged_dir(out) as tmp:
+    created when writing fails); neither may replace one of ``inputs``
+    (:class:`~tcbench.staging.InputOverwriteError`)."""
+    with staged_dir(out, inputs) as tmp:
         write_recording(rec, tmp / f"{stem}.csv")
     return Path(out) / f"{stem}.csv"

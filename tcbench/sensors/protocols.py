@@ -17,12 +17,15 @@ sensor's ``thermal_lag`` effect).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from tcbench.sensors.thermal import Segment, first_order_lag, gauss_markov, segment_index, setpoint
 
+MAX_LEVELS = 1000  # temperature levels of an oven run
+MAX_SAMPLES = 100_000_000  # a longer profile is refused before any array is made (8 bytes x columns each)
 POSITIONS = {  # label: (acceleration along the sensitive axis, across it), in g
     "+0g": (0.0, 1.0),
     "+1g": (1.0, 0.0),
@@ -65,6 +68,25 @@ class Chamber:
     package_tau_s: float = 180.0
 
 
+def check_length(duration_s: float, sample_rate_hz: float, thermal_dt_s: float | None = None) -> None:
+    """Refuse a profile of fewer than two samples, or of more than :data:`MAX_SAMPLES` samples
+    (or thermal steps of ``thermal_dt_s``), before anything is allocated."""
+    n = duration_s * sample_rate_hz
+    steps = duration_s / thermal_dt_s if thermal_dt_s else 0.0
+    if not n >= 2:
+        raise ValueError(f"protocol_params: {duration_s:g} s at {sample_rate_hz:g} Hz is {math.floor(n)} sample(s); "
+                         "a recording needs at least two (raise duration_s or sample_rate_hz)")
+    if max(n, steps) > MAX_SAMPLES:
+        raise ValueError(f"protocol_params: {duration_s:g} s at {sample_rate_hz:g} Hz is {max(n, steps):.3g} samples, "
+                         f"more than the {MAX_SAMPLES:.0e} a simulation makes (shorten it or lower sample_rate_hz)")
+
+
+def programme_s(segments: list[Segment], start_c: float, ramp_c_per_min: float) -> float:
+    """Length of a segment programme in s: its holds plus the ramps between them."""
+    targets = np.array([start_c] + [s.target_c for s in segments])
+    return float(np.abs(np.diff(targets)).sum() * 60.0 / ramp_c_per_min + sum(s.duration_s for s in segments))
+
+
 def _from_segments(
     name: str,
     sensor: str,
@@ -75,6 +97,7 @@ def _from_segments(
 ) -> Profile:
     """Sample a segment programme: set-point -> chamber air -> package, inputs per segment."""
     thermal_dt = min(1.0, 1.0 / sample_rate_hz)
+    check_length(programme_s(segments, start_c, chamber.ramp_c_per_min), sample_rate_hz, thermal_dt)
     t_th, sp = setpoint(segments, start_c, chamber.ramp_c_per_min, thermal_dt)
     air = first_order_lag(sp, thermal_dt, chamber.air_tau_s)
     package = first_order_lag(air, thermal_dt, chamber.package_tau_s)
@@ -134,6 +157,7 @@ def msra_roomtemp(
     The package warms by ``self_heating_c`` with time constant ``self_heating_tau_s`` after
     power-on, on top of an ambient that wanders (Gauss-Markov, std ``wander_c``).
     """
+    check_length(duration_s, sample_rate_hz)
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
     thermal_dt = max(1.0 / sample_rate_hz, 1.0)
     coarse_t = np.arange(0.0, duration_s + thermal_dt, thermal_dt)
@@ -158,6 +182,9 @@ def gyro_oven(
     chamber: Chamber = Chamber(ramp_c_per_min=1.0),
 ) -> Profile:
     """Seed 001 §4.1 oven run: room temperature, 60 degC, then 10 degC steps down to -40 degC."""
+    if (hot_c - cold_c) / step_c > MAX_LEVELS:
+        raise ValueError(f"protocol_params.step_c: {step_c:g} degC makes more than {MAX_LEVELS} levels from "
+                         f"{hot_c:g} to {cold_c:g} degC")
     levels = np.arange(hot_c, cold_c - 1e-9, -step_c)
     segments = [Segment(room_c, room_s, cross_g=0.0)]
     segments += [Segment(float(level), hold_s, cross_g=0.0) for level in levels]
@@ -169,6 +196,7 @@ def gyro_static(
 ) -> Profile:
     """A long run at rest and constant temperature (for Allan variance). The constant columns
     are read-only broadcast views, so a 24 h run at 100 Hz holds one full-length array (time)."""
+    check_length(duration_s, sample_rate_hz)
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
     zeros = np.broadcast_to(np.float64(0.0), t.shape)
     return Profile("static", "gyro", sample_rate_hz, t, np.broadcast_to(np.float64(temp_c), t.shape), zeros, zeros, zeros)

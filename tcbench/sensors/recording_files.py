@@ -2,6 +2,10 @@
 
 Reading returns normalised tables (see :mod:`tcbench.sensors.recording_schema`); writing goes
 through :func:`_atomic_write`, which renames complete temporary files into place.
+
+Before a CSV file is parsed its first line is read with a size cap and the rest is scanned in
+pieces for NUL bytes and over-long lines, and a table pyarrow cannot parse is diagnosed piece by
+piece: a binary, sparse or corrupted file of any size is judged with bounded memory.
 """
 
 from __future__ import annotations
@@ -23,6 +27,11 @@ import pyarrow.parquet as pq
 
 from tcbench.sensors.recording_schema import FORMATS, NUMERIC_COLUMNS, RecordingError, _check_columns, _normalise
 
+MAX_HEADER_BYTES = 64 * 1024  # a longer first line is no header
+MAX_LINE_BYTES = 1024 * 1024  # a longer line is no recording's (and would straddle pyarrow's blocks)
+MAX_SIDECAR_BYTES = 16 * 1024 * 1024
+CHUNK_BYTES = 4 * 1024 * 1024  # files are scanned and diagnosed in pieces of this size
+
 
 def _format(path: Path) -> str:
     """The table format from the suffix."""
@@ -34,6 +43,9 @@ def _format(path: Path) -> str:
 
 def _load_json(path: Path) -> Any:
     """Parsed JSON of a sidecar."""
+    size = path.stat().st_size
+    if size > MAX_SIDECAR_BYTES:
+        raise RecordingError(f"{size / 2**20:.0f} MiB is too big for a sidecar (at most {MAX_SIDECAR_BYTES >> 20} MiB)")
     try:
         return json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
@@ -43,16 +55,60 @@ def _load_json(path: Path) -> Any:
 
 
 def _header_names(path: Path) -> list[str]:
-    """Column names from the first line of a CSV file, whatever they are."""
+    """Column names from the first line of a CSV file, whatever they are (at most
+    :data:`MAX_HEADER_BYTES` of it are read)."""
     with path.open("rb") as f:
-        line = f.readline()
+        line = f.readline(MAX_HEADER_BYTES + 1)
+    if b"\0" in line:
+        raise RecordingError("the header holds a NUL byte: a binary file, not CSV text")
+    if len(line) > MAX_HEADER_BYTES:
+        raise RecordingError(f"the first line is longer than {MAX_HEADER_BYTES >> 10} KiB: not a CSV header")
     try:
         text = line.decode("utf-8-sig").strip()
     except UnicodeDecodeError:
         raise RecordingError("the header is not UTF-8 text") from None
     if not text:
         raise RecordingError("empty file (no header)")
-    return [c.strip() for c in next(csv.reader([text]))]
+    try:
+        return [c.strip() for c in next(csv.reader([text]))]
+    except csv.Error as exc:
+        raise RecordingError(f"the header cannot be read as CSV ({exc})") from None
+
+
+def _scan_text(path: Path, names: list[str]) -> None:
+    """Raise at the first NUL byte or line longer than :data:`MAX_LINE_BYTES` of a CSV file,
+    reading it in pieces of :data:`CHUNK_BYTES` (a binary or sparse file of any size costs one
+    piece of memory), before any parser sees it."""
+    line, line_start, offset = 0, 0, 0  # line number (0: the header), where it starts, where the piece starts
+    with path.open("rb") as f:
+        while piece := f.read(CHUNK_BYTES):
+            nul = piece.find(b"\0")
+            text = piece if nul < 0 else piece[:nul]
+            ends = np.flatnonzero(np.frombuffer(text, dtype=np.uint8) == ord("\n")) + offset
+            starts = np.concatenate(([line_start], ends[:-1] + 1))
+            long = np.flatnonzero(ends - starts > MAX_LINE_BYTES)
+            if long.size:
+                _long_line(f, int(starts[long[0]]), line + int(long[0]), names)
+            if ends.size:
+                line, line_start = line + ends.size, int(ends[-1]) + 1
+            if offset + len(text) - line_start > MAX_LINE_BYTES:
+                _long_line(f, line_start, line, names)
+            if nul >= 0:
+                f.seek(line_start)
+                j = f.read(offset + nul - line_start).count(b",")
+                raise RecordingError("a NUL byte: a binary file, not CSV text", row=line or None,
+                                     column=names[j] if j < len(names) else f"field {j + 1}")
+            offset += len(piece)
+
+
+def _long_line(f: BinaryIO, start: int, line: int, names: list[str]) -> None:
+    """Raise for the over-long line ``line`` starting at byte ``start``, naming its longest cell."""
+    f.seek(start)
+    cells = f.read(MAX_LINE_BYTES + 1).split(b",")
+    j = int(np.argmax([len(c) for c in cells]))
+    column = names[j] if j < len(names) else f"field {j + 1}"
+    raise RecordingError(f"a line longer than {MAX_LINE_BYTES >> 20} MiB ({len(cells[j])} bytes or more in this "
+                         "cell)", row=line or None, column=column)
 
 
 def _read_header(path: Path) -> list[str]:
@@ -65,6 +121,7 @@ def _read_header(path: Path) -> list[str]:
 def _read_csv(path: Path) -> pd.DataFrame:
     """Parse a CSV table fast with pyarrow; on any doubt re-read it as text to locate the problem."""
     names = _read_header(path)
+    _scan_text(path, names)
     types = {c: pa.float64() if c in NUMERIC_COLUMNS else pa.string() for c in names}
     try:
         table = _arrow_csv(path, names, types)
@@ -85,7 +142,7 @@ def _arrow_csv(path: Path, names: list[str], types: dict[str, pa.DataType]) -> p
     """Read the rows below the header with the given column types; empty cells become null."""
     return pcsv.read_csv(
         path,
-        read_options=pcsv.ReadOptions(column_names=names, skip_rows=1),
+        read_options=pcsv.ReadOptions(column_names=names, skip_rows=1, block_size=CHUNK_BYTES),
         parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
         convert_options=pcsv.ConvertOptions(column_types=types, null_values=[""], strings_can_be_null=True,
                                             quoted_strings_can_be_null=False),
@@ -94,34 +151,87 @@ def _arrow_csv(path: Path, names: list[str], types: dict[str, pa.DataType]) -> p
 
 def _diagnose_csv(path: Path, names: list[str], numeric: Sequence[str] = NUMERIC_COLUMNS) -> None:
     """Raise the first structural or cell problem (in the ``numeric`` columns) of a CSV table;
-    return if none is found."""
-    raw = path.read_bytes()
-    complete = raw.endswith(b"\n")
-    _check_fields(raw, names)
-    text = _arrow_csv(path, names, dict.fromkeys(names, pa.string()))
-    first: tuple[int, int, str] | None = None
-    for j, c in enumerate(numeric):
-        cells = text[c].combine_chunks().fill_null("")
-        i, problem = _first_bad_cell(cells, last_is_cut=not complete)
-        if problem and (first is None or i < first[0]):
-            first = (i, j, problem)
-    if first is not None:
-        raise RecordingError(first[2], row=first[0] + 1, column=numeric[first[1]])
+    return if none is found. The file is read in pieces, never whole."""
+    _check_fields(path, names)
+    try:
+        _first_bad_row(path, names, numeric)
+    except pa.ArrowInvalid:  # a problem the field count does not show: the caller's message stands
+        return
 
 
-def _check_fields(raw: bytes, names: list[str]) -> None:
-    """Raise at the first line of the CSV text ``raw`` below the header that is blank, cut short
-    or has a number of fields other than the header's."""
-    fields = _fields_per_line(raw)[1:]
+def _first_bad_row(path: Path, names: list[str], numeric: Sequence[str]) -> None:
+    """Raise at the first cell of the ``numeric`` columns that is empty, not a number or not
+    finite, reading the table in batches."""
+    complete = _ends_with_newline(path)
+    reader = pcsv.open_csv(
+        path,
+        read_options=pcsv.ReadOptions(column_names=names, skip_rows=1, block_size=CHUNK_BYTES),
+        parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+        convert_options=pcsv.ConvertOptions(column_types=dict.fromkeys(names, pa.string()), null_values=[""],
+                                            strings_can_be_null=True, quoted_strings_can_be_null=False),
+    )
+    row0, batch = 0, _next_batch(reader)
+    while batch is not None:
+        after = _next_batch(reader)
+        first: tuple[int, int, str] | None = None
+        for j, c in enumerate(numeric):
+            cells = batch.column(batch.schema.get_field_index(c)).fill_null("")
+            i, problem = _first_bad_cell(cells, last_is_cut=after is None and not complete)
+            if problem and (first is None or i < first[0]):
+                first = (i, j, problem)
+        if first is not None:
+            raise RecordingError(first[2], row=row0 + first[0] + 1, column=numeric[first[1]])
+        row0, batch = row0 + batch.num_rows, after
+
+
+def _ends_with_newline(path: Path) -> bool:
+    """True when the file's last byte is a newline (or the file is empty)."""
+    with path.open("rb") as f:
+        if f.seek(0, os.SEEK_END) == 0:
+            return True
+        f.seek(-1, os.SEEK_END)
+        return f.read(1) == b"\n"
+
+
+def _next_batch(reader: pcsv.CSVStreamingReader) -> pa.RecordBatch | None:
+    """The next non-empty record batch of a streaming CSV reader, or None at the end."""
+    for batch in reader:
+        if batch.num_rows:
+            return batch
+    return None
+
+
+def _check_fields(path: Path, names: list[str]) -> None:
+    """Raise at the first line of the CSV file below the header that is blank, cut short or has
+    a number of fields other than the header's (read in pieces of whole lines)."""
+    row0, rest = 0, b""
+    with path.open("rb") as f:
+        f.readline(MAX_HEADER_BYTES + 1)
+        while True:
+            piece = f.read(CHUNK_BYTES)
+            text = rest + piece
+            cut = len(text) if not piece else text.rfind(b"\n") + 1
+            block, rest = text[:cut], text[cut:]
+            if block:
+                _check_block(block, names, row0, last=not piece)
+                row0 += block.count(b"\n") + (not block.endswith(b"\n"))
+            if not piece:
+                return
+
+
+def _check_block(block: bytes, names: list[str], row0: int, *, last: bool) -> None:
+    """:func:`_check_fields` on whole lines ``block`` whose first line is data row ``row0 + 1``;
+    ``last`` when the block ends the file."""
+    fields = _fields_per_line(block)
     wrong = np.flatnonzero(fields != len(names))
     if wrong.size:
         i = int(wrong[0])
         n = int(fields[i])
         if n == 0:
-            raise RecordingError("blank line", row=i + 1)
-        if i == fields.size - 1 and n < len(names) and not raw.endswith(b"\n"):
-            raise RecordingError(f"truncated last line ({n} of {len(names)} fields)", row=i + 1)
-        raise RecordingError(f"{n} fields, the header has {len(names)}", row=i + 1)
+            raise RecordingError("blank line", row=row0 + i + 1)
+        if last and i == fields.size - 1 and n < len(names) and not block.endswith(b"\n"):
+            raise RecordingError(f"truncated last line ({n} of {len(names)} fields)", row=row0 + i + 1)
+        raise RecordingError(f"{n} fields, the header has {len(names)}", row=row0 + i + 1)
 
 
 def _fields_per_line(raw: bytes) -> np.ndarray:

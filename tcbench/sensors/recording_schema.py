@@ -28,6 +28,8 @@ STANDARD_UNITS = {
 KNOWN_UNITS = {c: tuple(dict.fromkeys(u[c] for u in STANDARD_UNITS.values())) for c in NUMERIC_COLUMNS}
 FORMATS = (".csv", ".parquet")
 RATE_TOLERANCE = 0.01
+TIME_LIMIT_S = 1.0e10  # |time_s| beyond this (317 years) is a unit mistake or a glitch, not a clock
+GAP_LIMIT = 1.0e4  # a step longer than this many times the time all samples cover is a clock glitch
 _SIDECAR_KEYS = ("schema_version", "sensor", "units", "sample_rate_hz", "device_id")
 
 
@@ -136,6 +138,30 @@ def _check_table(data: pd.DataFrame) -> None:
         problem = (f"duplicate time_s {cur!r} (same as row {i + 1})" if cur == prev
                    else f"time_s goes back from {prev!r} to {cur!r}")
         raise RecordingError(problem, row=i + 2, column="time_s")
+    _check_clock(t)
+
+
+def _check_clock(t_s: np.ndarray) -> None:
+    """An increasing clock that a sample rate can describe: every time within
+    :data:`TIME_LIMIT_S`, and no gap longer than :data:`GAP_LIMIT` times the time the samples
+    cover at the median step (``n * step``). A logger's bursts pass: their gaps are minutes
+    between seconds of data, not years after a minute; a uniform grid over the clock then stays
+    within ``GAP_LIMIT`` times the samples per gap."""
+    far = np.abs(t_s) > TIME_LIMIT_S
+    if far.any():
+        i = int(np.argmax(far))
+        raise RecordingError(f"{t_s[i]:g} s is not a plausible time (beyond ±{TIME_LIMIT_S:g} s, 317 years; "
+                             "ms or µs given as s?)", row=i + 1, column="time_s")
+    if t_s.size < 3:
+        return
+    dt = np.diff(t_s)
+    step_s = float(np.median(dt))
+    covered_s = t_s.size * step_s
+    i = int(np.argmax(dt))
+    if dt[i] > GAP_LIMIT * covered_s:
+        raise RecordingError(f"a gap of {dt[i]:.3g} s after {step_s:.3g} s steps: more than {GAP_LIMIT:g} times the "
+                             f"{covered_s:.3g} s the {t_s.size} samples cover at that step (a clock glitch?)",
+                             row=i + 2, column="time_s")
 
 
 def _meta_from_dict(doc: Any) -> RecordingMeta:

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Callable
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -44,9 +46,36 @@ def build_profile(
     if unknown:
         raise ValueError(f"protocol {protocol!r} has no parameter {', '.join(unknown)}; known: "
                          f"{', '.join(p for p in accepted if p != 'rng')}")
+    given = {k: _checked_param(k, v, accepted[k].default) for k, v in given.items()}
     if "rng" in accepted:
         given["rng"] = rng
     return fn(**given)
+
+
+def _checked_param(key: str, value: Any, default: Any) -> Any:
+    """A protocol parameter checked against its default's kind: a finite number (> 0 for a
+    rate, a total duration or a step, >= 0 for other durations), or a non-empty list of them."""
+    where = f"protocol_params.{key}"
+    if isinstance(default, tuple):
+        if not isinstance(value, (list, tuple)) or not value:
+            raise ValueError(f"{where}: must be a non-empty list of numbers, got {value!r}")
+        return tuple(_number(where, v) for v in value)
+    if not isinstance(default, Real):
+        raise ValueError(f"{where}: cannot be set from outside (it is a {type(default).__name__})")
+    x = _number(where, value)
+    if key.endswith("_hz") or key in {"duration_s", "step_c"}:
+        if x <= 0:
+            raise ValueError(f"{where}: must be a finite number > 0, got {x:g}")
+    elif key.endswith("_s") and x < 0:
+        raise ValueError(f"{where}: must be a finite number >= 0, got {x:g}")
+    return x
+
+
+def _number(where: str, value: Any) -> float:
+    """``value`` as a finite float, or a ``ValueError`` naming ``where``."""
+    if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(float(value)):
+        raise ValueError(f"{where}: must be a finite number, got {value!r}")
+    return float(value)
 
 
 def simulate_recording(
@@ -72,7 +101,11 @@ def simulate_recording(
             raise ValueError(f"the model is for a {model.kind}, not a {sensor}")
         device = Unit(f"fitted-{sensor}", model)
     base = device.model
-    model = base.with_effects(effects or {}).without(*without)
+    changed = base.with_effects(effects or {})
+    present = [e.id for e in changed.effects]
+    if unknown := [w for w in without if w not in present]:
+        raise ValueError(f"without: no effect {unknown[0]!r} in the {sensor} model; its effects: {', '.join(present)}")
+    model = changed.without(*without)
     profile_rng, sensor_rng, thermometer_rng = (
         np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
     )
