@@ -111,6 +111,7 @@ def simulate(args: list[str]) -> int:
     if cfg.device_seed < 0 or cfg.seed < 0:
         raise CommandError("device_seed and seed must be non-negative integers")
     out = writable_folder(cfg.out)
+    checked_store(cfg.tracking)
     if cfg.name is not None or "name=" in args:
         stem = file_stem(cfg.name or "", args)
     elif fitted is not None:
@@ -192,6 +193,7 @@ def metrics(args: list[str]) -> int:
     except OSError as exc:
         raise CommandError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     out = writable_folder(cfg.out or path.with_name(f"{path.stem}_metrics"))
+    checked_store(cfg.tracking)
     try:
         with staged_dir(out, [path, sidecar_path(path)]) as tmp:  # a failure leaves nothing behind
             report = _analysed(path, rec, tmp, scale)
@@ -279,6 +281,22 @@ def _analysed(path: Path, rec: Any, out: Path, scale_factor: float | None) -> An
         raise CommandError(f"{path}: {exc}") from None
 
 
+def checked_store(track: TrackingConfig) -> None:
+    """With tracking on: the experiment has a name and the store can be used, checked before any
+    work and without making anything (:func:`tcbench.tracking.check_store`); a
+    :class:`CommandError` otherwise."""
+    if not track.enabled:
+        return
+    if not str(track.experiment or "").strip():
+        raise CommandError("tracking.experiment: give the MLflow experiment a name, or tracking.enabled=false")
+    from tcbench import tracking
+
+    try:
+        tracking.check_store(track.uri, create=True)  # made when the results are logged
+    except tracking.StoreError as exc:
+        raise CommandError(str(exc)) from None
+
+
 def _show(path: Path, rec: Any, report: Any, track: TrackingConfig, tags: dict[str, Any]) -> None:
     """Print a metrics report and log it to MLflow when tracking is on."""
     width = max(len(k) for k in report.metrics)
@@ -291,17 +309,21 @@ def _show(path: Path, rec: Any, report: Any, track: TrackingConfig, tags: dict[s
         print("\n" + report.nodes.round(6).to_string(index=False))
     print(f"\nplots and tables: {', '.join(str(p) for p in report.files.values())}")
     if track.enabled:
-        run_id = _log_to_mlflow(path, rec, report, track, tags)
         from tcbench import tracking
 
+        try:
+            run_id = _log_to_mlflow(path, rec, report, track, tags)
+        except Exception as exc:  # noqa: BLE001 - a full disk or a dead server: the files are written
+            raise CommandError(f"the files are written, but MLflow at {tracking.tracking_uri(track.uri)} could not "
+                               f"record them ({tracking.first_line(exc)})") from None
         print(f"logged to MLflow run {run_id} in {tracking.tracking_uri(track.uri)} (experiment {track.experiment!r})")
 
 
 def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tags: dict[str, Any]) -> str:
     from tcbench import tracking
 
+    exp = tracking.prepare_store(track.uri, track.experiment)  # a store it cannot finish is not left behind
     client = tracking.client(track.uri)
-    exp = tracking.experiment_id(client, track.experiment)
     run = client.create_run(exp, run_name=f"{rec.meta.device_id}-{path.stem}", tags={
         "tcbench.kind": str(tags["kind"]), "tcbench.sensor": str(rec.meta.sensor),
         "tcbench.device_id": str(rec.meta.device_id), "tcbench.recording": str(path.resolve()),
@@ -323,8 +345,8 @@ def _log_to_mlflow(path: Path, rec: Any, report: Any, track: TrackingConfig, tag
             sidecar.write_text(OmegaConf.to_yaml(OmegaConf.create(extra)) if extra else "{}")
             handle.log_artifact(sidecar)
         handle.flush()
-    except BaseException:
-        client.set_terminated(run_id, status="FAILED")
+    except BaseException as exc:
+        tracking.mark_failed(client, run_id, f"{type(exc).__name__}: {exc}")
         raise
     client.set_terminated(run_id, status="FINISHED")
     return run_id

@@ -94,7 +94,8 @@ class StoreError(Exception):
     """The tracking store cannot be used: one line saying why."""
 
 
-def _first_line(exc: BaseException) -> str:
+def first_line(exc: BaseException) -> str:
+    """One line of an exception's text (a database error's own message where it wraps one)."""
     text = str(getattr(exc, "orig", None) or exc).strip()
     return text.splitlines()[0][:300] if text else type(exc).__name__
 
@@ -152,7 +153,7 @@ def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str
             MlflowClient(tracking_uri=resolved).search_experiments(max_results=1)
             problem = None
         except Exception as exc:  # noqa: BLE001 - any failure of an unknown store is the user's to fix
-            problem = _first_line(exc)
+            problem = first_line(exc)
     if problem:
         raise StoreError(f"tracking store {resolved}: {problem}")
     return resolved
@@ -173,7 +174,7 @@ def prepare_store(uri: str | None, experiment: str) -> str:
     except Exception as exc:  # noqa: BLE001 - a full disk, a locked or corrupt database, a refused login
         if new and db is not None:  # a store this call began is not left half-made
             db.unlink(missing_ok=True)
-        raise StoreError(f"tracking store {tracking_uri(uri)}: cannot be prepared ({_first_line(exc)})") from exc
+        raise StoreError(f"tracking store {tracking_uri(uri)}: cannot be prepared ({first_line(exc)})") from exc
 
 
 def flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
@@ -296,7 +297,7 @@ def mark_failed(c: MlflowClient, run_id: str, error: str, status: str = "FAILED"
         c.set_tag(run_id, f"{TAG_PREFIX}error", error[:4900])
         c.set_terminated(run_id, status=status)
     except Exception as exc:  # noqa: BLE001 - a full disk or a dead server: say so, do not mask the job's error
-        log.error("run %s could not be marked %s in %s: %s", run_id, status, c.tracking_uri, _first_line(exc))
+        log.error("run %s could not be marked %s in %s: %s", run_id, status, c.tracking_uri, first_line(exc))
         return False
     return True
 

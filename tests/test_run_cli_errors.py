@@ -85,3 +85,19 @@ def test_run_help_lists_plugin_optimisers(tmp_path: Path) -> None:
     out = tcbench("run", "--help", cwd=tmp_path)
     group = next(ln for ln in out.stdout.splitlines() if ln.startswith("optimiser:"))
     assert "cmaes" in group and "ifa" in group
+
+
+SIM = ["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=200",
+       "protocol_params.sample_rate_hz=1"]
+
+
+def test_simulate_and_metrics_check_the_store_before_any_work(tmp_path: Path) -> None:
+    """simulate and metrics log to MLflow too: a bad store is refused before anything is written."""
+    port = closed_port()
+    one_line_error(tcbench(*SIM, "tracking.uri=foo://bar", "out=o", cwd=tmp_path), "foo://bar")
+    one_line_error(tcbench(*SIM, "tracking.experiment=", "out=o", cwd=tmp_path), "tracking.experiment")
+    assert not (tmp_path / "o").exists() and not (tmp_path / "mlflow.db").exists()
+    assert tcbench(*SIM, "tracking.enabled=false", "metrics=false", "name=r", "out=o", cwd=tmp_path).returncode == 0
+    out = tcbench("metrics", "o/r.csv", f"tracking.uri=http://127.0.0.1:{port}", cwd=tmp_path)
+    one_line_error(out, "nothing answers")
+    assert not (tmp_path / "o" / "r_metrics").exists()

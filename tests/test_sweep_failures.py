@@ -225,3 +225,16 @@ def test_job_folders_on_a_full_disk_stop_the_sweep_in_one_line(site: Path, small
     assert run.returncode == 2 and "Traceback" not in run.stderr
     (line,) = [ln for ln in run.stderr.splitlines() if ln.startswith("tcbench: error:")]
     assert "cannot write multirun/" in line and "No space left on device" in line
+
+
+def test_simulate_on_a_full_store_disk_is_one_line(site: Path, tmp_path: Path, small_disk) -> None:  # type: ignore[no-untyped-def]
+    """simulate and metrics log to MLflow after writing their files: a store that cannot be made
+    is one line naming it, and leaves no half-made database."""
+    disk = small_disk("500k")
+    run = tcbench("simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=200",
+                  "protocol_params.sample_rate_hz=1", "out=o", f"tracking.uri=sqlite:///{disk / 'mlflow.db'}",
+                  cwd=tmp_path, site=site)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "could not record them" in run.stderr and "database or disk is full" in run.stderr
+    assert (tmp_path / "o" / "gyro-static-dev0-seed0.csv").exists()
+    assert not (disk / "mlflow.db").exists()
