@@ -150,6 +150,8 @@ def test_one_way_steps_without_soak_cannot_separate_lag_from_rate() -> None:
                              sample_rate_hz=1.0, hold_s=60.0, room_s=600.0)
     d = diagnose(rec)
     assert d.effect_ids == ["thermal_lag"]
+    # 2.6 h: the CV blocks are sized to the recording (390 s, not 15 min); with them the held-out
+    # error separates the lag from a rate term, but not from hysteresis, which also needs soaks
     pairs = {tuple(c["effects"]): c["test"] for c in d.confusable}
-    assert "soak" in pairs[("thermal_lag", "temperature_rate")]
-    assert "cannot be told from temperature_rate" in d.verdict
+    assert pairs and all(a == "thermal_lag" and "soak" in test for (a, _), test in pairs.items())
+    assert "thermal_lag cannot be told from" in d.verdict

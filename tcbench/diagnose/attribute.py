@@ -4,13 +4,23 @@ Each round tries every effect not yet in the model at every value of its grid, s
 
     gain = (SSE_heldout(model) - SSE_heldout(model + effect)) / v - 2 * extra parameters
 
-(the held-out SSE from blocked cross-validation; ``v`` the variance of the noise along the
-added signal: white output noise plus the thermometer's noise carried through the model; the
-``2`` per parameter is Akaike's penalty). The effect with the largest gain is kept when its gain
-exceeds ``threshold`` and a Wald statistic with a variance robust to slow noise (cluster scores
-with Bartlett-weighted neighbours, never above the known-noise Wald) exceeds
-``wald_threshold``; both are checked on recordings with nothing missing
-(``experiments/diagnose-concealed/calibrate.py``). Its nonlinear parameter is then refined
+(the held-out SSE from blocked cross-validation with blocks sized to the recording,
+:mod:`tcbench.diagnose.plan`; ``v`` the variance of the noise along the added signal: white
+output noise plus the thermometer's noise carried through the model; the ``2`` per parameter is
+Akaike's penalty). The effect with the largest gain is kept when its gain exceeds ``threshold``
+and it is significant against the residual's slow noise, by the strongest test the recording
+supports:
+
+- with enough clusters, a Wald statistic with a variance robust to slow noise (cluster scores
+  with Bartlett-weighted neighbours, never above the known-noise Wald) above
+  ``wald_threshold``; both thresholds are checked on recordings with nothing missing
+  (``experiments/diagnose-concealed/calibrate.py``);
+- with few clusters (a short recording), or when the effect removes at least half of the
+  held-out error above the noise and the Wald test still rejects it (its cluster variance then
+  counts the structure still unexplained as noise), the spectral surrogate test of
+  :mod:`tcbench.diagnose.surrogate` at p <= its ``LEVEL``.
+
+Each effect's evidence says which test decided. Its nonlinear parameter is then refined
 between its grid neighbours. After the forward pass each kept effect must still earn its place,
 and when the residual turns out to hold flicker, :func:`recheck_with_flicker` tests the kept
 effects again with that flicker in the noise model. Pairs that look alike (PHYSICS.md §3) are
@@ -27,13 +37,16 @@ from scipy.optimize import minimize_scalar
 
 from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
+from tcbench.diagnose.plan import ROBUST_WALD, SURROGATE, StatsPlan, plan_for
+from tcbench.diagnose.surrogate import LEVEL, surrogate_test
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
 
 PENALTY_PER_PARAM = 2.0
 DETECTION_THRESHOLD = 10.0  # gain in units of sigma^2; see experiments/diagnose-concealed/calibrate.py
 WALD_THRESHOLD = 25.0  # cluster-robust Wald statistic; same calibration
-CLUSTER_S = (300.0, 900.0)  # clusters of the robust variance: duration / 32, within these bounds
+MOST_OF_EXCESS = 0.5  # an effect removing this share of the held-out error above noise is never dropped by the Wald test alone
+SURROGATE_SEED = 20240611  # the surrogate test's generator: same recording, same diagnosis
 CONFUSABLE: dict[frozenset[str], str] = {
     frozenset({"thermal_lag", "temperature_rate"}): (
         "soaks of at least five die time constants after fast ramps: a lagging die keeps drifting "
@@ -65,6 +78,8 @@ class Evidence:
     reason: str = ""
     confusable_with: list[str] = field(default_factory=list)
     wald: float = float("nan")
+    test: str = ""
+    p_value: float = float("nan")
 
 
 @dataclass
@@ -81,13 +96,16 @@ class Attribution:
     designer: Designer
     fold: np.ndarray
     k: int
+    plan: StatsPlan | None = None
 
 
 class _Scorer:
     """Held-out fits of models on one recording, memoised."""
 
-    def __init__(self, designer: Designer, fold: np.ndarray, k: int, cluster: np.ndarray) -> None:
+    def __init__(self, designer: Designer, fold: np.ndarray, k: int, cluster: np.ndarray,
+                 rng: np.random.Generator | None = None) -> None:
         self.designer, self.fold, self.k, self.cluster = designer, fold, k, cluster
+        self.rng = rng if rng is not None else np.random.default_rng(SURROGATE_SEED)
         self.sigma2 = designer.data.white_sigma**2
         self._memo: dict[Model, Fit] = {}
         self._noise_memo: dict[tuple[Model, Model], tuple[float, float]] = {}
@@ -125,6 +143,33 @@ class _Scorer:
         known = float(z @ self.fit(base).residual) ** 2 / max(self._noise(base, model)[1], 1e-300)
         return min(robust, known)
 
+    def surrogate_p(self, base: Model, effect: str, value: float | None) -> float:
+        """p-value of adding ``effect`` to ``base`` by the surrogate test, searched over its
+        grid and ``value``; the noise model is the residual of ``base`` plus ``effect`` at ``value``."""
+        values = [*grid_values(effect), *([value] if value is not None else [])]
+        xs = [self.designer.matrix(base.with_effect(effect, v)) for v in values]
+        noise = self.fit(base.with_effect(effect, value)).residual
+        p, _ = surrogate_test(self.designer.matrix(base), xs, self.designer.data.output, noise, self.rng)
+        return p
+
+    def removes_most(self, base: Model, model: Model) -> bool:
+        """Whether ``model`` removes at least :data:`MOST_OF_EXCESS` of the held-out squared
+        error that ``base`` leaves above the white noise."""
+        excess = self.fit(base).sse_heldout - self.designer.data.n * self.sigma2
+        drop = self.fit(base).sse_heldout - self.fit(model).sse_heldout
+        return excess > 0 and drop >= MOST_OF_EXCESS * excess
+
+    def significant(self, base: Model, effect: str, value: float | None, test: str, wald_threshold: float
+                    ) -> tuple[bool, float, float, str]:
+        """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise:
+        ``(passed, robust Wald, surrogate p-value, test that decided)`` (see module doc)."""
+        model = base.with_effect(effect, value)
+        wald = self.wald(base, model)
+        if test == ROBUST_WALD and (wald > wald_threshold or not self.removes_most(base, model)):
+            return wald > wald_threshold, wald, float("nan"), ROBUST_WALD
+        p = self.surrogate_p(base, effect, value)
+        return p <= LEVEL, wald, p, SURROGATE
+
     def best(self, base: Model, effect: str) -> tuple[float, float | None]:
         """Best gain of adding ``effect`` to ``base`` over its grid, then refined."""
         values = grid_values(effect)
@@ -133,6 +178,8 @@ class _Scorer:
         if values[i] is None:
             return gains[i], None
         lo, hi = np.log(values[max(i - 1, 0)]), np.log(values[min(i + 1, len(values) - 1)])  # type: ignore[arg-type]
+        if i == len(values) - 1 and effect == "hysteresis":  # best at the grid's edge: search on, to half the span
+            hi = max(hi, float(np.log(0.5 * np.ptp(self.designer.data.temp_c))))
         res = minimize_scalar(lambda z: -self.gain(base, base.with_effect(effect, float(np.exp(z)))),
                               bounds=(lo, hi), method="bounded", options={"xatol": 0.02})
         if -res.fun > gains[i]:
@@ -146,17 +193,20 @@ def attribute(
     *,
     threshold: float = DETECTION_THRESHOLD,
     wald_threshold: float = WALD_THRESHOLD,
-    block_s: float = 900.0,
-    k: int = 5,
+    plan: StatsPlan | None = None,
     max_effects: int = 4,
+    seed: int = SURROGATE_SEED,
 ) -> Attribution:
-    """Forward selection of the library's deterministic effects onto ``base`` (see module doc)."""
+    """Forward selection of the library's deterministic effects onto ``base`` (see module doc);
+    ``plan`` the blocks, clusters and test (default: sized to the recording by
+    :func:`~tcbench.diagnose.plan.plan_for`), ``seed`` that of the surrogate test's generator."""
     base = base or Model()
     data = designer.data
-    fold = block_folds(data.t_s, block_s, k)
-    cluster_s = float(np.clip((data.t_s[-1] - data.t_s[0]) / 32.0, *CLUSTER_S))
-    cluster = np.floor((data.t_s - data.t_s[0]) / cluster_s).astype(np.int64)
-    scorer = _Scorer(designer, fold, k, cluster)
+    plan = plan or plan_for(data)
+    k = plan.k
+    fold = block_folds(data.t_s, plan.block_s, k)
+    cluster = np.floor((data.t_s - data.t_s[0]) / plan.cluster_s).astype(np.int64)
+    scorer = _Scorer(designer, fold, k, cluster, np.random.default_rng(seed))
     evidence: dict[str, Evidence] = {}
     for effect in DETERMINISTIC:
         if effect in base.ids:
@@ -170,32 +220,47 @@ def attribute(
         if not open_effects:
             break
         tried = {e: scorer.best(model, e) for e in open_effects}
-        walds = {e: scorer.wald(model, model.with_effect(e, v)) for e, (g, v) in tried.items()}
         for e, (g, v) in tried.items():
-            why = ("held-out gain below the threshold" if g <= threshold else
-                   "not significant against the residual's slow noise (robust Wald below the threshold)")
-            evidence[e] = Evidence(e, "rejected", g, threshold, v, why, wald=walds[e])
-        passing = [e for e in tried if tried[e][0] > threshold and walds[e] > wald_threshold]
+            if g <= threshold:
+                evidence[e] = Evidence(e, "rejected", g, threshold, v, "held-out gain below the threshold",
+                                       wald=scorer.wald(model, model.with_effect(e, v)))
+        passing = []
+        for e in (e for e in tried if tried[e][0] > threshold):
+            g, v = tried[e]
+            ok, wald, p, test = scorer.significant(model, e, v, plan.test, wald_threshold)
+            evidence[e] = Evidence(e, "rejected", g, threshold, v, _not_significant(test, p), wald=wald, test=test,
+                                   p_value=p)
+            if ok:
+                passing.append(e)
         if not passing:
             break
         winner = max(passing, key=lambda e: tried[e][0])
         gain, value = tried[winner]
         model = model.with_effect(winner, value)
-        evidence[winner] = Evidence(winner, "kept", gain, threshold, value, "held-out gain above the threshold",
-                                    wald=walds[winner])
+        evidence[winner].status, evidence[winner].reason = "kept", "held-out gain above the threshold"
     for effect in [e for e in model.ids if e not in base.ids]:  # backward check
         reduced = model.without(effect)
-        cost, wald = scorer.gain(reduced, model), scorer.wald(reduced, model)
-        if cost <= threshold or wald <= wald_threshold:
+        cost = scorer.gain(reduced, model)
+        value = _value(model, effect)
+        ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold)
+                             if cost > threshold else (False, scorer.wald(reduced, model), float("nan"), plan.test))
+        if not ok:
             model = reduced
             evidence[effect].status = "rejected"
             evidence[effect].reason = "superseded: the other kept effects explain what it did"
         else:
-            evidence[effect].gain, evidence[effect].wald = cost, wald
-            evidence[effect].value = _value(model, effect)
+            ev = evidence[effect]
+            ev.gain, ev.wald, ev.p_value, ev.test, ev.value = cost, wald, p, test, value
     confusions = _confusions(scorer, model, base, evidence, threshold)
     return Attribution(base, model, scorer.fit(base), scorer.fit(model), evidence, confusions,
-                       designer, fold, k)
+                       designer, fold, k, plan)
+
+
+def _not_significant(test: str, p: float) -> str:
+    if test == SURROGATE:
+        return (f"not significant against the residual's slow noise (surrogate test p = {p:.3g} above "
+                f"{LEVEL:g})")
+    return "not significant against the residual's slow noise (robust Wald below the threshold)"
 
 
 def _value(model: Model, effect: str) -> float | None:
@@ -238,6 +303,8 @@ def recheck_with_flicker(att: Attribution, b: float, *, draws: int = 16, seed: i
     bank = np.stack([flicker(data.n, dt_s, b, rng) for _ in range(draws)])
     model = att.final
     for effect in [e for e in att.final.ids if e not in att.base.ids]:
+        if att.evidence[effect].test == SURROGATE:
+            continue  # its null noise already had the residual's whole spectrum, flicker included
         reduced = model.without(effect)
         z = scorer.fit(reduced).residual - scorer.fit(model).residual
         var_flicker = float(np.mean((bank @ z) ** 2))

@@ -22,6 +22,9 @@ from tcbench.diagnose.attribute import (
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.explain import explain
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
+from tcbench.diagnose.plan import SURROGATE
+from tcbench.diagnose.reference import Reference, reference_fit
+from tcbench.diagnose.surrogate import LEVEL
 from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
@@ -30,6 +33,7 @@ log = logging.getLogger(__name__)
 FALSE_ALARM = 0.01  # of the mismatch scan and of the flicker test
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
 TIME_EFFECTS = ("warmup", "aging_drift")  # what a slow random excursion of the bias can mimic
+REFERENCE_RATIO = 1.25  # final / reference held-out RMSE above which deterministic structure remains
 FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every power-on and ageing keeps "
                 "its sign, a flicker excursion does neither")
 
@@ -65,6 +69,15 @@ class Diagnosis:
     confusable: list[dict[str, Any]]
     model: dict[str, Any]
     series: Series = field(repr=False)
+    reference: dict[str, Any] = field(default_factory=dict)
+    statistics: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def deterministic_remains(self) -> bool:
+        """Whether the physics-agnostic reference beats the final model by more than
+        :data:`REFERENCE_RATIO` held out: temperature structure the model leaves in its residual."""
+        ref = self.reference.get("rmse_heldout")
+        return bool(ref) and self.final["rmse_heldout"] > REFERENCE_RATIO * ref
 
     @property
     def effect_ids(self) -> list[str]:
@@ -82,7 +95,11 @@ class Diagnosis:
             return "nothing missing: the residual of the starting model is consistent with its noise"
         named = ", ".join(self.effect_ids)
         pairs = "; ".join(f"{c['effects'][0]} cannot be told from {c['effects'][1]}" for c in self.confusable)
-        return f"missing: {named}" + (f" ({pairs})" if pairs else "") + (f"; {rest}" if self.remaining else "")
+        out = f"missing: {named}" + (f" ({pairs})" if pairs else "") + (f"; {rest}" if self.remaining else "")
+        if self.deterministic_remains:
+            out += (f"; deterministic temperature structure remains: a generic temperature model reaches "
+                    f"{self.final['rmse_heldout'] / self.reference['rmse_heldout']:.3g}x lower held-out RMSE")
+        return out
 
     def to_json(self) -> dict[str, Any]:
         """``report.json``: plain JSON data."""
@@ -91,7 +108,7 @@ class Diagnosis:
             "verdict": self.verdict, "baseline": self.baseline,
             "mismatch": [m.to_dict() for m in self.mismatch],
             "remaining_mismatch": [m.to_dict() for m in self.remaining], "effects": self.effects,
-            "final": self.final, "noise": self.noise,
+            "final": self.final, "reference": self.reference, "statistics": self.statistics, "noise": self.noise,
             "candidates": [_evidence_json(e) for e in self.candidates],
             "confusable": self.confusable,
         }
@@ -101,8 +118,21 @@ def _evidence_json(e: Evidence) -> dict[str, Any]:
     out: dict[str, Any] = {"id": e.effect, "status": e.status, "reason": e.reason}
     if np.isfinite(e.gain):
         out |= {"gain_sigma2": round(float(e.gain), 2), "threshold_sigma2": float(e.threshold)}
+    out |= _test_json(e)
     if e.value is not None and e.effect in PARAM_NAME:
         out[PARAM_NAME[e.effect]] = float(e.value)
+    return out
+
+
+def _test_json(e: Evidence) -> dict[str, Any]:
+    """Which significance test decided for ``e`` and its statistic."""
+    if not e.test:
+        return {}
+    out: dict[str, Any] = {"test": e.test}
+    if np.isfinite(e.wald):
+        out["robust_wald"] = round(float(e.wald), 2)
+    if e.test == SURROGATE and np.isfinite(e.p_value):
+        out |= {"p_value": round(float(e.p_value), 4), "level": LEVEL}
     return out
 
 
@@ -200,6 +230,11 @@ def diagnose(
     # coefficient error, constant over its 15-min blocks, which looks like slow noise.
     allan_before, _ = _flicker(data, att.base_fit.residual, thermo_before)
     allan_after, b = _flicker(data, att.final_fit.residual, propagated_noise(designer, att.final, att.final_fit.beta))
+    reference = reference_fit(data, att.fold, att.k)
+    final_rmse = _rmse(att.final_fit.sse_heldout, n)
+    structure_left = final_rmse > REFERENCE_RATIO * reference.rmse_heldout
+    if structure_left:  # deterministic before stochastic: an Allan excess made by it is not flicker
+        b = None
     if b is not None and len(att.final.ids) > len(base.ids):
         rechecked = recheck_with_flicker(att, b)
         if rechecked is not att:
@@ -218,10 +253,15 @@ def diagnose(
     for e in found:
         evidence[e].reason = "dropping it costs more held-out error than chance allows"
         ev = {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold),
-              "robust_wald": round(float(evidence[e].wald), 2)}
+              **_test_json(evidence[e])}
         effects_out.append({"id": e, "params": fitted[e], "evidence": ev, "explanation": explain(e, fitted[e], data.unit),
                             **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})})
     evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared)
+    if structure_left and "bias_instability" not in declared:
+        evidence["bias_instability"] = Evidence(
+            "bias_instability", "not tested", reason=(
+                f"deterministic temperature structure remains (the reference reaches {reference.rmse_heldout:.4g}, "
+                f"the final model {final_rmse:.4g} {data.unit} held out): flicker is judged only once it is modelled"))
     confusable = [{"effects": [a, b_], "test": test} for a, b_, test in att.confusions if a in found]
     if b is not None and "bias_instability" not in declared:
         effects_out.append({
@@ -243,8 +283,19 @@ def diagnose(
                "model": ["minimal", *att.final.ids]},
         noise={"white_sigma": data.white_sigma, "thermometer_sigma_c": thermometer_sigma(designer),
                "samples": n, "folds": att.k},
+        reference=_reference_json(reference, final_rmse, data.white_sigma),
+        statistics=att.plan.to_json() if att.plan else {},
         candidates=[evidence[e] for e in (*DETERMINISTIC, "bias_instability") if e in evidence],
         confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
     )
+
+
+def _reference_json(ref: Reference, final_rmse: float, sigma: float) -> dict[str, Any]:
+    """report.json's ``reference``: the physics-agnostic model's held-out RMSE beside the final one."""
+    return {**ref.to_json(), "rmse_heldout_sigma": ref.rmse_heldout / sigma,
+            "final_over_reference": final_rmse / ref.rmse_heldout if ref.rmse_heldout > 0 else float("inf"),
+            "deterministic_structure_remains": final_rmse > REFERENCE_RATIO * ref.rmse_heldout,
+            "what": ("ridge regression on the smoothed thermometer temperature, its powers, first-order lags at "
+                     "several time constants, dT/dt and time, under the same blocked folds")}

@@ -7,7 +7,9 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
-from tcbench.diagnose.diagnosis import Diagnosis
+from tcbench.diagnose.diagnosis import REFERENCE_RATIO, Diagnosis
+from tcbench.diagnose.plan import SURROGATE
+from tcbench.diagnose.surrogate import LEVEL
 
 PLOT_CAPTIONS = {
     "residuals": "Held-out residual of the starting and the final model against time and temperature "
@@ -59,8 +61,13 @@ def _evidence_line(effect: dict[str, Any]) -> str:
         return (f"Allan deviation {_g(ev['allan_ratio'], 3)} times the white-noise line from tau = "
                 f"{_g(ev.get('tau_s'))} s, above the bound {_g(ev.get('bound'), 3)}.")
     if "gain_sigma2" in ev:
-        return (f"dropping it raises the held-out squared error by {_g(ev['gain_sigma2'])} sigma^2 "
-                f"(penalised), against a threshold of {_g(ev.get('threshold_sigma2'))} sigma^2.")
+        line = (f"dropping it raises the held-out squared error by {_g(ev['gain_sigma2'])} sigma^2 "
+                f"(penalised), against a threshold of {_g(ev.get('threshold_sigma2'))} sigma^2")
+        if ev.get("test") == SURROGATE:
+            return line + f"; significant by the {SURROGATE} test, p = {_g(ev.get('p_value'), 3)} <= {_g(LEVEL)}."
+        if "robust_wald" in ev:
+            return line + f"; cluster-robust Wald {_g(ev['robust_wald'], 3)} > {_g(WALD_THRESHOLD)}."
+        return line + "."
     return "-"
 
 
@@ -68,6 +75,12 @@ def _gain_cell(e: Evidence) -> str:
     if e.effect == "bias_instability":
         return f"Allan ratio {_g(e.gain, 3)} (bound {_g(e.threshold, 3)})" if math.isfinite(e.gain) else "-"
     return f"{_g(e.gain)} (threshold {_g(e.threshold)})" if math.isfinite(e.gain) else "-"
+
+
+def _test_cell(e: Evidence) -> str:
+    if e.test == SURROGATE:
+        return f"surrogate p = {_g(e.p_value, 3)}"
+    return f"Wald {_g(e.wald, 3)}" if math.isfinite(e.wald) else "-"
 
 
 def _value_cell(e: Evidence) -> str:
@@ -93,9 +106,31 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     for label, fit in (("baseline", d.baseline), ("final", d.final)):
         rows.append([label, ", ".join(fit.get("model", [])), _g(fit["rmse_fit"]), _g(fit["rmse_heldout"]),
                      f"{_g(fit['rmse_heldout'] / sigma, 3)} sigma"])
+    ref = d.reference
+    if ref:
+        rows.append(["reference (no physics)", f"ridge on {len(ref['terms'])} temperature terms", _g(ref["rmse_fit"]),
+                     _g(ref["rmse_heldout"]), f"{_g(ref['rmse_heldout'] / sigma, 3)} sigma"])
     out += _table(["model", "terms", f"RMSE fit ({d.unit})", f"RMSE held-out ({d.unit})", "held-out / white sigma"],
                   rows)
     out.append("")
+    if ref:
+        ratio = ref["final_over_reference"]
+        out += [(f"The reference is a {ref['what']} ({', '.join(ref['terms'])}); it names no physics and says how "
+                 f"far a model driven by the thermometer can go on this recording. Final / reference held-out RMSE: "
+                 f"**{_g(ratio, 3)}**"
+                 + (f", above {_g(REFERENCE_RATIO)}: deterministic temperature structure remains in the final "
+                    "residual, so bias instability is not judged." if ref["deterministic_structure_remains"] else ".")),
+                ""]
+    st = d.statistics
+    if st:
+        test = st["significance_test"]
+        why = (f"the recording holds {st['clusters']} clusters of {_g(st['cluster_s'])} s, too few for the "
+               "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
+               f"candidate model's residual (p <= {_g(LEVEL)})" if test == SURROGATE else
+               f"{st['clusters']} clusters of {_g(st['cluster_s'])} s for the cluster-robust Wald test (an effect that "
+               "removes most of the excess error and fails it is tried by the surrogate test instead)")
+        out += [(f"Statistics sized to this recording: blocks of {_g(st['cv_block_s'])} s in {st['folds']} interleaved "
+                 f"folds; {why}."), ""]
 
     out += ["## Where the starting model misses", ""]
     if d.mismatch:
@@ -142,11 +177,12 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
 
     out += ["## All candidates", "",
             ("Gain: drop in held-out squared error, in units of the white-noise variance, less 2 per added "
-             "parameter. An effect is kept when its gain exceeds the threshold and its cluster-robust Wald "
-             f"statistic exceeds {_g(WALD_THRESHOLD)}. For bias_instability the number is the Allan ratio "
-             "against its bound instead."), ""]
-    out += _table(["effect", "status", "gain (sigma^2)", "Wald", "best parameter", "reason"],
-                  ([e.effect, e.status, _gain_cell(e), _g(e.wald, 3), _value_cell(e), e.reason]
+             "parameter. An effect is kept when its gain exceeds the threshold and it is significant: its "
+             f"cluster-robust Wald statistic exceeds {_g(WALD_THRESHOLD)}, or, where that test cannot be used, "
+             f"the surrogate test's p-value is at most {_g(LEVEL)} (the column says which). For bias_instability "
+             "the number is the Allan ratio against its bound instead."), ""]
+    out += _table(["effect", "status", "gain (sigma^2)", "significance", "best parameter", "reason"],
+                  ([e.effect, e.status, _gain_cell(e), _test_cell(e), _value_cell(e), e.reason]
                    for e in d.candidates))
     out.append("")
 

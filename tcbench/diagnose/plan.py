@@ -1,0 +1,61 @@
+"""The statistics of a diagnosis, sized to the recording (DESIGN.md "Diagnosis").
+
+A diagnosis scores effects by blocked cross-validation and tests them against the residual's
+slow noise. Both need time spans that fit the recording:
+
+- **CV blocks** of ``block_s``: a 24th of the recording (at least four blocks per fold), at
+  least two smoothing windows (so a held-out block is not predicted by the smoothed thermometer
+  of its neighbours) and at most 15 min (the length the library proof was calibrated with on
+  8-12 h records, which keep it). A 70-min chamber cycle gets 18 blocks of 4 min instead of
+  five of 15 min, so leaving one fold out never removes a whole branch of the temperature cycle.
+- **Clusters** of the robust Wald test: ``cluster_s`` a 32nd of the recording, within
+  2.5 smoothing windows and 15 min.
+- **The significance test**: the cluster-robust Wald statistic needs many clusters to estimate
+  the variance of slow noise; with fewer than :data:`MIN_CLUSTERS` the recording cannot support
+  it and the diagnosis uses a surrogate test instead
+  (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric bootstrap under a noise
+  model with the spectrum of the candidate model's own residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tcbench.diagnose.signals import DiagnosisData
+
+FOLDS = 5
+MAX_BLOCK_S = 900.0
+BLOCKS_PER_RECORD = 24
+CLUSTERS_PER_RECORD = 32
+MIN_CLUSTERS = 24
+ROBUST_WALD = "cluster-robust Wald"
+SURROGATE = "spectral surrogate (parametric bootstrap)"
+
+
+@dataclass(frozen=True)
+class StatsPlan:
+    """Block length (s) and fold count of the cross-validation, cluster length (s) and count of
+    the robust test, and which significance test the recording supports (:data:`ROBUST_WALD`
+    or :data:`SURROGATE`)."""
+
+    block_s: float
+    k: int
+    cluster_s: float
+    n_clusters: int
+    test: str
+
+    def to_json(self) -> dict[str, float | int | str]:
+        return {"cv_block_s": self.block_s, "folds": self.k, "cluster_s": self.cluster_s,
+                "clusters": self.n_clusters, "significance_test": self.test}
+
+
+def plan_for(data: DiagnosisData) -> StatsPlan:
+    """The statistics for ``data`` (see module doc)."""
+    span = float(data.t_s[-1] - data.t_s[0])
+    block_s = float(np.clip(span / BLOCKS_PER_RECORD, min(2.0 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
+    cluster_s = float(np.clip(span / CLUSTERS_PER_RECORD, min(2.5 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
+    n_clusters = int(np.floor(span / cluster_s)) + 1
+    test = ROBUST_WALD if n_clusters >= MIN_CLUSTERS else SURROGATE
+    return StatsPlan(block_s, FOLDS, cluster_s, n_clusters, test)

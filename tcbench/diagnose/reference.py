@@ -1,0 +1,115 @@
+"""A physics-agnostic reference: how much temperature structure a recording holds.
+
+Ridge regression of the output on a generic library of temperature terms built from the
+smoothed thermometer ``T`` (degC): powers of ``u = (T - centre) / half range`` up to the
+third, ``T`` through first-order lags at several time constants (and their squares), dT/dt and
+time. It names no physics; it is fitted under the *same* blocked folds as the diagnosis, and
+its held-out RMSE says how far a model driven by the thermometer can go on this recording. A
+final model far above it leaves deterministic structure in its residual.
+
+The ridge penalty is chosen among :data:`ALPHAS` (relative to the mean diagonal of the Gram of
+the standardised columns) by the held-out error itself, so the reference is slightly optimistic.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tcbench.diagnose.signals import DiagnosisData, lagged
+
+ALPHAS = np.geomspace(1e-8, 1e-1, 15)
+N_LAGS = 6  # time constants, log-spaced
+MAX_LAG_FRACTION = 0.25  # the longest lag: a quarter of the recording
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The reference fit: held-out and fit RMSE (output unit), the terms and the ridge
+    penalty chosen; ``heldout_residual`` per sample."""
+
+    rmse_heldout: float
+    rmse_fit: float
+    terms: list[str]
+    alpha: float
+    heldout_residual: np.ndarray
+
+    def to_json(self) -> dict[str, object]:
+        return {"rmse_heldout": self.rmse_heldout, "rmse_fit": self.rmse_fit, "terms": self.terms,
+                "ridge_alpha": self.alpha}
+
+
+def lag_grid_s(data: DiagnosisData) -> np.ndarray:
+    """Time constants (s) of the reference's lags: from the smoothing window to a quarter of
+    the recording, :data:`N_LAGS` log-spaced."""
+    span = float(data.t_s[-1] - data.t_s[0])
+    lo = max(data.smooth_s / 2.0, 2.0 / data.sample_rate_hz)
+    hi = max(MAX_LAG_FRACTION * span, 2.0 * lo)
+    return np.geomspace(lo, hi, N_LAGS)
+
+
+def reference_terms(data: DiagnosisData) -> tuple[np.ndarray, list[str]]:
+    """Columns (n, p) of the reference library (without the intercept) and their names."""
+    temp = data.temp_c
+    centre = 0.5 * (temp.min() + temp.max())
+    half = max(0.5 * float(np.ptp(temp)), 1.0)
+    cols, names = [], []
+    u = (temp - centre) / half
+    for p in (1, 2, 3):
+        cols.append(u**p)
+        names.append(f"u^{p}")
+    for tau in lag_grid_s(data):
+        ul = (lagged(data.t_s, temp, float(tau)) - centre) / half
+        cols += [ul, ul * ul]
+        names += [f"lag(u, {tau:.0f} s)", f"lag(u, {tau:.0f} s)^2"]
+    cols.append(data.rate_c_per_s)
+    names.append("dT/dt")
+    span = max(float(data.t_s[-1] - data.t_s[0]), 1e-12)
+    cols.append((data.t_s - data.t_s[0]) / span)
+    names.append("t")
+    if data.input_levels >= 2:  # the scale factor, as the minimal model has it
+        a = data.input
+        cols += [a, a * u, a * u * u]
+        names += ["input", "input u", "input u^2"]
+    return np.column_stack(cols), names
+
+
+def _ridge_heldout(xs: np.ndarray, y: np.ndarray, fold: np.ndarray, k: int, alpha: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Held-out residual and in-sample residual of ridge (intercept unpenalised, columns
+    already standardised) at relative penalty ``alpha``."""
+    n, p = xs.shape
+    x1 = np.column_stack([np.ones(n), xs])
+    pen = np.full(p + 1, alpha * n)
+    pen[0] = 0.0
+    gram, rhs = x1.T @ x1, x1.T @ y
+    beta = np.linalg.solve(gram + np.diag(pen), rhs)
+    heldout = np.empty_like(y)
+    for f in range(k):
+        m = fold == f
+        if not m.any():
+            continue
+        xf = x1[m]
+        b = np.linalg.solve(gram - xf.T @ xf + np.diag(pen * (1.0 - m.mean())), rhs - xf.T @ y[m])
+        heldout[m] = y[m] - xf @ b
+    return heldout, y - x1 @ beta
+
+
+def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int) -> Reference:
+    """The reference fitted to ``data.output`` under the folds ``fold`` (``k`` of them)."""
+    x, names = reference_terms(data)
+    mu, sd = x.mean(axis=0), x.std(axis=0)
+    sd[sd == 0] = 1.0
+    xs = (x - mu) / sd
+    y = data.output
+    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
+    for alpha in ALPHAS:
+        heldout, resid = _ridge_heldout(xs, y, fold, k, float(alpha))
+        sse = float(heldout @ heldout)
+        if best is None or sse < best[0]:
+            best = (sse, float(alpha), heldout, resid)
+    assert best is not None
+    sse, alpha, heldout, resid = best
+    n = y.size
+    return Reference(float(np.sqrt(sse / n)), float(np.sqrt(resid @ resid / n)), names, alpha, heldout)
