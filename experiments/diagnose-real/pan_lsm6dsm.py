@@ -8,7 +8,7 @@ correction; the 3 samples flagged as spikes are dropped. The data are 25 bursts 
 about 50 Hz, 305 s apart: the recording keeps the bursts with their gaps, and the diagnosis
 treats each burst as a segment.
 
-    python experiments/diagnose-concealed/pan_lsm6dsm.py [--data DIR] [--out DIR]
+    python experiments/diagnose-real/pan_lsm6dsm.py [--data DIR] [--out DIR]
 """
 
 from __future__ import annotations

@@ -1,0 +1,82 @@
+"""Diagnose every gyro axis of the real recordings and hold each final model against the
+physics-agnostic reference (issue 23, item 6), in one command.
+
+Records (PROVENANCE.md beside each under ``../shared/data/real/``):
+- ``tofupilot``: the 70.7-min chamber cycle, -17.6 -> 74 -> 35 degC at about 2 Hz
+  (:func:`tcbench.diagnose.real_records.tofupilot_gyro`);
+- ``pan_lsm6dsm``: the 2-h thermal-vacuum cooling run, 25 bursts of 5 s at about 50 Hz
+  (``pan_lsm6dsm.convert``).
+
+Each axis's report goes to ``--out/<record>/<axis>/`` (report.json, report.md, model.yaml,
+plots); ``--out/summary.md`` holds one row per axis: the starting model's, the final model's
+and the reference's held-out RMSE in white sigma, final / reference (target <= 1.25), the test
+that decided, the effects named and the seconds taken.
+
+    python experiments/diagnose-real/run.py [--out DIR] [--records tofupilot,pan_lsm6dsm]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from pan_lsm6dsm import DATA as PAN_DATA
+from pan_lsm6dsm import convert as pan_gyro
+
+from tcbench.diagnose.diagnosis import REFERENCE_RATIO, diagnose
+from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
+from tcbench.diagnose.report import write_report
+from tcbench.sensors.recording import Recording
+
+RECORDS: dict[str, tuple[Callable[[str], Recording], str, Path]] = {
+    "tofupilot": (lambda axis: tofupilot_gyro(axis, TOFUPILOT_CSV), "tofupilot chamber cycle", TOFUPILOT_CSV),
+    "pan_lsm6dsm": (lambda axis: pan_gyro(PAN_DATA / "pan_lsm6dsm_tvac_cooling.csv", axis),
+                    "PAN LSM6DSM cooling (25 bursts)", PAN_DATA / "pan_lsm6dsm_tvac_cooling.csv"),
+}
+HEADER = ["| record | axis | baseline held-out | final held-out | reference held-out | final / reference | test "
+          "| effects named | s |", "|---|---|---|---|---|---|---|---|---|"]
+
+
+def diagnose_record(record: str, out: Path) -> list[str]:
+    """Diagnose the three gyro axes of ``record``, write their reports under ``out/<record>``;
+    the summary rows."""
+    load, title, source = RECORDS[record]
+    if not source.exists():
+        raise SystemExit(f"run.py: {source} not found (the shared data folder beside the project)")
+    rows = []
+    for axis in ("x", "y", "z"):
+        t0 = time.perf_counter()
+        d = diagnose(load(axis), name=f"{title} gyro {axis}")
+        seconds = time.perf_counter() - t0
+        write_report(d, out / record / axis)
+        s = d.noise["white_sigma"]
+        rows.append(f"| {record} | {axis} | {d.baseline['rmse_heldout'] / s:.2f} sigma | "
+                    f"{d.final['rmse_heldout'] / s:.2f} sigma | {d.reference['rmse_heldout'] / s:.2f} sigma | "
+                    f"{d.reference['final_over_reference']:.2f} | {d.statistics['significance_test']} | "
+                    f"{', '.join(d.effect_ids) or '-'} | {seconds:.1f} |")
+        print(f"{record} {axis}: {d.verdict}", flush=True)
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("leaderboards/diagnose-real"))
+    ap.add_argument("--records", default=",".join(RECORDS), help=f"comma-separated, of {', '.join(RECORDS)}")
+    args = ap.parse_args()
+    records = [r.strip() for r in args.records.split(",") if r.strip()]
+    if unknown := [r for r in records if r not in RECORDS]:
+        raise SystemExit(f"run.py: unknown record {unknown[0]!r}; known: {', '.join(RECORDS)}")
+    rows = [row for record in records for row in diagnose_record(record, args.out)]
+    head = [f"# Real gyro recordings: final model against the physics-agnostic reference (target <= {REFERENCE_RATIO:g})",
+            "", "Held-out RMSE in white sigma (first differences); blocks, folds and the significance test as in "
+            "each report.json `statistics`. Command: `python experiments/diagnose-real/run.py`.", ""]
+    text = "\n".join(head + HEADER + rows) + "\n"
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "summary.md").write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
