@@ -31,9 +31,10 @@ from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording
 
 RECORDS: dict[str, tuple[Callable[[str], Recording], str, Path]] = {
-    "tofupilot": (lambda axis: tofupilot_gyro(axis, TOFUPILOT_CSV), "tofupilot chamber cycle", TOFUPILOT_CSV),
+    "tofupilot": (lambda axis: tofupilot_gyro(axis, TOFUPILOT_CSV), "tofupilot chamber cycle gyro {axis}",
+                  TOFUPILOT_CSV),
     "pan_lsm6dsm": (lambda axis: pan_gyro(PAN_DATA / "pan_lsm6dsm_tvac_cooling.csv", axis),
-                    "PAN LSM6DSM cooling (25 bursts)", PAN_DATA / "pan_lsm6dsm_tvac_cooling.csv"),
+                    "PAN LSM6DSM gyro {axis} (cooling, 25 bursts)", PAN_DATA / "pan_lsm6dsm_tvac_cooling.csv"),
 }
 HEADER = ["| record | axis | baseline held-out | final held-out | reference held-out | final / reference | test "
           "| effects named | s |", "|---|---|---|---|---|---|---|---|---|"]
@@ -48,7 +49,7 @@ def diagnose_record(record: str, out: Path) -> list[str]:
     rows = []
     for axis in ("x", "y", "z"):
         t0 = time.perf_counter()
-        d = diagnose(load(axis), name=f"{title} gyro {axis}")
+        d = diagnose(load(axis), name=title.format(axis=axis))
         seconds = time.perf_counter() - t0
         write_report(d, out / record / axis)
         s = d.noise["white_sigma"]
