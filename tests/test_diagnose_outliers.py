@@ -12,14 +12,19 @@ finding names the time and size of the spike.
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.diagnose.concealed import concealed_profile, concealed_recording
 from tcbench.diagnose import diagnosis as dg
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.markdown import render_markdown
+from tcbench.diagnose.model_file import read_model, to_sensor_model
 from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
+from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording
 
 def _with_spikes(rec: Recording, index: list[int], sizes: list[float]) -> Recording:
@@ -116,3 +121,27 @@ def test_a_long_run_is_not_a_spike() -> None:
     found = find_outliers(t, r, 1.0)
     assert found.index.tolist() == [4000]
     assert found.size[0] == pytest.approx(40.0, abs=4.0)
+
+
+def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], tmp_path: Path) -> None:
+    # model.yaml records the spikes; the simulated model adds each at its sample and nowhere else
+    rec, sigma = clean
+    i = rec.time_s.size // 3
+    spiked = _with_spikes(rec, [i, rec.time_s.size - 1], [80.0 * sigma, -300.0 * sigma])
+    d = diagnose(spiked)
+    files = write_report(d, tmp_path / "report")
+    spec = read_model(files["model.yaml"])
+    assert [t for t, _ in spec.outliers] == [pytest.approx(rec.time_s[i]), pytest.approx(rec.time_s[-1])]
+    assert [v for _, v in spec.outliers] == [pytest.approx(80.0 * sigma, rel=0.1), pytest.approx(-300.0 * sigma, rel=0.03)]
+    model = to_sensor_model(spec)
+    profile = concealed_profile("gyro", np.random.default_rng(np.random.SeedSequence(5).spawn(7)[0]))
+    assert np.allclose(profile.t_s, rec.time_s)  # the record's own clock
+    with_spikes = model.simulate(profile, np.random.default_rng(1))
+    without_spikes = dataclasses.replace(model, spike_time_s=(), spike_size=()).simulate(profile, np.random.default_rng(1))
+    diff = with_spikes - without_spikes
+    assert np.flatnonzero(diff).tolist() == [i, rec.time_s.size - 1]
+    assert diff[[i, -1]].tolist() == [v for _, v in spec.outliers]
+    # and a model without outliers writes no outliers key (older files stay as they were)
+    clean_files = write_report(diagnose(rec), tmp_path / "clean")
+    assert "outliers" not in clean_files["model.yaml"].read_text()
+    assert read_model(clean_files["model.yaml"]).outliers == ()

@@ -283,6 +283,8 @@ def diagnose(
         fitted.setdefault(effect, dict(params))
     fitted["white_noise"] = {"density": data.white_sigma / np.sqrt(data.sample_rate_hz)}
     model = {"tcbench_model": 1, "sensor": data.sensor, "output_unit": data.unit, "core": core, "effects": fitted}
+    if outliers.count:  # so that ``tcbench simulate model=`` reproduces them
+        model["outliers"] = {"time_s": [float(t) for t in outliers.time_s], "size": [float(v) for v in outliers.size]}
     return Diagnosis(
         sensor=data.sensor, unit=data.unit, recording=name,
         baseline={"rmse_fit": _rmse(att.base_fit.sse_fit, n), "rmse_heldout": _rmse(att.base_fit.sse_heldout, n),
