@@ -22,6 +22,7 @@ from tcbench.diagnose.attribute import (
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.explain import explain
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
+from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.plan import SURROGATE
 from tcbench.diagnose.reference import Reference, reference_fit
 from tcbench.diagnose.surrogate import LEVEL
@@ -71,6 +72,7 @@ class Diagnosis:
     series: Series = field(repr=False)
     reference: dict[str, Any] = field(default_factory=dict)
     statistics: dict[str, Any] = field(default_factory=dict)
+    outliers: Outliers | None = None
 
     @property
     def deterministic_remains(self) -> bool:
@@ -89,17 +91,20 @@ class Diagnosis:
         """One line: nothing missing, which effects, and whether a mismatch remains unexplained."""
         rest = ("a mismatch remains that no effect of the library explains on this recording "
                 f"({len(self.remaining)} region(s) or band(s), see remaining_mismatch)")
-        if not self.effects:
+        spikes = (f"; {self.outliers.count} isolated outlier sample(s) given zero weight (see outliers)"
+                  if self.outliers is not None and self.outliers.count else "")
+        library = [e["id"] for e in self.effects if e.get("library", True)]
+        if not library:
             if self.remaining:
-                return f"no effect of the library found, but {rest}"
-            return "nothing missing: the residual of the starting model is consistent with its noise"
-        named = ", ".join(self.effect_ids)
+                return f"no effect of the library found, but {rest}{spikes}"
+            return f"nothing missing: the residual of the starting model is consistent with its noise{spikes}"
+        named = ", ".join(library)
         pairs = "; ".join(f"{c['effects'][0]} cannot be told from {c['effects'][1]}" for c in self.confusable)
         out = f"missing: {named}" + (f" ({pairs})" if pairs else "") + (f"; {rest}" if self.remaining else "")
         if self.deterministic_remains:
             out += (f"; deterministic temperature structure remains: a generic temperature model reaches "
                     f"{self.final['rmse_heldout'] / self.reference['rmse_heldout']:.3g}x lower held-out RMSE")
-        return out
+        return out + spikes
 
     def to_json(self) -> dict[str, Any]:
         """``report.json``: plain JSON data."""
@@ -218,8 +223,10 @@ def diagnose(
     recording that cannot show anything."""
     declared = declared or {}
     data = prepare(rec, sensor)
-    designer = Designer(data)
     base = base_model(declared)
+    outliers = _outliers(data, base)
+    data = without(data, outliers.index)  # zero weight in every fit, score and test below
+    designer = Designer(data)
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", data.n, data.white_sigma, data.unit)
     att = attribute(designer, base, threshold=threshold)
     n = data.n
@@ -270,10 +277,14 @@ def diagnose(
             "explanation": explain("bias_instability", {"b": b}, data.unit)})
         fitted["bias_instability"] = {"b": b}
         confusable += [{"effects": [e, "bias_instability"], "test": FLICKER_TEST} for e in found if e in TIME_EFFECTS]
+    if outliers.count:
+        effects_out.append(outliers.finding(data.unit))
     for effect, params in declared.items():
         fitted.setdefault(effect, dict(params))
     fitted["white_noise"] = {"density": data.white_sigma / np.sqrt(data.sample_rate_hz)}
     model = {"tcbench_model": 1, "sensor": data.sensor, "output_unit": data.unit, "core": core, "effects": fitted}
+    if outliers.count:  # so that ``tcbench simulate model=`` reproduces them
+        model["outliers"] = {"time_s": [float(t) for t in outliers.time_s], "size": [float(v) for v in outliers.size]}
     return Diagnosis(
         sensor=data.sensor, unit=data.unit, recording=name,
         baseline={"rmse_fit": _rmse(att.base_fit.sse_fit, n), "rmse_heldout": _rmse(att.base_fit.sse_heldout, n),
@@ -289,7 +300,16 @@ def diagnose(
         confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
+        outliers=outliers,
     )
+
+
+def _outliers(data: DiagnosisData, base: Model) -> Outliers:
+    """Isolated outliers of the in-sample residual of the starting model ``base`` on ``data``
+    (see :mod:`tcbench.diagnose.outliers`)."""
+    x = Designer(data).matrix(base)
+    beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
+    return find_outliers(data.t_s, data.output - x @ beta, data.white_sigma)
 
 
 def _reference_json(ref: Reference, final_rmse: float, sigma: float) -> dict[str, Any]:

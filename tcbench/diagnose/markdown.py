@@ -90,6 +90,22 @@ def _value_cell(e: Evidence) -> str:
     return _g(e.value) if name is None else _param(name, e.value, "")
 
 
+def _outliers_section(effect: dict[str, Any], unit: str, t0: float) -> list[str]:
+    """The ``outliers`` finding: count, bound and a table of the listed samples."""
+    p, ev = effect["params"], effect["evidence"]
+    out = ["### outliers (not a library effect)", "",
+           (f"- {p['count']} isolated sample(s) beyond the bound of {_g(ev['bound_z'], 3)} robust sigma "
+            f"(robust sigma {_g(ev['robust_sigma'])} {unit}; false-alarm probability {_g(ev['false_alarm'])} over "
+            "the record); given zero weight in every fit, held-out score and test."),
+           f"- Confirm with: {effect['confirm_with']}", ""]
+    out += _table(["time (s)", "time (h from start)", f"size ({unit})", "robust z"],
+                  ([_g(t, 8), _g((t - t0) / 3600.0, 4), _g(s), _g(z, 3)]
+                   for t, s, z in zip(p["time_s"], p["size"], ev["robust_z"], strict=True)))
+    if p["count"] > len(p["time_s"]):
+        out.append(f"({len(p['time_s'])} largest of {p['count']} listed.)")
+    return [*out, "", effect["explanation"], ""]
+
+
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
     the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
@@ -159,6 +175,9 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
         out += [("Nothing missing: no candidate effect improves the held-out error by more than chance allows; "
                  f"{allan}."), ""]
     for effect in d.effects:
+        if effect.get("shape") == "outliers":
+            out += _outliers_section(effect, d.unit, t0)
+            continue
         out += [f"### {effect['id']}", ""]
         params = "; ".join(_param(k, v, d.unit) for k, v in effect.get("params", {}).items())
         out += [f"- Parameters: {params or '-'}", f"- Evidence: {_evidence_line(effect)}"]

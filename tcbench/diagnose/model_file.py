@@ -15,6 +15,9 @@ A model file is YAML::
       thermal_lag: {tau_s: 420.0}
       warmup: {amplitude: 0.01, tau_s: 900.0}
       white_noise: {density: 0.0024}
+    outliers:                   # optional: isolated spikes added at these times
+      time_s: [35999.0]         # s
+      size: [0.42]              # output unit
 
 with ``u = (T_die - centre_c) / half_range_c`` and the model output
 ``sum_j bias[j] u^j + input * sum_j scale_factor[j] u^j``; ``input`` is the acceleration in g
@@ -39,7 +42,8 @@ from tcbench.sensors import effects as fx
 from tcbench.sensors.fitted import OUTPUT_UNITS, SENSORS, PolynomialModel
 
 VERSION = 1
-TOP_KEYS = ("tcbench_model", "sensor", "output_unit", "core", "effects")
+TOP_KEYS = ("tcbench_model", "sensor", "output_unit", "core", "effects", "outliers")
+OUTLIER_KEYS = ("time_s", "size")
 CORE_KEYS = ("kind", "centre_c", "half_range_c", "bias", "scale_factor")
 
 
@@ -50,7 +54,8 @@ class ModelFileError(ValueError):
 @dataclass(frozen=True)
 class ModelSpec:
     """A fitted model as plain data: temperatures in degC, coefficients in the output unit
-    (per input unit for the scale factor), effects as ``{id: {param: value}}``."""
+    (per input unit for the scale factor), effects as ``{id: {param: value}}``, isolated
+    outliers as ``(time_s, size)`` pairs (s, output unit)."""
 
     sensor: str
     centre_c: float
@@ -58,6 +63,7 @@ class ModelSpec:
     bias: tuple[float, ...]
     scale_factor: tuple[float, ...]
     effects: dict[str, dict[str, float]] = field(default_factory=dict)
+    outliers: tuple[tuple[float, float], ...] = ()
 
 
 def _number(value: Any, what: str, where: str) -> float:
@@ -111,6 +117,22 @@ def _effects(value: Any, where: str) -> dict[str, dict[str, float]]:
     return out
 
 
+def _outliers(value: Any, where: str) -> tuple[tuple[float, float], ...]:
+    """``{time_s: [...], size: [...]}`` of equal length as ``(time_s, size)`` pairs."""
+    if value is None:
+        return ()
+    if not isinstance(value, dict):
+        raise ModelFileError(f"{where}: outliers must be a mapping with time_s and size lists")
+    _unknown_keys(value, OUTLIER_KEYS, "outliers key", where)
+    times = value.get("time_s") or []
+    sizes = value.get("size") or []
+    times, sizes = (v if isinstance(v, list) else [v] for v in (times, sizes))
+    if len(times) != len(sizes):
+        raise ModelFileError(f"{where}: outliers.time_s has {len(times)} entries, outliers.size {len(sizes)}")
+    return tuple((_number(t, f"outliers.time_s[{i}]", where), _number(s, f"outliers.size[{i}]", where))
+                 for i, (t, s) in enumerate(zip(times, sizes, strict=True)))
+
+
 def parse_model(data: Any, where: str) -> ModelSpec:
     """Check parsed YAML ``data`` and return its spec; ``where`` names the source in errors."""
     if not isinstance(data, dict):
@@ -146,6 +168,7 @@ def parse_model(data: Any, where: str) -> ModelSpec:
         bias=_coefficients(core.get("bias"), "bias", where),
         scale_factor=_coefficients(core.get("scale_factor"), "scale_factor", where),
         effects=_effects(data.get("effects"), where),
+        outliers=_outliers(data.get("outliers"), where),
     )
 
 
@@ -175,7 +198,7 @@ def read_model(path: str | Path) -> ModelSpec:
 
 def to_data(spec: ModelSpec) -> dict[str, Any]:
     """The spec as the plain mapping written to a file."""
-    return {
+    out: dict[str, Any] = {
         "tcbench_model": VERSION,
         "sensor": spec.sensor,
         "output_unit": OUTPUT_UNITS[spec.sensor],
@@ -188,6 +211,9 @@ def to_data(spec: ModelSpec) -> dict[str, Any]:
         },
         "effects": {k: {p: float(v) for p, v in params.items()} for k, params in spec.effects.items()},
     }
+    if spec.outliers:
+        out["outliers"] = {"time_s": [float(t) for t, _ in spec.outliers], "size": [float(v) for _, v in spec.outliers]}
+    return out
 
 
 def write_model(spec: ModelSpec, path: str | Path) -> Path:
@@ -219,6 +245,7 @@ def to_sensor_model(spec: ModelSpec) -> PolynomialModel:
     return PolynomialModel(
         ref_c=spec.centre_c, effects=tuple(ordered), sensor=spec.sensor, centre_c=spec.centre_c,
         half_range_c=spec.half_range_c, bias=tuple(spec.bias), scale_factor=tuple(spec.scale_factor),
+        spike_time_s=tuple(t for t, _ in spec.outliers), spike_size=tuple(v for _, v in spec.outliers),
     )
 
 
@@ -228,4 +255,5 @@ def spec_from_model(model: PolynomialModel) -> ModelSpec:
         sensor=model.sensor, centre_c=model.centre_c, half_range_c=model.half_range_c,
         bias=tuple(model.bias), scale_factor=tuple(model.scale_factor),
         effects={e.id: {k: float(v) for k, v in e.params().items()} for e in model.effects},
+        outliers=tuple(zip(model.spike_time_s, model.spike_size, strict=True)),
     )

@@ -34,7 +34,9 @@ class PolynomialModel(SensorModel):
     ``bias`` is in the output unit (Hz or deg/s) per power of ``u``; ``scale_factor`` in the
     output unit per input unit (Hz/g or (deg/s)/(deg/s)) per power of ``u``. ``centre_c`` and
     ``half_range_c`` are in degC; ``ref_c`` (the reference of effects such as
-    ``temperature_cubic``) is normally ``centre_c``.
+    ``temperature_cubic``) is normally ``centre_c``. ``spike_time_s`` (s on the simulation
+    clock) and ``spike_size`` (output unit) are isolated outliers found by ``tcbench diagnose``,
+    added to the core output at those samples (see :meth:`spikes`).
     """
 
     sensor: str = "msra"
@@ -42,6 +44,8 @@ class PolynomialModel(SensorModel):
     half_range_c: float = 50.0
     bias: tuple[float, ...] = (0.0,)
     scale_factor: tuple[float, ...] = (1.0,)
+    spike_time_s: tuple[float, ...] = ()
+    spike_size: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         if self.sensor not in SENSORS:
@@ -57,6 +61,11 @@ class PolynomialModel(SensorModel):
             if not all(np.isfinite(values)):
                 raise ValueError(f"{name} coefficients must be finite, got {values!r}")
             object.__setattr__(self, name, values)
+        spikes = tuple(tuple(float(v) for v in np.atleast_1d(getattr(self, n))) for n in ("spike_time_s", "spike_size"))
+        if len(spikes[0]) != len(spikes[1]) or not np.all(np.isfinite(spikes[0] + spikes[1])):
+            raise ValueError("spike_time_s and spike_size must be finite and of equal length")
+        object.__setattr__(self, "spike_time_s", spikes[0])
+        object.__setattr__(self, "spike_size", spikes[1])
         object.__setattr__(self, "centre_c", float(self.centre_c))
         object.__setattr__(self, "half_range_c", float(self.half_range_c))
 
@@ -85,7 +94,23 @@ class PolynomialModel(SensorModel):
     def core(self, s: fx.Signals) -> np.ndarray:
         u = self.normalised(s.temp_die_c)
         applied = s.accel_g if self.sensor == "msra" else s.rate_dps
-        return npoly.polyval(u, self.bias) + applied * npoly.polyval(u, self.scale_factor)
+        return npoly.polyval(u, self.bias) + applied * npoly.polyval(u, self.scale_factor) + self.spikes(s.t_s)
+
+    def spikes(self, t_s: np.ndarray) -> np.ndarray:
+        """The isolated outliers of the model (output unit) on the clock ``t_s`` (s): each
+        ``spike_size`` added to the sample nearest its ``spike_time_s``, if that sample lies
+        within half a sample interval of it (spikes outside the clock are dropped)."""
+        out = np.zeros(np.shape(t_s))
+        if not self.spike_time_s or out.size == 0:
+            return out
+        times, sizes = np.asarray(self.spike_time_s), np.asarray(self.spike_size)
+        dt = float(np.median(np.diff(t_s))) if out.size > 1 else np.inf
+        right = np.clip(np.searchsorted(t_s, times), 0, out.size - 1)
+        left = np.clip(right - 1, 0, out.size - 1)
+        i = np.where(np.abs(t_s[left] - times) <= np.abs(t_s[right] - times), left, right)
+        on = np.abs(t_s[i] - times) <= 0.5 * dt
+        np.add.at(out, i[on], sizes[on])
+        return out
 
     def describe(self) -> dict[str, Any]:
         core = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "effects"}
