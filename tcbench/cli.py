@@ -127,7 +127,7 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
 
 
 def _first_line(text: str) -> str:
-    from tcbench.job import error_line
+    from tcbench.errors import error_line
 
     return error_line(text)
 

@@ -140,9 +140,8 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
         return run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
 
     from tcbench import tracking
-    from tcbench.job import sweep_id_from_hydra
 
-    sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
+    sweep = c["tracking"].get("sweep_id") or tracking.sweep_id_from_hydra()
     tkey, method = compensation_task_key(c["task"]), compensation_label(learner, c["optimiser"], c["task"])
     name = f"{method}-{tkey}-s{c['seed']}"
     if c["tracking"].get("resume"):

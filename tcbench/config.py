@@ -17,14 +17,11 @@ import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
+from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
 from tcbench.outputs import folder_problem
 from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
-
-
-class ConfigError(ValueError):
-    """A config value is out of range or names something unknown."""
 
 
 @dataclass

@@ -5,7 +5,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import re
 import tempfile
 import traceback
 from dataclasses import dataclass
@@ -16,6 +15,7 @@ import numpy as np
 import yaml
 
 from tcbench.config import as_dict, validate
+from tcbench.errors import error_line
 from tcbench.runner import RunResult, run_optimisation
 from tcbench.tasks import is_bbob, is_compensation, is_gyro
 
@@ -43,19 +43,6 @@ def task_key(task: dict[str, Any]) -> str:
 def method_label(opt: dict[str, Any]) -> str:
     """Leaderboard name of a method: the optimiser's ``label`` if set, else its name."""
     return str(opt.get("label") or opt["name"])
-
-
-def sweep_id_from_hydra() -> str:
-    """Id shared by the jobs of one multirun (hash of its sweep dir), or the run dir's."""
-    try:
-        from hydra.core.hydra_config import HydraConfig
-        from hydra.types import RunMode
-
-        hc = HydraConfig.get()
-        where = hc.sweep.dir if hc.mode == RunMode.MULTIRUN else hc.run.dir
-        return hashlib.sha256(str(Path(where).resolve()).encode()).hexdigest()[:12]
-    except (ImportError, ValueError):
-        return "interactive"
 
 
 def result_metrics(result: RunResult) -> dict[str, float]:
@@ -97,17 +84,6 @@ class JobFailure:
 # The failures of the jobs run in this process (and, in a sweep's parent, those its workers
 # reported): ``tcbench run`` lists them when no tracking store records them.
 FAILURES: list[JobFailure] = []
-
-
-def error_line(text: str) -> str:
-    """One line of an error's text: the first, or where a database names its error (SQLAlchemy
-    puts "(sqlite3.OperationalError) database or disk is full" below a line about autoflush)."""
-    lines = [ln.strip() for ln in str(text).strip().splitlines() if ln.strip()] or [""]
-    named = next((ln for ln in lines if re.match(r"\(\w+(\.\w+)*(Error|Exception)\)", ln)), None)
-    if named is None:
-        return lines[0]
-    prefix = lines[0].split(":", 1)[0] + ": " if ":" in lines[0] else ""
-    return prefix + named
 
 
 def failed(name: str, exc: BaseException) -> JobFailure:
@@ -163,7 +139,7 @@ def _run_optimisation_job(c: dict[str, Any]) -> RunResult | None:
 
     from tcbench import tracking
 
-    sweep = c["tracking"].get("sweep_id") or sweep_id_from_hydra()
+    sweep = c["tracking"].get("sweep_id") or tracking.sweep_id_from_hydra()
     tkey, method = task_key(c["task"]), method_label(c["optimiser"])
     if c["tracking"].get("resume"):
         done = tracking.finished_run(c)

@@ -27,6 +27,7 @@ from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 import tcbench  # noqa: E402
+from tcbench.errors import error_line  # noqa: E402
 
 TAG_PREFIX = "tcbench."
 log = logging.getLogger(__name__)
@@ -96,8 +97,7 @@ class StoreError(Exception):
 
 def first_line(exc: BaseException) -> str:
     """One line of an exception's text (a database error's own message where it wraps one)."""
-    text = str(getattr(exc, "orig", None) or exc).strip()
-    return text.splitlines()[0][:300] if text else type(exc).__name__
+    return error_line(str(getattr(exc, "orig", None) or exc))[:300] or type(exc).__name__
 
 
 def _http_problem(uri: str, timeout_s: float) -> str | None:
@@ -210,6 +210,19 @@ def git_commit() -> str:
         return out.stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown"
+
+
+def sweep_id_from_hydra() -> str:
+    """Id shared by the jobs of one multirun (hash of its sweep dir), or the run dir's."""
+    try:
+        from hydra.core.hydra_config import HydraConfig
+        from hydra.types import RunMode
+
+        hc = HydraConfig.get()
+        where = hc.sweep.dir if hc.mode == RunMode.MULTIRUN else hc.run.dir
+        return hashlib.sha256(str(Path(where).resolve()).encode()).hexdigest()[:12]
+    except (ImportError, ValueError):
+        return "interactive"
 
 
 def finished_run(cfg: Mapping[str, Any]) -> str | None:

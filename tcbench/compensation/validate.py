@@ -10,6 +10,7 @@ import yaml
 
 from tcbench.compensation.data import TaskDataError, file_data
 from tcbench.compensation.methods import BASELINES
+from tcbench.errors import ConfigError
 from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
@@ -17,8 +18,6 @@ from tcbench.optimisers.protocol import make_params
 
 
 def _error(message: str) -> Exception:
-    from tcbench.config import ConfigError
-
     return ConfigError(message)
 
 
