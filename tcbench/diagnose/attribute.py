@@ -31,19 +31,22 @@ recording cannot tell them apart, and the report says which test would.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
 from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
+from tcbench.diagnose.discover import OPEN_THRESHOLD, best_open
+from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_significant
+from tcbench.diagnose.open_terms import TERMS
 from tcbench.diagnose.plan import ROBUST_WALD, SURROGATE, StatsPlan, plan_for
 from tcbench.diagnose.surrogate import LEVEL, surrogate_test
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
 
 PENALTY_PER_PARAM = 2.0
-DETECTION_THRESHOLD = 10.0  # gain in units of sigma^2; see experiments/diagnose-concealed/calibrate.py
 WALD_THRESHOLD = 25.0  # cluster-robust Wald statistic; same calibration
 MOST_OF_EXCESS = 0.5  # an effect removing this share of the held-out error above noise is never dropped by the Wald test alone
 SURROGATE_SEED = 20240611  # the surrogate test's generator: same recording, same diagnosis
@@ -62,24 +65,6 @@ CONFUSABLE: dict[frozenset[str], str] = {
     frozenset({"aging_drift", "temperature_cubic"}): (
         "a profile that revisits the same temperatures hours apart: ageing follows time, a cubic follows temperature"),
 }
-
-
-@dataclass
-class Evidence:
-    """How one effect fared: ``status`` is ``kept``, ``rejected`` or ``not identifiable``;
-    ``gain`` its best penalised held-out gain (sigma^2 units) in the last round it was tried,
-    at nonlinear parameter ``value``."""
-
-    effect: str
-    status: str
-    gain: float = float("nan")
-    threshold: float = DETECTION_THRESHOLD
-    value: float | None = None
-    reason: str = ""
-    confusable_with: list[str] = field(default_factory=list)
-    wald: float = float("nan")
-    test: str = ""
-    p_value: float = float("nan")
 
 
 @dataclass
@@ -143,10 +128,12 @@ class _Scorer:
         known = float(z @ self.fit(base).residual) ** 2 / max(self._noise(base, model)[1], 1e-300)
         return min(robust, known)
 
-    def surrogate_p(self, base: Model, effect: str, value: float | None) -> float:
+    def surrogate_p(self, base: Model, effect: str, value: Any, searched: list[Any] | None = None) -> float:
         """p-value of adding ``effect`` to ``base`` by the surrogate test, searched over its
-        grid and ``value``; the noise model is the residual of ``base`` plus ``effect`` at ``value``."""
-        values = [*grid_values(effect), *([value] if value is not None else [])]
+        grid (or the values ``searched``) and ``value``; the noise model is the residual of
+        ``base`` plus ``effect`` at ``value``."""
+        grid = grid_values(effect) if searched is None else list(searched)
+        values = [*grid, *([value] if value is not None and value not in grid else [])]
         xs = [self.designer.matrix(base.with_effect(effect, v)) for v in values]
         noise = self.fit(base.with_effect(effect, value)).residual
         p, _ = surrogate_test(self.designer.matrix(base), xs, self.designer.data.output, noise, self.rng)
@@ -159,15 +146,15 @@ class _Scorer:
         drop = self.fit(base).sse_heldout - self.fit(model).sse_heldout
         return excess > 0 and drop >= MOST_OF_EXCESS * excess
 
-    def significant(self, base: Model, effect: str, value: float | None, test: str, wald_threshold: float
-                    ) -> tuple[bool, float, float, str]:
+    def significant(self, base: Model, effect: str, value: Any, test: str, wald_threshold: float,
+                    searched: list[Any] | None = None) -> tuple[bool, float, float, str]:
         """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise:
         ``(passed, robust Wald, surrogate p-value, test that decided)`` (see module doc)."""
         model = base.with_effect(effect, value)
         wald = self.wald(base, model)
         if test == ROBUST_WALD and (wald > wald_threshold or not self.removes_most(base, model)):
             return wald > wald_threshold, wald, float("nan"), ROBUST_WALD
-        p = self.surrogate_p(base, effect, value)
+        p = self.surrogate_p(base, effect, value, searched)
         return p <= LEVEL, wald, p, SURROGATE
 
     def best(self, base: Model, effect: str) -> tuple[float, float | None]:
@@ -194,12 +181,15 @@ def attribute(
     threshold: float = DETECTION_THRESHOLD,
     wald_threshold: float = WALD_THRESHOLD,
     plan: StatsPlan | None = None,
-    max_effects: int = 4,
+    max_effects: int = 6,
     seed: int = SURROGATE_SEED,
+    open_world: bool = True,
 ) -> Attribution:
     """Forward selection of the library's deterministic effects onto ``base`` (see module doc);
     ``plan`` the blocks, clusters and test (default: sized to the recording by
-    :func:`~tcbench.diagnose.plan.plan_for`), ``seed`` that of the surrogate test's generator."""
+    :func:`~tcbench.diagnose.plan.plan_for`), ``seed`` that of the surrogate test's generator;
+    with ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the
+    library's effects in every round."""
     base = base or Model()
     data = designer.data
     plan = plan or plan_for(data)
@@ -217,9 +207,10 @@ def attribute(
     while len(model.ids) - len(base.ids) < max_effects:
         open_effects = [e for e in DETERMINISTIC if e not in evidence or evidence[e].status == "rejected"]
         open_effects = [e for e in open_effects if e not in model.ids]
-        if not open_effects:
+        if not open_effects and not open_world:
             break
         tried = {e: scorer.best(model, e) for e in open_effects}
+        beyond = best_open(scorer, model, evidence, plan.test, wald_threshold) if open_world else None
         for e, (g, v) in tried.items():
             if g <= threshold:
                 evidence[e] = Evidence(e, "rejected", g, threshold, v, "held-out gain below the threshold",
@@ -228,10 +219,13 @@ def attribute(
         for e in (e for e in tried if tried[e][0] > threshold):
             g, v = tried[e]
             ok, wald, p, test = scorer.significant(model, e, v, plan.test, wald_threshold)
-            evidence[e] = Evidence(e, "rejected", g, threshold, v, _not_significant(test, p), wald=wald, test=test,
+            evidence[e] = Evidence(e, "rejected", g, threshold, v, not_significant(test, p), wald=wald, test=test,
                                    p_value=p)
             if ok:
                 passing.append(e)
+        if beyond is not None:
+            tried[beyond[0]] = beyond[1:]
+            passing.append(beyond[0])
         if not passing:
             break
         winner = max(passing, key=lambda e: tried[e][0])
@@ -242,8 +236,9 @@ def attribute(
         reduced = model.without(effect)
         cost = scorer.gain(reduced, model)
         value = _value(model, effect)
-        ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold)
-                             if cost > threshold else (False, scorer.wald(reduced, model), float("nan"), plan.test))
+        searched = [value] if effect in TERMS else None
+        ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
+                             if cost > (OPEN_THRESHOLD if effect in TERMS else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
         if not ok:
             model = reduced
             evidence[effect].status = "rejected"
@@ -254,13 +249,6 @@ def attribute(
     confusions = _confusions(scorer, model, base, evidence, threshold)
     return Attribution(base, model, scorer.fit(base), scorer.fit(model), evidence, confusions,
                        designer, fold, k, plan)
-
-
-def _not_significant(test: str, p: float) -> str:
-    if test == SURROGATE:
-        return (f"not significant against the residual's slow noise (surrogate test p = {p:.3g} above "
-                f"{LEVEL:g})")
-    return "not significant against the residual's slow noise (robust Wald below the threshold)"
 
 
 def _value(model: Model, effect: str) -> float | None:

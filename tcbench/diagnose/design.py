@@ -26,9 +26,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
+from tcbench.diagnose.open_terms import TERMS, term_columns
 from tcbench.diagnose.signals import DiagnosisData, hysteresis_state, lagged
 
 DETERMINISTIC = (
@@ -47,10 +49,11 @@ PARAM_NAME = {"thermal_lag": "tau_s", "hysteresis": "width_c", "warmup": "tau_s"
 @dataclass(frozen=True)
 class Model:
     """A model of the output: the minimal model, an optional die lag, and added effect terms
-    ``(effect_id, nonlinear parameter or None)``."""
+    ``(effect_id, nonlinear parameter or None)``; an open-world term
+    (:mod:`tcbench.diagnose.open_terms`) has a tuple of nonlinear parameters."""
 
     lag_tau_s: float | None = None
-    terms: tuple[tuple[str, float | None], ...] = ()
+    terms: tuple[tuple[str, Any], ...] = ()
 
     @property
     def ids(self) -> tuple[str, ...]:
@@ -69,8 +72,9 @@ class Model:
 
     @property
     def n_params(self) -> int:
-        """Extra parameters over the minimal model: each term's coefficient and searched value."""
-        return (1 if self.lag_tau_s else 0) + sum(1 + (v is not None) for _, v in self.terms)
+        """Extra parameters over the minimal model: each term's coefficients and searched values."""
+        return (1 if self.lag_tau_s else 0) + sum(
+            TERMS[e].n_params() if e in TERMS else 1 + (v is not None) for e, v in self.terms)
 
 
 @dataclass
@@ -80,6 +84,7 @@ class Designer:
     data: DiagnosisData
     _lag_cache: dict[float, np.ndarray] = field(default_factory=dict)
     _hyst_cache: dict[tuple[float, float | None], np.ndarray] = field(default_factory=dict)
+    _open_cache: dict[tuple[str, Any, float | None], np.ndarray] = field(default_factory=dict)
 
     @cached_property
     def centre_c(self) -> float:
@@ -133,11 +138,20 @@ class Designer:
             return d.input**2
         raise ValueError(f"effect {effect!r} has no regressor")
 
+    def columns(self, effect: str, value: Any, lag_tau_s: float | None) -> np.ndarray:
+        """The column(s) (n, m) of ``effect`` at ``value`` on the model temperature of ``lag_tau_s``."""
+        temp = self.temperature(lag_tau_s)
+        if effect not in TERMS:
+            return self.column(effect, value, temp, lag_tau_s)[:, None]
+        key = (effect, value, lag_tau_s)
+        if key not in self._open_cache:
+            self._open_cache[key] = term_columns(self.data, effect, value, temp)
+        return self._open_cache[key]
+
     def matrix(self, model: Model) -> np.ndarray:
-        """Design matrix of ``model``: core columns, then one column per term in order."""
-        temp = self.temperature(model.lag_tau_s)
-        cols = [self.core(temp)]
-        cols += [self.column(e, v, temp, model.lag_tau_s)[:, None] for e, v in model.terms]
+        """Design matrix of ``model``: core columns, then each term's column(s) in order."""
+        cols = [self.core(self.temperature(model.lag_tau_s))]
+        cols += [self.columns(e, v, model.lag_tau_s) for e, v in model.terms]
         return np.hstack(cols)
 
     def why_not_identifiable(self, effect: str) -> str | None:

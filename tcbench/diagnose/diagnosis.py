@@ -21,6 +21,7 @@ from tcbench.diagnose.attribute import (
 )
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.explain import explain
+from tcbench.diagnose.open_terms import TERMS, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.plan import SURROGATE
@@ -94,9 +95,15 @@ class Diagnosis:
         spikes = (f"; {self.outliers.count} isolated outlier sample(s) given zero weight (see outliers)"
                   if self.outliers is not None and self.outliers.count else "")
         library = [e["id"] for e in self.effects if e.get("library", True)]
+        beyond = [f"{e['id']} ({e['shape']})" for e in self.effects
+                  if not e.get("library", True) and e["id"] != "outliers"]
+        if beyond:
+            spikes = f"; beyond the library: {', '.join(beyond)}{spikes}"
         if not library:
             if self.remaining:
                 return f"no effect of the library found, but {rest}{spikes}"
+            if beyond:
+                return f"no effect of the library found{spikes}"
             return f"nothing missing: the residual of the starting model is consistent with its noise{spikes}"
         named = ", ".join(library)
         pairs = "; ".join(f"{c['effects'][0]} cannot be told from {c['effects'][1]}" for c in self.confusable)
@@ -178,8 +185,12 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
     effects: dict[str, dict[str, float]] = {}
     if att.final.lag_tau_s:
         effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
-    for (effect, value), coef in zip(att.final.terms, beta[n_core:], strict=True):
-        effects[effect] = _effect_params(effect, float(coef), value, d.half_range_c)
+    i = n_core
+    for effect, value in att.final.terms:
+        m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
+        coef, i = beta[i:i + m], i + m
+        effects[effect] = (TERMS[effect].params(value, coef) if effect in TERMS
+                           else _effect_params(effect, float(coef[0]), value, d.half_range_c))
     return core, effects
 
 
@@ -261,6 +272,9 @@ def diagnose(
         evidence[e].reason = "dropping it costs more held-out error than chance allows"
         ev = {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold),
               **_test_json(evidence[e])}
+        if e in TERMS:
+            effects_out.append(open_finding(e, fitted[e], ev, data.unit))
+            continue
         effects_out.append({"id": e, "params": fitted[e], "evidence": ev, "explanation": explain(e, fitted[e], data.unit),
                             **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})})
     evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared)

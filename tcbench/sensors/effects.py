@@ -215,11 +215,78 @@ class Quantisation(Effect):
         return noise.quantise(y, self.step)
 
 
+@dataclass(frozen=True)
+class BiasStep(Effect):
+    """A bias jump of ``size`` at ``time_s`` (mode hop, shock, restart; PHYSICS.md §8)."""
+
+    id: ClassVar[str] = "bias_step"
+    time_s: float = 0.0
+    size: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return np.where(s.t_s >= self.time_s, self.size, 0.0)
+
+
+@dataclass(frozen=True)
+class Periodic(Effect):
+    """``amplitude * sin(2 pi t / period_s + phase_rad)``: environmental cycling (PHYSICS.md §8)."""
+
+    id: ClassVar[str] = "periodic"
+    period_s: float = 1800.0
+    amplitude: float = 0.0
+    phase_rad: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.amplitude * np.sin(2.0 * np.pi * s.t_s / self.period_s + self.phase_rad)
+
+
+@dataclass(frozen=True)
+class Transient(Effect):
+    """A jump of ``amplitude`` at ``time_s`` decaying with ``tau_s`` (settling after a handling event)."""
+
+    id: ClassVar[str] = "transient"
+    time_s: float = 0.0
+    tau_s: float = 1800.0
+    amplitude: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        age = s.t_s - self.time_s
+        return np.where(age >= 0.0, self.amplitude * np.exp(-np.maximum(age, 0.0) / self.tau_s), 0.0)
+
+
+@dataclass(frozen=True)
+class TemperatureBump(Effect):
+    """A Gaussian bump of the bias in die temperature, ``amplitude`` at ``centre_c``, width
+    ``width_c`` (an activity dip: a mode crossing at one temperature)."""
+
+    id: ClassVar[str] = "temperature_bump"
+    centre_c: float = 25.0
+    width_c: float = 2.0
+    amplitude: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.amplitude * np.exp(-0.5 * ((s.temp_die_c - self.centre_c) / self.width_c) ** 2)
+
+
+@dataclass(frozen=True)
+class SecondNode(Effect):
+    """``coef_per_c * (lag(T_die, tau_s) - T_die)``: a second thermal node (a mount or board)
+    with its own time constant, unseen by the thermometer."""
+
+    id: ClassVar[str] = "second_node"
+    tau_s: float = 3600.0
+    coef_per_c: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        return self.coef_per_c * (first_order_lag(s.temp_die_c, s.dt_s, self.tau_s) - s.temp_die_c)
+
+
 EFFECTS: dict[str, type[Effect]] = {
     cls.id: cls
     for cls in (
         ThermalLag, TemperatureRate, Hysteresis, Warmup, AgingDrift, TemperatureCubic,
         AccelNonlinearity, BiasInstability, WhiteNoise, RandomWalk, Quantisation,
+        BiasStep, Periodic, Transient, TemperatureBump, SecondNode,
     )
 }
 

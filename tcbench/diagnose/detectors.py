@@ -1,0 +1,128 @@
+"""Generic detectors of shape: where in a residual an open-world term would go.
+
+Each detector reads the in-sample residual of the current model and proposes a few values of
+the nonlinear parameters of one term of :mod:`tcbench.diagnose.open_terms`; the held-out
+scoring of :mod:`tcbench.diagnose.discover` decides. They work on the residual averaged in
+time bins (:func:`binned`: a few thousand bins however long or fast the record, gaps left
+empty), so a 24 h record at 100 Hz costs what a 1 Hz one does.
+
+- **steps** (:func:`step_times`): change points of the binned residual's mean by binary
+  segmentation (``ruptures.Binseg``, l2 cost), each refined to the sample by the two-sample
+  mean statistic within a bin of it; the first sample after every long gap (a restart) too.
+- **spectral lines** (:func:`line_periods`): Lomb-Scargle periodogram of the binned residual
+  (gapped and burst records included) on at most :data:`LINE_BINS` bins, the highest peaks
+  with periods between three bins and two thirds of the span.
+- **temperature bumps** (:func:`bump_centres`): a matched filter of Gaussian bumps of several
+  widths against the residual averaged in 0.1 degC bins of the model temperature, each bump
+  taken orthogonal to the quadratic in temperature the model already holds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ruptures
+from scipy.signal import find_peaks, lombscargle
+
+MAX_BINS = 3000
+LINE_BINS = 1200  # the periodogram's bins: periods down to 3 bins (90 s on a 10 h record)
+MIN_BIN_S = 10.0
+N_CHANGES = 3
+N_LINES = 3
+N_BUMPS = 3
+GAP_FACTOR = 5.0  # a gap longer than this many median sample spacings may hide a restart
+MAX_GAPS = 12
+BUMP_WIDTHS_C = (1.0, 1.5, 2.5, 4.0, 6.0)
+TEMP_BIN_C = 0.1
+
+
+def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = MAX_BINS
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """``(centre_s, mean, count, width_s)`` of ``r`` in time bins of ``width_s`` (at least
+    :data:`MIN_BIN_S`, at most ``max_bins`` of them); empty bins left out."""
+    span = float(t_s[-1] - t_s[0])
+    width = max(MIN_BIN_S, span / max_bins, float(np.median(np.diff(t_s))))
+    idx = ((t_s - t_s[0]) / width).astype(np.int64)
+    count = np.bincount(idx).astype(float)
+    total = np.bincount(idx, weights=r)
+    keep = count > 0
+    centre = np.bincount(idx, weights=t_s)[keep] / count[keep]
+    return centre, total[keep] / count[keep], count[keep], width
+
+
+def _refine_step(t_s: np.ndarray, cum: np.ndarray, around_s: float, half_s: float) -> int:
+    """Index of the first sample after the jump: the split of the whole record within
+    ``around_s +- half_s`` with the largest two-sample mean statistic."""
+    n = t_s.size
+    lo = max(int(np.searchsorted(t_s, around_s - half_s)), 1)
+    hi = min(int(np.searchsorted(t_s, around_s + half_s)), n - 1)
+    if hi <= lo:
+        return min(max(lo, 1), n - 1)
+    k = np.arange(lo, hi + 1)
+    stat = (cum[k] - k / n * cum[n]) ** 2 / (k * (n - k) / n)
+    return int(k[np.argmax(stat)])
+
+
+def step_times(t_s: np.ndarray, r: np.ndarray, n_changes: int = N_CHANGES) -> list[float]:
+    """Candidate step times (s): the first sample after each change point of the mean of ``r``,
+    and after each of the longest gaps."""
+    centre, mean, _, width = binned(t_s, r)
+    out: list[float] = []
+    cum = np.concatenate(([0.0], np.cumsum(r)))
+    if mean.size >= 8:
+        n_bkps = min(n_changes, mean.size // 4)
+        algo = ruptures.Binseg(model="l2", min_size=2).fit(mean)
+        for b in algo.predict(n_bkps=n_bkps)[:-1]:
+            around = 0.5 * (centre[b - 1] + centre[b])
+            out.append(float(t_s[_refine_step(t_s, cum, around, width)]))
+    dt = np.diff(t_s)
+    gaps = np.flatnonzero(dt > GAP_FACTOR * np.median(dt))
+    for g in gaps[np.argsort(-dt[gaps])][:MAX_GAPS]:
+        out.append(float(t_s[g + 1]))
+    return sorted(set(out))
+
+
+def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list[float]:
+    """Periods (s) of the highest Lomb-Scargle peaks of ``r``, between three bins and two
+    thirds of the span."""
+    centre, mean, count, width = binned(t_s, r, LINE_BINS)
+    span = float(t_s[-1] - t_s[0])
+    if mean.size < 16:
+        return []
+    f_lo, f_hi = 1.5 / span, 1.0 / (3.0 * width)
+    if f_hi <= f_lo:
+        return []
+    df = 0.5 / span  # two frequencies per Fourier bin; the period is refined by the scorer
+    freq = np.arange(f_lo, f_hi, df)
+    power = lombscargle(centre - centre[0], mean - np.average(mean, weights=count), 2.0 * np.pi * freq,
+                        normalize=False)
+    peaks, _ = find_peaks(power, distance=4)
+    best = peaks[np.argsort(-power[peaks])][:n_lines]
+    return [float(1.0 / freq[i]) for i in best]
+
+
+def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> list[tuple[float, float]]:
+    """``(centre_c, width_c)`` of the Gaussian bumps in temperature that best match ``r``,
+    each bump orthogonal to ``1, T, T^2`` (sample-weighted)."""
+    lo, hi = float(temp_c.min()), float(temp_c.max())
+    span = hi - lo
+    idx = ((temp_c - lo) / TEMP_BIN_C).astype(np.int64)
+    count = np.bincount(idx).astype(float)
+    total = np.bincount(idx, weights=r)
+    tb = lo + (np.arange(count.size) + 0.5) * TEMP_BIN_C
+    u = (tb - 0.5 * (lo + hi)) / max(0.5 * span, 1e-9)
+    core = np.column_stack([np.ones_like(u), u, u * u])
+    gram = core.T @ (core * count[:, None])
+    found: list[tuple[float, float, float]] = []
+    for w in (w for w in BUMP_WIDTHS_C if 4.0 * w <= span):
+        centres = np.arange(lo + w, hi - w + 1e-9, max(TEMP_BIN_C, w / 8.0))
+        if centres.size == 0:
+            continue
+        g = np.exp(-0.5 * ((tb[:, None] - centres[None, :]) / w) ** 2)  # (bins, centres)
+        coef = np.linalg.solve(gram, core.T @ (g * count[:, None]))
+        g_perp = g - core @ coef
+        norm2 = np.einsum("bc,bc,b->c", g_perp, g_perp, count)
+        score = (total @ g_perp) ** 2 / np.maximum(norm2, 1e-300)
+        i = int(np.argmax(score))
+        found.append((float(score[i]), float(centres[i]), float(w)))
+    found.sort(reverse=True)
+    return [(c, w) for _, c, w in found[:n_bumps]]

@@ -1,0 +1,126 @@
+"""Open-world discovery: model what the effect library does not hold.
+
+In every round of the forward selection (:func:`tcbench.diagnose.attribute.attribute`), beside
+the library's effects, :func:`best_open` reads the in-sample residual of the current model, lets the detectors of
+:mod:`tcbench.diagnose.detectors` propose values for every term of
+:mod:`tcbench.diagnose.open_terms` (a step at each change point, a line at each periodogram
+peak, a transient from each change point at several time constants, a bump at each matched
+temperature, a second thermal node at several time constants), scores each proposal by the
+same penalised held-out gain as a library effect, refines the best one's continuous parameter,
+and offers the best term when its gain exceeds :data:`OPEN_THRESHOLD` and it is significant
+against the residual's slow noise by the test the recording supports (the surrogate test
+repeats the search over every proposal); the round keeps whichever, library effect or open-world
+term, gains most. Ranking the proposals and refining them uses the in-sample drop of squared
+error (one projection each); only the best of each term is cross-validated. The threshold is higher than the library's because
+the detectors search positions and periods: it is set on recordings with nothing hidden
+(``experiments/diagnose-concealed/calibrate.py``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from tcbench.diagnose.detectors import bump_centres, line_periods, step_times
+from tcbench.diagnose.design import Model
+from tcbench.diagnose.evidence import Evidence, not_significant
+
+OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world term must exceed
+TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
+NODE_TAU_S = np.geomspace(600.0, 4.0 * 3600.0, 9)
+
+
+def _testable(t_s: np.ndarray, fold: np.ndarray) -> tuple[float, float]:
+    """The times between which a step has samples of at least two folds on each side, so every
+    fold's held-out prediction is fitted on both levels: after the first block, before the last."""
+    first_change = int(np.argmax(fold != fold[0]))
+    last_change = fold.size - 1 - int(np.argmax(fold[::-1] != fold[-1]))
+    return float(t_s[first_change]), float(t_s[last_change])
+
+
+def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
+    """Values of each open-world term's nonlinear parameters worth scoring on ``model``'s residual."""
+    d = scorer.designer.data
+    r = scorer.fit(model).residual
+    temp = scorer.designer.temperature(model.lag_tau_s)
+    span = float(d.t_s[-1] - d.t_s[0])
+    lo, hi = _testable(d.t_s, scorer.fold)
+    steps = [t for t in step_times(d.t_s, r) if lo < t < hi]
+    out: dict[str, list[tuple[float, ...]]] = {
+        "bias_step": [(t,) for t in steps],
+        "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
+        "periodic": [(p,) for p in line_periods(d.t_s, r)],
+        "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
+    }
+    if scorer.designer.why_not_identifiable("thermal_lag") is None:
+        out["second_node"] = [(float(tau),) for tau in NODE_TAU_S if tau < 0.25 * span]
+    return {k: v for k, v in out.items() if v}
+
+
+class _Screen:
+    """In-sample SSE drop of adding columns to ``model``, cheap enough to rank every proposal:
+    the residual's squared projection on the new columns made orthogonal to the model's."""
+
+    def __init__(self, scorer: Any, model: Model) -> None:
+        self.scorer, self.model = scorer, model
+        x = scorer.designer.matrix(model)
+        scale = np.sqrt(np.mean(x * x, axis=0))
+        scale[scale == 0] = 1.0
+        self.q = np.linalg.qr(x / scale)[0]
+        self.r = scorer.fit(model).residual
+
+    def drop(self, term: str, value: tuple[float, ...]) -> float:
+        c = self.scorer.designer.columns(term, value, self.model.lag_tau_s)
+        c = c - self.q @ (self.q.T @ c)
+        norm = np.sqrt(np.sum(c * c, axis=0))
+        if not np.all(norm > 1e-9 * np.sqrt(c.shape[0])):
+            return 0.0
+        qc = np.linalg.qr(c / norm)[0]
+        proj = qc.T @ self.r
+        return float(proj @ proj)
+
+
+def _refine(screen: _Screen, term: str, value: tuple[float, ...]) -> tuple[float, ...]:
+    """``value`` with the term's continuous parameter (period, time constant) moved to the
+    largest in-sample drop nearby."""
+    if term == "periodic":
+        lo, hi, make = np.log(value[0] * 0.9), np.log(value[0] * 1.1), lambda z: (float(np.exp(z)),)
+    elif term in ("transient", "second_node"):
+        k = len(value) - 1
+        lo, hi = np.log(value[k] / 1.6), np.log(value[k] * 1.6)
+        make = lambda z: (*value[:k], float(np.exp(z)))  # noqa: E731
+    else:
+        return value
+    res = minimize_scalar(lambda z: -screen.drop(term, make(z)), bounds=(lo, hi), method="bounded",
+                          options={"xatol": 0.005})
+    return make(res.x) if -res.fun > screen.drop(term, value) else value
+
+
+def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: str, wald_threshold: float,
+              threshold: float = OPEN_THRESHOLD) -> tuple[str, float, tuple[float, ...]] | None:
+    """One round: the open-world term that adds most to ``model`` and passes (``(id, gain,
+    value)``), or None; every term's :class:`~tcbench.diagnose.evidence.Evidence` is written
+    into ``evidence``."""
+    tried: dict[str, tuple[float, tuple[float, ...], list[tuple[float, ...]]]] = {}
+    screen = _Screen(scorer, model)
+    for term, values in proposals(scorer, model).items():
+        if term in model.ids:
+            continue
+        value = _refine(screen, term, max(values, key=lambda v: screen.drop(term, v)))
+        tried[term] = (scorer.gain(model, model.with_effect(term, value)), value, values)
+    passing = []
+    for term, (gain, value, values) in tried.items():
+        if gain <= threshold:
+            evidence[term] = Evidence(term, "rejected", gain, threshold, None, "held-out gain below the threshold")
+            continue
+        ok, wald, p, used = scorer.significant(model, term, value, test, wald_threshold, searched=values)
+        evidence[term] = Evidence(term, "rejected", gain, threshold, None, not_significant(used, p),
+                                  wald=wald, test=used, p_value=p)
+        if ok:
+            passing.append(term)
+    if not passing:
+        return None
+    winner = max(passing, key=lambda t: tried[t][0])
+    return winner, tried[winner][0], tried[winner][1]
