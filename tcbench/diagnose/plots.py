@@ -203,8 +203,8 @@ def plot_spectrum(d: Diagnosis, path: Path) -> Path:
         for k, fr in enumerate(freqs):
             ax.axvline(fr, color=colour, lw=1.2, ls="--", zorder=3,
                        label=f"{name}: {fr:.3g} Hz ({1.0 / fr / 60.0:.3g} min)" if k == 0 else None)
-    ax.set(xlabel="frequency (Hz)", ylabel=f"power ({d.unit})²/Hz",
-           title=f"{d.recording or 'recording'}: {method} of the held-out residual")
+    ax.set(xlabel="frequency (Hz)", ylabel=f"power ({d.unit})²/Hz")
+    ax.set_title(f"{d.recording or 'recording'}: {method} of the held-out residual", fontsize=9)
     ax.legend(fontsize=7, loc="lower left")
     ax.grid(True, which="both", alpha=0.3)
     return _save(fig, path)
