@@ -272,7 +272,8 @@ def diagnose(
     if b is not None and "bias_instability" not in declared:
         effects_out.append(library_finding("bias_instability", {"b": b}, {
             "allan_ratio": evidence["bias_instability"].gain, "bound": evidence["bias_instability"].threshold,
-            "tau_s": float(allan_after.tau_s[allan_after.first_over])}, Extent.of(data)).to_json())  # type: ignore[union-attr,index]
+            "tau_s": float(allan_after.tau_s[allan_after.first_over]),  # type: ignore[union-attr,index]
+        }, Extent.of(data)).to_json())
         fitted["bias_instability"] = {"b": b}
         confusable += [{"effects": [e, "bias_instability"], "test": FLICKER_TEST} for e in found if e in TIME_EFFECTS]
     if outliers.count:
