@@ -184,7 +184,7 @@ def _listed_table(f: dict[str, Any], unit: str, t0: float) -> list[str]:
                 and all(isinstance(x, (int, float)) for x in v)}
     header, cols = [], []
     for k, v in columns.items():
-        header.append(k if k == "time_s" else f"{k} ({unit})" if k in ("size", "amplitude", "level") else k)
+        header.append("time (s)" if k == "time_s" else f"{k} ({unit})" if k in ("size", "amplitude", "level") else k)
         cols.append([_g(x, 8 if k == "time_s" else 4) for x in v])
         if k == "time_s":
             header.append("time (h from start)")
