@@ -1,4 +1,13 @@
-"""``report.md``: a :class:`~tcbench.diagnose.diagnosis.Diagnosis` in plain words for a reader."""
+"""``report.md``: a :class:`~tcbench.diagnose.diagnosis.Diagnosis` in plain words for a reader.
+
+Every finding of ``effects`` (the contract of :mod:`tcbench.diagnose.findings`, library effect or
+not) is rendered the same way, whatever its id: a row of the findings table (id, shape, library,
+where) and a section with its shape and what that shape looks like (PHYSICS.md §8), its scalar
+parameters with units, where (:func:`format_where`: instants in s and h from the start, periods
+in s and min, bands in degC, levels in the finding's ``params`` ``unit`` or the output unit), the
+evidence, what it cannot be told from, confirm-with, a table of its listed values (lists of one
+length in ``params`` and ``evidence``, such as outlier times and sizes) and its explanation.
+"""
 
 from __future__ import annotations
 
