@@ -201,3 +201,14 @@ def test_residual_spectrum_finds_a_line_at_the_white_level(bursts: bool) -> None
     assert abs(f[np.argmax(p)] - 1.0 / period) < 0.05 / period
     high = f > 0.05  # far from the line: white noise alone, one-sided density 2 sigma^2 / fs
     assert np.median(p[high]) == pytest.approx(2.0 * sigma**2 / fs * np.log(2.0), rel=0.25)
+
+
+def test_instants_outside_the_record_are_not_drawn(several: Diagnosis) -> None:
+    """An instant far outside the record (a power-on at t = 0 on a clock that starts at 1e9 s
+    would be one) would squash the time axis: it is skipped, the ones inside are drawn."""
+    t0, t1 = float(several.series.t_s[0]), float(several.series.t_s[-1])
+    finding = _open_world()[0] | {"where": {"time_s": [t0 - 10.0 * (t1 - t0), 0.5 * (t0 + t1), t1 + 1e9]}}
+    fig, ax = plt.subplots()
+    assert mark_times(ax, replace(several, effects=[finding]), t0, t1) == 1
+    assert float(ax.lines[0].get_xdata()[0]) == pytest.approx(0.5 * (t1 - t0) / 3600.0)
+    plt.close(fig)
