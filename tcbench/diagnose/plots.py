@@ -276,7 +276,8 @@ def plot_residuals(d: Diagnosis, path: Path) -> Path:
         mark_bands(ax_c, d, (float(np.min(temp)), float(np.max(temp))))
         rmse = fit["rmse_heldout"]
         terms = ", ".join(fit.get("model", [])) or "minimal"
-        ax_t.set_title(f"{label} ({terms}): RMSE held-out {rmse:.4g} {d.unit} = {rmse / sigma:.3g} σ", fontsize=9)
+        sep = "\n" if len(terms) > 40 else " "  # a long list of terms on a line of its own
+        ax_t.set_title(f"{label} ({terms}):{sep}RMSE held-out {rmse:.4g} {d.unit} = {rmse / sigma:.3g} σ", fontsize=9)
         ax_t.set_xlabel("time (h)")
         ax_c.set_xlabel("thermometer (°C)")
         ax_t.legend(fontsize=7, loc="upper right")
