@@ -30,8 +30,8 @@ def control() -> Diagnosis:
 
 
 def _assert_pngs(out: Path, plots: dict[str, str]) -> None:
-    assert set(plots) == {"residuals", "allan", "evidence"}
-    assert sorted(plots.values()) == ["allan.png", "evidence.png", "residuals.png"]
+    assert set(plots) == {"residuals", "allan", "evidence", "spectrum"}
+    assert sorted(plots.values()) == ["allan.png", "evidence.png", "residuals.png", "spectrum.png"]
     for filename in plots.values():
         data = (out / filename).read_bytes()
         assert data[:8] == PNG_MAGIC and len(data) > 10_000

@@ -10,7 +10,9 @@ Records (PROVENANCE.md beside each under ``../shared/data/real/``):
 Each axis's report goes to ``--out/<record>/<axis>/`` (report.json, report.md, model.yaml,
 plots); ``--out/summary.md`` holds one row per axis: the starting model's, the final model's
 and the reference's held-out RMSE in white sigma, final / reference (target <= 1.25), the test
-that decided, the effects named and the seconds taken.
+that decided, the effects named and the seconds taken; then, per axis, its residual plot
+(located findings marked), its verdict and every finding with its shape, where, explanation
+and the measurement that would confirm it.
 
     python experiments/diagnose-real/run.py [--out DIR] [--records tofupilot,pan_lsm6dsm]
 """
@@ -25,7 +27,8 @@ from pathlib import Path
 from pan_lsm6dsm import DATA as PAN_DATA
 from pan_lsm6dsm import convert as pan_gyro
 
-from tcbench.diagnose.diagnosis import REFERENCE_RATIO, diagnose
+from tcbench.diagnose.diagnosis import REFERENCE_RATIO, Diagnosis, diagnose
+from tcbench.diagnose.markdown import format_where
 from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
 from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording
@@ -40,25 +43,50 @@ HEADER = ["| record | axis | baseline held-out | final held-out | reference held
           "| effects named | s |", "|---|---|---|---|---|---|---|---|---|"]
 
 
-def diagnose_record(record: str, out: Path) -> list[str]:
+def _sentence(text: str) -> str:
+    """``text`` ending in one full stop."""
+    return text.rstrip().rstrip(".") + "."
+
+
+def axis_section(d: Diagnosis, record: str, axis: str, files: dict[str, Path], out: Path) -> list[str]:
+    """The summary's section of one axis: its residual plot (linked relative to ``out``), the
+    verdict and every finding with shape, where, explanation and confirm-with."""
+    rel = {name: path.relative_to(out).as_posix() for name, path in files.items()}
+    t0 = float(d.series.t_s[0])
+    lines = [f"### {record} {axis}", "", f"![{record} {axis} residuals]({rel['residuals.png']})", "",
+             f"Report: [report.md]({rel['report.md']}); spectrum: [spectrum.png]({rel['spectrum.png']}); "
+             f"Allan: [allan.png]({rel['allan.png']}).", "", f"**Verdict:** {d.verdict}", ""]
+    if not d.effects:
+        lines += ["No finding.", ""]
+    for f in d.effects:
+        kind = "library" if f["library"] else "not library"
+        where = format_where(f["where"], f["params"].get("unit", d.unit), t0)
+        lines += [f"- **{f['id']}** ({f['shape']}, {kind}); where: {where}. {_sentence(f['explanation'])} "
+                  f"*Confirm with:* {_sentence(f['confirm_with'])}"]
+    return [*lines, ""]
+
+
+def diagnose_record(record: str, out: Path) -> tuple[list[str], list[str]]:
     """Diagnose the three gyro axes of ``record``, write their reports under ``out/<record>``;
-    the summary rows."""
+    the summary rows and the per-axis sections."""
     load, title, source = RECORDS[record]
     if not source.exists():
         raise SystemExit(f"run.py: {source} not found (the shared data folder beside the project)")
-    rows = []
+    rows: list[str] = []
+    sections: list[str] = []
     for axis in ("x", "y", "z"):
         t0 = time.perf_counter()
         d = diagnose(load(axis), name=title.format(axis=axis))
         seconds = time.perf_counter() - t0
-        write_report(d, out / record / axis)
+        files = write_report(d, out / record / axis)
+        sections += axis_section(d, record, axis, files, out)
         s = d.noise["white_sigma"]
         rows.append(f"| {record} | {axis} | {d.baseline['rmse_heldout'] / s:.2f} sigma | "
                     f"{d.final['rmse_heldout'] / s:.2f} sigma | {d.reference['rmse_heldout'] / s:.2f} sigma | "
                     f"{d.reference['final_over_reference']:.2f} | {d.statistics['significance_test']} | "
                     f"{', '.join(d.effect_ids) or '-'} | {seconds:.1f} |")
         print(f"{record} {axis}: {d.verdict}", flush=True)
-    return rows
+    return rows, sections
 
 
 def main() -> None:
@@ -69,11 +97,18 @@ def main() -> None:
     records = [r.strip() for r in args.records.split(",") if r.strip()]
     if unknown := [r for r in records if r not in RECORDS]:
         raise SystemExit(f"run.py: unknown record {unknown[0]!r}; known: {', '.join(RECORDS)}")
-    rows = [row for record in records for row in diagnose_record(record, args.out)]
+    done = [diagnose_record(record, args.out) for record in records]
+    rows = [row for r, _ in done for row in r]
+    sections = [line for _, sec in done for line in sec]
     head = [f"# Real gyro recordings: final model against the physics-agnostic reference (target <= {REFERENCE_RATIO:g})",
             "", "Held-out RMSE in white sigma (first differences); blocks, folds and the significance test as in "
             "each report.json `statistics`. Command: `python experiments/diagnose-real/run.py`.", ""]
-    text = "\n".join(head + HEADER + rows) + "\n"
+    findings = ["", "## Findings per axis", "",
+                ("Each axis: the held-out residual of the starting and the final model against time and temperature "
+                 "(located findings marked: dashed lines at instants, strips over temperature bands), the verdict, "
+                 "and every finding of report.json `effects` with its shape, where, explanation and the measurement "
+                 "that would confirm it."), ""]
+    text = "\n".join(head + HEADER + rows + findings + sections).rstrip() + "\n"
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "summary.md").write_text(text)
     print(text)

@@ -20,7 +20,7 @@ from tcbench.diagnose.attribute import (
     recheck_with_flicker,
 )
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
-from tcbench.diagnose.explain import explain
+from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.open_terms import TERMS, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
@@ -272,11 +272,8 @@ def diagnose(
         evidence[e].reason = "dropping it costs more held-out error than chance allows"
         ev = {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold),
               **_test_json(evidence[e])}
-        if e in TERMS:
-            effects_out.append(open_finding(e, fitted[e], ev, data.unit))
-            continue
-        effects_out.append({"id": e, "params": fitted[e], "evidence": ev, "explanation": explain(e, fitted[e], data.unit),
-                            **({"confusable_with": evidence[e].confusable_with} if evidence[e].confusable_with else {})})
+        effects_out.append(open_finding(e, fitted[e], ev, data.unit) if e in TERMS else
+                           library_finding(e, fitted[e], ev, Extent.of(data), evidence[e].confusable_with).to_json())
     evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared)
     if structure_left and "bias_instability" not in declared:
         evidence["bias_instability"] = Evidence(
@@ -285,10 +282,10 @@ def diagnose(
                 f"the final model {final_rmse:.4g} {data.unit} held out): flicker is judged only once it is modelled"))
     confusable = [{"effects": [a, b_], "test": test} for a, b_, test in att.confusions if a in found]
     if b is not None and "bias_instability" not in declared:
-        effects_out.append({
-            "id": "bias_instability", "params": {"b": b},
-            "evidence": {"allan_ratio": evidence["bias_instability"].gain, "bound": evidence["bias_instability"].threshold},
-            "explanation": explain("bias_instability", {"b": b}, data.unit)})
+        effects_out.append(library_finding("bias_instability", {"b": b}, {
+            "allan_ratio": evidence["bias_instability"].gain, "bound": evidence["bias_instability"].threshold,
+            "tau_s": float(allan_after.tau_s[allan_after.first_over]),  # type: ignore[union-attr,index]
+        }, Extent.of(data)).to_json())
         fitted["bias_instability"] = {"b": b}
         confusable += [{"effects": [e, "bias_instability"], "test": FLICKER_TEST} for e in found if e in TIME_EFFECTS]
     if outliers.count:

@@ -1,4 +1,13 @@
-"""``report.md``: a :class:`~tcbench.diagnose.diagnosis.Diagnosis` in plain words for a reader."""
+"""``report.md``: a :class:`~tcbench.diagnose.diagnosis.Diagnosis` in plain words for a reader.
+
+Every finding of ``effects`` (the contract of :mod:`tcbench.diagnose.findings`, library effect or
+not) is rendered the same way, whatever its id: a row of the findings table (id, shape, library,
+where) and a section with its shape and what that shape looks like (PHYSICS.md §8), its scalar
+parameters with units, where (:func:`format_where`: instants in s and h from the start, periods
+in s and min, bands in degC, levels in the finding's ``params`` ``unit`` or the output unit), the
+evidence, what it cannot be told from, confirm-with, a table of its listed values (lists of one
+length in ``params`` and ``evidence``, such as outlier times and sizes) and its explanation.
+"""
 
 from __future__ import annotations
 
@@ -17,7 +26,12 @@ PLOT_CAPTIONS = {
     "allan": "Allan deviation of the held-out residual against the white (+ thermometer) noise line "
              "and the flagging bound.",
     "evidence": "Penalised held-out gain of each candidate effect against the detection threshold.",
+    "spectrum": "Spectrum of the held-out residual of the starting and the final model (periodogram, or "
+                "Lomb-Scargle for a record of bursts) against the white-noise level; dashed: located lines.",
+    "output": "Output and thermometer against time; dashed: located instants, dash-dotted: located levels.",
 }
+LOCATED_NOTE = ("Findings are marked from their `where`: dashed vertical lines at located instants, strips (and "
+                "shading, when narrower than the recording's range) over located temperature bands.")
 
 
 def _g(x: Any, digits: int = 4) -> str:
@@ -55,22 +69,6 @@ def _param(name: str, value: float, unit: str) -> str:
     return f"{name} = {v}"
 
 
-def _evidence_line(effect: dict[str, Any]) -> str:
-    ev = effect.get("evidence", {})
-    if "allan_ratio" in ev:
-        return (f"Allan deviation {_g(ev['allan_ratio'], 3)} times the white-noise line from tau = "
-                f"{_g(ev.get('tau_s'))} s, above the bound {_g(ev.get('bound'), 3)}.")
-    if "gain_sigma2" in ev:
-        line = (f"dropping it raises the held-out squared error by {_g(ev['gain_sigma2'])} sigma^2 "
-                f"(penalised), against a threshold of {_g(ev.get('threshold_sigma2'))} sigma^2")
-        if ev.get("test") == SURROGATE:
-            return line + f"; significant by the {SURROGATE} test, p = {_g(ev.get('p_value'), 3)} <= {_g(LEVEL)}."
-        if "robust_wald" in ev:
-            return line + f"; cluster-robust Wald {_g(ev['robust_wald'], 3)} > {_g(WALD_THRESHOLD)}."
-        return line + "."
-    return "-"
-
-
 def _gain_cell(e: Evidence) -> str:
     if e.effect == "bias_instability":
         return f"Allan ratio {_g(e.gain, 3)} (bound {_g(e.threshold, 3)})" if math.isfinite(e.gain) else "-"
@@ -90,20 +88,147 @@ def _value_cell(e: Evidence) -> str:
     return _g(e.value) if name is None else _param(name, e.value, "")
 
 
-def _outliers_section(effect: dict[str, Any], unit: str, t0: float) -> list[str]:
-    """The ``outliers`` finding: count, bound and a table of the listed samples."""
-    p, ev = effect["params"], effect["evidence"]
-    out = ["### outliers (not a library effect)", "",
-           (f"- {p['count']} isolated sample(s) beyond the bound of {_g(ev['bound_z'], 3)} robust sigma "
-            f"(robust sigma {_g(ev['robust_sigma'])} {unit}; false-alarm probability {_g(ev['false_alarm'])} over "
-            "the record); given zero weight in every fit, held-out score and test."),
-           f"- Confirm with: {effect['confirm_with']}", ""]
-    out += _table(["time (s)", "time (h from start)", f"size ({unit})", "robust z"],
-                  ([_g(t, 8), _g((t - t0) / 3600.0, 4), _g(s), _g(z, 3)]
-                   for t, s, z in zip(p["time_s"], p["size"], ev["robust_z"], strict=True)))
-    if p["count"] > len(p["time_s"]):
-        out.append(f"({len(p['time_s'])} largest of {p['count']} listed.)")
-    return [*out, "", effect["explanation"], ""]
+SHAPE_SIGNATURE = {  # PHYSICS.md §8: what each shape looks like in the residual
+    "step": "a bias jump at one instant, flat before and after",
+    "periodic": "a spectral line, often unrelated to temperature",
+    "trend": "a slow drift against time, not temperature",
+    "transient": "a decay after power-on or after a handling event",
+    "temperature_function": "a smooth function of the thermometer beyond the model's order",
+    "temperature_dynamics": "depends on how the temperature got there: rate, lag, heating against cooling",
+    "input_function": "depends on the applied input",
+    "variance": "the noise level changes with temperature or time",
+    "saturation": "a flat ceiling or floor",
+    "outliers": "isolated samples far off the rest",
+    "quantisation": "output or thermometer on a grid",
+    "noise": "random structure left after every deterministic term",
+}
+MAX_LISTED_WHERE = 10  # instants or lines listed in a ``Where`` line; the rest counted
+
+
+def _numbers(x: Any) -> list[float]:
+    """A number or a list of numbers as a list."""
+    return [float(v) for v in x] if isinstance(x, (list, tuple)) else [float(x)]
+
+
+def _listed(items: list[str], what: str) -> str:
+    if len(items) <= MAX_LISTED_WHERE:
+        return ", ".join(items)
+    return ", ".join(items[:MAX_LISTED_WHERE]) + f", ... ({len(items)} {what} in all)"
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` in s, with min or h beside when it is long."""
+    if abs(seconds) >= 7200.0:
+        return f"{_g(seconds)} s ({_g(seconds / 3600.0, 3)} h)"
+    if abs(seconds) >= 120.0:
+        return f"{_g(seconds)} s ({_g(seconds / 60.0, 3)} min)"
+    return f"{_g(seconds)} s"
+
+
+def format_where(where: dict[str, Any], unit: str, t0: float) -> str:
+    """A finding's ``where`` in words: instants in s and h from the start of the recording,
+    periods in s and min, temperature bands in degC, levels with ``unit``."""
+    parts = []
+    if "time_s" in where:
+        times = [f"{_g(t, 8)} s ({_g((t - t0) / 3600.0, 4)} h from the start)" for t in _numbers(where["time_s"])]
+        parts.append("at t = " + _listed(times, "instants"))
+    if "period_s" in where:
+        periods = [f"{_g(p)} s ({_g(p / 60.0, 3)} min)" for p in _numbers(where["period_s"])]
+        parts.append("period " + _listed(periods, "periods"))
+    if "frequency_hz" in where:
+        freqs = [f"{_g(f)} Hz" + (f" (period {_g(1.0 / f / 60.0, 3)} min)" if f > 0 else "")
+                 for f in _numbers(where["frequency_hz"])]
+        parts.append("frequency " + _listed(freqs, "lines"))
+    if "temperature_c" in where:
+        low, high = where["temperature_c"]
+        parts.append(f"temperature band {_g(low)} to {_g(high)} degC")
+    if "level" in where:
+        parts.append("level " + _listed([f"{_g(v)} {unit}" for v in _numbers(where["level"])], "levels"))
+    return "; ".join(parts) if parts else "not localised: the whole record"
+
+
+def _evidence_text(ev: dict[str, Any]) -> str:
+    """Evidence in words: the held-out gain and its test, the Allan ratio, the outlier bound,
+    or any other evidence as ``name = value`` pairs."""
+    if "allan_ratio" in ev:
+        return (f"Allan deviation {_g(ev['allan_ratio'], 3)} times the white-noise line from tau = "
+                f"{_g(ev.get('tau_s'))} s, above the bound {_g(ev.get('bound'), 3)}.")
+    if "gain_sigma2" in ev:
+        line = (f"dropping it raises the held-out squared error by {_g(ev['gain_sigma2'])} sigma^2 "
+                f"(penalised), against a threshold of {_g(ev.get('threshold_sigma2'))} sigma^2")
+        if ev.get("test") == SURROGATE:
+            return line + f"; significant by the {SURROGATE} test, p = {_g(ev.get('p_value'), 3)} <= {_g(LEVEL)}."
+        if "robust_wald" in ev:
+            return line + f"; cluster-robust Wald {_g(ev['robust_wald'], 3)} > {_g(WALD_THRESHOLD)}."
+        if ev.get("test"):
+            return line + f"; test: {ev['test']}."
+        return line + "."
+    if "bound_z" in ev:
+        return (f"robust z beyond the bound of {_g(ev['bound_z'], 3)} (robust sigma {_g(ev.get('robust_sigma'))}; "
+                f"false-alarm probability {_g(ev.get('false_alarm'))} over the record); test: {ev.get('test', '-')}.")
+    pairs = [f"{k} = {_g(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else v}"
+             for k, v in ev.items() if not isinstance(v, (list, tuple, dict))]
+    return "; ".join(pairs) + "." if pairs else "-"
+
+
+def _scalar_params(params: dict[str, Any], unit: str) -> str:
+    out = []
+    for k, v in params.items():
+        if isinstance(v, bool) or isinstance(v, (list, tuple, dict)):
+            continue
+        out.append(_param(k, v, unit) if isinstance(v, (int, float)) else f"{k} = {v}")
+    return "; ".join(out) or "-"
+
+
+def _listed_table(f: dict[str, Any], unit: str, t0: float) -> list[str]:
+    """Lists of one length in ``params`` and ``evidence`` (instants, sizes, scores) as a table,
+    with hours from the start beside ``time_s``."""
+    columns = {k: v for k, v in f["params"].items() if isinstance(v, (list, tuple)) and v
+               and all(isinstance(x, (int, float)) for x in v)}
+    if not columns:
+        return []
+    n = len(next(iter(columns.values())))
+    columns = {k: v for k, v in columns.items() if len(v) == n}
+    columns |= {k: v for k, v in f["evidence"].items() if isinstance(v, (list, tuple)) and len(v) == n
+                and all(isinstance(x, (int, float)) for x in v)}
+    header, cols = [], []
+    for k, v in columns.items():
+        header.append("time (s)" if k == "time_s" else f"{k} ({unit})" if k in ("size", "amplitude", "level") else k)
+        cols.append([_g(x, 8 if k == "time_s" else 4) for x in v])
+        if k == "time_s":
+            header.append("time (h from start)")
+            cols.append([_g((x - t0) / 3600.0, 4) for x in v])
+    rows = list(zip(*cols, strict=True))
+    out = _table(header, rows)
+    count = f["params"].get("count")
+    if isinstance(count, int) and count > n:
+        out.append(f"({n} largest of {count} listed.)")
+    return [*out, ""]
+
+
+def finding_section(f: dict[str, Any], unit: str, t0: float) -> list[str]:
+    """One finding of the report contract (any ``id``): shape, library or not, parameters,
+    where, evidence, what it cannot be told from, confirm-with, listed values and explanation."""
+    kind = "library effect" if f.get("library") else "not a library effect"
+    shape = f.get("shape", "-")
+    unit_here = str(f["params"].get("unit", unit))
+    out = [f"### {f['id']} ({shape}, {kind})", "",
+           f"- Shape: {shape}" + (f" ({SHAPE_SIGNATURE[shape]})" if shape in SHAPE_SIGNATURE else ""),
+           f"- Parameters: {_scalar_params(f['params'], unit_here)}",
+           f"- Where: {format_where(f.get('where', {}), unit_here, t0)}",
+           f"- Evidence: {_evidence_text(f.get('evidence', {}))}"]
+    if f.get("confusable_with"):
+        out.append(f"- Cannot be told from: {', '.join(f['confusable_with'])} (see below)")
+    out += [f"- Confirm with: {f.get('confirm_with', '-')}", ""]
+    out += _listed_table(f, unit_here, t0)
+    return [*out, f.get("explanation", ""), ""]
+
+
+def findings_table(effects: list[dict[str, Any]], unit: str, t0: float) -> list[str]:
+    """One row per finding: id, shape, library, where."""
+    return _table(["finding", "shape", "library", "where"],
+                  ([f["id"], f.get("shape", "-"), "yes" if f.get("library") else "no",
+                    format_where(f.get("where", {}), str(f["params"].get("unit", unit)), t0)] for f in effects))
 
 
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
@@ -174,16 +299,10 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
                  else f"bias instability: {flicker.reason}" if flicker else "bias instability was not tested")
         out += [("Nothing missing: no candidate effect improves the held-out error by more than chance allows; "
                  f"{allan}."), ""]
+    if d.effects:
+        out += [*findings_table(d.effects, d.unit, t0), ""]
     for effect in d.effects:
-        if effect.get("shape") == "outliers":
-            out += _outliers_section(effect, d.unit, t0)
-            continue
-        out += [f"### {effect['id']}", ""]
-        params = "; ".join(_param(k, v, d.unit) for k, v in effect.get("params", {}).items())
-        out += [f"- Parameters: {params or '-'}", f"- Evidence: {_evidence_line(effect)}"]
-        if effect.get("confusable_with"):
-            out.append(f"- Cannot be told from: {', '.join(effect['confusable_with'])} (see below)")
-        out += ["", effect.get("explanation", ""), ""]
+        out += finding_section(effect, d.unit, t0)
 
     out += ["## Effects this recording cannot tell apart", ""]
     if d.confusable:
@@ -208,6 +327,6 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     if plots:
         out += ["## Plots", ""]
         for name, filename in plots.items():
-            caption = PLOT_CAPTIONS.get(name, name)
+            caption = PLOT_CAPTIONS.get(name, name) + (f" {LOCATED_NOTE}" if name == "residuals" and d.effects else "")
             out += [f"![{name}]({filename})", "", caption, ""]
     return "\n".join(out).rstrip() + "\n"

@@ -4,8 +4,17 @@ Each ``plot_*`` function writes one PNG to ``path`` and returns ``path``:
 :func:`plot_residuals` (held-out residual of the starting and the final model against time and
 temperature, with the located mismatch shaded), :func:`plot_allan` (Allan deviation of both
 residuals against the white-noise line and the flagging bound) and :func:`plot_evidence` (each
-candidate effect's penalised held-out gain against the detection threshold).
-:func:`write_plots` writes all three into a directory.
+candidate effect's penalised held-out gain against the detection threshold) and
+:func:`plot_spectrum` (spectrum of both residuals: ``scipy.signal.periodogram``
+for a continuous record, Lomb-Scargle for one made of bursts). :func:`plot_output` (the output
+and the thermometer against time) is written when the diagnosis's series carries the output.
+
+Every finding of ``report.json`` ``effects`` is marked from its ``where``, whatever its id:
+vertical lines at its ``time_s`` on the time panels, its ``temperature_c`` band as a strip (and,
+when narrower than the recording's range, a shading) on the temperature panels, its
+``frequency_hz`` or ``period_s`` as vertical lines on the spectrum, its ``level`` as a
+horizontal line on the output panel (on the thermometer's axis when the finding's ``params``
+give ``unit`` degC). :func:`write_plots` writes them all into a directory.
 """
 
 from __future__ import annotations
@@ -18,10 +27,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from scipy.signal import lombscargle, periodogram
 
 from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
 from tcbench.diagnose.diagnosis import Diagnosis
 from tcbench.diagnose.locate import AllanExcess
+from tcbench.sensors.segments import segments, within_rate_hz
 
 BEFORE_COLOUR, AFTER_COLOUR = "tab:red", "tab:blue"
 STATUS_COLOUR = {"kept": "tab:green", "rejected": "0.6", "in the model": "tab:blue", "not identifiable": "0.3"}
@@ -30,7 +41,15 @@ MAX_POINTS = 20_000
 MEAN_WINDOW_S = 300.0
 DPI = 110
 _BAND = re.compile(r"temperature band\s+(-?[\d.eE+]+)\.\.(-?[\d.eE+]+)")
-PLOT_FILES = {"residuals": "residuals.png", "allan": "allan.png", "evidence": "evidence.png"}
+PLOT_FILES = {"residuals": "residuals.png", "allan": "allan.png", "evidence": "evidence.png",
+              "spectrum": "spectrum.png"}
+OUTPUT_FILE = "output.png"
+FINDING_COLOURS = ("tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive", "tab:cyan",
+                   "0.35")
+SPECTRUM_POINTS = 4000  # faint points per spectrum (every k-th frequency)
+SPECTRUM_BINS = 160  # log-spaced frequency bins of the averaged periodogram
+LS_FREQUENCIES = 3000  # frequencies of the Lomb-Scargle periodogram of a burst record
+NARROW_BAND = 0.8  # a temperature band narrower than this share of the range is also shaded
 
 
 def _save(fig: plt.Figure, path: Path) -> Path:
@@ -60,6 +79,161 @@ def _spans(d: Diagnosis) -> tuple[list[tuple[float, float]], list[tuple[float, f
              for m in d.mismatch if m.what.startswith("time span")]
     bands = [(float(g[1]), float(g[2])) for m in d.mismatch if (g := _BAND.match(m.what))]
     return times, bands
+
+
+
+def _numbers(x: object) -> list[float]:
+    """A number or a list of numbers as a list of floats."""
+    return [float(v) for v in x] if isinstance(x, (list, tuple, np.ndarray)) else [float(x)]  # type: ignore[arg-type]
+
+
+def located(d: Diagnosis, key: str) -> list[tuple[str, str, object]]:
+    """``(id, colour, value)`` of every finding of ``d`` whose ``where`` has ``key``; colours
+    follow the findings' order so that one finding has one colour in every plot."""
+    out = []
+    for i, f in enumerate(d.effects):
+        where = f.get("where") or {}
+        if key in where and where[key] is not None:
+            out.append((str(f["id"]), FINDING_COLOURS[i % len(FINDING_COLOURS)], where[key]))
+    return out
+
+
+def _frequencies(d: Diagnosis) -> list[tuple[str, str, list[float]]]:
+    """Located lines (Hz) of every finding: its ``frequency_hz`` or, failing that, 1 / ``period_s``."""
+    out = [(i, c, _numbers(v)) for i, c, v in located(d, "frequency_hz")]
+    named = {i for i, _, _ in out}
+    out += [(i, c, [1.0 / p for p in _numbers(v) if p > 0]) for i, c, v in located(d, "period_s") if i not in named]
+    return out
+
+
+def mark_times(ax: plt.Axes, d: Diagnosis, t0: float, t1: float) -> int:
+    """Vertical lines (hours from ``t0``) at each finding's ``time_s`` inside the record's span
+    ``[t0, t1]`` (5 % margin); the number of lines drawn."""
+    margin = 0.05 * (t1 - t0)
+    drawn = 0
+    for name, colour, value in located(d, "time_s"):
+        times = [t for t in _numbers(value) if t0 - margin <= t <= t1 + margin]
+        for k, t in enumerate(times):
+            ax.axvline((t - t0) / 3600.0, color=colour, lw=1.0, ls="--", alpha=0.8, zorder=3,
+                       label=f"{name}: time" if k == 0 else None)
+        drawn += len(times)
+    return drawn
+
+
+def mark_bands(ax: plt.Axes, d: Diagnosis, temp_range: tuple[float, float]) -> int:
+    """Each finding's ``temperature_c`` band as a strip at the bottom of ``ax`` (one row per
+    finding), also shaded over the panel's height when narrower than :data:`NARROW_BAND` of the
+    recording's ``temp_range``; the number of bands drawn."""
+    width = max(temp_range[1] - temp_range[0], 1e-9)
+    bands = located(d, "temperature_c")
+    for row, (name, colour, band) in enumerate(bands):
+        low, high = (float(v) for v in band)  # type: ignore[union-attr]
+        y0 = 0.02 + 0.04 * row
+        ax.axvspan(low, high, ymin=y0, ymax=y0 + 0.03, color=colour, alpha=0.8, lw=0, zorder=3,
+                   label=f"{name}: temperature band")
+        if high - low < NARROW_BAND * width:
+            ax.axvspan(low, high, color=colour, alpha=0.12, lw=0, zorder=0)
+    return len(bands)
+
+
+def mark_levels(ax: plt.Axes, d: Diagnosis, unit: str) -> int:
+    """Horizontal lines at the ``level`` of each finding whose ``params`` ``unit`` (the output
+    unit when it gives none) is ``unit``; the number of lines drawn."""
+    drawn = 0
+    for i, f in enumerate(d.effects):
+        where = f.get("where") or {}
+        if where.get("level") is None or str((f.get("params") or {}).get("unit", d.unit)) != unit:
+            continue
+        colour = FINDING_COLOURS[i % len(FINDING_COLOURS)]
+        for k, level in enumerate(_numbers(where["level"])):
+            ax.axhline(level, color=colour, lw=1.2, ls="-.", zorder=3, label=f"{f['id']}: level" if k == 0 else None)
+            drawn += 1
+    return drawn
+
+
+def residual_spectrum(t_s: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """One-sided spectrum of a residual: ``(frequency Hz, power, method)``. A continuous record
+    takes ``scipy.signal.periodogram`` (density, unit^2/Hz, at its median sample interval); a
+    record of bursts takes the Lomb-Scargle periodogram on log-spaced frequencies from one over
+    its span to half its within-burst rate, scaled to the same density for white noise."""
+    t = np.asarray(t_s, dtype=np.float64)
+    x = np.asarray(r, dtype=np.float64) - float(np.mean(r))
+    if segments(t)[-1] == 0:
+        fs = 1.0 / float(np.median(np.diff(t)))
+        f, p = periodogram(x, fs=fs, detrend="constant")
+        return f[1:], p[1:], "periodogram"
+    fs = within_rate_hz(t)
+    f = np.geomspace(1.0 / float(t[-1] - t[0]), 0.5 * fs, LS_FREQUENCIES)
+    power = lombscargle(t, x, 2.0 * np.pi * f)  # about the variance at every frequency for white noise
+    return f, power * (2.0 / fs), "Lomb-Scargle"
+
+
+def _log_binned(f: np.ndarray, p: np.ndarray, bins: int = SPECTRUM_BINS) -> tuple[np.ndarray, np.ndarray]:
+    """Mean power in log-spaced frequency bins (empty bins dropped)."""
+    edges = np.geomspace(f[0], f[-1] * (1 + 1e-9), bins + 1)
+    idx = np.clip(np.searchsorted(edges, f, side="right") - 1, 0, bins - 1)
+    n = np.bincount(idx, minlength=bins)
+    ok = n > 0
+    fm = np.bincount(idx, weights=np.log(f), minlength=bins)[ok] / n[ok]
+    pm = np.bincount(idx, weights=p, minlength=bins)[ok] / n[ok]
+    return np.exp(fm), pm
+
+
+def plot_spectrum(d: Diagnosis, path: Path) -> Path:
+    """Log-log spectrum of the held-out residual of the starting and the final model (faint:
+    every frequency; line: log-binned means) against the white-noise level ``2 sigma^2 / fs``,
+    with each finding's located lines (``frequency_hz`` or ``period_s``) marked."""
+    s = d.series
+    sigma = float(d.noise["white_sigma"])
+    fig, ax = plt.subplots(figsize=(7, 4))
+    method, floor = "periodogram", float("inf")
+    fs = within_rate_hz(np.asarray(s.t_s, dtype=np.float64))
+    for res, colour, label in ((s.residual_before, BEFORE_COLOUR, "starting model"),
+                               (s.residual_after, AFTER_COLOUR, "final model")):
+        f, p, method = residual_spectrum(s.t_s, res)
+        step = max(1, int(np.ceil(f.size / SPECTRUM_POINTS)))
+        ax.loglog(f[::step], p[::step], ".", ms=1, color=colour, alpha=0.15, rasterized=True)
+        fb, pb = _log_binned(f, p)
+        ax.loglog(fb, pb, "-", color=colour, lw=1.3, label=f"{label} (log-binned)")
+        floor = min(floor, float(np.min(pb[pb > 0])) if (pb > 0).any() else floor)
+    white = 2.0 * sigma**2 / fs
+    ax.axhline(white, color="k", ls="--", lw=1, label="white-noise level")
+    ax.set_ylim(bottom=min(floor, white) / 10.0)
+    for name, colour, freqs in _frequencies(d):
+        for k, fr in enumerate(freqs):
+            ax.axvline(fr, color=colour, lw=1.2, ls="--", zorder=3,
+                       label=f"{name}: {fr:.3g} Hz ({1.0 / fr / 60.0:.3g} min)" if k == 0 else None)
+    ax.set(xlabel="frequency (Hz)", ylabel=f"power ({d.unit})²/Hz")
+    ax.set_title(f"{d.recording or 'recording'}: {method} of the held-out residual", fontsize=9)
+    ax.legend(fontsize=7, loc="lower left")
+    ax.grid(True, which="both", alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_output(d: Diagnosis, path: Path) -> Path:
+    """The output (left axis) and the smoothed thermometer (right axis) against time, with
+    each finding's instants and levels marked. Needs ``d.series.output``."""
+    s = d.series
+    t = np.asarray(s.t_s, dtype=np.float64)
+    y = np.asarray(s.output, dtype=np.float64)  # type: ignore[attr-defined]
+    step = max(1, int(np.ceil(t.size / MAX_POINTS)))
+    t_h = (t - t[0]) / 3600.0
+    fig, ax = plt.subplots(figsize=(9, 4))
+    ax.plot(t_h[::step], y[::step], ".", ms=1, color="0.3", alpha=0.4, rasterized=True)
+    ax_t = ax.twinx()
+    ax_t.plot(t_h, s.temp_c, "-", color="tab:red", lw=1.0, alpha=0.7, label="thermometer (smoothed)")
+    mark_times(ax, d, float(t[0]), float(t[-1]))
+    mark_levels(ax, d, d.unit)
+    mark_levels(ax_t, d, "degC")
+    ax.set(xlabel="time (h)", ylabel=f"output ({d.unit})",
+           title=f"{d.recording or 'recording'}: output and thermometer, located findings marked")
+    ax_t.set_ylabel("thermometer (°C)")
+    lines = ax.get_legend_handles_labels()
+    lines_t = ax_t.get_legend_handles_labels()
+    if lines[0] or lines_t[0]:
+        ax.legend(lines[0] + lines_t[0], lines[1] + lines_t[1], fontsize=7, loc="upper right")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path)
 
 
 def plot_residuals(d: Diagnosis, path: Path) -> Path:
@@ -98,9 +272,12 @@ def plot_residuals(d: Diagnosis, path: Path) -> Path:
         for i, (a, b) in enumerate(bands):
             ax_c.axvspan(a, b, color=SPAN_COLOUR, alpha=0.25, lw=0, zorder=0,
                          label="located temperature band" if i == 0 else None)
+        mark_times(ax_t, d, float(t[0]), float(t[-1]))
+        mark_bands(ax_c, d, (float(np.min(temp)), float(np.max(temp))))
         rmse = fit["rmse_heldout"]
         terms = ", ".join(fit.get("model", [])) or "minimal"
-        ax_t.set_title(f"{label} ({terms}): RMSE held-out {rmse:.4g} {d.unit} = {rmse / sigma:.3g} σ", fontsize=9)
+        sep = "\n" if len(terms) > 40 else " "  # a long list of terms on a line of its own
+        ax_t.set_title(f"{label} ({terms}):{sep}RMSE held-out {rmse:.4g} {d.unit} = {rmse / sigma:.3g} σ", fontsize=9)
         ax_t.set_xlabel("time (h)")
         ax_c.set_xlabel("thermometer (°C)")
         ax_t.legend(fontsize=7, loc="upper right")
@@ -224,10 +401,16 @@ def _flicker_panel(ax: plt.Axes, e: Evidence | None) -> None:
 
 
 def write_plots(d: Diagnosis, out_dir: str | Path) -> dict[str, str]:
-    """Write ``residuals.png``, ``allan.png`` and ``evidence.png`` into ``out_dir`` (created if
-    needed); returns name -> file name (relative to ``out_dir``)."""
+    """Write ``residuals.png``, ``allan.png``, ``evidence.png``, ``spectrum.png`` and, when the
+    series carries the output, ``output.png`` into ``out_dir`` (created if needed); returns
+    name -> file name (relative to ``out_dir``)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    for name, plot in (("residuals", plot_residuals), ("allan", plot_allan), ("evidence", plot_evidence)):
+    plots = {"residuals": plot_residuals, "allan": plot_allan, "evidence": plot_evidence, "spectrum": plot_spectrum}
+    for name, plot in plots.items():
         plot(d, out / PLOT_FILES[name])
-    return dict(PLOT_FILES)
+    files = dict(PLOT_FILES)
+    if getattr(d.series, "output", None) is not None:
+        plot_output(d, out / OUTPUT_FILE)
+        files["output"] = OUTPUT_FILE
+    return files
