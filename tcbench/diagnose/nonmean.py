@@ -1,0 +1,153 @@
+"""The detectors whose structure is not an additive mean term, as one step of ``diagnose``.
+
+- before :func:`~tcbench.diagnose.signals.prepare`: the thermometer's quantisation, which sets
+  the smoothing window (:func:`~tcbench.diagnose.quantisation.thermometer_steps`);
+- before any fit: the output's quantisation (:mod:`~tcbench.diagnose.quantisation`) and its
+  saturation (:mod:`~tcbench.diagnose.saturation`), whose clipped samples get zero weight;
+- after the final fit: the variance of its in-sample residual (:mod:`~tcbench.diagnose.variance`).
+
+:class:`NonMean` collects what they found for the report (``findings``), for ``model.yaml``
+(:meth:`NonMean.write_model`) and for ``statistics`` (including which were not tested and why).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from tcbench.diagnose.outliers import without
+from tcbench.diagnose.quantisation import (
+    OutputQuantisation,
+    ThermometerSteps,
+    find_output_quantisation,
+    thermometer_steps,
+)
+from tcbench.diagnose.saturation import Saturation, find_saturation
+from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
+from tcbench.diagnose.variance import Variance, find_variance
+from tcbench.sensors.recording import Recording
+
+DEFAULT_SMOOTH_S = 120.0  # the thermometer smoothing window of a record without a coarse staircase
+CLEAR_SIGMA = 3.0  # white sigmas between a sample's fitted value and a clip level for the variance test
+
+
+def _white_sigma(data: DiagnosisData) -> float:
+    """The white sigma from first differences of consecutive kept samples in one run (as
+    :func:`~tcbench.diagnose.signals.prepare` does, after samples were removed)."""
+    dt = np.diff(data.t_s)
+    same = (data.run_id[1:] == data.run_id[:-1]) & (dt <= 1.5 * float(np.median(dt)))
+    d = np.diff(data.output)[same]
+    if d.size < 10:
+        return data.white_sigma
+    sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    return sigma if sigma > 0 else data.white_sigma
+
+
+@dataclass
+class NonMean:
+    """What the non-additive detectors found on one record (see the module doc)."""
+
+    thermometer: ThermometerSteps | None = None
+    quantisation: OutputQuantisation | None = None
+    saturation: Saturation | None = None
+    variance: Variance | None = None
+    not_tested: dict[str, str] = field(default_factory=dict)
+    unit: str = ""
+
+    @classmethod
+    def before(cls, rec: Recording) -> NonMean:
+        """The thermometer's lattice, read from the raw reading before it is smoothed."""
+        t, temp = rec.time_s, rec.temperature_c
+        out = cls()
+        if t.size >= 2 and t[-1] > t[0]:
+            out.thermometer = thermometer_steps(t, temp, DEFAULT_SMOOTH_S)
+        return out
+
+    @property
+    def smooth_s(self) -> float:
+        """The thermometer smoothing window (s): widened for an undithered staircase."""
+        return self.thermometer.smooth_s if self.thermometer is not None else DEFAULT_SMOOTH_S
+
+    def prefit(self, data: DiagnosisData) -> DiagnosisData:
+        """Find the output's lattice and clipping; ``data`` with the clipped samples removed
+        (and its white sigma re-measured without them)."""
+        self.unit = data.unit
+        self.quantisation = find_output_quantisation(data.output, data.white_sigma)
+        step = self.quantisation.step if self.quantisation is not None else 0.0
+        self.saturation = find_saturation(data, step)
+        if not self.saturation.index.size:
+            return data
+        kept = without(data, self.saturation.index)
+        return replace(kept, white_sigma=_white_sigma(kept))
+
+    def postfit(self, data: DiagnosisData, residual: np.ndarray) -> list[dict[str, Any]]:
+        """Test the final in-sample ``residual`` for a changing noise level; every finding, as
+        report.json ``effects`` entries."""
+        q = self.quantisation
+        if q is not None and q.step > q.white_sigma:
+            self.not_tested["variance"] = (f"the output's quantisation step ({q.step:.4g}) exceeds its white noise: "
+                                           "the scatter follows the signal's place on the grid")
+        else:
+            keep = self._clear_of_clipping(data, residual)
+            self.variance = find_variance(data.t_s[keep], data.temp_c[keep], residual[keep], data.run_id[keep],
+                                          data.sample_rate_hz)
+            if self.variance.reason:
+                self.not_tested["variance"] = self.variance.reason
+        return self.findings()
+
+    def _clear_of_clipping(self, data: DiagnosisData, residual: np.ndarray) -> np.ndarray:
+        """Samples whose fitted value lies more than :data:`CLEAR_SIGMA` white sigmas inside
+        the clip levels: nearer, the unclipped samples kept are a truncated, less scattered part
+        of their distribution, which the variance test would take for a quieter band."""
+        keep = np.ones(data.n, dtype=bool)
+        if self.saturation is None or not self.saturation.found:
+            return keep
+        fitted = data.output - residual
+        margin = CLEAR_SIGMA * data.white_sigma
+        levels = self.saturation.model_params()
+        if "upper" in levels:
+            keep &= fitted < levels["upper"] - margin
+        if "lower" in levels:
+            keep &= fitted > levels["lower"] + margin
+        return keep
+
+    def findings(self) -> list[dict[str, Any]]:
+        """The report.json ``effects`` entries of everything found."""
+        out = []
+        if self.saturation is not None and self.saturation.found:
+            out.append(self.saturation.finding(self.unit))
+        if self.quantisation is not None:
+            out.append(self.quantisation.finding(self.unit))
+        if self.thermometer is not None and self.thermometer.staircase:
+            out.append(self.thermometer.finding())
+        if self.variance is not None and self.variance.found is not None:
+            out.append(self.variance.finding(self.unit))
+        return out
+
+    def write_model(self, model: dict[str, Any]) -> None:
+        """Add the terms found to ``model`` (model.yaml's mapping): the variance's noise in
+        place of ``white_noise``, then ``quantisation`` and ``saturation`` (the final stage, in
+        that order), and ``thermometer_quantisation``."""
+        effects = model["effects"]
+        noise = self.variance.model_effect() if self.variance is not None else None
+        if noise is not None:
+            effects.pop("white_noise", None)
+            effects[noise[0]] = {k: float(v) for k, v in noise[1].items()}
+        if self.quantisation is not None:
+            effects["quantisation"] = {"step": float(self.quantisation.step)}
+        if self.saturation is not None and self.saturation.found:
+            effects["saturation"] = self.saturation.model_params()
+        if self.thermometer is not None and self.thermometer.staircase:
+            effects["thermometer_quantisation"] = {"step_c": float(self.thermometer.step_c)}
+
+    def statistics(self) -> dict[str, Any]:
+        """report.json ``statistics`` entries: the thermometer window, the variance test, and
+        which detectors were not tested and why."""
+        out: dict[str, Any] = {"thermometer_smooth_s": self.smooth_s}
+        if self.variance is not None and not self.variance.reason:
+            out["variance"] = self.variance.statistics()
+        if self.not_tested:
+            out["not_tested"] = dict(self.not_tested)
+        return out
