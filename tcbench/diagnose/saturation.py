@@ -15,7 +15,7 @@ output has one maximum and its density falls towards it. :func:`find_saturation`
   extreme; even a noise-free sine on a lattice, whose density rises towards its peak, puts at most
   about 2.4 times the next level's count on its top level). So of the samples in the two cells
   the top one holds a fraction ``p0 = RATIO w_top / (RATIO w_top + h)`` at most (``w_top`` =
-  ``tol`` for a continuous output, one step on a lattice: 0.11 and 0.75). Clipping is called when
+  ``tol`` for a continuous output, one step on a lattice: 0.012 and 0.75). Clipping is called when
   the top cell holds at least :data:`MIN_COUNT` samples and a binomial test rejects ``p0`` at
   :data:`ALPHA` / 2 per side (1 % family-wise).
 
@@ -41,7 +41,7 @@ from tcbench.diagnose.signals import DiagnosisData
 ALPHA = 0.01  # family-wise over the two sides
 RATIO = 3.0  # density at the extreme over the next cell's that an unclipped output can reach
 MIN_COUNT = 5  # samples at the clip level at least
-TOL_SIGMA = 0.01  # white sigmas: the tolerance of the clip level for a continuous output
+TOL_SIGMA = 1e-3  # white sigmas: the tolerance of the clip level for a continuous output
 NEXT_SIGMA = 0.25  # white sigmas: the width of the cell next to the clip level
 EPISODE_GAP = 30  # samples: clipped samples closer than this belong to one episode
 MAX_EPISODE_FRACTION = 0.5  # episodes wider than this fraction of the record: drop only the clipped samples
@@ -95,8 +95,7 @@ class Saturation:
         said = " and ".join(f"{k} {s.level:.6g} {unit} ({s.count} samples)" for k, s in sides.items())
         return Finding(
             id="saturation", shape="saturation", library=False,
-            params={**self.model_params(), "clipped": self.clipped, "zero_weight": int(self.index.size),
-                    "unit": unit},
+            params={**self.model_params(), "clipped": self.clipped, "zero_weight": int(self.index.size)},
             where=where,
             evidence={"sides": {k: {"count": s.count, "next_count": s.next_count, "p_value": float(s.p_value)}
                                 for k, s in sides.items()},

@@ -107,7 +107,7 @@ class Variance:
         span = "degC" if test.against == "temperature" else "s"
         return Finding(
             id=effect, shape="variance", library=False,
-            params={**params, "sigma_quiet": test.sigma_band[0], "sigma_noisy": test.sigma_band[1], "unit": unit},
+            params={**params, "sigma_quiet": test.sigma_band[0], "sigma_noisy": test.sigma_band[1]},
             where=where,
             evidence={"test": "F test of the blocks' log variance of paired differences on a quadratic in "
                               f"{test.against} against a constant",
