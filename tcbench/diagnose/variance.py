@@ -12,7 +12,7 @@ Test (:func:`find_variance`), on the final model's in-sample residual ``r``:
    slow structure (a missed temperature term, flicker) that would otherwise look like scatter;
    non-overlapping pairs are independent under white noise, each ``d ~ N(0, 2 sigma^2)``.
    ``|d|`` is clipped at :data:`CLIP` robust sigmas, so a residual glitch cannot make a block noisy.
-2. **Blocks**: consecutive pairs in ``B`` blocks of ``m >=`` :data:`MIN_PAIRS` pairs (at most
+2. **Blocks**: consecutive pairs in ``B`` blocks of ``m`` or ``m + 1 >=`` :data:`MIN_PAIRS` pairs (at most
    :data:`MAX_BLOCKS` blocks); ``v_b = log(mean d^2)`` per block, ``x_b`` its mean temperature
    (or time).
 3. **F test**: regress ``v_b`` on ``[1, z, z^2]`` (``z`` the standardised temperature, or time)
@@ -191,14 +191,15 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
                if blocks < MIN_BLOCKS else "the residual has no sample-to-sample scatter")
         return Variance(None, [], blocks, 0, sigma, 0.0, sample_rate_hz, reason=why)
     m = d.size // blocks
-    used = blocks * m
-    d2 = np.minimum(np.abs(d[:used]), CLIP * scale) ** 2
-    v = np.log(d2.reshape(blocks, m).mean(axis=1))
+    edges = (np.arange(blocks) * d.size) // blocks  # blocks of m or m + 1 pairs, every pair used
+    sizes = np.diff(np.append(edges, d.size))
+    d2 = np.minimum(np.abs(d), CLIP * scale) ** 2
+    v = np.log(np.add.reduceat(d2, edges) / sizes)
     mid = 0.5 * (t_s[start] + t_s[start + 1])
     temps = 0.5 * (temp_c[start] + temp_c[start + 1])
     tests = []
     for against, x_pairs in (("temperature", temps), ("time", mid)):
-        x = x_pairs[:used].reshape(blocks, m).mean(axis=1)
+        x = np.add.reduceat(x_pairs, edges) / sizes
         f, p, slope = _f_test(v, x)
         band, (quiet, noisy) = _band(v, x)
         # log mean d^2 = log(2 sigma^2) (+ a bias common to all blocks)
@@ -210,5 +211,5 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
     if found is not None:
         x_pairs = temps if found.against == "temperature" else mid
         ref = float(np.round(np.median(x_pairs), 3))
-        sigma_ref = float(np.sqrt(np.mean(d2 * np.exp(-2.0 * found.slope * (x_pairs[:used] - ref))) / 2.0))
+        sigma_ref = float(np.sqrt(np.mean(d2 * np.exp(-2.0 * found.slope * (x_pairs - ref))) / 2.0))
     return Variance(found, tests, blocks, m, sigma_ref, ref, sample_rate_hz)
