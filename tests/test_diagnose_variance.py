@@ -20,7 +20,7 @@ from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, read_model, to_sensor_model
 from tcbench.diagnose.report import write_report
 from tcbench.diagnose.signals import prepare
-from tcbench.diagnose.variance import ALPHA, find_variance, paired_differences
+from tcbench.diagnose.variance import ALPHA, MIN_SIGMA_RATIO, find_variance, paired_differences
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording
 
@@ -75,13 +75,23 @@ def test_noise_growing_with_time_is_told_from_temperature() -> None:
 def test_false_alarms_at_one_percent(tails: str) -> None:
     # 300 records of constant-level noise, Gaussian or with Student-t (5 dof) tails: the F test
     # estimates the blocks' scatter itself, so heavy tails do not raise the level. Binomial(300,
-    # 0.01): P(>= 8) = 1.2 %; measured 3 and 2 (n = 4000), 2 and 4 (38000), 1 and 2 (86400) of 300.
+    # 0.01): P(>= 8) = 1.2 %; measured 3 and 2 (n = 4000), 1 and 3 (38000), 1 and 2 (86400) of 300.
     rng = np.random.default_rng(33 if tails == "gauss" else 34)
     t, temp, run = _clock()
     draw = (lambda: rng.standard_normal(N)) if tails == "gauss" else (lambda: rng.standard_t(5, N))
     alarms = sum(find_variance(t, temp, draw(), run, 1.0).found is not None for _ in range(300))
     assert alarms <= 8
     assert ALPHA == 0.01
+
+
+def test_a_small_significant_change_is_not_reported() -> None:
+    # sigma 10 % higher above 30 degC over a day at 1 Hz: significant, but below the 1.2 ratio
+    rng = np.random.default_rng(38)
+    t, temp, run = _clock(86_400)
+    v = find_variance(t, temp, rng.standard_normal(t.size) * np.where(temp > 30.0, 1.1, 1.0), run, 1.0)
+    tested = {x.against: x for x in v.tests}
+    assert tested["temperature"].p_value < 1e-6 and v.found is None
+    assert tested["temperature"].sigma_band[1] / tested["temperature"].sigma_band[0] < MIN_SIGMA_RATIO
 
 
 def test_short_record_says_so() -> None:
