@@ -15,7 +15,7 @@ import pytest
 
 from tcbench.diagnose.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.model_file import ModelFileError, ModelSpec, parse_model, to_sensor_model
+from tcbench.diagnose.model_file import ModelFileError, parse_model, to_sensor_model
 from tcbench.diagnose.report import write_report
 from tcbench.diagnose.saturation import find_saturation
 from tcbench.diagnose.signals import DiagnosisData, prepare
