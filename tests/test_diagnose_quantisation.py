@@ -152,3 +152,23 @@ def test_diagnosis_names_a_whole_degree_thermometer() -> None:
     assert report["statistics"]["thermometer_smooth_s"] > 3 * 120.0
     assert d.model["effects"]["thermometer_quantisation"] == {"step_c": 1.0}
     assert d.final["rmse_heldout"] < 1.01 * truth.white_sigma
+
+
+def test_noise_on_a_coarse_grid_is_measured_and_simulated_right() -> None:
+    # sigma 1 on a grid of 1.5: the MAD of first differences reads about 1.57, the truth with the
+    # grid's variance is sqrt(1 + 1.5^2 / 12) = 1.09; the model's white noise (before the grid) is 1
+    from tcbench.diagnose.signals import DiagnosisData
+
+    rng = np.random.default_rng(25)
+    n = 50_000
+    y = np.round(rng.standard_normal(n) / 1.5) * 1.5
+    t = np.arange(n, dtype=float)
+    temp = np.linspace(0.0, 40.0, n)
+    d = nm.NonMean()
+    data = d.prefit(DiagnosisData("gyro", "deg/s", t, temp, temp, np.zeros(n), np.zeros(n), y,
+                                  np.zeros(n, dtype=np.int64), 1.57, 1.0, 120.0))
+    assert data.white_sigma == pytest.approx(np.sqrt(1.0 + 1.5**2 / 12.0), rel=0.02)
+    model = {"effects": {"white_noise": {"density": data.white_sigma}}}
+    d.write_model(model)
+    assert model["effects"]["white_noise"]["density"] == pytest.approx(1.0, rel=0.03)
+    assert model["effects"]["quantisation"] == {"step": pytest.approx(1.5)}

@@ -31,18 +31,36 @@ from tcbench.sensors.recording import Recording
 
 DEFAULT_SMOOTH_S = 120.0  # the thermometer smoothing window of a record without a coarse staircase
 CLEAR_SIGMA = 3.0  # white sigmas between a sample's fitted value and a clip level for the variance test
+CLIP_SIGMA = 8.0  # differences clipped at this many sigmas (or steps) when the output is quantised
+
+
+def _differences(data: DiagnosisData) -> np.ndarray:
+    """First differences of consecutive samples in one run, at most 1.5 sample intervals apart."""
+    dt = np.diff(data.t_s)
+    same = (data.run_id[1:] == data.run_id[:-1]) & (dt <= 1.5 * float(np.median(dt)))
+    return np.diff(data.output)[same]
 
 
 def _white_sigma(data: DiagnosisData) -> float:
     """The white sigma from first differences of consecutive kept samples in one run (as
     :func:`~tcbench.diagnose.signals.prepare` does, after samples were removed)."""
-    dt = np.diff(data.t_s)
-    same = (data.run_id[1:] == data.run_id[:-1]) & (dt <= 1.5 * float(np.median(dt)))
-    d = np.diff(data.output)[same]
+    d = _differences(data)
     if d.size < 10:
         return data.white_sigma
     sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
     return sigma if sigma > 0 else data.white_sigma
+
+
+def _quantised_sigma(data: DiagnosisData, step: float) -> float:
+    """The output's per-sample noise, quantisation included, on a lattice of ``step``: the
+    RMS of first differences / sqrt(2), each clipped at :data:`CLIP_SIGMA` times the larger of
+    the MAD estimate and the step. The MAD of differences that take a few lattice values is
+    not a sigma (for noise of sigma 1 on a grid of 1.5 it reads 1.57 where the truth is 1.09)."""
+    d = _differences(data)
+    if d.size < 10:
+        return data.white_sigma
+    bound = CLIP_SIGMA * max(data.white_sigma, step)
+    return float(np.sqrt(np.mean(np.minimum(np.abs(d), bound) ** 2) / 2.0))
 
 
 @dataclass
@@ -55,6 +73,7 @@ class NonMean:
     variance: Variance | None = None
     not_tested: dict[str, str] = field(default_factory=dict)
     unit: str = ""
+    sample_rate_hz: float = 1.0
 
     @classmethod
     def before(cls, rec: Recording) -> NonMean:
@@ -73,14 +92,17 @@ class NonMean:
     def prefit(self, data: DiagnosisData) -> DiagnosisData:
         """Find the output's lattice and clipping; ``data`` with the clipped samples removed
         (and its white sigma re-measured without them)."""
-        self.unit = data.unit
+        self.unit, self.sample_rate_hz = data.unit, data.sample_rate_hz
         self.quantisation = find_output_quantisation(data.output, data.white_sigma)
         step = self.quantisation.step if self.quantisation is not None else 0.0
+        if step:
+            data = replace(data, white_sigma=_quantised_sigma(data, step))
+            self.quantisation = replace(self.quantisation, white_sigma=data.white_sigma)  # type: ignore[arg-type]
         self.saturation = find_saturation(data, step)
         if not self.saturation.index.size:
             return data
         kept = without(data, self.saturation.index)
-        return replace(kept, white_sigma=_white_sigma(kept))
+        return replace(kept, white_sigma=_quantised_sigma(kept, step) if step else _white_sigma(kept))
 
     def postfit(self, data: DiagnosisData, residual: np.ndarray) -> list[dict[str, Any]]:
         """Test the final in-sample ``residual`` for a changing noise level; every finding, as
@@ -128,15 +150,21 @@ class NonMean:
 
     def write_model(self, model: dict[str, Any]) -> None:
         """Add the terms found to ``model`` (model.yaml's mapping): the variance's noise in
-        place of ``white_noise``, then ``quantisation`` and ``saturation`` (the final stage, in
-        that order), and ``thermometer_quantisation``."""
+        place of ``white_noise``, then ``quantisation`` (with the white noise reduced by the
+        grid's own ``q^2 / 12``, which simulate adds back by quantising) and ``saturation`` (the
+        final stage, in that order), and ``thermometer_quantisation``."""
         effects = model["effects"]
         noise = self.variance.model_effect() if self.variance is not None else None
         if noise is not None:
             effects.pop("white_noise", None)
             effects[noise[0]] = {k: float(v) for k, v in noise[1].items()}
         if self.quantisation is not None:
-            effects["quantisation"] = {"step": float(self.quantisation.step)}
+            q = self.quantisation.step
+            if "white_noise" in effects:  # the noise before the converter: simulate quantises it again
+                fs = self.sample_rate_hz
+                sigma = effects["white_noise"]["density"] * np.sqrt(fs)  # per sample, quantisation included
+                effects["white_noise"] = {"density": float(np.sqrt(max(sigma**2 - q**2 / 12.0, 0.0) / fs))}
+            effects["quantisation"] = {"step": float(q)}
         if self.saturation is not None and self.saturation.found:
             effects["saturation"] = self.saturation.model_params()
         if self.thermometer is not None and self.thermometer.staircase:
