@@ -92,6 +92,7 @@ class Variance:
     ref: float  # reference temperature (degC) or time (s) of ``sigma_ref``
     sample_rate_hz: float
     reason: str = ""
+    rms_sigma: float = 0.0  # per-sample RMS sigma over the record (output unit): the level sums of squares see
 
     def model_effect(self) -> tuple[str, dict[str, float]] | None:
         """The effect id and parameters written to ``model.yaml`` in place of ``white_noise``."""
@@ -221,4 +222,5 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
         x_pairs = temps if found.against == "temperature" else mid
         ref = float(np.round(np.median(x_pairs), 3))
         sigma_ref = float(np.sqrt(np.mean(d2 * np.exp(-2.0 * found.slope * (x_pairs - ref))) / 2.0))
-    return Variance(found, tests, blocks, m, sigma_ref, ref, sample_rate_hz)
+    rms = float(np.sqrt(np.mean(d2) / 2.0))
+    return Variance(found, tests, blocks, m, sigma_ref, ref, sample_rate_hz, rms_sigma=rms)
