@@ -149,6 +149,10 @@ def test_diagnosis_names_noise_growing_with_temperature(tmp_path: Path) -> None:
     assert abs(low - median) < 5.0 and high > float(np.max(d.series.temp_c)) - 1.0
     assert finding["params"]["sigma_noisy"] / finding["params"]["sigma_quiet"] == pytest.approx(2.0, rel=0.15)
     assert "variance" in report["statistics"]
+    # the white sigma is the record's RMS (sqrt((1 + 4) / 2) = 1.58 sigma), not the median
+    # difference's 1.35, so the Allan test does not take the noisy half for flicker
+    assert "bias_instability" not in found
+    assert d.noise["white_sigma"] == pytest.approx(np.sqrt(2.5) * truth.white_sigma, rel=0.05)
     # model.yaml: the noise level follows temperature instead of one white sigma, and a
     # simulation of it shows the same growth
     spec = read_model(write_report(d, tmp_path / "r")["model.yaml"])
