@@ -196,8 +196,7 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
     scale = float(MAD_TO_SIGMA * np.median(np.abs(d))) if d.size else 0.0
     sigma = scale / np.sqrt(2.0)
     if blocks < MIN_BLOCKS or not scale > 0:
-        why = (f"too few pairs of consecutive samples ({d.size}; clear of any clip level) for {MIN_BLOCKS} blocks "
-               f"of {MIN_PAIRS}"
+        why = (f"too few pairs of consecutive samples ({d.size}) for {MIN_BLOCKS} blocks of {MIN_PAIRS}"
                if blocks < MIN_BLOCKS else "the residual has no sample-to-sample scatter")
         return Variance(None, [], blocks, 0, sigma, 0.0, sample_rate_hz, reason=why)
     m = d.size // blocks
