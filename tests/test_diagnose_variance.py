@@ -141,7 +141,9 @@ def test_diagnosis_names_noise_growing_with_temperature(tmp_path: Path) -> None:
     d = diagnose(Recording(data, rec.meta))
     report = d.to_json()
     found = {e["id"]: e for e in report["effects"]}
-    assert "noise_temperature" in found
+    # and nothing else: each sample is judged for outliers at its own noise level (against the
+    # record's, the noisy half showed 3-8 false outliers)
+    assert set(found) == {"noise_temperature"}
     finding = found["noise_temperature"]
     assert finding["shape"] == "variance"
     low, high = finding["where"]["temperature_c"]

@@ -226,7 +226,7 @@ def diagnose(
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s))  # output lattice; clipping
     base = base_model(declared)
-    outliers = _outliers(data, base)
+    outliers = _outliers(data, base, nonmean.relative_sigma(data))  # judged at the local noise level
     data = without(data, outliers.index)  # zero weight in every fit, score and test below
     designer = Designer(data)
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", data.n, data.white_sigma, data.unit)
@@ -308,12 +308,12 @@ def diagnose(
     )
 
 
-def _outliers(data: DiagnosisData, base: Model) -> Outliers:
+def _outliers(data: DiagnosisData, base: Model, relative_sigma: np.ndarray | None = None) -> Outliers:
     """Isolated outliers of the in-sample residual of the starting model ``base`` on ``data``
     (see :mod:`tcbench.diagnose.outliers`)."""
     x = Designer(data).matrix(base)
     beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
-    return find_outliers(data.t_s, data.output - x @ beta, data.white_sigma)
+    return find_outliers(data.t_s, data.output - x @ beta, data.white_sigma, relative_sigma=relative_sigma)
 
 
 def _reference_json(ref: Reference, final_rmse: float, sigma: float) -> dict[str, Any]:

@@ -77,6 +77,7 @@ class NonMean:
     quantisation: OutputQuantisation | None = None
     saturation: Saturation | None = None
     variance: Variance | None = None
+    first_variance: Variance | None = None  # the test before any fit, on the minimal model's residual
     not_tested: dict[str, str] = field(default_factory=dict)
     unit: str = ""
     sample_rate_hz: float = 1.0
@@ -96,8 +97,10 @@ class NonMean:
         return self.thermometer.smooth_s if self.thermometer is not None else DEFAULT_SMOOTH_S
 
     def prefit(self, data: DiagnosisData) -> DiagnosisData:
-        """Find the output's lattice and clipping; ``data`` with the clipped samples removed
-        (and its white sigma re-measured without them)."""
+        """Find the output's lattice and clipping; ``data`` with the clipped samples removed,
+        its white sigma re-measured without them (from the RMS of differences on a lattice), and
+        raised to the RMS sigma where a first variance test on the minimal model's residual
+        finds the noise level changing."""
         self.unit, self.sample_rate_hz = data.unit, data.sample_rate_hz
         self.quantisation = find_output_quantisation(data.output, data.white_sigma)
         step = self.quantisation.step if self.quantisation is not None else 0.0
@@ -111,10 +114,18 @@ class NonMean:
         if self._variance_testable(data):
             x = Designer(data).matrix(Model())
             beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
-            first = self._variance(data, data.output - x @ beta)
+            first = self.first_variance = self._variance(data, data.output - x @ beta)
             if first.found is not None and first.rms_sigma > data.white_sigma:
                 data = replace(data, white_sigma=first.rms_sigma)
         return data
+
+    def relative_sigma(self, data: DiagnosisData) -> np.ndarray | None:
+        """The noise level per sample relative to the record's RMS where the first variance test
+        found it changing (for the outlier test's local scale); None where it did not."""
+        first = self.first_variance
+        if first is None or first.found is None:
+            return None
+        return first.relative_sigma(data.temp_c, data.t_s)
 
     def _variance_testable(self, data: DiagnosisData) -> bool:
         """Whether the variance test applies (not on an output whose grid is coarser than its noise)."""

@@ -78,6 +78,7 @@ class Test:
     slope: float
     band: tuple[float, float]
     sigma_band: tuple[float, float]  # per-sample sigma of the quietest and the noisiest bin
+    profile: tuple[tuple[float, ...], tuple[float, ...]] = ((), ())  # bins' mean regressor and per-sample sigma
 
 
 @dataclass(frozen=True)
@@ -129,6 +130,16 @@ class Variance:
             confirm_with=CONFIRM_WITH[test.against],
         ).to_json()
 
+    def relative_sigma(self, temp_c: np.ndarray, t_s: np.ndarray) -> np.ndarray:
+        """Per-sample noise level relative to the record's RMS (1 where nothing was found): the
+        found test's bins interpolated at each sample's temperature (degC) or time (s)."""
+        if self.found is None:
+            return np.ones(np.shape(t_s))
+        centre, sigma = (np.asarray(a) for a in self.found.profile)
+        x = temp_c if self.found.against == "temperature" else t_s
+        out = np.interp(x, centre, sigma)
+        return out / np.sqrt(np.mean(out**2))
+
     def statistics(self) -> dict[str, Any]:
         """A line for report.json ``statistics``: how the test ran, or why it did not."""
         if self.reason:
@@ -172,11 +183,12 @@ def _f_test(v: np.ndarray, x: np.ndarray) -> tuple[float, float, float]:
     return float(f), float(f_dist.sf(f, 2, dof)), slope
 
 
-def _band(v: np.ndarray, x: np.ndarray) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The noisiest band of ``x`` and the sigma-of-differences ratio's ends, from :data:`BINS` bins."""
+def _band(v: np.ndarray, x: np.ndarray) -> tuple[tuple[float, float], np.ndarray, np.ndarray]:
+    """The noisiest band of ``x``, and the mean ``x`` and mean ``v`` of each of :data:`BINS` bins."""
     order = np.argsort(x, kind="stable")
     bins = np.array_split(order, BINS)
     level = np.array([v[b].mean() for b in bins])
+    centre = np.array([x[b].mean() for b in bins])
     lo_x = np.array([x[b].min() for b in bins])
     hi_x = np.array([x[b].max() for b in bins])
     top = int(np.argmax(level))
@@ -184,7 +196,7 @@ def _band(v: np.ndarray, x: np.ndarray) -> tuple[tuple[float, float], tuple[floa
     breaks = np.flatnonzero(~above)
     left = int(breaks[breaks < top].max() + 1) if (breaks < top).any() else 0
     right = int(breaks[breaks > top].min() - 1) if (breaks > top).any() else BINS - 1
-    return (float(lo_x[left]), float(hi_x[right])), (float(level.min()), float(level.max()))
+    return (float(lo_x[left]), float(hi_x[right])), centre, level
 
 
 def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run_id: np.ndarray,
@@ -210,10 +222,10 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
     for against, x_pairs in (("temperature", temps), ("time", mid)):
         x = np.add.reduceat(x_pairs, edges) / sizes
         f, p, slope = _f_test(v, x)
-        band, (quiet, noisy) = _band(v, x)
-        # log mean d^2 = log(2 sigma^2) (+ a bias common to all blocks)
-        tests.append(Test(against, f, p, 0.5 * slope, band,
-                          (float(np.sqrt(np.exp(quiet) / 2.0)), float(np.sqrt(np.exp(noisy) / 2.0)))))
+        band, centre, level = _band(v, x)
+        sigma_bins = np.sqrt(np.exp(level) / 2.0)  # log mean d^2 = log(2 sigma^2) (+ a bias common to all blocks)
+        tests.append(Test(against, f, p, 0.5 * slope, band, (float(sigma_bins.min()), float(sigma_bins.max())),
+                          (tuple(centre.tolist()), tuple(sigma_bins.tolist()))))
     passed = [t for t in tests if t.p_value < 0.5 * alpha and t.sigma_band[1] >= MIN_SIGMA_RATIO * t.sigma_band[0]]
     found = max(passed, key=lambda t: t.f) if passed else None
     ref, sigma_ref = 0.0, sigma
