@@ -90,7 +90,7 @@ def test_spike_at_the_last_sample(clean: tuple[Recording, float], k: float) -> N
 def test_without_exclusion_the_spike_dominates(clean: tuple[Recording, float], monkeypatch: pytest.MonkeyPatch) -> None:
     # the same 300-sigma spike, detector switched off: the behaviour this module removes
     rec, sigma = clean
-    monkeypatch.setattr(dg, "find_outliers", lambda t, r, w: Outliers(*(np.zeros(0),) * 4, w, 5.0))
+    monkeypatch.setattr(dg, "find_outliers", lambda t, r, w, **_: Outliers(*(np.zeros(0),) * 4, w, 5.0))
     d = dg.diagnose(_with_spikes(rec, [rec.time_s.size - 1], [300.0 * sigma]))
     assert d.final["rmse_heldout"] > 1.7 * sigma
     assert "bias_instability" in d.effect_ids

@@ -23,6 +23,7 @@ from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.open_terms import TERMS, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
+from tcbench.diagnose.nonmean import NonMean
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.plan import SURROGATE
 from tcbench.diagnose.reference import Reference, reference_fit
@@ -233,9 +234,10 @@ def diagnose(
     (``{effect_id: params}``). Raises :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a
     recording that cannot show anything."""
     declared = declared or {}
-    data = prepare(rec, sensor)
+    nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
+    data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s))  # output lattice; clipping
     base = base_model(declared)
-    outliers = _outliers(data, base)
+    outliers = _outliers(data, base, nonmean.relative_sigma(data))  # judged at the local noise level
     data = without(data, outliers.index)  # zero weight in every fit, score and test below
     designer = Designer(data)
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", data.n, data.white_sigma, data.unit)
@@ -290,12 +292,14 @@ def diagnose(
         confusable += [{"effects": [e, "bias_instability"], "test": FLICKER_TEST} for e in found if e in TIME_EFFECTS]
     if outliers.count:
         effects_out.append(outliers.finding(data.unit))
+    effects_out += nonmean.postfit(data, att.final_fit.residual)  # saturation, quantisation, variance
     for effect, params in declared.items():
         fitted.setdefault(effect, dict(params))
     fitted["white_noise"] = {"density": data.white_sigma / np.sqrt(data.sample_rate_hz)}
     model = {"tcbench_model": 1, "sensor": data.sensor, "output_unit": data.unit, "core": core, "effects": fitted}
     if outliers.count:  # so that ``tcbench simulate model=`` reproduces them
         model["outliers"] = {"time_s": [float(t) for t in outliers.time_s], "size": [float(v) for v in outliers.size]}
+    nonmean.write_model(model)  # so that ``tcbench simulate model=`` reproduces them too
     return Diagnosis(
         sensor=data.sensor, unit=data.unit, recording=name,
         baseline={"rmse_fit": _rmse(att.base_fit.sse_fit, n), "rmse_heldout": _rmse(att.base_fit.sse_heldout, n),
@@ -306,7 +310,7 @@ def diagnose(
         noise={"white_sigma": data.white_sigma, "thermometer_sigma_c": thermometer_sigma(designer),
                "samples": n, "folds": att.k},
         reference=_reference_json(reference, final_rmse, data.white_sigma),
-        statistics=att.plan.to_json() if att.plan else {},
+        statistics={**(att.plan.to_json() if att.plan else {}), **nonmean.statistics()},
         candidates=[evidence[e] for e in (*DETERMINISTIC, "bias_instability") if e in evidence],
         confusable=confusable,
         model=model,
@@ -315,12 +319,12 @@ def diagnose(
     )
 
 
-def _outliers(data: DiagnosisData, base: Model) -> Outliers:
+def _outliers(data: DiagnosisData, base: Model, relative_sigma: np.ndarray | None = None) -> Outliers:
     """Isolated outliers of the in-sample residual of the starting model ``base`` on ``data``
     (see :mod:`tcbench.diagnose.outliers`)."""
     x = Designer(data).matrix(base)
     beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
-    return find_outliers(data.t_s, data.output - x @ beta, data.white_sigma)
+    return find_outliers(data.t_s, data.output - x @ beta, data.white_sigma, relative_sigma=relative_sigma)
 
 
 def _reference_json(ref: Reference, final_rmse: float, sigma: float) -> dict[str, Any]:

@@ -15,6 +15,10 @@ A model file is YAML::
       thermal_lag: {tau_s: 420.0}
       warmup: {amplitude: 0.01, tau_s: 900.0}
       white_noise: {density: 0.0024}
+      quantisation: {step: 0.001}          # output on a grid of this step (output unit)
+      saturation: {upper: 2.5}             # output clipped at upper and/or lower (output unit)
+      noise_temperature: {density: 0.0024, growth_per_c: 0.02, ref_c: 10.0}  # white noise, sigma grows with T
+      thermometer_quantisation: {step_c: 1.0}  # the thermometer reading on a 1 degC grid
     outliers:                   # optional: isolated spikes added at these times
       time_s: [35999.0]         # s
       size: [0.42]              # output unit
@@ -22,8 +26,12 @@ A model file is YAML::
 with ``u = (T_die - centre_c) / half_range_c`` and the model output
 ``sum_j bias[j] u^j + input * sum_j scale_factor[j] u^j``; ``input`` is the acceleration in g
 (msra) or the rate in deg/s (gyro). Effects take their defaults for parameters not given; an
-effect with no parameters may be written ``warmup: {}``. Every problem with a file raises
-:class:`ModelFileError` with one line naming the file.
+effect with no parameters may be written ``warmup: {}``. ``final``-stage effects (``quantisation``,
+``saturation``) act on the finished output in file order, after every additive term; the
+``thermometer``-stage effect (``thermometer_quantisation``) changes only the thermometer reading a
+simulated recording carries. Every problem with a file raises :class:`ModelFileError` with one
+line naming the file (and the effect's key for a value out of its range: a saturation's upper
+not above its lower, a step not > 0).
 """
 
 from __future__ import annotations
@@ -114,6 +122,10 @@ def _effects(value: Any, where: str) -> dict[str, dict[str, float]]:
             raise ModelFileError(f"{where}: effect {effect_id!r} has no parameter {', '.join(unknown)}; "
                                  f"known: {', '.join(known)}")
         out[effect_id] = {k: _number(v, f"effects.{effect_id}.{k}", where) for k, v in params.items()}
+        try:
+            fx.make_effect(effect_id, **out[effect_id])
+        except ValueError as exc:
+            raise ModelFileError(f"{where}: effects.{effect_id}: {str(exc).removeprefix(effect_id + ': ')}") from None
     return out
 
 
@@ -239,7 +251,7 @@ def write_model(spec: ModelSpec, path: str | Path) -> Path:
 
 def to_sensor_model(spec: ModelSpec) -> PolynomialModel:
     """The simulatable model: polynomial core (``ref_c = centre_c``) and the spec's effects in
-    file order, ``final``-stage ones (``quantisation``) last."""
+    file order, ``final``-stage ones (``quantisation``, ``saturation``) last."""
     built = [fx.make_effect(effect_id, **params) for effect_id, params in spec.effects.items()]
     ordered = [e for e in built if e.stage != "final"] + [e for e in built if e.stage == "final"]
     return PolynomialModel(

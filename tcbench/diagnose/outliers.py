@@ -15,7 +15,8 @@ Detection, on the residual ``r`` of the current model (output unit):
    shorter than half the window and follows steps and slow structure the model misses, so only
    isolated departures remain.
 2. **Robust scale**: ``s = 1.4826 * MAD`` of that high-passed residual (the white sigma when
-   the MAD is zero, e.g. for a quantised output).
+   the MAD is below :data:`MIN_SCALE` of it: on an output quantised to about two sigma or more
+   most samples equal their neighbours' median, and the MAD reads 0.002 sigma).
 3. **Bound on the record's length**: with ``n`` samples and a family-wise false-alarm level
    ``alpha`` (:data:`ALPHA` = 1 %), a sample is an outlier when ``|z| = |r - median| / s``
    exceeds ``z_n = TAIL * Phi^-1(1 - alpha / (2 n))`` (Bonferroni over the ``n`` two-sided
@@ -48,6 +49,7 @@ TAIL = 1.1  # the difference from a neighbours' median has heavier tails than it
 WINDOW = 31  # samples in the running median that sets the local level
 MAX_RUN = 5  # the longest run of consecutive samples still called a spike
 MAX_LISTED = 20  # outliers listed by time and size in the report; the count covers all
+MIN_SCALE = 0.5  # of the white sigma: a robust scale below it is a coarse grid's, not the noise's
 
 EXPLANATION = ("isolated samples far beyond the noise: candidate causes are a bus or logging glitch (a corrupted "
                "or duplicated frame), a mechanical shock or a vibration burst, an electrostatic discharge, or a "
@@ -100,9 +102,11 @@ class Outliers:
 
 
 def find_outliers(t_s: np.ndarray, residual: np.ndarray, white_sigma: float, *, alpha: float = ALPHA,
-                  max_run: int = MAX_RUN) -> Outliers:
+                  max_run: int = MAX_RUN, relative_sigma: np.ndarray | None = None) -> Outliers:
     """Isolated outliers of ``residual`` (output unit, samples at ``t_s`` in s); see the module
-    doc. ``white_sigma`` (output unit) is the scale when the MAD is zero."""
+    doc. ``white_sigma`` (output unit) is the scale when the MAD is zero. ``relative_sigma``
+    (per sample, RMS 1) is the noise level where it changes with temperature or time: each
+    sample is then judged against its own level, not the record's."""
     r = np.asarray(residual, dtype=float)
     n = r.size
     bound = z_bound(n, alpha)
@@ -112,10 +116,11 @@ def find_outliers(t_s: np.ndarray, residual: np.ndarray, white_sigma: float, *, 
     footprint = np.ones(WINDOW, dtype=bool)
     footprint[WINDOW // 2] = False  # the level a sample is judged against does not contain it
     high = r - median_filter(r, footprint=footprint, mode="mirror")
-    scale = float(MAD_TO_SIGMA * np.median(np.abs(high - np.median(high))))
-    if not scale > 0:
+    level = np.ones(n) if relative_sigma is None else np.asarray(relative_sigma, dtype=float)
+    scale = float(MAD_TO_SIGMA * np.median(np.abs(high / level - np.median(high / level))))
+    if not scale > MIN_SCALE * white_sigma:  # a grid coarser than the noise: the MAD reads near 0
         scale = float(white_sigma)
-    z = high / scale
+    z = high / (scale * level)
     flagged = np.abs(z) > bound
     edges = np.diff(np.concatenate(([0], flagged.astype(np.int8), [0])))
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)

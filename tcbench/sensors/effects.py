@@ -6,7 +6,9 @@ at one of three stages:
 - ``die``: change the die temperature the physics sees (``thermal_lag``);
 - ``output``: add a term to the output, in the sensor's output unit (Hz for the MSRA, deg/s
   for the gyroscope);
-- ``final``: transform the finished output (``quantisation``).
+- ``final``: transform the finished output (``quantisation``, ``saturation``);
+- ``thermometer``: transform the thermometer reading a recording carries, not the temperature
+  the physics sees (``thermometer_quantisation``).
 
 The same objects serve simulation now and diagnosis later (fitting their parameters to a
 residual), so each is a small frozen dataclass whose fields are its parameters.
@@ -60,6 +62,10 @@ class Effect:
 
     def transform(self, y: np.ndarray) -> np.ndarray:
         """Stage ``final``: the output after this effect."""
+        raise NotImplementedError
+
+    def reading(self, temp_c: np.ndarray) -> np.ndarray:
+        """Stage ``thermometer``: the thermometer reading after this effect (degC)."""
         raise NotImplementedError
 
     def params(self) -> dict[str, float]:
@@ -281,12 +287,95 @@ class SecondNode(Effect):
         return self.coef_per_c * (first_order_lag(s.temp_die_c, s.dt_s, self.tau_s) - s.temp_die_c)
 
 
+@dataclass(frozen=True)
+class Saturation(Effect):
+    """Output clipped to ``[lower, upper]`` (output unit): a range limit, ADC clipping or a
+    filter's overflow. A side left at its infinite default does not clip (and is not listed
+    in :meth:`params`)."""
+
+    id: ClassVar[str] = "saturation"
+    stage: ClassVar[str] = "final"
+    upper: float = float("inf")
+    lower: float = float("-inf")
+
+    def __post_init__(self) -> None:
+        if np.isnan(self.upper) or np.isnan(self.lower) or not self.upper > self.lower:
+            raise ValueError(f"saturation: upper must be above lower, got upper={self.upper!r}, lower={self.lower!r}")
+        if np.isinf(self.upper) and np.isinf(self.lower):
+            raise ValueError("saturation: give upper, lower or both (the clip levels, output unit)")
+
+    def transform(self, y: np.ndarray) -> np.ndarray:
+        return np.clip(y, self.lower, self.upper)
+
+    def params(self) -> dict[str, float]:
+        return {k: v for k, v in dataclasses.asdict(self).items() if np.isfinite(v)}
+
+
+@dataclass(frozen=True)
+class ThermometerQuantisation(Effect):
+    """Thermometer reading rounded to multiples of ``step_c`` (degC; a whole-degree register
+    gives 1.0); the die temperature the output follows is not rounded."""
+
+    id: ClassVar[str] = "thermometer_quantisation"
+    stage: ClassVar[str] = "thermometer"
+    step_c: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.step_c > 0:
+            raise ValueError(f"thermometer_quantisation: step_c must be > 0, got {self.step_c!r}")
+
+    def reading(self, temp_c: np.ndarray) -> np.ndarray:
+        return noise.quantise(temp_c, self.step_c)
+
+
+@dataclass(frozen=True)
+class NoiseTemperature(Effect):
+    """White noise whose level depends on the die temperature: per-sample standard deviation
+    ``density * sqrt(fs) * exp(growth_per_c * (T_die - ref_c))`` (``density`` in output unit
+    per sqrt(Hz) at ``ref_c``; ``growth_per_c`` the relative growth of sigma per degC)."""
+
+    id: ClassVar[str] = "noise_temperature"
+    density: float = 0.0
+    growth_per_c: float = 0.0
+    ref_c: float = 25.0
+
+    def __post_init__(self) -> None:
+        if not self.density >= 0:
+            raise ValueError(f"noise_temperature: density must be >= 0, got {self.density!r}")
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        x = noise.white(s.t_s.size, self.density / np.sqrt(s.dt_s), rng)
+        x *= np.exp(self.growth_per_c * (s.temp_die_c - self.ref_c))
+        return x
+
+
+@dataclass(frozen=True)
+class NoiseTime(Effect):
+    """White noise whose level changes with time since power-on: per-sample standard deviation
+    ``density * sqrt(fs) * exp(growth_per_h * t / 3600)`` (``density`` in output unit per
+    sqrt(Hz) at t = 0; ``growth_per_h`` the relative growth of sigma per hour)."""
+
+    id: ClassVar[str] = "noise_time"
+    density: float = 0.0
+    growth_per_h: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not self.density >= 0:
+            raise ValueError(f"noise_time: density must be >= 0, got {self.density!r}")
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        x = noise.white(s.t_s.size, self.density / np.sqrt(s.dt_s), rng)
+        x *= np.exp(self.growth_per_h * s.t_s / 3600.0)
+        return x
+
+
 EFFECTS: dict[str, type[Effect]] = {
     cls.id: cls
     for cls in (
         ThermalLag, TemperatureRate, Hysteresis, Warmup, AgingDrift, TemperatureCubic,
         AccelNonlinearity, BiasInstability, WhiteNoise, RandomWalk, Quantisation,
         BiasStep, Periodic, Transient, TemperatureBump, SecondNode,
+        Saturation, ThermometerQuantisation, NoiseTemperature, NoiseTime,
     )
 }
 
@@ -323,6 +412,14 @@ def apply_effects(
         if effect.stage == "final":
             y = effect.transform(y)
     return y
+
+
+def thermometer_reading(effects: list[Effect], temp_c: np.ndarray) -> np.ndarray:
+    """The thermometer reading after the ``thermometer`` stage effects (``temp_c`` if none)."""
+    for effect in effects:
+        if effect.stage == "thermometer":
+            temp_c = effect.reading(temp_c)
+    return temp_c
 
 
 def die_temperature(effects: list[Effect], s: Signals) -> np.ndarray:

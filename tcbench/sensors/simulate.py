@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.sensors import effects as fx
 from tcbench.sensors import protocols
 from tcbench.sensors.devices import unit
 from tcbench.sensors.models import SensorModel, Unit
@@ -127,7 +128,8 @@ def simulate_recording(
         **profile.info,
     }
     return make_recording(
-        profile.t_s, quantise(reading, THERMOMETER_STEP_C, in_place=True), profile.input, output,
+        profile.t_s, fx.thermometer_reading(list(model.effects), quantise(reading, THERMOMETER_STEP_C, in_place=True)),
+        profile.input, output,
         sensor=sensor, sample_rate_hz=profile.sample_rate_hz, device_id=device.device_id,
         position=profile.position, extra=_plain(extra),
     )

@@ -24,7 +24,7 @@ from tcbench.sensors.models import SensorModel, _signals
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.simulate import build_profile
 
-STOCHASTIC_EFFECTS = ("white_noise", "bias_instability", "random_walk", "quantisation")
+STOCHASTIC_EFFECTS = ("white_noise", "bias_instability", "random_walk", "quantisation", "noise_temperature", "noise_time")
 # Input step of the sensitivity's central difference, in the input unit (g or deg/s). The MSRA
 # output is quadratic and the gyro output linear in the input, so the central difference is
 # exact up to rounding for both.
