@@ -1,0 +1,466 @@
+"""Recordings with a mismatch hidden that lies outside the effect library (open world), and
+the rules that score a diagnosis of them.
+
+Each recording is a concealed recording (:mod:`tcbench.diagnose.concealed`: the same 1 Hz,
+8-12 h heat-and-cool staircase, the same device with every effect removed, so that without
+the hidden mismatch it *is* the minimal model plus white noise) with one structure of
+PHYSICS.md §8 that no library effect makes. The kinds (:data:`KINDS`), with the ``shape`` and
+``where`` the report must state:
+
+- ``step``: a bias jump at one instant (``time_s``);
+- ``restart_after_gap``: 5-30 min of data lost and a bias jump across the gap (``time_s`` = the
+  first sample after it);
+- ``periodic``: a sinusoid of 10-40 min period (``period_s``);
+- ``slow_oscillation``: a sinusoid of 2-5 h period (``period_s``);
+- ``transient``: a jump that decays exponentially (tau 10-60 min) from an instant in the middle
+  60 % of the record (``time_s`` = onset);
+- ``temperature_bump``: a Gaussian of the package temperature, width 2-6 degC, centred inside the
+  profile's range (``temperature_c`` = centre -/+ 2 widths);
+- ``second_node``: ``coef * (lag(T_pkg, tau2) - T_pkg)``, tau2 20-90 min (no ``where``);
+- ``variance_temperature``: white sigma growing exponentially from cold to hot by a factor 2-4
+  (``temperature_c`` = the upper half of the range);
+- ``saturation``: the output clipped (ceiling or floor) at a level the noise-free output
+  reaches only in one temperature band (``level``);
+- ``output_quantisation``: the output read on a grid of step q (``level`` = q);
+- ``thermometer_steps``: the thermometer read in whole degrees (``level`` = 1.0);
+- ``spikes``: 1-5 isolated samples off by 8-20 sigma (``time_s`` = their instants).
+
+Sizing, "what the starting model cannot absorb is 0.5-1 sigma per sample":
+
+- additive kinds (:data:`ADDITIVE`): the noise-free contribution ``d`` is projected out of the
+  minimal model's columns (:func:`~tcbench.diagnose.concealed.minimal_columns` of the package
+  temperature and the acceleration, on the samples kept), and its amplitude is set so that the
+  RMS of what is left is ``rho * sigma``, ``rho ~ U(0.5, 1)``, with the white sigma the device's
+  own times a log-uniform factor in 1-3 (as for the concealed set's free-amplitude effects);
+- ``saturation``: the same projection of the noise-free clipped amount ``clip(y) - y``; the
+  level is the least clipping level (on a grid of the noise-free output's quantiles, at most
+  30 % of the samples clipped) whose left-over RMS reaches ``rho`` times the device sigma, and
+  the white sigma is then that RMS / ``rho`` exactly (clipping acts on output plus noise);
+- ``thermometer_steps``: the amplitude is the device's own temperature slope; the white sigma
+  is the RMS of the noise-free output the minimal model *in the read temperature* cannot absorb,
+  divided by ``rho`` (as ``thermal_lag`` in the concealed set);
+- ``output_quantisation``: ``q = sqrt(12) * rho * sigma``, so the rounding error's RMS is
+  ``rho * sigma``;
+- ``variance_temperature``: cold-end sigma = device sigma times the factor, hot/cold ratio 2-4;
+  the truth's ``white_sigma`` is the RMS over samples of the per-sample sigma;
+- ``spikes``: sizes 8-20 white sigma, random sign, at least 10 min apart, in the middle 90 %.
+
+Controls have nothing hidden (white sigma = device sigma times the factor). Every random draw
+comes from generators spawned from ``np.random.SeedSequence(seed)``, always in the same order,
+so one seed gives one profile and one device whatever the kind, and the same recording twice.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from tcbench.diagnose.concealed import (
+    NOISE_FACTOR,
+    SAMPLE_RATE_HZ,
+    THERMOMETER_NOISE_C,
+    THERMOMETER_STEP_C,
+    concealed_profile,
+    minimal_columns,
+    unexplained,
+)
+from tcbench.sensors import noise
+from tcbench.sensors.devices import unit
+from tcbench.sensors.models import MSRA, SensorModel
+from tcbench.sensors.recording import Recording, make_recording
+from tcbench.sensors.thermal import first_order_lag
+
+SHAPE: dict[str, str] = {
+    "step": "step",
+    "restart_after_gap": "step",
+    "periodic": "periodic",
+    "slow_oscillation": "periodic",
+    "transient": "transient",
+    "temperature_bump": "temperature_function",
+    "second_node": "temperature_dynamics",
+    "variance_temperature": "variance",
+    "saturation": "saturation",
+    "output_quantisation": "quantisation",
+    "thermometer_steps": "quantisation",
+    "spikes": "outliers",
+}
+KINDS: tuple[str, ...] = tuple(SHAPE)
+SENSORS = ("msra", "gyro")
+ADDITIVE = ("step", "restart_after_gap", "periodic", "slow_oscillation", "transient", "temperature_bump",
+            "second_node")
+DETERMINISTIC = (*ADDITIVE, "saturation")  # a model term can take them out: the refit target applies
+NOISE_SHAPES = ("noise",)
+NOISE_IDS = ("bias_instability",)
+
+RATIO = (0.5, 1.0)
+STEP_AT = (0.15, 0.85)  # fraction of the span
+GAP_AT = (0.2, 0.8)
+GAP_S = (300.0, 1800.0)
+PERIOD_S = (600.0, 2400.0)
+SLOW_PERIOD_S = (7200.0, 18000.0)
+TRANSIENT_AT = (0.2, 0.8)
+TRANSIENT_TAU_S = (600.0, 3600.0)
+BUMP_WIDTH_C = (2.0, 6.0)
+SECOND_NODE_TAU_S = (1200.0, 5400.0)
+VARIANCE_GROWTH = (2.0, 4.0)  # sigma hot / sigma cold
+MAX_CLIPPED = 0.3  # fraction of samples
+THERMOMETER_STEPS_C = 1.0
+SPIKES = (1, 5)
+SPIKE_SIGMA = (8.0, 20.0)
+SPIKE_SEPARATION_S = 600.0
+TIME_TOLERANCE_S = 600.0
+TIME_TOLERANCE_SPAN = 0.02
+PERIOD_TOLERANCE = 0.15
+LEVEL_TOLERANCE = 0.25
+
+
+@dataclass(frozen=True)
+class OpenWorld:
+    """What was hidden: ``kind`` (``None`` for a control), the ``shape`` and ``where`` a report
+    must state (keys of :data:`tcbench.diagnose.findings.WHERE_KEYS`), the kind's parameters
+    (output units, s, degC), ``ratio`` (RMS the minimal model cannot absorb / white sigma; NaN
+    where it does not apply), the white sigma (output unit; the RMS of the per-sample sigma for
+    ``variance_temperature``), the recording's time span (s) and the seed."""
+
+    sensor: str
+    kind: str | None
+    shape: str | None
+    where: dict[str, Any]
+    params: dict[str, float]
+    ratio: float
+    white_sigma: float
+    span_s: float
+    seed: int
+
+    @property
+    def deterministic(self) -> bool:
+        """Whether a model term can take the hidden structure out (the refit target applies)."""
+        return self.kind in DETERMINISTIC
+
+
+@dataclass
+class _Draw:
+    """Intermediate arrays of one recording (all full length before ``keep``)."""
+
+    t_s: np.ndarray
+    temp_c: np.ndarray
+    accel: np.ndarray | None
+    base: np.ndarray
+    keep: np.ndarray
+    params: dict[str, float] = field(default_factory=dict)
+    where: dict[str, Any] = field(default_factory=dict)
+
+
+def _rms(x: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(x * x)))
+
+
+def _device(sensor: str, device_seed: int) -> tuple[SensorModel, float]:
+    """The unit with every effect removed (MSRA misalignment zero) and its white sigma per sample."""
+    device = unit(sensor, device_seed).model
+    white_fx = device.effect("white_noise")
+    sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(SAMPLE_RATE_HZ)
+    model = dataclasses.replace(device, effects=())
+    if isinstance(model, MSRA):
+        model = dataclasses.replace(model, misalignment_rad=0.0)
+    return model, float(sigma)
+
+
+def _left(d: np.ndarray, draw: _Draw, temp_c: np.ndarray | None = None) -> float:
+    """RMS of what the minimal model's columns (of ``temp_c``, default the package temperature)
+    cannot absorb of ``d``, on the samples kept."""
+    k = draw.keep
+    temp = draw.temp_c if temp_c is None else temp_c
+    cols = minimal_columns(temp[k], None if draw.accel is None else draw.accel[k])
+    return _rms(unexplained(d[k], cols))
+
+
+def _at(t_s: np.ndarray, frac: tuple[float, float], rng: np.random.Generator) -> int:
+    """Index of the first sample at or after a uniform fraction ``frac`` of the span."""
+    target = t_s[0] + rng.uniform(*frac) * (t_s[-1] - t_s[0])
+    return int(np.searchsorted(t_s, target))
+
+
+def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarray, str, float]:
+    """Unit-amplitude contribution of an additive ``kind`` (sign included), the name of its
+    amplitude parameter and the sign; fills ``draw.params``, ``draw.where`` and (for a gap)
+    ``draw.keep``."""
+    t, temp = draw.t_s, draw.temp_c
+    sign = float(rng.choice([-1.0, 1.0]))
+    p, w = draw.params, draw.where
+    if kind == "step":
+        t0 = float(t[_at(t, STEP_AT, rng)])
+        p["time_s"], w["time_s"] = t0, t0
+        return sign * (t >= t0), "jump", sign
+    if kind == "restart_after_gap":
+        start = float(t[_at(t, GAP_AT, rng)])
+        gap_s = float(np.round(rng.uniform(*GAP_S)))
+        draw.keep = ~((t >= start) & (t < start + gap_s))
+        after = float(t[np.searchsorted(t, start + gap_s)])
+        p |= {"gap_start_s": start, "gap_s": gap_s, "time_s": after}
+        w["time_s"] = after
+        return sign * (t >= after), "jump", sign
+    if kind in ("periodic", "slow_oscillation"):
+        period = float(rng.uniform(*(PERIOD_S if kind == "periodic" else SLOW_PERIOD_S)))
+        phase = float(rng.uniform(0.0, 2.0 * np.pi))
+        p |= {"period_s": period, "phase_rad": phase}
+        w["period_s"] = period
+        return sign * np.sin(2.0 * np.pi * t / period + phase), "amplitude", sign
+    if kind == "transient":
+        t0 = float(t[_at(t, TRANSIENT_AT, rng)])
+        tau = float(rng.uniform(*TRANSIENT_TAU_S))
+        p |= {"time_s": t0, "tau_s": tau}
+        w["time_s"] = t0
+        return sign * np.where(t >= t0, np.exp(-np.maximum(t - t0, 0.0) / tau), 0.0), "jump", sign
+    if kind == "temperature_bump":
+        width = float(rng.uniform(*BUMP_WIDTH_C))
+        lo, hi = float(temp.min()), float(temp.max())
+        centre = float(rng.uniform(lo + width, hi - width))
+        p |= {"centre_c": centre, "width_c": width}
+        w["temperature_c"] = [centre - 2.0 * width, centre + 2.0 * width]
+        return sign * np.exp(-0.5 * ((temp - centre) / width) ** 2), "amplitude", sign
+    if kind == "second_node":
+        tau = float(rng.uniform(*SECOND_NODE_TAU_S))
+        p["tau_s"] = tau
+        return sign * (first_order_lag(temp, 1.0 / SAMPLE_RATE_HZ, tau) - temp), "coef_per_c", sign
+    raise ValueError(f"not an additive kind: {kind!r}")  # pragma: no cover
+
+
+def _saturation(draw: _Draw, rho: float, sigma0: float, rng: np.random.Generator) -> tuple[float, bool, float]:
+    """Clip level, whether it is a ceiling, and the RMS left of the noise-free clipped amount."""
+    y = draw.base
+    first_ceiling = bool(rng.random() < 0.5)
+    fracs = np.geomspace(1e-3, MAX_CLIPPED, 60)
+    best: tuple[float, bool, float] | None = None
+    for ceiling in (first_ceiling, not first_ceiling):
+        levels = np.quantile(y, 1.0 - fracs) if ceiling else np.quantile(y, fracs)
+        for level in levels:
+            clipped = np.minimum(y, level) if ceiling else np.maximum(y, level)
+            mask = clipped != y
+            if not mask.any() or not _one_band(draw, mask, ceiling, float(level)):
+                continue
+            left = _left(clipped - y, draw)
+            if best is None or left > best[2]:
+                best = (float(level), ceiling, left)
+            if left >= rho * sigma0:
+                return float(level), ceiling, left
+        if best is not None:
+            return best
+    raise RuntimeError("no clip level makes a single temperature band")  # pragma: no cover
+
+
+def _one_band(draw: _Draw, clipped: np.ndarray, ceiling: bool, level: float) -> bool:
+    """Whether the clipped samples fill one temperature interval: no unclipped sample with the
+    same acceleration lies strictly inside their temperature hull."""
+    temp = draw.temp_c
+    same = np.ones_like(clipped) if draw.accel is None else np.isin(draw.accel, np.unique(draw.accel[clipped]))
+    lo, hi = temp[clipped].min(), temp[clipped].max()
+    inside = same & ~clipped & (temp > lo) & (temp < hi)
+    return not bool(inside.any())
+
+
+def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Recording, OpenWorld]:
+    """A schema-v1 recording (1 Hz; MSRA output in Hz, gyro in deg/s) with ``kind`` hidden
+    (``None``: a control) and its truth. Raises ``ValueError`` for an unknown sensor or kind or
+    a negative seed."""
+    if sensor not in SENSORS:
+        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(SENSORS)}")
+    if kind is not None and kind not in SHAPE:
+        raise ValueError(f"unknown kind {kind!r}; known: {', '.join(KINDS)}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    streams = np.random.SeedSequence(int(seed)).spawn(8)  # the eighth is kept for a new kind
+    r_profile, r_device, r_kind, r_sim, r_scale, r_white, r_thermo = (
+        np.random.default_rng(s) for s in streams[:7])
+    profile = concealed_profile(sensor, r_profile)
+    device_seed = int(r_device.integers(0, 10_000))
+    model, default_sigma = _device(sensor, device_seed)
+    base = model.simulate(profile, r_sim)
+    n = profile.t_s.size
+    factor = float(np.exp(r_scale.uniform(*np.log(NOISE_FACTOR))))
+    rho = float(r_scale.uniform(*RATIO))
+    sigma = default_sigma * factor
+    draw = _Draw(profile.t_s, profile.temp_c, profile.accel_g if sensor == "msra" else None, base,
+                 np.ones(n, dtype=bool))
+    white = noise.white(n, 1.0, r_white)  # unit noise, scaled below
+    reading = profile.temp_c + r_thermo.standard_normal(n) * THERMOMETER_NOISE_C
+    thermometer = noise.quantise(reading, THERMOMETER_STEP_C)
+    output = base + sigma * white
+    ratio, white_sigma = float("nan"), sigma
+    if kind in ADDITIVE:
+        d, amp_name, sign = _pattern(kind, draw, r_kind)
+        scale = rho * sigma / _left(d, draw)
+        draw.params[amp_name] = sign * scale
+        output = base + d * scale + sigma * white
+        ratio = rho
+    elif kind == "saturation":
+        level, ceiling, left = _saturation(draw, rho, sigma, r_kind)
+        white_sigma = left / rho
+        noisy = base + white_sigma * white
+        output = np.minimum(noisy, level) if ceiling else np.maximum(noisy, level)
+        band = draw.temp_c[(np.minimum(base, level) if ceiling else np.maximum(base, level)) != base]
+        draw.params |= {"level": level, "ceiling": float(ceiling), "band_low_c": float(band.min()),
+                        "band_high_c": float(band.max())}
+        draw.where["level"] = level
+        ratio = rho
+    elif kind == "output_quantisation":
+        q = float(np.sqrt(12.0) * rho * sigma)
+        output = noise.quantise(output, q)
+        draw.params["step"] = q
+        draw.where["level"] = q
+        ratio = rho
+    elif kind == "thermometer_steps":
+        thermometer = noise.quantise(reading, THERMOMETER_STEPS_C)
+        white_sigma = _left(base, draw, temp_c=thermometer) / rho
+        output = base + white_sigma * white
+        draw.params["step_c"] = THERMOMETER_STEPS_C
+        draw.where["level"] = THERMOMETER_STEPS_C
+        ratio = rho
+    elif kind == "variance_temperature":
+        growth = float(r_kind.uniform(*VARIANCE_GROWTH))
+        lo, hi = float(draw.temp_c.min()), float(draw.temp_c.max())
+        sigma_t = sigma * growth ** ((draw.temp_c - lo) / (hi - lo))
+        output = base + sigma_t * white
+        white_sigma = _rms(sigma_t)
+        draw.params |= {"sigma_cold": sigma, "growth": growth}
+        draw.where["temperature_c"] = [(lo + hi) / 2.0, hi]
+    elif kind == "spikes":
+        times, sizes = _spikes(draw.t_s, sigma, r_kind)
+        idx = np.searchsorted(draw.t_s, times)
+        output = output.copy()
+        output[idx] += sizes
+        draw.params |= {"count": float(times.size), **{f"size_{i}": float(s) for i, s in enumerate(sizes)}}
+        draw.where["time_s"] = [float(x) for x in times]
+    k = draw.keep
+    t_kept = draw.t_s[k]
+    truth = OpenWorld(sensor, kind, SHAPE.get(kind) if kind else None, dict(draw.where),
+                      {key: float(v) for key, v in draw.params.items()}, ratio, float(white_sigma),
+                      float(t_kept[-1] - t_kept[0]), int(seed))
+    extra = {"open_world": dataclasses.asdict(truth), "device_seed": device_seed, "profile": dict(profile.info)}
+    rec = make_recording(t_kept, thermometer[k], profile.input[k], output[k], sensor=sensor,
+                         sample_rate_hz=SAMPLE_RATE_HZ, device_id=f"open-world-{sensor}-{seed}", extra=extra)
+    return rec, truth
+
+
+def _spikes(t_s: np.ndarray, sigma: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Instants (s, on the sample grid, >= 10 min apart, middle 90 % of the span) and sizes."""
+    count = int(rng.integers(SPIKES[0], SPIKES[1] + 1))
+    span = t_s[-1] - t_s[0]
+    lo, hi = t_s[0] + 0.05 * span, t_s[0] + 0.95 * span
+    slots = np.arange(lo, hi - SPIKE_SEPARATION_S, SPIKE_SEPARATION_S)  # one spike per 10-min slot at most
+    chosen = np.sort(rng.choice(slots.size, size=count, replace=False))
+    offsets = rng.uniform(0.0, SPIKE_SEPARATION_S / 2.0, size=count)  # keeps neighbours >= 5 min apart
+    times = t_s[np.searchsorted(t_s, slots[chosen] + offsets)]
+    sizes = rng.uniform(*SPIKE_SIGMA, size=count) * sigma * rng.choice([-1.0, 1.0], size=count)
+    return times, sizes
+
+
+# --- scoring -------------------------------------------------------------------------------
+
+
+def time_tolerance_s(span_s: float) -> float:
+    """How far a stated instant may be from the true one: max(10 min, 2 % of the span)."""
+    return max(TIME_TOLERANCE_S, TIME_TOLERANCE_SPAN * float(span_s))
+
+
+def _numbers(x: Any) -> np.ndarray:
+    """A number or a list of numbers as a 1-d float array (ValueError/TypeError otherwise)."""
+    arr = np.atleast_1d(np.asarray(x, dtype=float))
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)):
+        raise ValueError("not a finite number or list of numbers")
+    return arr
+
+
+def _times_match(true: Any, found: Any, tol_s: float) -> bool:
+    """Every true instant has a stated one within ``tol_s`` and every stated one a true one."""
+    a, b = _numbers(true), _numbers(found)
+    close = np.abs(np.subtract.outer(a, b)) <= tol_s
+    return bool(close.any(axis=1).all() and close.any(axis=0).all())
+
+
+def _period(where: Mapping[str, Any]) -> float | None:
+    if where.get("period_s") is not None:
+        return float(_numbers(where["period_s"])[0])
+    if where.get("frequency_hz") is not None:
+        f = float(_numbers(where["frequency_hz"])[0])
+        return 1.0 / f if f > 0 else None
+    return None
+
+
+def _band_matches(true: Sequence[float], found: Any) -> bool:
+    """The stated band overlaps the middle half of the true band (for a Gaussian bump stated as
+    centre -/+ 2 widths: centre -/+ 1 width)."""
+    lo, hi = (float(x) for x in true)
+    f = _numbers(found)
+    if f.size != 2 or f[0] > f[1]:
+        return False
+    quarter = (hi - lo) / 4.0
+    return bool(f[0] <= hi - quarter and f[1] >= lo + quarter)
+
+
+def where_matches(true: Mapping[str, Any], found: Mapping[str, Any] | None, span_s: float) -> bool:
+    """Whether ``found`` states every key of the truth's ``where`` within the fixed tolerances:
+    instants within :func:`time_tolerance_s`, period within 15 % (``frequency_hz`` accepted),
+    temperature band overlapping the true band's middle half, level within 25 %. A missing or
+    malformed key does not match; a truth without ``where`` (``second_node``) matches anything."""
+    found = found if isinstance(found, Mapping) else {}
+    try:
+        for key, value in true.items():
+            if key == "time_s":
+                if found.get("time_s") is None or not _times_match(value, found["time_s"], time_tolerance_s(span_s)):
+                    return False
+            elif key == "period_s":
+                p = _period(found)
+                if p is None or abs(p - float(value)) > PERIOD_TOLERANCE * float(value):
+                    return False
+            elif key == "temperature_c":
+                if found.get("temperature_c") is None or not _band_matches(value, found["temperature_c"]):
+                    return False
+            elif key == "level":
+                if found.get("level") is None:
+                    return False
+                level = float(_numbers(found["level"])[0])
+                if abs(level - float(value)) > LEVEL_TOLERANCE * abs(float(value)):
+                    return False
+            else:  # pragma: no cover - the truth only uses the keys above
+                return False
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def finding_matches(truth: OpenWorld, finding: Mapping[str, Any]) -> bool:
+    """Whether one report finding characterises the hidden structure: same shape and where."""
+    if truth.shape is None or finding.get("shape") != truth.shape:
+        return False
+    return where_matches(truth.where, finding.get("where"), truth.span_s)
+
+
+@dataclass(frozen=True)
+class Score:
+    """How a report fared on one recording (see :func:`score`)."""
+
+    characterised: bool  # some finding matches shape and where
+    shape_found: bool  # some finding has the true shape
+    explained_as_noise: bool  # findings only of shape noise / bias_instability
+    false_alarm: bool  # a control with any finding
+    findings: int
+
+
+def score(truth: OpenWorld, effects: Sequence[Mapping[str, Any]]) -> Score:
+    """Score the ``effects`` of a report (``Diagnosis.to_json()["effects"]``) against the truth."""
+    effects = [e for e in effects if isinstance(e, Mapping)]
+    noise_only = bool(effects) and all(e.get("shape") in NOISE_SHAPES or e.get("id") in NOISE_IDS for e in effects)
+    if truth.kind is None:
+        return Score(False, False, noise_only, bool(effects), len(effects))
+    return Score(
+        characterised=any(finding_matches(truth, e) for e in effects),
+        shape_found=any(e.get("shape") == truth.shape for e in effects),
+        explained_as_noise=noise_only,
+        false_alarm=False,
+        findings=len(effects),
+    )
