@@ -103,7 +103,7 @@ def test_step_and_gap_jump_at_the_stated_instant() -> None:
 
 @pytest.mark.parametrize("kind", ["periodic", "slow_oscillation"])
 def test_periodic_line_at_the_stated_period(kind: str) -> None:
-    rec, truth, hidden = _hidden("msra", kind)
+    _, truth, hidden = _hidden("msra", kind)
     period = truth.where["period_s"]
     assert (600 <= period <= 2400) if kind == "periodic" else (7200 <= period <= 18000)
     freqs = np.fft.rfftfreq(hidden.size, 1.0)
@@ -260,3 +260,65 @@ def test_control_with_any_finding_is_a_false_alarm() -> None:
     assert score(control, [_finding("step", {"time_s": 5.0})]).false_alarm
     assert score(control, [{"id": "thermal_lag"}]).false_alarm
     assert not score(control, [_finding("step", {"time_s": 5.0})]).characterised
+
+
+# --- the experiment script: plan and one scored row --------------------------------------------
+
+
+def _script():
+    """experiments/diagnose-concealed/open_world.py as a module."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "experiments" / "diagnose-concealed" / "open_world.py"
+    spec = importlib.util.spec_from_file_location("open_world_script", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_default_plan_is_big_enough_with_unique_fresh_seeds() -> None:
+    script = _script()
+    jobs = script.plan(10, 10, script.FIRST_SEED)
+    seeds = [s for _, _, s in jobs]
+    assert len(jobs) >= 120 and sum(k is None for _, k, _ in jobs) >= 20
+    assert len(set(seeds)) == len(seeds) and min(seeds) == 41_000_000
+    for kind in KINDS:
+        assert {s for s, k, _ in jobs if k == kind} == {"msra", "gyro"}
+    quick = script.plan(2, 2, script.QUICK_SEED)
+    assert max(s for _, _, s in quick) < script.FIRST_SEED  # development seeds never reach the proof's
+
+
+class _Report:
+    def __init__(self, effects: list) -> None:
+        self.effects = effects
+
+    def to_json(self) -> dict:
+        return {"effects": self.effects, "baseline": {"rmse_heldout": 2.0}, "final": {"rmse_heldout": 1.0}}
+
+
+def test_one_row_scores_what_the_diagnosis_states(monkeypatch: pytest.MonkeyPatch) -> None:
+    script = _script()
+
+    def truthful(rec: Recording, **_: object) -> _Report:
+        truth = rec.meta.extra["open_world"]
+        return _Report([_finding(truth["shape"], truth["where"])] if truth["shape"] else [])
+
+    monkeypatch.setattr(script, "diagnose", truthful)
+    rows = [script.one("gyro", "step", SEED), script.one("msra", None, SEED)]
+    assert rows[0]["characterised"] and not rows[0]["explained_as_noise"] and rows[0]["found"] == "x:step"
+    assert rows[0]["final_over_sigma"] == pytest.approx(1.0 / rows[0]["white_sigma"])
+    assert not rows[1]["false_alarm"] and rows[1]["found"] == "nothing"
+    monkeypatch.setattr(script, "diagnose", lambda rec, **_: _Report([_finding("noise", {}, "bias_instability")]))
+    noisy = script.one("gyro", "periodic", SEED)
+    assert noisy["explained_as_noise"] and not noisy["characterised"]
+    assert script.one("gyro", None, SEED)["false_alarm"]
+
+    def broken(rec: Recording, **_: object) -> _Report:
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(script, "diagnose", broken)
+    failed = script.one("gyro", "spikes", SEED)
+    assert failed["error"] == "RuntimeError: boom" and not failed["characterised"]
+    text = script.summary(pd.DataFrame(rows + [noisy, failed]), 1.0, 1, "x")
+    assert "| no deterministic case explained as noise only | 1 of 2 | NOT met |" in text
