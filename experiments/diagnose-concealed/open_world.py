@@ -130,11 +130,10 @@ def summary(df: pd.DataFrame, elapsed_s: float, workers: int, seeds: str) -> str
         (f"| <= 5 % false alarms on controls (any finding) | {_pct(n_alarm, len(controls))} "
          f"| {_ok(len(controls) > 0 and n_alarm <= FALSE_ALARM_TARGET * len(controls))} |"),
         "",
-        "Per kind (characterised / recordings; \"shape stated\": some finding has the true shape; "
-        "\"noise only\": every finding is noise / bias_instability; final: held-out RMSE after the "
-        "refit / true white sigma):",
-        "",
-        "A finding is listed as id:shape, `?` for a finding without a shape.",
+        ("Per kind (characterised / recordings, for controls false alarms; \"shape stated\": some finding "
+         "has the true shape; \"noise only\": every finding is noise / bias_instability; final: held-out "
+         "RMSE after the refit / true white sigma). A finding is listed as id:shape, `?` for one without "
+         "a shape."),
         "",
         "| kind | shape | msra | gyro | shape stated | noise only | nothing found | final <= 1.05 | median final |",
         "|---|---|---|---|---|---|---|---|---|",
