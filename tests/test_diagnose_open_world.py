@@ -160,8 +160,22 @@ def test_saturation_clips_at_the_level_in_one_band(sensor: str) -> None:
     # the clipped samples sit in the stated band (widened by what the noise clips near its edges)
     temp = rec.temperature_c[at]
     band = truth.params["band_high_c"] - truth.params["band_low_c"]
-    assert band < 0.9 * np.ptp(rec.temperature_c)
+    assert band / np.ptp(rec.temperature_c) == pytest.approx(truth.params["band_share"], abs=0.06)
+    assert 0.15 <= truth.params["band_share"] <= 0.4
+    assert truth.white_sigma == open_world_recording(sensor, None, SEED)[1].white_sigma
     assert np.median(temp) >= truth.params["band_low_c"] - 1 and np.median(temp) <= truth.params["band_high_c"] + 1
+
+
+@pytest.mark.parametrize("sensor", ["msra", "gyro"])
+def test_thermometer_steps_sized_by_the_temperature_sensitivity(sensor: str) -> None:
+    rec, truth = open_world_recording(sensor, "thermometer_steps", SEED)
+    ctrl, control = open_world_recording(sensor, None, SEED)
+    assert truth.white_sigma == control.white_sigma  # the noise stays the device's
+    k = truth.params["tempco_scale"]
+    varying = (rec.output - ctrl.output) / (k - 1.0)  # same noise: the difference is (k - 1) x the varying part
+    left = np.sqrt(np.mean(_resid(k * varying, _cols(rec)) ** 2))  # columns of the whole-degree reading
+    assert left / truth.white_sigma == pytest.approx(truth.ratio, rel=0.05)
+    assert 0.5 <= truth.ratio <= 1.0
 
 
 def test_quantisation_grids() -> None:

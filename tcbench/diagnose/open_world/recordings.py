@@ -31,13 +31,15 @@ Sizing, "what the starting model cannot absorb is 0.5-1 sigma per sample":
   temperature and the acceleration, on the samples kept), and its amplitude is set so that the
   RMS of what is left is ``rho * sigma``, ``rho ~ U(0.5, 1)``, with the white sigma the device's
   own times a log-uniform factor in 1-3 (as for the concealed set's free-amplitude effects);
-- ``saturation``: the same projection of the noise-free clipped amount ``clip(y) - y``; the
-  level is the least clipping level (on a grid of the noise-free output's quantiles, at most
-  30 % of the samples clipped) whose left-over RMS reaches ``rho`` times the device sigma, and
-  the white sigma is then that RMS / ``rho`` exactly (clipping acts on output plus noise);
-- ``thermometer_steps``: the amplitude is the device's own temperature slope; the white sigma
-  is the RMS of the noise-free output the minimal model *in the read temperature* cannot absorb,
-  divided by ``rho`` (as ``thermal_lag`` in the concealed set);
+- ``saturation`` and ``thermometer_steps``: the white sigma stays the device's times the
+  factor and the device's *temperature sensitivity* is set instead: the noise-free output is
+  split into its part on the columns without temperature (``1``, ``a``) and the part that moves
+  with temperature, and the latter is multiplied by ``k`` so that what the minimal model cannot
+  absorb is ``rho * sigma`` (params ``tempco_scale``). For ``saturation`` that is the noise-free
+  clipped amount; the clipping side is random and the level is the one whose clipped samples (at
+  the extreme input on that side) fill one temperature band spanning the drawn 15-40 % of the
+  temperature range (as close as the profile allows); the clip acts on output plus noise. For ``thermometer_steps`` it is the output the minimal model *in the read temperature*
+  cannot absorb;
 - ``output_quantisation``: ``q = sqrt(12) * rho * sigma``, so the rounding error's RMS is
   ``rho * sigma``;
 - ``variance_temperature``: cold-end sigma = device sigma times the factor, hot/cold ratio 2-4;
@@ -103,7 +105,7 @@ TRANSIENT_TAU_S = (600.0, 3600.0)
 BUMP_WIDTH_C = (2.0, 6.0)
 SECOND_NODE_TAU_S = (1200.0, 5400.0)
 VARIANCE_GROWTH = (2.0, 4.0)  # sigma hot / sigma cold
-MAX_CLIPPED = 0.3  # fraction of samples
+CLIP_BAND = (0.15, 0.4)  # share of the temperature range where the output clips
 THERMOMETER_STEPS_C = 1.0
 SPIKES = (1, 5)
 SPIKE_SIGMA = (8.0, 20.0)
@@ -222,37 +224,60 @@ def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarr
     raise ValueError(f"not an additive kind: {kind!r}")  # pragma: no cover
 
 
-def _saturation(draw: _Draw, rho: float, sigma0: float, rng: np.random.Generator) -> tuple[float, bool, float]:
-    """Clip level, whether it is a ceiling, and the RMS left of the noise-free clipped amount."""
-    y = draw.base
+def _split(draw: _Draw) -> tuple[np.ndarray, np.ndarray]:
+    """The noise-free output as ``fixed + varying``: ``fixed`` its part on the minimal model's
+    columns without temperature (``1`` and ``a``), ``varying`` the part that moves with
+    temperature (``u``, ``u^2`` and ``a`` times those). The device has no other effect, so the
+    two add up to the output (to rounding)."""
+    cols = minimal_columns(draw.temp_c, draw.accel)
+    coef, *_ = np.linalg.lstsq(cols, draw.base, rcond=None)
+    fixed_cols = [0] if draw.accel is None else [0, 3]
+    fixed = cols[:, fixed_cols] @ coef[fixed_cols]
+    return fixed, draw.base - fixed
+
+
+def _saturation(
+    draw: _Draw, varying: np.ndarray, rng: np.random.Generator
+) -> tuple[float, bool, float, np.ndarray, np.ndarray]:
+    """Where the output clips, for a unit temperature sensitivity: the band's drawn share of the
+    temperature range (:data:`CLIP_BAND`), the clipping side (ceiling or floor, random, the other
+    tried when the first makes no band within 0.05 of the share), the threshold on ``varying``,
+    the group of samples that can clip (those at the extreme input on that side) and the unit
+    clipped amount (``clip(varying) - varying`` on the group, 0 elsewhere). The threshold is the
+    quantile of ``varying`` over the group (1-60 % clipped) whose clipped samples fill one
+    temperature band closest to the drawn share."""
     first_ceiling = bool(rng.random() < 0.5)
-    fracs = np.geomspace(1e-3, MAX_CLIPPED, 60)
-    best: tuple[float, bool, float] | None = None
+    share = float(rng.uniform(*CLIP_BAND))
+    range_c = float(np.ptp(draw.temp_c))
+    best: tuple[float, bool, float, np.ndarray] | None = None
     for ceiling in (first_ceiling, not first_ceiling):
-        levels = np.quantile(y, 1.0 - fracs) if ceiling else np.quantile(y, fracs)
-        for level in levels:
-            clipped = np.minimum(y, level) if ceiling else np.maximum(y, level)
-            mask = clipped != y
-            if not mask.any() or not _one_band(draw, mask, ceiling, float(level)):
+        if draw.accel is None:
+            group = np.ones(varying.size, dtype=bool)
+        else:
+            group = draw.accel == (draw.accel.max() if ceiling else draw.accel.min())
+        fractions = np.linspace(0.01, 0.6, 60)
+        for threshold in np.quantile(varying[group], 1.0 - fractions if ceiling else fractions):
+            beyond = group & ((varying > threshold) if ceiling else (varying < threshold))
+            if not beyond.any() or not _one_band(draw, beyond, group):
                 continue
-            left = _left(clipped - y, draw)
-            if best is None or left > best[2]:
-                best = (float(level), ceiling, left)
-            if left >= rho * sigma0:
-                return float(level), ceiling, left
-        if best is not None:
-            return best
-    raise RuntimeError("no clip level makes a single temperature band")  # pragma: no cover
+            miss = abs(float(np.ptp(draw.temp_c[beyond])) / range_c - share)
+            if best is None or miss < best[0]:
+                best = (miss, ceiling, float(threshold), group)
+        if best is not None and best[0] <= 0.05:
+            break
+    if best is None:  # pragma: no cover - a monotonic side always makes one band
+        raise RuntimeError("no clipping threshold makes a single temperature band")
+    _, ceiling, threshold, group = best
+    beyond = group & ((varying > threshold) if ceiling else (varying < threshold))
+    return share, ceiling, threshold, group, np.where(beyond, threshold - varying, 0.0)
 
 
-def _one_band(draw: _Draw, clipped: np.ndarray, ceiling: bool, level: float) -> bool:
-    """Whether the clipped samples fill one temperature interval: no unclipped sample with the
-    same acceleration lies strictly inside their temperature hull."""
+def _one_band(draw: _Draw, clipped: np.ndarray, group: np.ndarray) -> bool:
+    """Whether the ``clipped`` samples fill one temperature interval: no other sample of the
+    ``group`` (same input) lies strictly inside their temperature hull."""
     temp = draw.temp_c
-    same = np.ones_like(clipped) if draw.accel is None else np.isin(draw.accel, np.unique(draw.accel[clipped]))
     lo, hi = temp[clipped].min(), temp[clipped].max()
-    inside = same & ~clipped & (temp > lo) & (temp < hi)
-    return not bool(inside.any())
+    return not bool((group & ~clipped & (temp > lo) & (temp < hi)).any())
 
 
 def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Recording, OpenWorld]:
@@ -290,13 +315,19 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
         output = base + d * scale + sigma * white
         ratio = rho
     elif kind == "saturation":
-        level, ceiling, left = _saturation(draw, rho, sigma, r_kind)
-        white_sigma = left / rho
-        noisy = base + white_sigma * white
+        fixed, varying = _split(draw)
+        share, ceiling, threshold, group, amount = _saturation(draw, varying, r_kind)
+        k = rho * sigma / _left(amount, draw)  # temperature sensitivity that makes the clip rho sigma
+        draw.base = fixed + k * varying
+        level = float(np.median(fixed[group]) + k * threshold)
+        outside = draw.base[~group]
+        if outside.size and (outside.max() >= level if ceiling else outside.min() <= level):
+            raise RuntimeError("the clip level reaches samples at another input")  # pragma: no cover
+        noisy = draw.base + sigma * white
         output = np.minimum(noisy, level) if ceiling else np.maximum(noisy, level)
-        band = draw.temp_c[(np.minimum(base, level) if ceiling else np.maximum(base, level)) != base]
-        draw.params |= {"level": level, "ceiling": float(ceiling), "band_low_c": float(band.min()),
-                        "band_high_c": float(band.max())}
+        band = draw.temp_c[amount != 0]
+        draw.params |= {"level": level, "ceiling": float(ceiling), "band_share": share, "tempco_scale": k,
+                        "band_low_c": float(band.min()), "band_high_c": float(band.max())}
         draw.where["level"] = level
         ratio = rho
     elif kind == "output_quantisation":
@@ -307,9 +338,11 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
         ratio = rho
     elif kind == "thermometer_steps":
         thermometer = noise.quantise(reading, THERMOMETER_STEPS_C)
-        white_sigma = _left(base, draw, temp_c=thermometer) / rho
-        output = base + white_sigma * white
-        draw.params["step_c"] = THERMOMETER_STEPS_C
+        fixed, varying = _split(draw)
+        k = rho * sigma / _left(varying, draw, temp_c=thermometer)
+        draw.base = fixed + k * varying
+        output = draw.base + sigma * white
+        draw.params |= {"step_c": THERMOMETER_STEPS_C, "tempco_scale": k}
         draw.where["level"] = THERMOMETER_STEPS_C
         ratio = rho
     elif kind == "variance_temperature":
