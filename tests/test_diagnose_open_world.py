@@ -101,14 +101,23 @@ def test_step_and_gap_jump_at_the_stated_instant() -> None:
     assert np.flatnonzero(np.diff(rec.time_s) > 1.5).tolist() == [k - 1]  # the only gap
 
 
-@pytest.mark.parametrize("kind", ["periodic", "slow_oscillation"])
+@pytest.mark.parametrize("kind", ["periodic", "slow_oscillation", "compressor_cycling"])
 def test_periodic_line_at_the_stated_period(kind: str) -> None:
     _, truth, hidden = _hidden("msra", kind)
     period = truth.where["period_s"]
-    assert (600 <= period <= 2400) if kind == "periodic" else (7200 <= period <= 18000)
+    assert (7200 <= period <= 18000) if kind == "slow_oscillation" else (600 <= period <= 2400)
     freqs = np.fft.rfftfreq(hidden.size, 1.0)
     peak = freqs[1 + np.argmax(np.abs(np.fft.rfft(hidden))[1:])]
-    assert 1.0 / peak == pytest.approx(period, rel=0.15 if kind == "periodic" else 0.3)
+    assert 1.0 / peak == pytest.approx(period, rel=0.3 if kind == "slow_oscillation" else 0.15)
+
+
+def test_compressor_runs_only_below_room_temperature() -> None:
+    rec, truth, hidden = _hidden("gyro", "compressor_cycling")
+    on = hidden != 0
+    assert np.unique(np.round(hidden / truth.params["jump"], 9)).tolist() == [0.0, 1.0]
+    assert np.all(rec.temperature_c[on] < truth.params["below_c"] + 0.2)  # thermometer noise and 1/16 degC steps
+    cold = rec.temperature_c < truth.params["below_c"] - 0.2
+    assert on[cold].mean() == pytest.approx(truth.params["duty"], abs=0.1)
 
 
 def test_transient_starts_at_onset_and_decays() -> None:

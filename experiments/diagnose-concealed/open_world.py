@@ -1,9 +1,9 @@
 """Proof, open world: can ``tcbench diagnose`` characterise a mismatch outside the effect library?
 
 Generates recordings (``tcbench.diagnose.open_world``) in which one structure no library effect
-makes (a step, a gap with a restart, a spectral line, a slow oscillation, a transient, a bump in
-temperature, a second thermal node, noise growing with temperature, saturation, quantisation of
-the output or of the thermometer, spikes) is hidden so that what the minimal model cannot absorb
+makes (a step, a gap with a restart, a spectral line, a slow oscillation, a compressor switching
+in the cold, a transient, a bump in temperature, a second thermal node, noise growing with
+temperature, saturation, quantisation of the output or of the thermometer, spikes) is hidden so that what the minimal model cannot absorb
 is 0.5-1 of the per-sample noise, plus controls with nothing hidden; diagnoses each with
 ``tcbench.diagnose.diagnosis.diagnose`` and scores ``Diagnosis.to_json()["effects"]`` against the
 truth by fixed rules (``tcbench.diagnose.open_world.score``, README.md). Writes, to ``--out``:

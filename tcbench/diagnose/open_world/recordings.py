@@ -11,6 +11,9 @@ PHYSICS.md §8 that no library effect makes. The kinds (:data:`KINDS`), with the
   first sample after it);
 - ``periodic``: a sinusoid of 10-40 min period (``period_s``);
 - ``slow_oscillation``: a sinusoid of 2-5 h period (``period_s``);
+- ``compressor_cycling``: a bias offset switched on and off with a period of 10-40 min (duty
+  30-70 %) while the chamber holds the package more than 1 degC below room temperature, as a
+  chamber compressor loading the supply (``period_s``);
 - ``transient``: a jump that decays exponentially (tau 10-60 min) from an instant in the middle
   60 % of the record (``time_s`` = onset);
 - ``temperature_bump``: a Gaussian of the package temperature, width 2-6 degC, centred inside the
@@ -79,6 +82,7 @@ SHAPE: dict[str, str] = {
     "restart_after_gap": "step",
     "periodic": "periodic",
     "slow_oscillation": "periodic",
+    "compressor_cycling": "periodic",
     "transient": "transient",
     "temperature_bump": "temperature_function",
     "second_node": "temperature_dynamics",
@@ -90,8 +94,8 @@ SHAPE: dict[str, str] = {
 }
 KINDS: tuple[str, ...] = tuple(SHAPE)
 SENSORS = ("msra", "gyro")
-ADDITIVE = ("step", "restart_after_gap", "periodic", "slow_oscillation", "transient", "temperature_bump",
-            "second_node")
+ADDITIVE = ("step", "restart_after_gap", "periodic", "slow_oscillation", "compressor_cycling", "transient",
+            "temperature_bump", "second_node")
 DETERMINISTIC = (*ADDITIVE, "saturation")  # a model term can take them out: the refit target applies
 
 RATIO = (0.5, 1.0)
@@ -100,6 +104,8 @@ GAP_AT = (0.2, 0.8)
 GAP_S = (300.0, 1800.0)
 PERIOD_S = (600.0, 2400.0)
 SLOW_PERIOD_S = (7200.0, 18000.0)
+DUTY = (0.3, 0.7)  # share of each compressor cycle it runs
+COMPRESSOR_BELOW_C = 1.0  # the compressor runs while the package is this much below room temperature
 TRANSIENT_AT = (0.2, 0.8)
 TRANSIENT_TAU_S = (600.0, 3600.0)
 BUMP_WIDTH_C = (2.0, 6.0)
@@ -145,6 +151,7 @@ class _Draw:
     accel: np.ndarray | None
     base: np.ndarray
     keep: np.ndarray
+    room_c: float
     params: dict[str, float] = field(default_factory=dict)
     where: dict[str, Any] = field(default_factory=dict)
 
@@ -204,6 +211,15 @@ def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarr
         p |= {"period_s": period, "phase_rad": phase}
         w["period_s"] = period
         return sign * np.sin(2.0 * np.pi * t / period + phase), "amplitude", sign
+    if kind == "compressor_cycling":
+        period = float(rng.uniform(*PERIOD_S))
+        duty = float(rng.uniform(*DUTY))
+        phase = float(rng.uniform(0.0, 1.0))
+        below_c = draw.room_c - COMPRESSOR_BELOW_C
+        p |= {"period_s": period, "duty": duty, "phase_cycles": phase, "below_c": below_c}
+        w["period_s"] = period
+        running = (np.mod(t / period + phase, 1.0) < duty) & (temp < below_c)
+        return sign * running.astype(float), "jump", sign
     if kind == "transient":
         t0 = float(t[_at(t, TRANSIENT_AT, rng)])
         tau = float(rng.uniform(*TRANSIENT_TAU_S))
@@ -302,7 +318,7 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
     rho = float(r_scale.uniform(*RATIO))
     sigma = default_sigma * factor
     draw = _Draw(profile.t_s, profile.temp_c, profile.accel_g if sensor == "msra" else None, base,
-                 np.ones(n, dtype=bool))
+                 np.ones(n, dtype=bool), float(profile.info["start_c"]))
     white = noise.white(n, 1.0, r_white)  # unit noise, scaled below
     reading = profile.temp_c + r_thermo.standard_normal(n) * THERMOMETER_NOISE_C
     thermometer = noise.quantise(reading, THERMOMETER_STEP_C)
