@@ -376,13 +376,13 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
         output[idx] += sizes
         draw.params |= {"count": float(times.size), **{f"size_{i}": float(s) for i, s in enumerate(sizes)}}
         draw.where["time_s"] = [float(x) for x in times]
-    k = draw.keep
-    t_kept = draw.t_s[k]
+    kept = draw.keep
+    t_kept = draw.t_s[kept]
     truth = OpenWorld(sensor, kind, SHAPE.get(kind) if kind else None, dict(draw.where),
                       {key: float(v) for key, v in draw.params.items()}, ratio, float(white_sigma),
                       float(t_kept[-1] - t_kept[0]), int(seed))
     extra = {"open_world": dataclasses.asdict(truth), "device_seed": device_seed, "profile": dict(profile.info)}
-    rec = make_recording(t_kept, thermometer[k], profile.input[k], output[k], sensor=sensor,
+    rec = make_recording(t_kept, thermometer[kept], profile.input[kept], output[kept], sensor=sensor,
                          sample_rate_hz=SAMPLE_RATE_HZ, device_id=f"open-world-{sensor}-{seed}", extra=extra)
     return rec, truth
 
