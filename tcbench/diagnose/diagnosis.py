@@ -311,7 +311,7 @@ def diagnose(
                "samples": n, "folds": att.k},
         reference=_reference_json(reference, final_rmse, data.white_sigma),
         statistics={**(att.plan.to_json() if att.plan else {}), **nonmean.statistics()},
-        candidates=[evidence[e] for e in (*DETERMINISTIC, "bias_instability") if e in evidence],
+        candidates=[evidence[e] for e in (*DETERMINISTIC, *TERMS, "bias_instability") if e in evidence],
         confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),

@@ -364,6 +364,9 @@ def plot_evidence(d: Diagnosis, path: Path) -> Path:
         x_text, ha = (e.gain, "left") if e.gain >= 0 else (e.gain, "right")
         ax.text(x_text, yi, f"  {note}  " if ha == "left" else f"{note}  ", va="center", ha=ha, fontsize=7)
     ax.axvline(threshold, color="k", ls="--", lw=1, label=f"detection threshold {threshold:g} σ²")
+    for yi, e in zip(y, det, strict=True):  # open-world terms need more: their detectors search
+        if float(e.threshold) != threshold:
+            ax.plot([e.threshold, e.threshold], [yi - 0.4, yi + 0.4], color="k", ls=":", lw=1.5)
     ax.axvline(0.0, color="k", lw=0.5)
     ax.set_xscale("symlog", linthresh=max(threshold, 1.0))
     ax.set_xlim(-span, span)

@@ -183,8 +183,10 @@ def prepare(
     if d.size < 10:
         raise DiagnosisDataError("too few consecutive samples at constant input to measure the noise")
     sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    if not sigma > 0:  # most steps zero: an output on a coarse grid; the RMS of the steps still measures it
+        sigma = float(np.sqrt(np.mean(d * d) / 2.0))
     if not sigma > 0:
-        raise DiagnosisDataError("the output has no sample-to-sample noise (constant or quantised to a few values)")
+        raise DiagnosisDataError("the output has no sample-to-sample noise: it is constant at constant input")
     smooth, rate = smooth_temperature(t, temp, smooth_s)
     units = rec.meta.units or {}
     return DiagnosisData(

@@ -1,0 +1,108 @@
+"""Open-world terms: detectors on cases worked by hand, the terms in a diagnosis, and simulate."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tcbench.diagnose.concealed import concealed_recording, minimal_columns, unexplained
+from tcbench.diagnose.detectors import bump_centres, line_periods, step_times
+from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.discover import _testable
+from tcbench.diagnose.findings import check_finding
+from tcbench.diagnose.model_file import parse_model, to_sensor_model
+from tcbench.sensors.effects import Signals, make_effect
+from tcbench.sensors.recording import make_recording
+
+
+def test_step_detector_finds_a_hand_made_jump_to_the_sample() -> None:
+    rng = np.random.default_rng(1)
+    t = np.arange(20_000.0)
+    r = rng.standard_normal(t.size) + np.where(t >= 12_345.0, 0.4, 0.0)
+    assert any(abs(s - 12_345.0) <= 30.0 for s in step_times(t, r))
+
+
+def test_step_detector_proposes_the_sample_after_a_gap() -> None:
+    rng = np.random.default_rng(2)
+    t = np.concatenate([np.arange(5000.0), np.arange(6800.0, 12_000.0)])
+    assert 6800.0 in step_times(t, rng.standard_normal(t.size))
+
+
+def test_line_detector_finds_a_hand_made_period_also_with_gaps() -> None:
+    rng = np.random.default_rng(3)
+    t = np.arange(36_000.0)
+    keep = (t % 3600.0) < 2400.0  # bursts: a third of every hour lost
+    t = t[keep]
+    r = rng.standard_normal(t.size) + 0.3 * np.sin(2 * np.pi * t / 1500.0)
+    best = line_periods(t, r)[0]
+    assert abs(best / 1500.0 - 1.0) < 0.02
+
+
+def test_bump_detector_finds_a_hand_made_bump_in_temperature() -> None:
+    rng = np.random.default_rng(4)
+    temp = np.linspace(-20.0, 60.0, 30_000)
+    r = rng.standard_normal(temp.size) + 0.5 * np.exp(-0.5 * ((temp - 31.0) / 3.0) ** 2)
+    centre, width = bump_centres(temp, r)[0]
+    assert abs(centre - 31.0) < 1.5 and 1.0 <= width <= 6.0
+
+
+def test_steps_are_only_testable_with_two_folds_on_each_side() -> None:
+    t = np.arange(10_000.0)
+    fold = (np.floor(t / 900.0) % 5).astype(np.int64)
+    assert _testable(t, fold) == (900.0, 9899.0)
+
+
+@pytest.mark.parametrize(("term", "params"), [
+    ("bias_step", {"time_s": 50.0, "size": 2.0}),
+    ("periodic", {"period_s": 40.0, "amplitude": 1.5, "phase_rad": 0.3}),
+    ("transient", {"time_s": 30.0, "tau_s": 20.0, "amplitude": -1.0}),
+    ("temperature_bump", {"centre_c": 30.0, "width_c": 2.0, "amplitude": 0.7}),
+    ("second_node", {"tau_s": 60.0, "coef_per_c": 0.2}),
+])
+def test_each_term_is_simulated_as_the_diagnosis_models_it(term: str, params: dict[str, float]) -> None:
+    """The simulated effect equals the diagnosis's columns times the fitted coefficients."""
+    from tcbench.diagnose.open_terms import TERMS
+    from tcbench.diagnose.signals import DiagnosisData
+
+    t = np.arange(200.0)
+    temp = 20.0 + 0.1 * t
+    s = Signals(t_s=t, dt_s=1.0, temp_meas_c=temp, temp_die_c=temp, temp_rate_c_per_s=np.full(t.size, 0.1),
+                accel_g=np.zeros(t.size), cross_g=np.zeros(t.size), rate_dps=np.zeros(t.size))
+    simulated = make_effect(term, **params).term(s, np.random.default_rng(0))
+    kind = TERMS[term]
+    data = DiagnosisData("gyro", "deg/s", t, temp, temp, np.full(t.size, 0.1), np.zeros(t.size), np.zeros(t.size),
+                         np.zeros(t.size, dtype=np.int64), 1.0, 1.0, 120.0)
+    value = tuple(params[name] for name in kind.value_names)
+    cols = kind.columns(data, value, temp)
+    coef, *_ = np.linalg.lstsq(cols, simulated, rcond=None)
+    np.testing.assert_allclose(cols @ coef, simulated, atol=1e-9 * max(1.0, np.abs(simulated).max()))
+    back = kind.params(value, coef)
+    for name, v in params.items():
+        assert back[name] == pytest.approx(v, rel=1e-6, abs=1e-9)
+
+
+def _hidden_step(seed: int) -> tuple[object, float, float]:
+    rec, truth = concealed_recording("gyro", None, seed)
+    t = rec.time_s
+    t0 = 0.55 * float(t[-1])
+    h = (t >= t0).astype(float)
+    left = float(np.sqrt(np.mean(unexplained(h, minimal_columns(rec.temperature_c, None)) ** 2)))
+    h *= 0.8 * truth.white_sigma / left
+    out = make_recording(t, rec.temperature_c, rec.input, rec.output + h, sensor="gyro", sample_rate_hz=1.0,
+                         device_id="hidden-step")
+    return out, t0, truth.white_sigma
+
+
+def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml() -> None:
+    rec, t0, sigma = _hidden_step(1)
+    d = diagnose(rec, sensor="gyro")
+    report = d.to_json()
+    for entry in report["effects"]:
+        check_finding(entry)
+    steps = [e for e in report["effects"] if e["shape"] == "step"]
+    assert steps and abs(steps[0]["where"]["time_s"] - t0) < 600.0
+    assert d.final["rmse_heldout"] / sigma < 1.05 < d.baseline["rmse_heldout"] / sigma
+    assert "beyond the library: bias_step (step)" in d.verdict
+    spec = parse_model(d.model, "model.yaml")
+    step = next(e for e in to_sensor_model(spec).effects if e.id == "bias_step")
+    assert step.time_s == pytest.approx(steps[0]["where"]["time_s"])
