@@ -93,9 +93,13 @@ def _hidden_step(seed: int) -> tuple[object, float, float]:
     return out, t0, truth.white_sigma
 
 
-def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml() -> None:
+def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from tcbench.diagnose.report import write_report
+
     rec, t0, sigma = _hidden_step(1)
     d = diagnose(rec, sensor="gyro")
+    written = write_report(d, tmp_path / "out")
+    assert "bias_step" in written["report.md"].read_text()
     report = d.to_json()
     for entry in report["effects"]:
         check_finding(entry)

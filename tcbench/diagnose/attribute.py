@@ -245,7 +245,8 @@ def attribute(
             evidence[effect].reason = "superseded: the other kept effects explain what it did"
         else:
             ev = evidence[effect]
-            ev.gain, ev.wald, ev.p_value, ev.test, ev.value = cost, wald, p, test, value
+            ev.gain, ev.wald, ev.p_value, ev.test = cost, wald, p, test
+            ev.value = None if effect in TERMS else value  # an open-world term's values are in its params
     confusions = _confusions(scorer, model, base, evidence, threshold)
     return Attribution(base, model, scorer.fit(base), scorer.fit(model), evidence, confusions,
                        designer, fold, k, plan)
