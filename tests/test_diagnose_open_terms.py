@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from tcbench.diagnose.concealed import concealed_recording, minimal_columns, unexplained
-from tcbench.diagnose.detectors import bump_centres, line_periods, step_times
+from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.discover import _testable
 from tcbench.diagnose.findings import check_finding
@@ -38,6 +40,15 @@ def test_line_detector_finds_a_hand_made_period_also_with_gaps() -> None:
     assert abs(best / 1500.0 - 1.0) < 0.02
 
 
+def test_line_window_finds_where_a_cycle_runs() -> None:
+    rng = np.random.default_rng(5)
+    t = np.arange(36_000.0)
+    on = (t >= 12_000.0) & (t < 24_000.0)
+    r = rng.standard_normal(t.size) + on * 0.5 * np.sign(np.sin(2 * np.pi * t / 1200.0))
+    start, end = line_window(t, r, 1200.0)
+    assert abs(start - 12_000.0) < 1500.0 and abs(end - 24_000.0) < 1500.0
+
+
 def test_bump_detector_finds_a_hand_made_bump_in_temperature() -> None:
     rng = np.random.default_rng(4)
     temp = np.linspace(-20.0, 60.0, 30_000)
@@ -56,6 +67,8 @@ def test_steps_are_only_testable_with_two_folds_on_each_side() -> None:
     ("bias_step", {"time_s": 50.0, "size": 2.0}),
     ("periodic", {"period_s": 40.0, "amplitude": 1.5, "phase_rad": 0.3}),
     ("transient", {"time_s": 30.0, "tau_s": 20.0, "amplitude": -1.0}),
+    ("gated_periodic", {"period_s": 30.0, "start_s": 40.0, "end_s": 150.0, "sin1": 1.0, "cos1": -0.5,
+                        "sin2": 0.2, "cos2": 0.1}),
     ("temperature_bump", {"centre_c": 30.0, "width_c": 2.0, "amplitude": 0.7}),
     ("second_node", {"tau_s": 60.0, "coef_per_c": 0.2}),
 ])
@@ -79,6 +92,7 @@ def test_each_term_is_simulated_as_the_diagnosis_models_it(term: str, params: di
     back = kind.params(value, coef)
     for name, v in params.items():
         assert back[name] == pytest.approx(v, rel=1e-6, abs=1e-9)
+    assert set(back) <= {f.name for f in dataclasses.fields(type(make_effect(term)))}  # model.yaml reads it back
 
 
 def _hidden_step(seed: int) -> tuple[object, float, float]:

@@ -12,6 +12,8 @@ empty), so a 24 h record at 100 Hz costs what a 1 Hz one does.
 - **spectral lines** (:func:`line_periods`): Lomb-Scargle periodogram of the binned residual
   (gapped and burst records included) on at most :data:`LINE_BINS` bins, the highest peaks
   with periods between three bins and two thirds of the span.
+  :func:`line_window` locates where a line is present (a cycle in part of the run) by complex
+  demodulation.
 - **temperature bumps** (:func:`bump_centres`): a matched filter of Gaussian bumps of several
   widths against the residual averaged in 0.1 degC bins of the model temperature, each bump
   taken orthogonal to the quadratic in temperature the model already holds.
@@ -98,6 +100,24 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list
     peaks, _ = find_peaks(power, distance=4)
     best = peaks[np.argsort(-power[peaks])][:n_lines]
     return [float(1.0 / freq[i]) for i in best]
+
+
+def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float) -> tuple[float, float]:
+    """``(start_s, end_s)`` where a line of ``period_s`` is present in ``r``: the contiguous span
+    around its strongest part where the complex-demodulated amplitude, averaged over two
+    periods, stays above half its peak."""
+    centre, mean, count, width = binned(t_s, r, LINE_BINS)
+    z = mean * count * np.exp(-2j * np.pi * centre / period_s)
+    m = max(int(round(2.0 * period_s / width)), 1)
+    kernel = np.ones(m)
+    envelope = np.abs(np.convolve(z, kernel, "same")) / np.maximum(np.convolve(count, kernel, "same"), 1.0)
+    peak = int(np.argmax(envelope))
+    above = envelope >= 0.5 * envelope[peak]
+    lo = peak - int(np.argmin(above[peak::-1])) if not above[: peak + 1].all() else 0
+    hi = peak + int(np.argmin(above[peak:])) if not above[peak:].all() else centre.size
+    start = float(t_s[0]) if lo == 0 else float(centre[lo] + 0.5 * width)
+    end = float(t_s[-1]) + 1.0 if hi >= centre.size else float(centre[hi] - 0.5 * width)
+    return start, end
 
 
 def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> list[tuple[float, float]]:

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.detectors import bump_centres, line_periods, step_times
+from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
 
@@ -48,10 +48,12 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
     span = float(d.t_s[-1] - d.t_s[0])
     lo, hi = _testable(d.t_s, scorer.fold)
     steps = [t for t in step_times(d.t_s, r) if lo < t < hi]
+    lines = line_periods(d.t_s, r)
     out: dict[str, list[tuple[float, ...]]] = {
         "bias_step": [(t,) for t in steps],
         "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
-        "periodic": [(p,) for p in line_periods(d.t_s, r)],
+        "periodic": [(p,) for p in lines],
+        "gated_periodic": [(p, *w) for p in lines if (w := line_window(d.t_s, r, p))[1] - w[0] < 0.8 * span],
         "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
     }
     if scorer.designer.why_not_identifiable("thermal_lag") is None:
@@ -85,8 +87,9 @@ class _Screen:
 def _refine(screen: _Screen, term: str, value: tuple[float, ...]) -> tuple[float, ...]:
     """``value`` with the term's continuous parameter (period, time constant) moved to the
     largest in-sample drop nearby."""
-    if term == "periodic":
-        lo, hi, make = np.log(value[0] * 0.9), np.log(value[0] * 1.1), lambda z: (float(np.exp(z)),)
+    if term in ("periodic", "gated_periodic"):
+        lo, hi = np.log(value[0] * 0.9), np.log(value[0] * 1.1)
+        make = lambda z: (float(np.exp(z)), *value[1:])  # noqa: E731
     elif term in ("transient", "second_node"):
         k = len(value) - 1
         lo, hi = np.log(value[k] / 1.6), np.log(value[k] * 1.6)

@@ -247,6 +247,29 @@ class Periodic(Effect):
 
 
 @dataclass(frozen=True)
+class GatedPeriodic(Effect):
+    """A cycle of ``period_s`` present only in ``[start_s, end_s)``: fundamental
+    ``sin1 sin(wt) + cos1 cos(wt)`` plus the second harmonic ``sin2, cos2`` (a compressor or
+    heater that cycles in part of the run); ``amplitude`` (the fundamental's) is informative."""
+
+    id: ClassVar[str] = "gated_periodic"
+    period_s: float = 1800.0
+    start_s: float = 0.0
+    end_s: float = 0.0
+    sin1: float = 0.0
+    cos1: float = 0.0
+    sin2: float = 0.0
+    cos2: float = 0.0
+    amplitude: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        phase = 2.0 * np.pi * s.t_s / self.period_s
+        wave = (self.sin1 * np.sin(phase) + self.cos1 * np.cos(phase)
+                + self.sin2 * np.sin(2.0 * phase) + self.cos2 * np.cos(2.0 * phase))
+        return np.where((s.t_s >= self.start_s) & (s.t_s < self.end_s), wave, 0.0)
+
+
+@dataclass(frozen=True)
 class Transient(Effect):
     """A jump of ``amplitude`` at ``time_s`` decaying with ``tau_s`` (settling after a handling event)."""
 
@@ -374,7 +397,7 @@ EFFECTS: dict[str, type[Effect]] = {
     for cls in (
         ThermalLag, TemperatureRate, Hysteresis, Warmup, AgingDrift, TemperatureCubic,
         AccelNonlinearity, BiasInstability, WhiteNoise, RandomWalk, Quantisation,
-        BiasStep, Periodic, Transient, TemperatureBump, SecondNode,
+        BiasStep, Periodic, GatedPeriodic, Transient, TemperatureBump, SecondNode,
         Saturation, ThermometerQuantisation, NoiseTemperature, NoiseTime,
     )
 }
