@@ -30,6 +30,7 @@ from tcbench.diagnose.evidence import Evidence, not_significant
 OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world term must exceed
 TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
 NODE_TAU_S = np.geomspace(600.0, 4.0 * 3600.0, 9)
+GATED_MIN_CYCLES = 4.0  # a line present in part of the run must hold this many cycles there: flicker makes one or two
 
 
 def _testable(t_s: np.ndarray, fold: np.ndarray) -> tuple[float, float]:
@@ -53,7 +54,8 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
         "bias_step": [(t,) for t in steps],
         "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
         "periodic": [(p,) for p in lines],
-        "gated_periodic": [(p, *w) for p in lines if (w := line_window(d.t_s, r, p))[1] - w[0] < 0.8 * span],
+        "gated_periodic": [(p, *w) for p in lines
+                           if GATED_MIN_CYCLES * p <= (w := line_window(d.t_s, r, p))[1] - w[0] < 0.8 * span],
         "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
     }
     if scorer.designer.why_not_identifiable("thermal_lag") is None:
