@@ -30,7 +30,7 @@ recording cannot tell them apart, and the report says which test would.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
