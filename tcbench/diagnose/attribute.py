@@ -184,12 +184,13 @@ def attribute(
     max_effects: int = 6,
     seed: int = SURROGATE_SEED,
     open_world: bool = True,
+    open_threshold: float = OPEN_THRESHOLD,
 ) -> Attribution:
     """Forward selection of the library's deterministic effects onto ``base`` (see module doc);
     ``plan`` the blocks, clusters and test (default: sized to the recording by
     :func:`~tcbench.diagnose.plan.plan_for`), ``seed`` that of the surrogate test's generator;
     with ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the
-    library's effects in every round."""
+    library's effects in every round, kept above ``open_threshold``."""
     base = base or Model()
     data = designer.data
     plan = plan or plan_for(data)
@@ -210,7 +211,7 @@ def attribute(
         if not open_effects and not open_world:
             break
         tried = {e: scorer.best(model, e) for e in open_effects}
-        beyond = best_open(scorer, model, evidence, plan.test, wald_threshold) if open_world else None
+        beyond = best_open(scorer, model, evidence, plan.test, wald_threshold, open_threshold) if open_world else None
         for e, (g, v) in tried.items():
             if g <= threshold:
                 evidence[e] = Evidence(e, "rejected", g, threshold, v, "held-out gain below the threshold",
@@ -238,7 +239,7 @@ def attribute(
         value = _value(model, effect)
         searched = [value] if effect in TERMS else None
         ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
-                             if cost > (OPEN_THRESHOLD if effect in TERMS else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
+                             if cost > (open_threshold if effect in TERMS else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
         if not ok:
             model = reduced
             evidence[effect].status = "rejected"

@@ -20,6 +20,7 @@ from tcbench.diagnose.attribute import (
     recheck_with_flicker,
 )
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
+from tcbench.diagnose.discover import OPEN_THRESHOLD
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.open_terms import TERMS, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
@@ -237,11 +238,12 @@ def diagnose(
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s))  # output lattice; clipping
     base = base_model(declared)
-    outliers = _outliers(data, base, nonmean.relative_sigma(data))  # judged at the local noise level
+    relative_sigma = nonmean.relative_sigma(data)
+    outliers = _outliers(data, base, relative_sigma)  # judged at the local noise level
     data = without(data, outliers.index)  # zero weight in every fit, score and test below
     designer = Designer(data)
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", data.n, data.white_sigma, data.unit)
-    att = attribute(designer, base, threshold=threshold)
+    att = attribute(designer, base, threshold=threshold, open_threshold=_open_threshold(relative_sigma))
     n = data.n
     before, after = att.base_fit.heldout_residual, att.final_fit.heldout_residual
     thermo_before = propagated_noise(designer, att.base, att.base_fit.beta)
@@ -317,6 +319,15 @@ def diagnose(
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
         outliers=outliers,
     )
+
+
+def _open_threshold(relative_sigma: np.ndarray | None) -> float:
+    """The open-world terms' gain threshold: gains are in units of the record's RMS noise
+    variance, so where the noise level changes a search that lands in the noisiest part finds
+    chance gains larger by its variance ratio (up to 4x)."""
+    if relative_sigma is None:
+        return OPEN_THRESHOLD
+    return OPEN_THRESHOLD * float(np.clip(np.max(relative_sigma) ** 2, 1.0, 4.0))
 
 
 def _outliers(data: DiagnosisData, base: Model, relative_sigma: np.ndarray | None = None) -> Outliers:
