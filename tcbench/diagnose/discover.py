@@ -26,6 +26,7 @@ from scipy.optimize import minimize_scalar
 from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
+from tcbench.diagnose.open_terms import term_columns
 
 OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world term must exceed
 TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
@@ -76,7 +77,8 @@ class _Screen:
         self.r = scorer.fit(model).residual
 
     def drop(self, term: str, value: tuple[float, ...]) -> float:
-        c = self.scorer.designer.columns(term, value, self.model.lag_tau_s)
+        designer = self.scorer.designer  # not through its cache: a search visits many values once
+        c = term_columns(designer.data, term, value, designer.temperature(self.model.lag_tau_s))
         c = c - self.q @ (self.q.T @ c)
         norm = np.sqrt(np.sum(c * c, axis=0))
         if not np.all(norm > 1e-9 * np.sqrt(c.shape[0])):
