@@ -68,7 +68,9 @@ def test_steps_are_only_testable_with_two_folds_on_each_side() -> None:
     ("periodic", {"period_s": 40.0, "amplitude": 1.5, "phase_rad": 0.3}),
     ("transient", {"time_s": 30.0, "tau_s": 20.0, "amplitude": -1.0}),
     ("gated_periodic", {"period_s": 30.0, "start_s": 40.0, "end_s": 150.0, "sin1": 1.0, "cos1": -0.5,
-                        "sin2": 0.2, "cos2": 0.1}),
+                        "sin2": 0.2, "cos2": 0.1, "sin3": -0.1, "cos3": 0.05, "sin5": 0.02, "offset": 0.4}),
+    ("duty_cycle", {"period_s": 30.0, "on_s": 7.0, "duty": 0.4, "start_s": 40.0, "end_s": 150.0,
+                    "offset": -0.3, "size": 0.8}),
     ("temperature_bump", {"centre_c": 30.0, "width_c": 2.0, "amplitude": 0.7}),
     ("second_node", {"tau_s": 60.0, "coef_per_c": 0.2}),
 ])
@@ -124,3 +126,15 @@ def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_p
     spec = parse_model(d.model, "model.yaml")
     step = next(e for e in to_sensor_model(spec).effects if e.id == "bias_step")
     assert step.time_s == pytest.approx(steps[0]["where"]["time_s"])
+
+
+def test_duty_phase_reads_a_switched_load_hand_worked() -> None:
+    """A load on for 30 % of every 600 s from phase 120 s, inside [2000, 8000) s, in unit noise."""
+    from tcbench.diagnose.detectors import duty_phase
+
+    t = np.arange(10_000.0)
+    on = (np.mod(t - 120.0, 600.0) < 180.0) & (t >= 2000.0) & (t < 8000.0)
+    r = 0.8 * on + np.random.default_rng(3).standard_normal(t.size)
+    on_s, duty = duty_phase(t, r, 600.0, 2000.0, 8000.0)
+    assert abs(on_s - 120.0) <= 600.0 / 64 + 1e-9
+    assert abs(duty - 0.3) <= 2.0 / 64

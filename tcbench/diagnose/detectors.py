@@ -26,6 +26,7 @@ import ruptures
 from scipy.signal import find_peaks, lombscargle
 
 MAX_BINS = 3000
+DUTY_PHASES = 64  # phase bins a switched load's cycle is folded into
 LINE_BINS = 1200  # the periodogram's bins: periods down to 3 bins (90 s on a 10 h record)
 MIN_BIN_S = 10.0
 N_CHANGES = 3
@@ -118,6 +119,29 @@ def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float) -> tuple[float,
     start = float(t_s[0]) if lo == 0 else float(centre[lo] + 0.5 * width)
     end = float(t_s[-1]) + 1.0 if hi >= centre.size else float(centre[hi] - 0.5 * width)
     return start, end
+
+
+def duty_phase(t_s: np.ndarray, r: np.ndarray, period_s: float, start_s: float, end_s: float,
+               n_phases: int = DUTY_PHASES) -> tuple[float, float]:
+    """``(on_s, duty)`` of a load switched on for a share ``duty`` of every ``period_s`` inside
+    ``[start_s, end_s)``: ``r`` folded on the period into ``n_phases`` phase bins, and the
+    contiguous arc of bins (wrapping) whose mean differs most from the rest's, by the
+    between-group sum of squares; ``on_s`` is the arc's first instant (mod the period)."""
+    inside = (t_s >= start_s) & (t_s < end_s)
+    k = (np.mod(t_s[inside], period_s) / period_s * n_phases).astype(np.int64) % n_phases
+    count = np.bincount(k, minlength=n_phases).astype(float)
+    total = np.bincount(k, weights=r[inside], minlength=n_phases)
+    n_all, s_all = count.sum(), total.sum()
+    # every arc [i, i + length) on the circle, by cumulative sums of the doubled sequence
+    cc, cs = np.concatenate([[0.0], np.cumsum(np.tile(count, 2))]), np.concatenate([[0.0], np.cumsum(np.tile(total, 2))])
+    i, length = np.meshgrid(np.arange(n_phases), np.arange(1, n_phases), indexing="ij")
+    n_on, s_on = cc[i + length] - cc[i], cs[i + length] - cs[i]
+    n_off = n_all - n_on
+    ok = (n_on > 0) & (n_off > 0)
+    between = np.where(ok, (s_on / np.where(ok, n_on, 1.0) - (s_all - s_on) / np.where(ok, n_off, 1.0)) ** 2
+                       * n_on * n_off / n_all, -np.inf)
+    best = np.unravel_index(int(np.argmax(between)), between.shape)
+    return float(best[0] * period_s / n_phases), float((best[1] + 1) / n_phases)
 
 
 def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> list[tuple[float, float]]:

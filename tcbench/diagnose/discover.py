@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
+from tcbench.diagnose.detectors import DUTY_PHASES, bump_centres, duty_phase, line_periods, line_window, step_times
 from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
 from tcbench.diagnose.open_terms import term_columns
@@ -32,7 +32,7 @@ OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world t
 TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
 NODE_TAU_S = np.geomspace(600.0, 4.0 * 3600.0, 9)
 GATED_MIN_CYCLES = 4.0  # a line present in part of the run must hold this many cycles there: flicker makes one or two
-
+DUTY_MIN_CYCLES = 3.0  # a switched load's square cycle is a sharper shape than a line's: flicker does not mimic three
 
 def _testable(t_s: np.ndarray, fold: np.ndarray) -> tuple[float, float]:
     """The times between which a step has samples of at least two folds on each side, so every
@@ -51,12 +51,15 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
     lo, hi = _testable(d.t_s, scorer.fold)
     steps = [t for t in step_times(d.t_s, r) if lo < t < hi]
     lines = line_periods(d.t_s, r)
+    windows = [(p, *line_window(d.t_s, r, p)) for p in lines]
+    gated = [(p, a, b) for p, a, b in windows if GATED_MIN_CYCLES * p <= b - a < 0.8 * span]
+    switched = [(p, a, b) for p, a, b in windows if DUTY_MIN_CYCLES * p <= b - a < 0.8 * span]
     out: dict[str, list[tuple[float, ...]]] = {
         "bias_step": [(t,) for t in steps],
         "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
         "periodic": [(p,) for p in lines],
-        "gated_periodic": [(p, *w) for p in lines
-                           if GATED_MIN_CYCLES * p <= (w := line_window(d.t_s, r, p))[1] - w[0] < 0.8 * span],
+        "gated_periodic": gated,
+        "duty_cycle": [(p, *duty_phase(d.t_s, r, p, a, b), a, b) for p, a, b in switched],
         "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
     }
     if scorer.designer.why_not_identifiable("thermal_lag") is None:
@@ -88,21 +91,70 @@ class _Screen:
         return float(proj @ proj)
 
 
+def _refine_window(screen: _Screen, term: str, value: tuple[float, ...]) -> tuple[float, ...]:
+    """A gated line's value with each edge of its span (the last two entries) moved, on a grid
+    of a 16th of the period within 1.5 periods, to the largest in-sample drop: the demodulated
+    envelope places the edges only to about a period, and a switched load's level inside the
+    span makes a misplaced edge costly. The span keeps :data:`GATED_MIN_CYCLES` cycles
+    (:data:`DUTY_MIN_CYCLES` for a switched load)."""
+    period = value[0]
+    offsets = period * np.arange(-24, 25) / 16.0
+    for edge in (len(value) - 2, len(value) - 1):
+        moved = [(*value[:edge], float(value[edge] + off), *value[edge + 1:]) for off in offsets]
+        moved = [v for v in moved if v[-1] - v[-2] >= (DUTY_MIN_CYCLES if term == "duty_cycle" else GATED_MIN_CYCLES) * period]
+        if moved:
+            value = max(moved, key=lambda v: screen.drop(term, v))
+    return value
+
+
+def _refold(screen: _Screen, value: tuple[float, ...]) -> tuple[float, ...]:
+    """A switched load's ``(period_s, on_s, duty, start_s, end_s)`` with its phase and duty
+    read again from the residual folded on its period and span."""
+    period, _, _, start, end = value
+    d = screen.scorer.designer.data
+    return (period, *duty_phase(d.t_s, screen.r, period, start, end), start, end)
+
+
 def _refine(screen: _Screen, term: str, value: tuple[float, ...]) -> tuple[float, ...]:
-    """``value`` with the term's continuous parameter (period, time constant) moved to the
-    largest in-sample drop nearby."""
-    if term in ("periodic", "gated_periodic"):
+    """``value`` with the term's continuous parameter (period, time constant; a gated line's
+    edges, a switched load's phase and duty too) moved to the largest in-sample drop nearby."""
+    if term in ("periodic", "gated_periodic", "duty_cycle"):
         lo, hi = np.log(value[0] * 0.9), np.log(value[0] * 1.1)
-        make = lambda z: (float(np.exp(z)), *value[1:])  # noqa: E731
+        fold = _refold if term == "duty_cycle" else (lambda _, v: v)
+        make = lambda z: fold(screen, (float(np.exp(z)), *value[1:]))  # noqa: E731
     elif term in ("transient", "second_node"):
         k = len(value) - 1
         lo, hi = np.log(value[k] / 1.6), np.log(value[k] * 1.6)
         make = lambda z: (*value[:k], float(np.exp(z)))  # noqa: E731
     else:
         return value
+    if term == "duty_cycle":  # a square cycle's drop has side maxima in the period: bracket first
+        grid = np.linspace(lo, hi, 41)
+        i = int(np.argmax([screen.drop(term, make(z)) for z in grid]))
+        lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    # a line holding many cycles needs its period to a fraction of a cycle over the span
     res = minimize_scalar(lambda z: -screen.drop(term, make(z)), bounds=(lo, hi), method="bounded",
-                          options={"xatol": 0.005})
-    return make(res.x) if -res.fun > screen.drop(term, value) else value
+                          options={"xatol": 5e-4})
+    value = make(res.x) if -res.fun > screen.drop(term, value) else value
+    if term == "gated_periodic":
+        return _refine_window(screen, term, value)
+    if term == "duty_cycle":
+        return _refine_edges(screen, _refold(screen, _refine_window(screen, term, value)))
+    return value
+
+
+def _refine_edges(screen: _Screen, value: tuple[float, ...]) -> tuple[float, ...]:
+    """A switched load's on and off instants moved within one phase bin of the fold, to the
+    largest in-sample drop: a switching edge misplaced by a few samples leaves a spike at every
+    cycle, which the Allan test would take for flicker."""
+    period, on_s, duty, start, end = value
+    step = period / DUTY_PHASES
+    grid = np.linspace(-step, step, 17)
+    on_s = max((on_s + g for g in grid), key=lambda x: screen.drop("duty_cycle", (period, x, duty, start, end)))
+    off = on_s + duty * period
+    off = max((off + g for g in grid if 0.0 < off + g - on_s < period),
+              key=lambda x: screen.drop("duty_cycle", (period, on_s, (x - on_s) / period, start, end)))
+    return period, float(on_s), float((off - on_s) / period), start, end
 
 
 def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: str, wald_threshold: float,

@@ -10,8 +10,11 @@ id                    column(s)                               value             
 ====================  ======================================  ===================  =====================
 ``bias_step``         ``1[t >= time_s]``                      ``(time_s,)``        step
 ``periodic``          ``sin, cos(2 pi t / period_s)``         ``(period_s,)``      periodic
-``gated_periodic``    the same and its 2nd harmonic, inside   ``(period_s,         periodic
-                      ``[start_s, end_s)`` only               start_s, end_s)``
+``gated_periodic``    a level, the same and its harmonics     ``(period_s,         periodic
+                      to the 5th, inside ``[start_s, end_s)`` start_s, end_s)``
+``duty_cycle``        a level and ``1[(t - on_s) mod period   ``(period_s, on_s,   periodic
+                      < duty period]``, inside the span       duty, start_s,
+                                                              end_s)``
 ``transient``         ``1[t >= t0] exp(-(t - t0) / tau_s)``   ``(t0, tau_s)``      transient
 ``temperature_bump``  ``exp(-((T - c) / w)^2 / 2)``           ``(c, w)``           temperature_function
 ``second_node``       ``lag(T, tau_s) - T``                   ``(tau_s,)``         temperature_dynamics
@@ -33,7 +36,7 @@ from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.signals import DiagnosisData, lagged
 
 Value = tuple[float, ...]
-GATED_HARMONICS = 2  # a switched load (a compressor's duty cycle) is not a sinusoid
+GATED_HARMONICS = 5  # a switched load (a compressor's duty cycle) is not a sinusoid: its level and harmonics
 
 
 @dataclass(frozen=True)
@@ -83,15 +86,22 @@ def _node_columns(d: DiagnosisData, v: Value, temp_c: np.ndarray) -> np.ndarray:
 def _gated_columns(d: DiagnosisData, v: Value, temp_c: np.ndarray) -> np.ndarray:
     inside = ((d.t_s >= v[1]) & (d.t_s < v[2])).astype(float)
     phase = 2.0 * np.pi * d.t_s / v[0]
-    return np.column_stack([inside * f(k * phase) for k in range(1, GATED_HARMONICS + 1) for f in (np.sin, np.cos)])
+    waves = [inside * f(k * phase) for k in range(1, GATED_HARMONICS + 1) for f in (np.sin, np.cos)]
+    return np.column_stack([inside, *waves])
 
 
 def _gated_params(v: Value, c: np.ndarray) -> dict[str, float]:
-    out = {"period_s": v[0], "start_s": v[1], "end_s": v[2]}
+    out = {"period_s": v[0], "start_s": v[1], "end_s": v[2], "offset": float(c[0])}
     for k in range(GATED_HARMONICS):
-        out[f"sin{k + 1}"], out[f"cos{k + 1}"] = float(c[2 * k]), float(c[2 * k + 1])
-    out["amplitude"] = float(np.hypot(c[0], c[1]))
+        out[f"sin{k + 1}"], out[f"cos{k + 1}"] = float(c[1 + 2 * k]), float(c[2 + 2 * k])
+    out["amplitude"] = float(np.hypot(c[1], c[2]))
     return out
+
+
+def _duty_columns(d: DiagnosisData, v: Value, temp_c: np.ndarray) -> np.ndarray:
+    period, on_s, duty, start, end = v
+    inside = ((d.t_s >= start) & (d.t_s < end)).astype(float)
+    return np.column_stack([inside, inside * (np.mod(d.t_s - on_s, period) < duty * period)])
 
 
 def _periodic_params(v: Value, c: np.ndarray) -> dict[str, float]:
@@ -119,16 +129,29 @@ TERMS: dict[str, TermKind] = {k.id: k for k in (
             "by the sampling."),
         "the chamber's own log of compressor and heater cycles; a run with the chamber idle at constant temperature"),
     TermKind(
-        "gated_periodic", "periodic", ("period_s", "start_s", "end_s"), 2 * GATED_HARMONICS, _gated_columns,
+        "gated_periodic", "periodic", ("period_s", "start_s", "end_s"), 1 + 2 * GATED_HARMONICS, _gated_columns,
         _gated_params,
         lambda p: {"period_s": p["period_s"], "frequency_hz": 1.0 / p["period_s"], "time_s": [p["start_s"], p["end_s"]]},
         lambda p, unit: (
             f"A line in the residual's spectrum, a cycle of {_g(p['period_s'] / 60)} min ({_g(p['amplitude'])} {unit} "
-            f"at the fundamental, with a second harmonic), present only from t = {_g(p['start_s'] / 3600)} h to "
+            f"at the fundamental, with harmonics and a mean offset of {_g(p['offset'])} {unit}), present only from t = {_g(p['start_s'] / 3600)} h to "
             f"{_g(p['end_s'] / 3600)} h. Something that cycles only in part of the run does this: a chamber "
             "compressor that runs below room temperature, a heater's duty cycle, a fan switched with the set-point."),
         "the chamber's log of compressor and heater cycles over the run; a soak at the same temperature with the "
         "chamber's cooling switched off"),
+    TermKind(
+        "duty_cycle", "periodic", ("period_s", "on_s", "duty", "start_s", "end_s"), 2, _duty_columns,
+        lambda v, c: {"period_s": v[0], "on_s": v[1], "duty": v[2], "start_s": v[3], "end_s": v[4],
+                      "offset": float(c[0]), "size": float(c[1])},
+        lambda p: {"period_s": p["period_s"], "frequency_hz": 1.0 / p["period_s"], "time_s": [p["start_s"], p["end_s"]]},
+        lambda p, unit: (
+            f"A load switched on and off: every {_g(p['period_s'] / 60)} min the bias jumps by {_g(p['size'])} {unit} "
+            f"for {_g(100 * p['duty'])} % of the cycle, from t = {_g(p['start_s'] / 3600)} h to "
+            f"{_g(p['end_s'] / 3600)} h only (a mean offset of {_g(p['offset'])} {unit} there). A chamber compressor "
+            "or heater on a thermostat loading the supply or shaking the mount does this, as does a pump or fan on "
+            "a timer."),
+        "the chamber's log of compressor and heater cycles over the run; the supply voltage logged beside the "
+        "output; a soak at the same temperature with the chamber's cooling switched off"),
     TermKind(
         "transient", "transient", ("time_s", "tau_s"), 1, _transient_columns,
         lambda v, c: {"time_s": v[0], "tau_s": v[1], "amplitude": float(c[0])},

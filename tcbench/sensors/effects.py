@@ -248,9 +248,10 @@ class Periodic(Effect):
 
 @dataclass(frozen=True)
 class GatedPeriodic(Effect):
-    """A cycle of ``period_s`` present only in ``[start_s, end_s)``: fundamental
-    ``sin1 sin(wt) + cos1 cos(wt)`` plus the second harmonic ``sin2, cos2`` (a compressor or
-    heater that cycles in part of the run); ``amplitude`` (the fundamental's) is informative."""
+    """A cycle of ``period_s`` present only in ``[start_s, end_s)``: a mean ``offset``, the
+    fundamental ``sin1 sin(wt) + cos1 cos(wt)`` and the harmonics ``sin2, cos2, sin3, cos3`` (a
+    compressor or heater switched on and off in part of the run loads the supply with a duty
+    cycle, not a sinusoid); ``amplitude`` (the fundamental's) is informative."""
 
     id: ClassVar[str] = "gated_periodic"
     period_s: float = 1800.0
@@ -260,13 +261,40 @@ class GatedPeriodic(Effect):
     cos1: float = 0.0
     sin2: float = 0.0
     cos2: float = 0.0
+    sin3: float = 0.0
+    cos3: float = 0.0
+    sin4: float = 0.0
+    cos4: float = 0.0
+    sin5: float = 0.0
+    cos5: float = 0.0
+    offset: float = 0.0
     amplitude: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
         phase = 2.0 * np.pi * s.t_s / self.period_s
-        wave = (self.sin1 * np.sin(phase) + self.cos1 * np.cos(phase)
-                + self.sin2 * np.sin(2.0 * phase) + self.cos2 * np.cos(2.0 * phase))
+        wave = self.offset + sum(getattr(self, f"sin{k}") * np.sin(k * phase) + getattr(self, f"cos{k}") * np.cos(k * phase)
+                                 for k in range(1, 6))
         return np.where((s.t_s >= self.start_s) & (s.t_s < self.end_s), wave, 0.0)
+
+
+@dataclass(frozen=True)
+class DutyCycle(Effect):
+    """A load switched on for a share ``duty`` of every ``period_s`` (from ``on_s``), inside
+    ``[start_s, end_s)`` only: the bias moves by ``offset`` in the span and by ``size`` more
+    while the load is on (a compressor or heater on a thermostat)."""
+
+    id: ClassVar[str] = "duty_cycle"
+    period_s: float = 1800.0
+    on_s: float = 0.0
+    duty: float = 0.5
+    start_s: float = 0.0
+    end_s: float = 0.0
+    offset: float = 0.0
+    size: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        on = np.mod(s.t_s - self.on_s, self.period_s) < self.duty * self.period_s
+        return np.where((s.t_s >= self.start_s) & (s.t_s < self.end_s), self.offset + self.size * on, 0.0)
 
 
 @dataclass(frozen=True)
@@ -397,7 +425,7 @@ EFFECTS: dict[str, type[Effect]] = {
     for cls in (
         ThermalLag, TemperatureRate, Hysteresis, Warmup, AgingDrift, TemperatureCubic,
         AccelNonlinearity, BiasInstability, WhiteNoise, RandomWalk, Quantisation,
-        BiasStep, Periodic, GatedPeriodic, Transient, TemperatureBump, SecondNode,
+        BiasStep, Periodic, GatedPeriodic, DutyCycle, Transient, TemperatureBump, SecondNode,
         Saturation, ThermometerQuantisation, NoiseTemperature, NoiseTime,
     )
 }
