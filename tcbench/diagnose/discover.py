@@ -67,8 +67,8 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
         "bias_step": [(t,) for t in steps],
         "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
         "periodic": [(p,) for p in lines],
-        "gated_periodic": [(p, *w) for p in lines
-                           if GATED_MIN_CYCLES * p <= (w := line_window(d.t_s, r, p))[1] - w[0] < GATED_MAX_PART * span],
+        "gated_periodic": [(p, *w) for p in lines if GATED_MIN_CYCLES * p
+                           <= (w := line_window(d.t_s, r, p))[1] - w[0] < GATED_MAX_PART * span],
         "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
     }
     if scorer.designer.why_not_identifiable("thermal_lag") is None:

@@ -273,8 +273,10 @@ def why_no_allan(t: np.ndarray) -> str | None:
     """Why :func:`allan_excess` cannot test a residual sampled at ``t``, or None."""
     n = t.size
     m_max = min(n // 10, (n - 1) // 2)
-    if segments(t)[-1] > 0:
-        return "the Allan deviation needs one record without gaps; this record is made of bursts"
+    gaps = int(segments(t)[-1]) if n else 0
+    if gaps:
+        return (f"the Allan deviation needs a record without gaps; this one has {gaps} gap(s) of more than "
+                "five sample intervals (bursts, or samples given zero weight)")
     if m_max < MIN_ALLAN_M:
         return (f"the Allan deviation needs clusters of {MIN_ALLAN_M} samples at a tenth of the record "
                 f"({10 * MIN_ALLAN_M} samples); this record has {n}")
