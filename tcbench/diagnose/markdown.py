@@ -271,7 +271,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
                     "residual, so bias instability is not judged." if ref["deterministic_structure_remains"] else ".")),
                 ""]
     st = d.statistics
-    if st:
+    if "significance_test" in st:  # not_tested alone does not describe the plan
         test = st["significance_test"]
         why = (f"the recording holds {st['clusters']} clusters of {_g(st['cluster_s'])} s, too few for the "
                "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
