@@ -28,7 +28,13 @@ def test_same_seeds_give_a_byte_identical_recording(tmp_path: Path, sensor: str,
     assert other.read_bytes() != paths[0].read_bytes()
 
 
-@pytest.mark.parametrize("name", sorted(registry.available()))
+# ngopt's determinism (~20 s here) is in the default suite twice already: the contract run of
+# test_every_registered_optimiser_passes[ngopt] and test_peers_nevergrad's same-seed test.
+SLOW_DETERMINISM = {"ngopt"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_DETERMINISM else n
+                                  for n in sorted(registry.available())])
 def test_same_seed_gives_an_identical_optimiser_result(name: str) -> None:
     cls = registry.get(name)
     task = {"name": "zdt1" if not cls.single_objective else "rastrigin", "dim": 4}

@@ -26,12 +26,19 @@ def sphere(x: np.ndarray) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["ngopt", "ng_de"])
-def test_registered_through_the_entry_point_and_contract(name: str) -> None:
+def test_registered_through_the_entry_point(name: str) -> None:
     entry = available()[name]
     assert entry.package == "tcbench-peers"
     assert entry.cls.single_objective and not entry.cls.multi_objective
+
+
+# ngopt's contract run (~17 s) is already in the default suite as test_check_optimizer's
+# test_every_registered_optimiser_passes[ngopt], and test_no_helper_thread_outlives_a_call checks
+# its threads: here it runs again only in the slow suite.
+@pytest.mark.parametrize("name", [pytest.param("ngopt", marks=pytest.mark.slow), "ng_de"])
+def test_contract_leaves_no_helper_thread(name: str) -> None:
     start = set(threading.enumerate())
-    assert check_optimizer(entry.cls) >= 2
+    assert check_optimizer(available()[name].cls) >= 2
     assert new_threads(start) == set()
 
 

@@ -35,6 +35,10 @@ N_BUMPS = 3
 GAP_FACTOR = 5.0  # a gap longer than this many median sample spacings may hide a restart
 MAX_GAPS = 12
 BUMP_WIDTHS_C = (1.0, 1.5, 2.5, 4.0, 6.0)
+BUMP_SPANS = 4.0  # a bump of width w is searched where the temperature spans at least this many w
+MIN_STEP_BINS = 8  # binned residual means the change-point search needs
+MIN_LINE_BINS = 16  # binned residual means the periodogram needs
+LINE_CYCLES = 1.5  # the longest period searched fits this many times in the span
 TEMP_BIN_C = 0.1
 
 
@@ -42,14 +46,19 @@ def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = MAX_BINS
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """``(centre_s, mean, count, width_s)`` of ``r`` in time bins of ``width_s`` (at least
     :data:`MIN_BIN_S`, at most ``max_bins`` of them); empty bins left out."""
-    span = float(t_s[-1] - t_s[0])
-    width = max(MIN_BIN_S, span / max_bins, float(np.median(np.diff(t_s))))
+    width = bin_width(t_s, max_bins)
     idx = ((t_s - t_s[0]) / width).astype(np.int64)
     count = np.bincount(idx).astype(float)
     total = np.bincount(idx, weights=r)
     keep = count > 0
     centre = np.bincount(idx, weights=t_s)[keep] / count[keep]
     return centre, total[keep] / count[keep], count[keep], width
+
+
+def bin_width(t_s: np.ndarray, max_bins: int = MAX_BINS) -> float:
+    """The width (s) of :func:`binned`'s time bins."""
+    span = float(t_s[-1] - t_s[0])
+    return max(MIN_BIN_S, span / max_bins, float(np.median(np.diff(t_s))))
 
 
 def _refine_step(t_s: np.ndarray, cum: np.ndarray, around_s: float, half_s: float) -> int:
@@ -71,7 +80,7 @@ def step_times(t_s: np.ndarray, r: np.ndarray, n_changes: int = N_CHANGES) -> li
     centre, mean, _, width = binned(t_s, r)
     out: list[float] = []
     cum = np.concatenate(([0.0], np.cumsum(r)))
-    if mean.size >= 8:
+    if mean.size >= MIN_STEP_BINS:
         n_bkps = min(n_changes, mean.size // 4)
         algo = ruptures.Binseg(model="l2", min_size=2).fit(mean)
         for b in algo.predict(n_bkps=n_bkps)[:-1]:
@@ -89,9 +98,9 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list
     thirds of the span."""
     centre, mean, count, width = binned(t_s, r, LINE_BINS)
     span = float(t_s[-1] - t_s[0])
-    if mean.size < 16:
+    if mean.size < MIN_LINE_BINS:
         return []
-    f_lo, f_hi = 1.5 / span, 1.0 / (3.0 * width)
+    f_lo, f_hi = LINE_CYCLES / span, 1.0 / (3.0 * width)
     if f_hi <= f_lo:
         return []
     df = 0.5 / span  # two frequencies per Fourier bin; the period is refined by the scorer
@@ -157,7 +166,7 @@ def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> l
     core = np.column_stack([np.ones_like(u), u, u * u])
     gram = core.T @ (core * count[:, None])
     found: list[tuple[float, float, float]] = []
-    for w in (w for w in BUMP_WIDTHS_C if 4.0 * w <= span):
+    for w in (w for w in BUMP_WIDTHS_C if BUMP_SPANS * w <= span):
         centres = np.arange(lo + w, hi - w + 1e-9, max(TEMP_BIN_C, w / 8.0))
         if centres.size == 0:
             continue
@@ -170,3 +179,40 @@ def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> l
         found.append((float(score[i]), float(centres[i]), float(w)))
     found.sort(reverse=True)
     return [(c, w) for _, c, w in found[:n_bumps]]
+
+
+def _bins(t_s: np.ndarray, max_bins: int) -> int:
+    """How many non-empty bins :func:`binned` makes of ``t_s``."""
+    width = bin_width(t_s, max_bins)
+    return int(np.unique(((t_s - t_s[0]) / width).astype(np.int64)).size)
+
+
+def why_no_steps(t_s: np.ndarray) -> str | None:
+    """Why :func:`step_times` cannot search change points on a record sampled at ``t_s``, or None."""
+    n = _bins(t_s, MAX_BINS)
+    if n >= MIN_STEP_BINS:
+        return None
+    return (f"change points need at least {MIN_STEP_BINS} bins of {bin_width(t_s):.4g} s of the residual; "
+            f"this record has {n}")
+
+
+def why_no_lines(t_s: np.ndarray) -> str | None:
+    """Why :func:`line_periods` cannot search spectral lines on ``t_s``, or None."""
+    n, width = _bins(t_s, LINE_BINS), bin_width(t_s, LINE_BINS)
+    if n < MIN_LINE_BINS:
+        return (f"spectral lines need at least {MIN_LINE_BINS} bins of {width:.4g} s of the residual; "
+                f"this record has {n}")
+    longest, shortest = float(t_s[-1] - t_s[0]) / LINE_CYCLES, 3.0 * width
+    if longest <= shortest:
+        return (f"a line needs {LINE_CYCLES:g} cycles inside the record and 3 bins per cycle: the longest "
+                f"testable period ({longest:.4g} s) is below the shortest ({shortest:.4g} s)")
+    return None
+
+
+def why_no_bumps(temp_c: np.ndarray) -> str | None:
+    """Why :func:`bump_centres` cannot search temperature bumps on ``temp_c``, or None."""
+    span, w = float(np.ptp(temp_c)), min(BUMP_WIDTHS_C)
+    if BUMP_SPANS * w <= span:
+        return None
+    return (f"a temperature bump of width {w:g} degC needs a temperature span of {BUMP_SPANS * w:g} degC; "
+            f"this record spans {span:.3g} degC")

@@ -20,10 +20,10 @@ from tcbench.diagnose.attribute import (
     recheck_with_flicker,
 )
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
-from tcbench.diagnose.discover import OPEN_THRESHOLD
+from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.open_terms import TERMS, open_finding
-from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate
+from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate, why_no_allan
 from tcbench.diagnose.nonmean import NonMean
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.plan import SURROGATE
@@ -208,14 +208,14 @@ def _flicker(
     return ex, float(excess[ex.first_over:].max() / FLICKER_FLOOR)
 
 
-def _flicker_evidence(allan: AllanExcess | None, b: float | None, declared: bool) -> Evidence:
+def _flicker_evidence(allan: AllanExcess | None, b: float | None, declared: bool, t_s: np.ndarray) -> Evidence:
     """How ``bias_instability`` fared; for a kept one ``gain`` is the Allan ratio at the first
     flagged tau and ``threshold`` its bound."""
     effect = "bias_instability"
     if declared:
         return Evidence(effect, "in the model", reason="declared in the starting model")
     if allan is None:
-        return Evidence(effect, "not identifiable", reason="no Allan deviation: the recording is too short or made of bursts")
+        return Evidence(effect, "not identifiable", reason=why_no_allan(t_s) or "no Allan deviation on this record")
     if b is None or allan.first_over is None:
         return Evidence(effect, "rejected", reason="the residual's Allan deviation follows the white-noise line")
     k = allan.first_over
@@ -278,7 +278,7 @@ def diagnose(
               **_test_json(evidence[e])}
         effects_out.append(open_finding(e, fitted[e], ev, data.unit) if e in TERMS else
                            library_finding(e, fitted[e], ev, Extent.of(data), evidence[e].confusable_with).to_json())
-    evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared)
+    evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared, data.t_s)
     if structure_left and "bias_instability" not in declared:
         evidence["bias_instability"] = Evidence(
             "bias_instability", "not tested", reason=(
@@ -312,13 +312,24 @@ def diagnose(
         noise={"white_sigma": data.white_sigma, "thermometer_sigma_c": thermometer_sigma(designer),
                "samples": n, "folds": att.k},
         reference=_reference_json(reference, final_rmse, data.white_sigma),
-        statistics={**(att.plan.to_json() if att.plan else {}), **nonmean.statistics()},
+        statistics={**(att.plan.to_json() if att.plan else {}), **nonmean.statistics(),
+                    **_not_tested(att, evidence, nonmean)},
         candidates=[evidence[e] for e in (*DETERMINISTIC, *TERMS, "bias_instability") if e in evidence],
         confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),
         outliers=outliers,
     )
+
+
+def _not_tested(att: Attribution, evidence: dict[str, Evidence], nonmean: NonMean) -> dict[str, Any]:
+    """report.json ``statistics.not_tested``: ``{detector: why it could not run on this record}``
+    for the library effects the record cannot show, the open-world detectors it is too short,
+    too coarse or too narrow in temperature for, the Allan test and the non-mean detectors."""
+    why = {e: ev.reason for e, ev in evidence.items() if ev.status in ("not identifiable", "not tested")}
+    why |= {e: r for e, r in why_untestable(att.designer, att.fold).items() if e not in evidence}
+    why |= nonmean.not_tested
+    return {"not_tested": why} if why else {}
 
 
 def _open_threshold(relative_sigma: np.ndarray | None) -> float:

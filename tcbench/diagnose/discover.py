@@ -23,7 +23,19 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.detectors import DUTY_PHASES, bump_centres, duty_phase, line_periods, line_window, step_times
+from tcbench.diagnose.detectors import (
+    DUTY_PHASES,
+    LINE_BINS,
+    bin_width,
+    bump_centres,
+    duty_phase,
+    line_periods,
+    line_window,
+    step_times,
+    why_no_bumps,
+    why_no_lines,
+    why_no_steps,
+)
 from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
 from tcbench.diagnose.open_terms import term_columns
@@ -33,6 +45,9 @@ TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
 NODE_TAU_S = np.geomspace(600.0, 4.0 * 3600.0, 9)
 GATED_MIN_CYCLES = 4.0  # a line present in part of the run must hold this many cycles there: flicker makes one or two
 DUTY_MIN_CYCLES = 3.0  # a switched load's square cycle is a sharper shape than a line's: flicker does not mimic three
+GATED_MAX_PART = 0.8  # ... and be absent from more than this fraction of the span
+NODE_SPANS = 4.0  # a second node's time constant is searched below the span over this
+
 
 def _testable(t_s: np.ndarray, fold: np.ndarray) -> tuple[float, float]:
     """The times between which a step has samples of at least two folds on each side, so every
@@ -52,8 +67,8 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
     steps = [t for t in step_times(d.t_s, r) if lo < t < hi]
     lines = line_periods(d.t_s, r)
     windows = [(p, *line_window(d.t_s, r, p)) for p in lines]
-    gated = [(p, a, b) for p, a, b in windows if GATED_MIN_CYCLES * p <= b - a < 0.8 * span]
-    switched = [(p, a, b) for p, a, b in windows if DUTY_MIN_CYCLES * p <= b - a < 0.8 * span]
+    gated = [(p, a, b) for p, a, b in windows if GATED_MIN_CYCLES * p <= b - a < GATED_MAX_PART * span]
+    switched = [(p, a, b) for p, a, b in windows if DUTY_MIN_CYCLES * p <= b - a < GATED_MAX_PART * span]
     out: dict[str, list[tuple[float, ...]]] = {
         "bias_step": [(t,) for t in steps],
         "transient": [(t, tau) for t in steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (d.t_s[-1] - t)],
@@ -63,8 +78,70 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
         "temperature_bump": [(c, w) for c, w in bump_centres(temp, r)],
     }
     if scorer.designer.why_not_identifiable("thermal_lag") is None:
-        out["second_node"] = [(float(tau),) for tau in NODE_TAU_S if tau < 0.25 * span]
+        out["second_node"] = [(float(tau),) for tau in NODE_TAU_S if tau < span / NODE_SPANS]
     return {k: v for k, v in out.items() if v}
+
+
+def _why_no_transient(t_s: np.ndarray, fold: np.ndarray) -> str | None:
+    """Why no transient can be proposed: its shortest time constant needs twice its length of
+    record after a testable step."""
+    lo, hi = _testable(t_s, fold)
+    after = float(t_s[-1]) - lo
+    need = 2.0 * float(TRANSIENT_TAU_S[0])
+    if after > need and hi > lo:
+        return None
+    return (f"a transient of time constant {TRANSIENT_TAU_S[0]:.0f} s needs {need:.0f} s of record after a "
+            f"testable step; this record has {max(after, 0.0):.0f} s after the earliest one")
+
+
+def _why_no_gated(t_s: np.ndarray, min_cycles: float = GATED_MIN_CYCLES, what: str = "a line") -> str | None:
+    """Why no line present in part of the record (or switched load, ``min_cycles`` apart) can be
+    tested: even the shortest period the periodogram resolves needs its cycles inside less than
+    the whole record."""
+    span = float(t_s[-1] - t_s[0])
+    longest = GATED_MAX_PART * span / min_cycles
+    shortest = 3.0 * bin_width(t_s, LINE_BINS)
+    if longest >= shortest:
+        return None
+    return (f"{what} present in part of the record needs {min_cycles:g} cycles inside "
+            f"{GATED_MAX_PART:.0%} of it: the longest testable period is {longest:.4g} s, below the shortest "
+            f"the periodogram resolves ({shortest:.4g} s)")
+
+
+def _why_no_node(designer: Any) -> str | None:
+    """Why no second thermal node can be proposed: thermal lag not identifiable, or a record
+    shorter than :data:`NODE_SPANS` times the shortest time constant."""
+    why = designer.why_not_identifiable("thermal_lag")
+    if why is not None:
+        return f"a second thermal node needs what thermal lag needs: {why}"
+    d = designer.data
+    span, need = float(d.t_s[-1] - d.t_s[0]), NODE_SPANS * float(NODE_TAU_S[0])
+    if span > need:
+        return None
+    return (f"a second thermal node of time constant {NODE_TAU_S[0]:.0f} s needs a record of more than "
+            f"{need:.0f} s; this record spans {span:.0f} s")
+
+
+def why_untestable(designer: Any, fold: np.ndarray) -> dict[str, str]:
+    """``{open-world term: why its detector cannot run on this record}`` for every term whose
+    detector cannot propose anything whatever the residual (too few bins, too short a span, too
+    narrow a temperature range)."""
+    t = designer.data.t_s
+    lines = why_no_lines(t)
+    steps = why_no_steps(t)
+    lo, hi = _testable(t, fold)
+    if steps is None and not hi > lo:
+        steps = "a step needs samples of two cross-validation folds on each side; this record has no such time"
+    why = {
+        "bias_step": steps,
+        "transient": steps or _why_no_transient(t, fold),
+        "periodic": lines,
+        "gated_periodic": lines or _why_no_gated(t),
+        "duty_cycle": lines or _why_no_gated(t, DUTY_MIN_CYCLES, "a switched load"),
+        "temperature_bump": why_no_bumps(designer.temperature(None)),
+        "second_node": _why_no_node(designer),
+    }
+    return {k: v for k, v in why.items() if v is not None}
 
 
 class _Screen:

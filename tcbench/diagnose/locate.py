@@ -269,6 +269,20 @@ class AllanExcess:
     first_over: int | None
 
 
+def why_no_allan(t: np.ndarray) -> str | None:
+    """Why :func:`allan_excess` cannot test a residual sampled at ``t``, or None."""
+    n = t.size
+    m_max = min(n // 10, (n - 1) // 2)
+    gaps = int(segments(t)[-1]) if n else 0
+    if gaps:
+        return (f"the Allan deviation needs a record without gaps; this one has {gaps} gap(s) of more than "
+                "five sample intervals (bursts, or samples given zero weight)")
+    if m_max < MIN_ALLAN_M:
+        return (f"the Allan deviation needs clusters of {MIN_ALLAN_M} samples at a tenth of the record "
+                f"({10 * MIN_ALLAN_M} samples); this record has {n}")
+    return None
+
+
 def allan_excess(
     t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool,
     coloured: np.ndarray | None = None,
@@ -280,7 +294,7 @@ def allan_excess(
     n = r.size
     fs = (n - 1) / (t[-1] - t[0])
     m_max = min(n // 10, (n - 1) // 2)
-    if m_max < MIN_ALLAN_M or segments(t)[-1] > 0:
+    if why_no_allan(t) is not None:
         return None
     m = MIN_ALLAN_M * 2 ** np.arange(int(np.log2(m_max / MIN_ALLAN_M)) + 1)
     ad = allan_deviation(r, fs, m / fs)

@@ -231,6 +231,14 @@ def findings_table(effects: list[dict[str, Any]], unit: str, t0: float) -> list[
                     format_where(f.get("where", {}), str(f["params"].get("unit", unit)), t0)] for f in effects))
 
 
+def not_tested_section(not_tested: dict[str, str]) -> list[str]:
+    """The "Not tested on this record" list: each detector that could not run, and why."""
+    if not not_tested:
+        return []
+    return ["## Not tested on this record", "",
+            *(f"- **{name}**: {reason}." for name, reason in not_tested.items()), ""]
+
+
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
     the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
@@ -263,7 +271,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
                     "residual, so bias instability is not judged." if ref["deterministic_structure_remains"] else ".")),
                 ""]
     st = d.statistics
-    if st:
+    if "significance_test" in st:  # not_tested alone does not describe the plan
         test = st["significance_test"]
         why = (f"the recording holds {st['clusters']} clusters of {_g(st['cluster_s'])} s, too few for the "
                "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
@@ -323,6 +331,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
                   ([e.effect, e.status, _gain_cell(e), _test_cell(e), _value_cell(e), e.reason]
                    for e in d.candidates))
     out.append("")
+    out += not_tested_section(d.statistics.get("not_tested", {}))
 
     if plots:
         out += ["## Plots", ""]

@@ -203,11 +203,9 @@ class NonMean:
             effects["thermometer_quantisation"] = {"step_c": float(self.thermometer.step_c)}
 
     def statistics(self) -> dict[str, Any]:
-        """report.json ``statistics`` entries: the thermometer window, the variance test, and
-        which detectors were not tested and why."""
+        """report.json ``statistics`` entries: the thermometer window and the variance test
+        (which detectors were not tested and why: :attr:`not_tested`, merged by the diagnosis)."""
         out: dict[str, Any] = {"thermometer_smooth_s": self.smooth_s}
         if self.variance is not None and not self.variance.reason:
             out["variance"] = self.variance.statistics()
-        if self.not_tested:
-            out["not_tested"] = dict(self.not_tested)
         return out
