@@ -97,11 +97,13 @@ def test_each_term_is_simulated_as_the_diagnosis_models_it(term: str, params: di
     assert set(back) <= {f.name for f in dataclasses.fields(type(make_effect(term)))}  # model.yaml reads it back
 
 
-def _hidden_step(seed: int) -> tuple[object, float, float]:
+def _hidden_step(seed: int, at: tuple[float, ...] = (0.55,), sizes: tuple[float, ...] = (1.0,)) -> tuple[object, float, float]:
+    """A concealed gyro control with steps at fractions ``at`` of its span (relative ``sizes``),
+    together 0.8 sigma the minimal model cannot absorb; the first step's time and sigma."""
     rec, truth = concealed_recording("gyro", None, seed)
     t = rec.time_s
-    t0 = 0.55 * float(t[-1])
-    h = (t >= t0).astype(float)
+    t0 = at[0] * float(t[-1])
+    h = sum(size * (t >= f * float(t[-1])) for f, size in zip(at, sizes, strict=True)).astype(float)
     left = float(np.sqrt(np.mean(unexplained(h, minimal_columns(rec.temperature_c, None)) ** 2)))
     h *= 0.8 * truth.white_sigma / left
     out = make_recording(t, rec.temperature_c, rec.input, rec.output + h, sensor="gyro", sample_rate_hz=1.0,
@@ -138,3 +140,39 @@ def test_duty_phase_reads_a_switched_load_hand_worked() -> None:
     on_s, duty = duty_phase(t, r, 600.0, 2000.0, 8000.0)
     assert abs(on_s - 120.0) <= 600.0 / 64 + 1e-9
     assert abs(duty - 0.3) <= 2.0 / 64
+
+
+def test_a_slow_line_at_the_band_edge_is_proposed_and_windowed() -> None:
+    """A line of 1.8 cycles in the record peaks at the periodogram's low edge: it is proposed,
+    and its window (demodulated over two periods, longer than the record) stays inside it."""
+    t = np.arange(0.0, 32_000.0, 1.0)
+    r = 0.6 * np.sin(2.0 * np.pi * t / 17_800.0) + np.random.default_rng(5).standard_normal(t.size)
+    periods = line_periods(t, r)
+    assert any(abs(p - 17_800.0) < 0.3 * 17_800.0 for p in periods)
+    start, end = line_window(t, r, max(periods))
+    assert t[0] <= start < end <= t[-1] + 1.0
+
+
+def test_two_steps_are_two_instances_of_the_term_and_simulate_back(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """A record with a jump at 30 % and a smaller one the same way at 70 % of its span: both are
+    found, as ``bias_step`` and ``bias_step_2``, and model.yaml simulates both. (A jump up and
+    back down is a box, which the greedy selection can take for a slow line or hysteresis.)"""
+    rec, _, sigma = _hidden_step(2, at=(0.3, 0.7), sizes=(1.0, 0.7))
+    d = diagnose(rec, sensor="gyro")
+    report = d.to_json()
+    steps = sorted(e["where"]["time_s"] for e in report["effects"] if e["shape"] == "step")
+    span = float(rec.time_s[-1])
+    assert len(steps) == 2 and abs(steps[0] - 0.3 * span) < 600.0 and abs(steps[1] - 0.7 * span) < 600.0
+    assert {"bias_step", "bias_step_2"} <= {e["id"] for e in report["effects"]}
+    assert d.final["rmse_heldout"] / sigma < 1.05
+    effects = to_sensor_model(parse_model(d.model, "model.yaml")).effects
+    assert sorted(e.time_s for e in effects if e.id == "bias_step") == pytest.approx(steps)
+
+
+def test_a_fourth_instance_or_an_unknown_suffix_is_refused() -> None:
+    from tcbench.sensors.effects import effect_class
+
+    assert effect_class("bias_step_3") is effect_class("bias_step")
+    assert effect_class("bias_step_4") is None and effect_class("hysteresis_2") is None
+    with pytest.raises(ValueError, match="unknown effect 'hysteresis_2'"):
+        make_effect("hysteresis_2")

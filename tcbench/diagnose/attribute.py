@@ -40,7 +40,7 @@ from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
 from tcbench.diagnose.discover import OPEN_THRESHOLD, best_open
 from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_significant
-from tcbench.diagnose.open_terms import TERMS
+from tcbench.diagnose.open_terms import is_open, term_threshold
 from tcbench.diagnose.plan import ROBUST_WALD, SURROGATE, StatsPlan, plan_for
 from tcbench.diagnose.surrogate import LEVEL, surrogate_test
 from tcbench.diagnose.thermometer import thermometer_variance
@@ -237,9 +237,9 @@ def attribute(
         reduced = model.without(effect)
         cost = scorer.gain(reduced, model)
         value = _value(model, effect)
-        searched = [value] if effect in TERMS else None
+        searched = [value] if is_open(effect) else None
         ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
-                             if cost > (open_threshold if effect in TERMS else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
+                             if cost > (term_threshold(effect, open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
         if not ok:
             model = reduced
             evidence[effect].status = "rejected"
@@ -247,7 +247,7 @@ def attribute(
         else:
             ev = evidence[effect]
             ev.gain, ev.wald, ev.p_value, ev.test = cost, wald, p, test
-            ev.value = None if effect in TERMS else value  # an open-world term's values are in its params
+            ev.value = None if is_open(effect) else value  # an open-world term's values are in its params
     confusions = _confusions(scorer, model, base, evidence, threshold)
     return Attribution(base, model, scorer.fit(base), scorer.fit(model), evidence, confusions,
                        designer, fold, k, plan)

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.open_terms import TERMS, term_columns
+from tcbench.diagnose.open_terms import kind_of, term_columns
 from tcbench.diagnose.signals import DiagnosisData, hysteresis_state, lagged
 
 DETERMINISTIC = (
@@ -74,7 +74,7 @@ class Model:
     def n_params(self) -> int:
         """Extra parameters over the minimal model: each term's coefficients and searched values."""
         return (1 if self.lag_tau_s else 0) + sum(
-            TERMS[e].n_params() if e in TERMS else 1 + (v is not None) for e, v in self.terms)
+            kind.n_params() if (kind := kind_of(e)) else 1 + (v is not None) for e, v in self.terms)
 
 
 @dataclass
@@ -141,7 +141,7 @@ class Designer:
     def columns(self, effect: str, value: Any, lag_tau_s: float | None) -> np.ndarray:
         """The column(s) (n, m) of ``effect`` at ``value`` on the model temperature of ``lag_tau_s``."""
         temp = self.temperature(lag_tau_s)
-        if effect not in TERMS:
+        if kind_of(effect) is None:
             return self.column(effect, value, temp, lag_tau_s)[:, None]
         key = (effect, value, lag_tau_s)
         if key not in self._open_cache:

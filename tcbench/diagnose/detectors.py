@@ -108,7 +108,9 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list
     power = lombscargle(centre - centre[0], mean - np.average(mean, weights=count), 2.0 * np.pi * freq,
                         normalize=False)
     peaks, _ = find_peaks(power, distance=4)
-    best = peaks[np.argsort(-power[peaks])][:n_lines]
+    best = list(peaks[np.argsort(-power[peaks])][:n_lines])
+    if power.size > 4 and power[0] > power[1:5].max():  # a slow line (under two cycles) peaks at the low edge
+        best.append(0)
     return [float(1.0 / freq[i]) for i in best]
 
 
@@ -118,7 +120,7 @@ def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float) -> tuple[float,
     periods, stays above half its peak."""
     centre, mean, count, width = binned(t_s, r, LINE_BINS)
     z = mean * count * np.exp(-2j * np.pi * centre / period_s)
-    m = max(int(round(2.0 * period_s / width)), 1)
+    m = min(max(int(round(2.0 * period_s / width)), 1), centre.size)  # 'same' would return the longer
     kernel = np.ones(m)
     envelope = np.abs(np.convolve(z, kernel, "same")) / np.maximum(np.convolve(count, kernel, "same"), 1.0)
     peak = int(np.argmax(envelope))

@@ -22,7 +22,7 @@ from tcbench.diagnose.attribute import (
 from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
 from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
 from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.open_terms import TERMS, open_finding
+from tcbench.diagnose.open_terms import TERMS, is_open, kind_of, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate, why_no_allan
 from tcbench.diagnose.nonmean import NonMean
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
@@ -191,9 +191,16 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
     for effect, value in att.final.terms:
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
         coef, i = beta[i:i + m], i + m
-        effects[effect] = (TERMS[effect].params(value, coef) if effect in TERMS
+        effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
                            else _effect_params(effect, float(coef[0]), value, d.half_range_c))
     return core, effects
+
+
+def _open_ids(evidence: dict[str, Evidence]) -> list[str]:
+    """The open-world ids with evidence, in :data:`TERMS` order, further instances after the first."""
+    order = list(TERMS)
+    ids = [e for e in evidence if is_open(e)]
+    return sorted(ids, key=lambda e: (order.index(kind_of(e).id), len(e), e))  # type: ignore[union-attr]
 
 
 def _flicker(
@@ -276,7 +283,7 @@ def diagnose(
         evidence[e].reason = "dropping it costs more held-out error than chance allows"
         ev = {"gain_sigma2": round(float(evidence[e].gain), 2), "threshold_sigma2": float(evidence[e].threshold),
               **_test_json(evidence[e])}
-        effects_out.append(open_finding(e, fitted[e], ev, data.unit) if e in TERMS else
+        effects_out.append(open_finding(e, fitted[e], ev, data.unit) if is_open(e) else
                            library_finding(e, fitted[e], ev, Extent.of(data), evidence[e].confusable_with).to_json())
     evidence["bias_instability"] = _flicker_evidence(allan_after, b, "bias_instability" in declared, data.t_s)
     if structure_left and "bias_instability" not in declared:
@@ -314,7 +321,7 @@ def diagnose(
         reference=_reference_json(reference, final_rmse, data.white_sigma),
         statistics={**(att.plan.to_json() if att.plan else {}), **nonmean.statistics(),
                     **_not_tested(att, evidence, nonmean)},
-        candidates=[evidence[e] for e in (*DETERMINISTIC, *TERMS, "bias_instability") if e in evidence],
+        candidates=[evidence[e] for e in (*DETERMINISTIC, *_open_ids(evidence), "bias_instability") if e in evidence],
         confusable=confusable,
         model=model,
         series=Series(data.t_s, data.temp_c, before, after, allan_before, allan_after),

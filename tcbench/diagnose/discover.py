@@ -38,7 +38,7 @@ from tcbench.diagnose.detectors import (
 )
 from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
-from tcbench.diagnose.open_terms import term_columns
+from tcbench.diagnose.open_terms import free_id, term_columns, term_threshold
 
 OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world term must exceed
 TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
@@ -66,7 +66,7 @@ def proposals(scorer: Any, model: Model) -> dict[str, list[tuple[float, ...]]]:
     lo, hi = _testable(d.t_s, scorer.fold)
     steps = [t for t in step_times(d.t_s, r) if lo < t < hi]
     lines = line_periods(d.t_s, r)
-    windows = [(p, *line_window(d.t_s, r, p)) for p in lines]
+    windows = [(p, *line_window(d.t_s, r, p)) for p in lines if DUTY_MIN_CYCLES * p < GATED_MAX_PART * span]
     gated = [(p, a, b) for p, a, b in windows if GATED_MIN_CYCLES * p <= b - a < GATED_MAX_PART * span]
     switched = [(p, a, b) for p, a, b in windows if DUTY_MIN_CYCLES * p <= b - a < GATED_MAX_PART * span]
     out: dict[str, list[tuple[float, ...]]] = {
@@ -242,17 +242,19 @@ def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: str, wa
     tried: dict[str, tuple[float, tuple[float, ...], list[tuple[float, ...]]]] = {}
     screen = _Screen(scorer, model)
     for term, values in proposals(scorer, model).items():
-        if term in model.ids:
+        new = free_id(term, model.ids)  # a second step, line ... is a further instance of its term
+        if new is None:
             continue
         value = _refine(screen, term, max(values, key=lambda v: screen.drop(term, v)))
-        tried[term] = (scorer.gain(model, model.with_effect(term, value)), value, values)
+        tried[new] = (scorer.gain(model, model.with_effect(new, value)), value, values)
     passing = []
     for term, (gain, value, values) in tried.items():
-        if gain <= threshold:
-            evidence[term] = Evidence(term, "rejected", gain, threshold, None, "held-out gain below the threshold")
+        bound = term_threshold(term, threshold)
+        if gain <= bound:
+            evidence[term] = Evidence(term, "rejected", gain, bound, None, "held-out gain below the threshold")
             continue
         ok, wald, p, used = scorer.significant(model, term, value, test, wald_threshold, searched=values)
-        evidence[term] = Evidence(term, "rejected", gain, threshold, None, not_significant(used, p),
+        evidence[term] = Evidence(term, "rejected", gain, bound, None, not_significant(used, p),
                                   wald=wald, test=used, p_value=p)
         if ok:
             passing.append(term)

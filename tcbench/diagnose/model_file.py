@@ -111,12 +111,13 @@ def _effects(value: Any, where: str) -> dict[str, dict[str, float]]:
         raise ModelFileError(f"{where}: effects must be a mapping of effect id to parameters")
     out: dict[str, dict[str, float]] = {}
     for effect_id, params in value.items():
-        if effect_id not in fx.EFFECTS:
+        cls = fx.effect_class(effect_id)
+        if cls is None:
             raise ModelFileError(f"{where}: unknown effect {effect_id!r}; known: {', '.join(sorted(fx.EFFECTS))}")
         params = {} if params is None else params
         if not isinstance(params, dict):
             raise ModelFileError(f"{where}: effect {effect_id!r} needs a mapping of parameters, got {params!r}")
-        known = [f.name for f in dataclasses.fields(fx.EFFECTS[effect_id])]
+        known = [f.name for f in dataclasses.fields(cls)]
         unknown = [str(k) for k in params if k not in known]
         if unknown:
             raise ModelFileError(f"{where}: effect {effect_id!r} has no parameter {', '.join(unknown)}; "

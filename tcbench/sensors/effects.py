@@ -431,11 +431,27 @@ EFFECTS: dict[str, type[Effect]] = {
 }
 
 
+REPEATABLE = ("bias_step", "periodic", "gated_periodic", "duty_cycle", "transient", "temperature_bump", "second_node")
+MAX_REPEATS = 3  # instances of one repeatable effect in a model: ``bias_step``, ``bias_step_2``, ``bias_step_3``
+
+
+def effect_class(effect_id: str) -> type[Effect] | None:
+    """The effect class of ``effect_id``: an id of :data:`EFFECTS`, or a further instance of a
+    :data:`REPEATABLE` one (``bias_step_2``: a second step); None for an unknown id."""
+    if effect_id in EFFECTS:
+        return EFFECTS[effect_id]
+    base, _, k = effect_id.rpartition("_")
+    if base in REPEATABLE and k.isdigit() and 2 <= int(k) <= MAX_REPEATS:
+        return EFFECTS[base]
+    return None
+
+
 def make_effect(effect_id: str, **params: Any) -> Effect:
     """Build an effect by id; unknown ids or parameters raise ``ValueError`` naming the known ones."""
-    if effect_id not in EFFECTS:
-        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(sorted(EFFECTS))}")
-    cls = EFFECTS[effect_id]
+    cls = effect_class(effect_id)
+    if cls is None:
+        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(sorted(EFFECTS))} "
+                         f"(and {REPEATABLE[0]}_2 ... _{MAX_REPEATS} for further instances of {', '.join(REPEATABLE)})")
     known = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(params) - known)
     if unknown:
