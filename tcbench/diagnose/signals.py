@@ -79,6 +79,40 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
     return value, rate
 
 
+MIN_WINDOW_SAMPLES = 10  # a fitted smoothing window never holds fewer samples than this
+BIAS_TO_NOISE = 0.5  # the window halves while the smoothing's RMS bias exceeds this share of its noise
+
+
+def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> float:
+    """The thermometer smoothing window fitted to the profile's time scales: ``window_s`` halved
+    while the bias it puts on the smoothed temperature exceeds :data:`BIAS_TO_NOISE` of the
+    thermometer noise it leaves (a deterministic error, e.g. at the corners of a fast ramp
+    through a short package lag, is read by the output's temperature and acceleration terms as
+    structure; the noise is accounted for by :mod:`tcbench.diagnose.thermometer`). A quadratic
+    smoother's bias scales as W^4, so halving takes it down 16x: the bias of ``W`` is estimated
+    from the difference between the readings smoothed over ``W`` and ``W/2``, less that
+    difference's noise share; the noise of each, from the same smoothing of white noise with the
+    reading's per-sample spread (fixed seed, so a diagnosis is repeatable). A slow profile keeps
+    ``window_s``; a fast one, or a high sample rate (many samples per window, so little noise),
+    gets a shorter window; never below :data:`MIN_WINDOW_SAMPLES` samples."""
+    if t_s.size < 2 * MIN_WINDOW_SAMPLES:
+        return window_s
+    rate_hz = (t_s.size - 1) / max(float(t_s[-1] - t_s[0]), 1e-12)
+    rng = np.random.default_rng(0)
+    white = rng.standard_normal(t_s.size)
+    w = float(window_s)
+    while w / 2.0 * rate_hz >= MIN_WINDOW_SAMPLES:
+        wide, narrow = smooth_temperature(t_s, temp_c, w)[0], smooth_temperature(t_s, temp_c, w / 2.0)[0]
+        sigma_c = float(np.std(temp_c - narrow))
+        noise_wide = sigma_c * smooth_temperature(t_s, white, w)[0]
+        noise_narrow = sigma_c * smooth_temperature(t_s, white, w / 2.0)[0]
+        bias2 = np.mean((wide - narrow) ** 2) - np.mean((noise_wide - noise_narrow) ** 2)
+        if bias2 <= (BIAS_TO_NOISE * (15.0 / 16.0)) ** 2 * np.mean(noise_wide**2):
+            break
+        w /= 2.0
+    return w
+
+
 def check_grid(t_s: np.ndarray, grid_s: float = GRID_S) -> None:
     """Refuse a recording whose span on a uniform clock of ``grid_s`` would exceed
     :data:`MAX_GRID_SAMPLES`, before anything is allocated."""
