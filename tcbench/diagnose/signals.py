@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
-from scipy.signal import lfilter, savgol_filter
+from scipy.signal import lfilter, oaconvolve, savgol_coeffs, savgol_filter
 
 from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
@@ -50,6 +50,24 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.nd
     return value, slope
 
 
+FFT_WINDOW = 255  # longer Savitzky-Golay windows convolve by FFT (a 120 s window at 100 Hz holds 12001 samples)
+
+
+def savgol(x: np.ndarray, window: int, deriv: int = 0, delta_s: float = 1.0) -> np.ndarray:
+    """``savgol_filter(x, window, 2, deriv, delta_s, mode="interp")``, in O(n log n) for a long
+    window: the interior by overlap-add convolution with the same coefficients, the first and
+    last ``window // 2`` samples from a quadratic fitted to the first and last ``window``."""
+    if window <= FFT_WINDOW:
+        return savgol_filter(x, window, 2, deriv=deriv, delta=delta_s, mode="interp")
+    y = oaconvolve(x, savgol_coeffs(window, 2, deriv=deriv, delta=delta_s, use="conv"), mode="same")
+    half, pos = window // 2, np.arange(window, dtype=float)
+    for sl, keep in ((slice(0, window), slice(0, half)), (slice(x.size - window, x.size), slice(window - half, window))):
+        poly = np.polyder(np.polyfit(pos, x[sl], 2), deriv) if deriv else np.polyfit(pos, x[sl], 2)
+        edge = np.polyval(poly, pos[keep]) / delta_s**deriv
+        y[sl][keep] = edge
+    return y
+
+
 def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Smoothed thermometer and its rate (degC/s).
 
@@ -72,8 +90,8 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
         fs = (n - 1) / max(t_s[b - 1] - t_s[a], 1e-12)
         w = round(window_s * fs) | 1
         if n >= w >= 5:
-            value[a:b] = savgol_filter(temp_c[a:b], w, 2, mode="interp")
-            rate[a:b] = savgol_filter(temp_c[a:b], w, 2, deriv=1, delta=1.0 / fs, mode="interp")
+            value[a:b] = savgol(temp_c[a:b], w)
+            rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
         else:
             value[a:b], rate[a:b] = wide_value[a:b], wide_rate[a:b]
     return value, rate
