@@ -134,7 +134,7 @@ class Sizing:
 
     @classmethod
     def for_duration(cls, duration_s: float) -> Sizing:
-        """A programme of about ``duration_s`` (within -/+ 20 %): every time scale of the 10 h
+        """A programme of ``duration_s`` to 1.25 times that: every time scale of the 10 h
         nominal set times ``s = duration_s / 10 h`` (soaks, package lag; acceleration dwells only
         shortened, to >= 10 s), the ramp rate divided by ``s`` but at most
         :data:`MAX_RAMP_C_PER_MIN`; where that cap binds, the temperature steps and span shrink
@@ -145,7 +145,7 @@ class Sizing:
         ramp = (min(lo, MAX_RAMP_C_PER_MIN / 4.0), min(hi, MAX_RAMP_C_PER_MIN))
         shrink = min(1.0, ramp[1] / hi)  # temperature scale kept in proportion to the ramp
         return cls(
-            duration_s=(0.8 * duration_s, 1.2 * duration_s),
+            duration_s=(duration_s, 1.25 * duration_s),
             soak_s=(SOAK_S[0] * s, SOAK_S[1] * s),
             ramp_c_per_min=ramp,
             step_c=(STEP_C[0] * shrink, STEP_C[1] * shrink),
