@@ -117,6 +117,11 @@ def summary(df: pd.DataFrame, wall_s: float, seeds: str, proof: bool) -> str:
         f"any effect (the open-world rule). Records shorter than the diagnosis's 30-min minimum are refused "
         f"with `DiagnosisDataError` by design; any other exception is a crash.",
         "",
+        f"Seeds: proof base {PROOF_SEED} + i (fresh, never looked at while tuning), development base "
+        f"{DEV_SEED} + i (used while finding and fixing the causes below; `--dev`). Every fix was made "
+        f"before the proof run. Grid: {len(FORMS)} (duration, rate) pairs x continuous/bursts x 2 sensors; "
+        f"bursts keep a sixth of every period of 1/12 of the record within 1-10 min (`forms.bursts_for`).",
+        "",
         f"- **False alarms: {alarms}/{n} = {100 * rate:.1f} %** (target <= {100 * TARGET:.0f} %: "
         f"{'met' if rate <= TARGET else 'NOT met'})",
         f"- crashes: {crashes}; refused (too short, by design): {refused}",

@@ -69,7 +69,9 @@ def control_recording(sensor: str, form: Form, seed: int) -> tuple[Recording, di
     """A control of ``form`` (nothing hidden) and its truth (white sigma per sample, span, seed)."""
     streams = np.random.SeedSequence(int(seed)).spawn(6)
     r_profile, r_device, r_sim, r_scale, r_white, r_thermo = (np.random.default_rng(s) for s in streams)
-    profile = concealed_profile(sensor, r_profile, Sizing.for_duration(form.duration_s), form.rate_hz)
+    # one burst period longer, so the kept bursts still span the requested length
+    sizing = Sizing.for_duration(form.duration_s + form.period_s)
+    profile = concealed_profile(sensor, r_profile, sizing, form.rate_hz)
     device_seed = int(r_device.integers(0, 10_000))
     model, default_sigma = device_without_effects(sensor, device_seed, form.rate_hz)
     sigma = default_sigma * float(np.exp(r_scale.uniform(*np.log(NOISE_FACTOR))))
