@@ -117,13 +117,19 @@ def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> flo
     difference's noise share; the noise of each, from the same smoothing of white noise with the
     reading's per-sample spread (fixed seed, so a diagnosis is repeatable). A slow profile keeps
     ``window_s``; a fast one, or a high sample rate (many samples per window, so little noise),
-    gets a shorter window; never below :data:`MIN_WINDOW_SAMPLES` samples."""
+    gets a shorter window; never below :data:`MIN_WINDOW_SAMPLES` samples. In bursts the halving
+    starts from the longest burst (each is smoothed over at most its own samples), so a burst
+    through a fast bend is also smoothed over less than its whole length."""
     if t_s.size < 2 * MIN_WINDOW_SAMPLES:
         return window_s
-    rate_hz = (t_s.size - 1) / max(float(t_s[-1] - t_s[0]), 1e-12)
+    rate_hz = 1.0 / max(float(np.median(np.diff(t_s))), 1e-12)  # within bursts, not over the gaps
+    seg = segments(t_s)
+    starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
+    ends = np.append(starts[1:], t_s.size) - 1
+    longest_s = float(np.max(t_s[ends] - t_s[starts]))  # a burst shorter than the window is smoothed whole
     rng = np.random.default_rng(0)
     white = rng.standard_normal(t_s.size)
-    w = float(window_s)
+    w = float(min(window_s, longest_s)) if longest_s * rate_hz >= 2 * MIN_WINDOW_SAMPLES else float(window_s)
     while w / 2.0 * rate_hz >= MIN_WINDOW_SAMPLES:
         wide, narrow = smooth_temperature(t_s, temp_c, w)[0], smooth_temperature(t_s, temp_c, w / 2.0)[0]
         sigma_c = float(np.std(temp_c - narrow))
