@@ -89,8 +89,13 @@ class NonMean:
         t, temp = rec.time_s, rec.temperature_c
         out = cls()
         if t.size >= 2 and t[-1] > t[0]:
-            out.default_smooth_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
-            out.thermometer = thermometer_steps(t, temp, out.default_smooth_s)
+            out.thermometer = thermometer_steps(t, temp, DEFAULT_SMOOTH_S)
+            # An undithered staircase's steps are not white noise (they would read as bias): it keeps
+            # its own wide window. Otherwise the window is fitted to the profile's time scales.
+            if out.thermometer is None or not out.thermometer.staircase:
+                out.default_smooth_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
+                if out.thermometer is not None:
+                    out.thermometer = thermometer_steps(t, temp, out.default_smooth_s)
         return out
 
     @property
