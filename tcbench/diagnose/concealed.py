@@ -70,6 +70,8 @@ NOISE_FACTOR = (1.0, 3.0)  # free-amplitude effects: white sigma / device defaul
 THERMOMETER_NOISE_C = 0.03
 THERMOMETER_STEP_C = 1.0 / 16.0
 _MAX_DRAWS = 10_000
+NOMINAL_DURATION_S = 10.0 * 3600.0  # the middle of DURATION_S: time scales are sized from it
+MAX_RAMP_C_PER_MIN = 10.0  # the fastest chamber ramp a sized programme asks for
 
 # Shape parameters drawn from PHYSICS.md §3; the amplitude parameter (if any) is set later.
 _AMPLITUDE = {
@@ -116,14 +118,53 @@ def _check_sensor(sensor: str) -> None:
         raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(EFFECTS_BY_SENSOR)}")
 
 
-def _programme(rng: np.random.Generator) -> tuple[float, list[float], np.ndarray, Chamber]:
+@dataclass(frozen=True)
+class Sizing:
+    """The time and temperature scales of a staircase programme (defaults: the 8-12 h, 1 Hz set).
+
+    :meth:`for_duration` sizes one to another record length."""
+
+    duration_s: tuple[float, float] = DURATION_S
+    soak_s: tuple[float, float] = SOAK_S
+    ramp_c_per_min: tuple[float, float] = RAMP_C_PER_MIN
+    step_c: tuple[float, float] = STEP_C
+    min_span_c: float = MIN_SPAN_C
+    package_tau_s: tuple[float, float] = PACKAGE_TAU_S
+    dwell_s: tuple[float, float] = DWELL_S
+
+    @classmethod
+    def for_duration(cls, duration_s: float) -> Sizing:
+        """A programme of ``duration_s`` to 1.25 times that: every time scale of the 10 h
+        nominal set times ``s = duration_s / 10 h`` (soaks, package lag; acceleration dwells only
+        shortened, to >= 10 s), the ramp rate divided by ``s`` but at most
+        :data:`MAX_RAMP_C_PER_MIN`; where that cap binds, the temperature steps and span shrink
+        by the same factor, so a 10-min record holds a whole small staircase rather than part
+        of a 35-min soak."""
+        s = float(duration_s) / NOMINAL_DURATION_S
+        lo, hi = RAMP_C_PER_MIN[0] / s, RAMP_C_PER_MIN[1] / s
+        ramp = (min(lo, MAX_RAMP_C_PER_MIN / 4.0), min(hi, MAX_RAMP_C_PER_MIN))
+        shrink = min(1.0, ramp[1] / hi)  # temperature scale kept in proportion to the ramp
+        return cls(
+            duration_s=(duration_s, 1.25 * duration_s),
+            soak_s=(SOAK_S[0] * s, SOAK_S[1] * s),
+            ramp_c_per_min=ramp,
+            step_c=(STEP_C[0] * shrink, STEP_C[1] * shrink),
+            min_span_c=MIN_SPAN_C * shrink,
+            package_tau_s=(max(PACKAGE_TAU_S[0] * s, 5.0), max(PACKAGE_TAU_S[1] * s, 10.0)),
+            dwell_s=(max(DWELL_S[0] * min(s, 1.0), 10.0), max(DWELL_S[1] * min(s, 1.0), 20.0)),
+        )
+
+
+def _programme(rng: np.random.Generator, sizing: Sizing | None = None,
+               ) -> tuple[float, list[float], np.ndarray, Chamber]:
     """Start temperature, soak levels (degC) in order, soak durations (s) and chamber."""
+    z = sizing or Sizing()
     for _ in range(_MAX_DRAWS):
         room_c = float(rng.uniform(*ROOM_C))
-        step_c = float(rng.uniform(*STEP_C))
+        step_c = float(rng.uniform(*z.step_c))
         n_up, n_down = (int(n) for n in rng.integers(1, 4, size=2))
         via_hot = bool(rng.random() < 0.5)
-        ramp = float(rng.uniform(*RAMP_C_PER_MIN))
+        ramp = float(rng.uniform(*z.ramp_c_per_min))
         grid = [room_c + step_c * k for k in range(-n_down, n_up + 1)]  # one grid, exact revisits
         room, hot, cold = n_down, len(grid) - 1, 0
         path = list(range(room, hot + 1)) + list(range(hot - 1, cold - 1, -1))
@@ -132,35 +173,39 @@ def _programme(rng: np.random.Generator) -> tuple[float, list[float], np.ndarray
         else:
             path += list(range(cold + 1, room + 1))
         levels = [grid[i] for i in path]
-        soaks_s = np.round(rng.uniform(*SOAK_S, size=len(levels)))
+        soaks_s = np.round(rng.uniform(*z.soak_s, size=len(levels)))
         travel_c = float(np.abs(np.diff(levels)).sum())
         duration_s = float(soaks_s.sum()) + travel_c / (ramp / 60.0)
-        ok = (grid[-1] <= LIMITS_C[1] and grid[0] >= LIMITS_C[0] and grid[-1] - grid[0] >= MIN_SPAN_C
-              and DURATION_S[0] <= duration_s <= DURATION_S[1])
+        ok = (grid[-1] <= LIMITS_C[1] and grid[0] >= LIMITS_C[0] and grid[-1] - grid[0] >= z.min_span_c
+              and z.duration_s[0] <= duration_s <= z.duration_s[1])
         if ok:
-            chamber = Chamber(ramp_c_per_min=ramp, package_tau_s=float(rng.uniform(*PACKAGE_TAU_S)))
+            chamber = Chamber(ramp_c_per_min=ramp, package_tau_s=float(rng.uniform(*z.package_tau_s)))
             return room_c, levels, soaks_s, chamber
     raise RuntimeError("no temperature programme met the constraints")  # pragma: no cover
 
 
-def _accel_cycle(t_s: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+def _accel_cycle(t_s: np.ndarray, rng: np.random.Generator,
+                 dwell_s: tuple[float, float] = DWELL_S) -> np.ndarray:
     """Acceleration (g) stepping through +1, 0, -1, 0 g with dwells of 60-120 s (whole s)."""
-    n_steps = int(np.ceil((t_s[-1] + 1.0) / DWELL_S[0])) + 1
-    edges = np.cumsum(np.round(rng.uniform(*DWELL_S, size=n_steps)))
+    n_steps = int(np.ceil((t_s[-1] + 1.0) / dwell_s[0])) + 1
+    edges = np.cumsum(np.round(rng.uniform(*dwell_s, size=n_steps)))
     step = np.searchsorted(edges, t_s, side="right")
     return np.asarray(ACCEL_CYCLE_G)[step % len(ACCEL_CYCLE_G)]
 
 
-def concealed_profile(sensor: str, rng: np.random.Generator) -> Profile:
+def concealed_profile(sensor: str, rng: np.random.Generator, sizing: Sizing | None = None,
+                      rate_hz: float = SAMPLE_RATE_HZ) -> Profile:
     """A 1 Hz, 8-12 h heat-and-cool staircase (package temperature ``temp_c`` in degC); MSRA
     acceleration cycling +1, 0, -1, 0 g throughout, gyro at rest. ``info`` lists the soak
-    levels (``levels_c``) and durations (``soaks_s``) as space-separated numbers."""
+    levels (``levels_c``) and durations (``soaks_s``) as space-separated numbers. ``sizing``
+    and ``rate_hz`` make the same kind of staircase at another length and rate."""
     _check_sensor(sensor)
-    start_c, levels, soaks_s, chamber = _programme(rng)
+    z = sizing or Sizing()
+    start_c, levels, soaks_s, chamber = _programme(rng, z)
     segments = [Segment(level, float(s), "", 0.0, 0.0) for level, s in zip(levels, soaks_s, strict=True)]
-    profile = _from_segments("concealed", sensor, segments, start_c, SAMPLE_RATE_HZ, chamber)
+    profile = _from_segments("concealed", sensor, segments, start_c, rate_hz, chamber)
     zeros = np.zeros_like(profile.t_s)
-    accel = _accel_cycle(profile.t_s, rng) if sensor == "msra" else zeros.copy()
+    accel = _accel_cycle(profile.t_s, rng, z.dwell_s) if sensor == "msra" else zeros.copy()
     info: dict[str, float | str] = {
         **profile.info, "start_c": start_c, "air_tau_s": chamber.air_tau_s,
         "levels_c": " ".join(f"{x:.6f}" for x in levels), "soaks_s": " ".join(f"{s:.0f}" for s in soaks_s),

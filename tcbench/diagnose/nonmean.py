@@ -31,7 +31,7 @@ from tcbench.diagnose.quantisation import (
     thermometer_steps,
 )
 from tcbench.diagnose.saturation import Saturation, find_saturation
-from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
+from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData, fitted_window_s
 from tcbench.diagnose.variance import Variance, find_variance
 from tcbench.sensors.recording import Recording
 
@@ -74,6 +74,7 @@ class NonMean:
     """What the non-additive detectors found on one record (see the module doc)."""
 
     thermometer: ThermometerSteps | None = None
+    default_smooth_s: float = DEFAULT_SMOOTH_S  # fitted to the profile (signals.fitted_window_s)
     quantisation: OutputQuantisation | None = None
     saturation: Saturation | None = None
     variance: Variance | None = None
@@ -89,12 +90,18 @@ class NonMean:
         out = cls()
         if t.size >= 2 and t[-1] > t[0]:
             out.thermometer = thermometer_steps(t, temp, DEFAULT_SMOOTH_S)
+            # An undithered staircase's steps are not white noise (they would read as bias): it keeps
+            # its own wide window. Otherwise the window is fitted to the profile's time scales.
+            if out.thermometer is None or not out.thermometer.staircase:
+                out.default_smooth_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
+                if out.thermometer is not None:
+                    out.thermometer = thermometer_steps(t, temp, out.default_smooth_s)
         return out
 
     @property
     def smooth_s(self) -> float:
         """The thermometer smoothing window (s): widened for an undithered staircase."""
-        return self.thermometer.smooth_s if self.thermometer is not None else DEFAULT_SMOOTH_S
+        return self.thermometer.smooth_s if self.thermometer is not None else self.default_smooth_s
 
     def prefit(self, data: DiagnosisData) -> DiagnosisData:
         """Find the output's lattice and clipping; ``data`` with the clipped samples removed,

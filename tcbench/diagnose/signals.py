@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
-from scipy.signal import lfilter, savgol_filter
+from scipy.signal import lfilter, oaconvolve, savgol_coeffs, savgol_filter
 
 from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
@@ -50,14 +50,36 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.nd
     return value, slope
 
 
+MIN_WINDOW_SAMPLES = 10  # a fitted smoothing window never holds fewer samples than this
+FFT_WINDOW = 255  # longer Savitzky-Golay windows convolve by FFT (a 120 s window at 100 Hz holds 12001 samples)
+
+
+def savgol(x: np.ndarray, window: int, deriv: int = 0, delta_s: float = 1.0) -> np.ndarray:
+    """``savgol_filter(x, window, 2, deriv, delta_s, mode="interp")``, in O(n log n) for a long
+    window: the interior by overlap-add convolution with the same coefficients, the first and
+    last ``window // 2`` samples from a quadratic fitted to the first and last ``window``."""
+    if window <= FFT_WINDOW:
+        return savgol_filter(x, window, 2, deriv=deriv, delta=delta_s, mode="interp")
+    y = oaconvolve(x, savgol_coeffs(window, 2, deriv=deriv, delta=delta_s, use="conv"), mode="same")
+    half, pos = window // 2, np.arange(window, dtype=float)
+    for sl, keep in ((slice(0, window), slice(0, half)), (slice(x.size - window, x.size), slice(window - half, window))):
+        poly = np.polyder(np.polyfit(pos, x[sl], 2), deriv) if deriv else np.polyfit(pos, x[sl], 2)
+        edge = np.polyval(poly, pos[keep]) / delta_s**deriv
+        y[sl][keep] = edge
+    return y
+
+
 def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:
     """Smoothed thermometer and its rate (degC/s).
 
     Inside a continuous segment at least ``window_s`` long: a local quadratic (Savitzky-Golay)
     over ``window_s``, whose value has no bias where the profile bends (a local line would lag
-    by about T'' W^2 / 24 at every corner of a ramp). Segments shorter than that (bursts) take
-    the local line over ``window_s`` or, if wider, three segment spacings, which reaches across
-    the gaps.
+    by about T'' W^2 / 24 at every corner of a ramp). A shorter segment (a burst) holding at
+    least :data:`MIN_WINDOW_SAMPLES` samples takes the local quadratic over its own samples: a
+    line reaching across gaps of minutes misses the profile's bends between bursts by degrees
+    (2 degC RMS on an 8 h staircase sampled 100 s of every 10 min), far more than the noise
+    averaging gains. Sparser segments take the local line over ``window_s`` or, if wider, three
+    segment spacings, which reaches across the gaps.
     """
     seg = segments(t_s)
     value = np.empty_like(temp_c)
@@ -71,12 +93,53 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
         n = b - a
         fs = (n - 1) / max(t_s[b - 1] - t_s[a], 1e-12)
         w = round(window_s * fs) | 1
+        if MIN_WINDOW_SAMPLES <= n < w:  # a burst: its own samples, not a line across the gaps
+            w = n if n % 2 else n - 1
         if n >= w >= 5:
-            value[a:b] = savgol_filter(temp_c[a:b], w, 2, mode="interp")
-            rate[a:b] = savgol_filter(temp_c[a:b], w, 2, deriv=1, delta=1.0 / fs, mode="interp")
+            value[a:b] = savgol(temp_c[a:b], w)
+            rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
         else:
             value[a:b], rate[a:b] = wide_value[a:b], wide_rate[a:b]
     return value, rate
+
+
+BIAS_TO_NOISE = 0.5  # the window halves while the smoothing's RMS bias exceeds this share of its noise
+
+
+def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> float:
+    """The thermometer smoothing window fitted to the profile's time scales: ``window_s`` halved
+    while the bias it puts on the smoothed temperature exceeds :data:`BIAS_TO_NOISE` of the
+    thermometer noise it leaves (a deterministic error, e.g. at the corners of a fast ramp
+    through a short package lag, is read by the output's temperature and acceleration terms as
+    structure; the noise is accounted for by :mod:`tcbench.diagnose.thermometer`). A quadratic
+    smoother's bias scales as W^4, so halving takes it down 16x: the bias of ``W`` is estimated
+    from the difference between the readings smoothed over ``W`` and ``W/2``, less that
+    difference's noise share; the noise of each, from the same smoothing of white noise with the
+    reading's per-sample spread (fixed seed, so a diagnosis is repeatable). A slow profile keeps
+    ``window_s``; a fast one, or a high sample rate (many samples per window, so little noise),
+    gets a shorter window; never below :data:`MIN_WINDOW_SAMPLES` samples. In bursts the halving
+    starts from the longest burst (each is smoothed over at most its own samples), so a burst
+    through a fast bend is also smoothed over less than its whole length."""
+    if t_s.size < 2 * MIN_WINDOW_SAMPLES:
+        return window_s
+    rate_hz = 1.0 / max(float(np.median(np.diff(t_s))), 1e-12)  # within bursts, not over the gaps
+    seg = segments(t_s)
+    starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
+    ends = np.append(starts[1:], t_s.size) - 1
+    longest_s = float(np.max(t_s[ends] - t_s[starts]))  # a burst shorter than the window is smoothed whole
+    rng = np.random.default_rng(0)
+    white = rng.standard_normal(t_s.size)
+    w = float(min(window_s, longest_s)) if longest_s * rate_hz >= 2 * MIN_WINDOW_SAMPLES else float(window_s)
+    while w / 2.0 * rate_hz >= MIN_WINDOW_SAMPLES:
+        wide, narrow = smooth_temperature(t_s, temp_c, w)[0], smooth_temperature(t_s, temp_c, w / 2.0)[0]
+        sigma_c = float(np.std(temp_c - narrow))
+        noise_wide = sigma_c * smooth_temperature(t_s, white, w)[0]
+        noise_narrow = sigma_c * smooth_temperature(t_s, white, w / 2.0)[0]
+        bias2 = np.mean((wide - narrow) ** 2) - np.mean((noise_wide - noise_narrow) ** 2)
+        if bias2 <= (BIAS_TO_NOISE * (15.0 / 16.0)) ** 2 * np.mean(noise_wide**2):
+            break
+        w /= 2.0
+    return w
 
 
 def check_grid(t_s: np.ndarray, grid_s: float = GRID_S) -> None:

@@ -160,11 +160,13 @@ def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x * x)))
 
 
-def _device(sensor: str, device_seed: int) -> tuple[SensorModel, float]:
-    """The unit with every effect removed (MSRA misalignment zero) and its white sigma per sample."""
+def device_without_effects(sensor: str, device_seed: int, rate_hz: float = SAMPLE_RATE_HZ,
+                           ) -> tuple[SensorModel, float]:
+    """The unit with every effect removed (MSRA misalignment zero) and its white sigma per
+    sample at ``rate_hz`` (density times sqrt(rate))."""
     device = unit(sensor, device_seed).model
     white_fx = device.effect("white_noise")
-    sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(SAMPLE_RATE_HZ)
+    sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(rate_hz)
     model = dataclasses.replace(device, effects=())
     if isinstance(model, MSRA):
         model = dataclasses.replace(model, misalignment_rad=0.0)
@@ -311,7 +313,7 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
         np.random.default_rng(s) for s in streams[:7])
     profile = concealed_profile(sensor, r_profile)
     device_seed = int(r_device.integers(0, 10_000))
-    model, default_sigma = _device(sensor, device_seed)
+    model, default_sigma = device_without_effects(sensor, device_seed)
     base = model.simulate(profile, r_sim)
     n = profile.t_s.size
     factor = float(np.exp(r_scale.uniform(*np.log(NOISE_FACTOR))))
