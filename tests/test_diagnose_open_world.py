@@ -305,7 +305,7 @@ def test_default_plan_is_big_enough_with_unique_fresh_seeds() -> None:
     jobs = script.plan(10, 10, script.FIRST_SEED)
     seeds = [s for _, _, s in jobs]
     assert len(jobs) >= 120 and sum(k is None for _, k, _ in jobs) >= 20
-    assert len(set(seeds)) == len(seeds) and min(seeds) == 43_000_000
+    assert len(set(seeds)) == len(seeds) and min(seeds) == 44_000_000
     for kind in KINDS:
         assert {s for s, k, _ in jobs if k == kind} == {"msra", "gyro"}
     quick = script.plan(2, 2, script.QUICK_SEED)

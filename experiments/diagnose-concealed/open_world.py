@@ -38,7 +38,7 @@ from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import SHAPES
 from tcbench.diagnose.open_world import KINDS, SENSORS, SHAPE, open_world_recording, score
 
-FIRST_SEED = 43_000_000  # the proof's base: 41 000 000 was the first proof, before gated_periodic (README)
+FIRST_SEED = 44_000_000  # the proof's base: 41 000 000 was the first proof, 43 000 000 the second, before duty_cycle (README)
 QUICK_SEED = 40_900_000
 CHARACTERISED_TARGET = 0.80
 REFIT_TARGET = 0.80

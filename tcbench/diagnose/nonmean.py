@@ -84,8 +84,9 @@ class NonMean:
     sample_rate_hz: float = 1.0
 
     @classmethod
-    def before(cls, rec: Recording) -> NonMean:
-        """The thermometer's lattice, read from the raw reading before it is smoothed."""
+    def before(cls, rec: Recording, window_s: float | None = None) -> NonMean:
+        """The thermometer's lattice, read from the raw reading before it is smoothed; the
+        smoothing window fitted to the profile, or ``window_s`` when given."""
         t, temp = rec.time_s, rec.temperature_c
         out = cls()
         if t.size >= 2 and t[-1] > t[0]:
@@ -93,7 +94,7 @@ class NonMean:
             # An undithered staircase's steps are not white noise (they would read as bias): it keeps
             # its own wide window. Otherwise the window is fitted to the profile's time scales.
             if out.thermometer is None or not out.thermometer.staircase:
-                out.default_smooth_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
+                out.default_smooth_s = window_s if window_s is not None else fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
                 if out.thermometer is not None:
                     out.thermometer = thermometer_steps(t, temp, out.default_smooth_s)
         return out
