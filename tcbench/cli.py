@@ -90,6 +90,9 @@ def _keyvalue_command(command: str, argv: list[str]) -> list[str] | None:
             if cfg != "job":
                 what = f"--cfg {cfg}" if cfg else "--cfg without a value"
                 raise UserError(f"{what}: tcbench {command} prints only its job config; use --cfg job")
+        elif flag in {"-m", "--multirun"}:
+            raise UserError(f"{flag}: tcbench {command} does not sweep yet (only tcbench run does); "
+                            "run it once per value")
         else:
             raise _unknown_option(command, flag)
     if cfg is None:
@@ -451,6 +454,8 @@ COMMANDS = {
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) == 2 and argv[0] == "help" and argv[1] in COMMANDS:  # tcbench help simulate
+        argv = [argv[1], "--help"]
     if not argv or argv[0] in {"-h", "--help", "help"}:
         print(USAGE)
         return 0 if argv else 2

@@ -148,3 +148,15 @@ def test_an_unknown_option_is_one_line_exit_2(command: str, flag: str, capsys: p
 def test_commands_without_parameters_refuse_arguments(command: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main([command, "seed=3"]) == 2
     assert "takes no arguments" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", KEYVALUE)
+def test_a_sweep_flag_says_only_run_sweeps(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([command, "-m", "seed=1,2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"-m: tcbench {command} does not sweep yet" in err[0]
+
+
+def test_help_command_shows_a_command_s_usage(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["help", "diagnose"]) == 0
+    assert capsys.readouterr().out.startswith("usage: tcbench diagnose")
