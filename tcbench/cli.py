@@ -15,22 +15,26 @@ if TYPE_CHECKING:
 USAGE = """usage: tcbench <command> [args]
 
 commands:
-  run [-m] [key=value ...]   run one job, or a Hydra sweep with -m (e.g. optimiser=fa,ifa seed='range(30)')
-  leaderboard [options]      aggregate finished runs into leaderboards/<task>.md/.csv/.png
-  quickstart                 FA against IFA on 2-D Rastrigin, 10 seeds each, with a results table
-  list                       registered tasks and optimisers
-  simulate key=value ...     simulate a recording: sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR
-  import csv=PATH sensor=msra|gyro time=COL[:unit] temperature=COL[:unit] output=COL[:unit] out=DIR
-                             your own CSV as a recording ([input=COL[:unit]] [drop=FLAG_COL] [name=STEM])
-  metrics PATH [key=value]   validate a recording and compute the papers' metrics, with plots
-  diagnose recording=PATH out=DIR [model=PATH] [sensor=msra|gyro]
-                             find the physics a model leaves out; report.json/.md, plots, model.yaml
+  run          one job, or a Hydra sweep with -m (e.g. tcbench run -m optimiser=fa,ifa seed='range(30)')
+  leaderboard  aggregate finished runs into leaderboards/<task>.md/.csv/.png
+  quickstart   FA against IFA on 2-D Rastrigin, 10 seeds each, with a results table
+  list         registered tasks, optimisers and learners
+  simulate     simulate a recording (sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR) and its metrics
+  import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL[:unit] ... out=DIR)
+  metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
+  diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
 
-`tcbench run --help` shows the Hydra options and config groups.
+`tcbench <command> --help` (or -h) shows a command's parameters, their defaults, examples and
+where its output goes; `--cfg job` prints the config a command would run with, and runs nothing.
 """
 
 
 HYDRA_INFO_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc"}
+HYDRA_FLAGS = HYDRA_INFO_FLAGS | {
+    "--version", "--resolve", "-p", "--package", "-r", "--run", "-m", "--multirun", "-cp", "--config-path",
+    "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun",
+}
+HELP_FLAGS = {"-h", "--help"}
 
 
 class UserError(Exception):
@@ -40,6 +44,64 @@ class UserError(Exception):
 def _fail(message: str, code: int = 2) -> int:
     print(f"tcbench: error: {message}", file=sys.stderr)
     return code
+
+
+def _flag_name(arg: str) -> str | None:
+    """The option an argument is (``--cfg=job`` is ``--cfg``), or None for ``key=value``."""
+    return arg.split("=", 1)[0] if arg.startswith("-") else None
+
+
+def _unknown_option(command: str, flag: str) -> UserError:
+    return UserError(f"unknown option {flag!r} for tcbench {command}; see `tcbench {command} --help`")
+
+
+def _no_arguments(command: str, argv: list[str], help_text: str) -> bool:
+    """For a command without parameters: True after printing its help for -h/--help; a
+    :class:`UserError` for anything else given."""
+    if any(a in HELP_FLAGS for a in argv):
+        print(help_text)
+        return True
+    for a in argv:
+        if (flag := _flag_name(a)) is not None:
+            raise _unknown_option(command, flag)
+    if argv:
+        raise UserError(f"tcbench {command} takes no arguments, got {argv[0]!r}; see `tcbench {command} --help`")
+    return False
+
+
+def _keyvalue_command(command: str, argv: list[str]) -> list[str] | None:
+    """The ``key=value`` arguments of a command parsed by :mod:`tcbench.sensors_cli`, or None
+    when ``--help`` or ``--cfg job`` was answered here (nothing is run or written)."""
+    from tcbench import cli_help
+    from tcbench.sensors_cli import CommandError
+
+    if any(a in HELP_FLAGS for a in argv):
+        print(cli_help.usage(command))
+        return None
+    args: list[str] = []
+    cfg: str | None = None
+    it = iter(argv)
+    for a in it:
+        flag = _flag_name(a)
+        if flag is None:
+            args.append(a)
+        elif flag in {"--cfg", "-c"}:
+            cfg = a.split("=", 1)[1] if "=" in a else next(it, None)
+            if cfg != "job":
+                what = f"--cfg {cfg}" if cfg else "--cfg without a value"
+                raise UserError(f"{what}: tcbench {command} prints only its job config; use --cfg job")
+        elif flag in {"-m", "--multirun"}:
+            raise UserError(f"{flag}: tcbench {command} does not sweep yet (only tcbench run does); "
+                            "run it once per value")
+        else:
+            raise _unknown_option(command, flag)
+    if cfg is None:
+        return args
+    try:
+        print(cli_help.composed_yaml(command, args), end="")
+    except CommandError as exc:
+        raise UserError(str(exc)) from None
+    return None
 
 
 def _run_sweep(args: list[str]) -> Plan | None:
@@ -145,7 +207,14 @@ def _failures_report(jobs: int) -> int:
 
 
 def cmd_run(args: list[str]) -> int:
+    from tcbench.app import VALUE_FLAGS
     from tcbench.job import FAILURES
+
+    after_value_flag = False
+    for a in args:
+        if not after_value_flag and (flag := _flag_name(a)) is not None and flag not in HYDRA_FLAGS:
+            raise _unknown_option("run", flag)
+        after_value_flag = a in VALUE_FLAGS
 
     FAILURES.clear()  # this command's jobs only
     checked = _run_sweep(args)
@@ -157,14 +226,52 @@ def cmd_run(args: list[str]) -> int:
     return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri, expected)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse whose usage errors are one line (a :class:`UserError`) and whose ``--help``
+    returns instead of exiting the process."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        if message.startswith("unrecognized arguments: "):
+            flag = message.split(": ", 1)[1].split()[0].split("=", 1)[0]
+            raise _unknown_option(self.prog.split()[-1], flag) if flag.startswith("-") else \
+                UserError(f"{self.prog}: unexpected argument {flag!r}; see `{self.prog} --help`")
+        raise UserError(f"{self.prog}: {message}")
+
+    def exit(self, status: int = 0, message: str | None = None) -> None:  # type: ignore[override]
+        if message:
+            print(message, file=sys.stderr, end="")
+        raise _HelpShown(status)
+
+
+class _HelpShown(Exception):
+    """argparse printed its help: the command ends with this exit code."""
+
+    def __init__(self, status: int) -> None:
+        super().__init__(status)
+        self.status = status
+
+
+LEADERBOARD_EPILOG = """examples:
+  tcbench leaderboard                                         all runs of experiment tcbench
+  tcbench leaderboard --experiment quickstart --sweep SWEEP_ID --out lb --ecdf
+
+output: OUT/<task>.md, OUT/<task>.csv and OUT/<task>_convergence.png per task (compensation
+tasks too), the tables also printed; --ecdf adds OUT/ecdf_<d>d.png. Reads the MLflow store, writes
+nothing to it."""
+
+
 def cmd_leaderboard(argv: list[str]) -> int:
-    ap = argparse.ArgumentParser(prog="tcbench leaderboard", description="Aggregate runs into leaderboards.")
+    ap = _Parser(prog="tcbench leaderboard", description="Aggregate finished runs into leaderboards.",
+                 epilog=LEADERBOARD_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--experiment", action="append", help="MLflow experiment (repeatable; default: tcbench)")
     ap.add_argument("--sweep", help="only runs of this sweep id")
     ap.add_argument("--out", default="leaderboards", help="output directory (default: leaderboards)")
     ap.add_argument("--tracking-uri", help="MLflow store (default: $MLFLOW_TRACKING_URI or ./mlflow.db)")
     ap.add_argument("--ecdf", action="store_true", help="also write COCO-style ECDF plots per dimension")
-    ns = ap.parse_args(argv)
+    try:
+        ns = ap.parse_args(argv)
+    except _HelpShown as shown:
+        return shown.status
     from tcbench import leaderboard, tracking
     from tcbench.compensation import leaderboard as comp_board
     from tcbench.outputs import folder_problem
@@ -203,9 +310,38 @@ def cmd_leaderboard(argv: list[str]) -> int:
     return 0
 
 
+def _quickstart_help() -> str:
+    from importlib.resources import files
+
+    settings = [ln for ln in files("tcbench.conf").joinpath("experiment/quickstart.yaml").read_text().splitlines()
+                if ln.strip() and not ln.lstrip().startswith("#")]
+    return "\n".join([
+        "usage: tcbench quickstart [-h]", "",
+        "FA against IFA on 2-D Rastrigin, 10 seeds each (seed 000 settings), then a results table.",
+        "Takes no parameters: it runs `tcbench run -m experiment=quickstart`; run that with your own",
+        "key=value overrides to change it. The settings it uses (tcbench/conf/experiment/quickstart.yaml):", "",
+        *(f"  {ln}" for ln in settings), "",
+        "examples:", "  tcbench quickstart", "  tcbench run -m experiment=quickstart budget=1010", "",
+        "output: runs in MLflow (./mlflow.db, experiment quickstart), the leaderboard in",
+        "tcbench-quickstart/, Hydra job logs and resolved configs in multirun/.",
+    ])
+
+
+LIST_HELP = """usage: tcbench list [-h]
+
+Print the registered tasks (their gymnasium env id and task= name), optimisers (with the
+package that provides them: tcbench or a plugin), learners and broken plugins. Takes no
+parameters.
+
+example:
+  tcbench list
+
+output: stdout only."""
+
+
 def cmd_quickstart(argv: list[str]) -> int:
-    if argv:
-        raise UserError("quickstart takes no arguments; use `tcbench run -m ...` for your own sweep")
+    if _no_arguments("quickstart", argv, _quickstart_help()):
+        return 0
     sweep = uuid.uuid4().hex[:12]
     out = Path("tcbench-quickstart")
     print("tcbench quickstart: FA vs IFA on 2-D Rastrigin (seed 000 settings), 10 seeds each")
@@ -226,6 +362,8 @@ def cmd_quickstart(argv: list[str]) -> int:
 
 
 def cmd_list(argv: list[str]) -> int:
+    if _no_arguments("list", argv, LIST_HELP):
+        return 0
     from tcbench.optimisers import registry
     from tcbench.tasks import BBOB_ID, FUNCTIONS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
 
@@ -266,8 +404,10 @@ def cmd_list(argv: list[str]) -> int:
 def cmd_simulate(argv: list[str]) -> int:
     from tcbench.sensors_cli import CommandError, simulate
 
+    if (args := _keyvalue_command("simulate", argv)) is None:
+        return 0
     try:
-        return simulate(argv)
+        return simulate(args)
     except CommandError as exc:
         raise UserError(str(exc)) from None
 
@@ -275,8 +415,10 @@ def cmd_simulate(argv: list[str]) -> int:
 def cmd_import(argv: list[str]) -> int:
     from tcbench.sensors_cli import CommandError, import_command
 
+    if (args := _keyvalue_command("import", argv)) is None:
+        return 0
     try:
-        return import_command(argv)
+        return import_command(args)
     except CommandError as exc:
         raise UserError(str(exc)) from None
 
@@ -284,8 +426,10 @@ def cmd_import(argv: list[str]) -> int:
 def cmd_metrics(argv: list[str]) -> int:
     from tcbench.sensors_cli import CommandError, metrics
 
+    if (args := _keyvalue_command("metrics", argv)) is None:
+        return 0
     try:
-        return metrics(argv)
+        return metrics(args)
     except CommandError as exc:
         raise UserError(str(exc)) from None
 
@@ -294,8 +438,10 @@ def cmd_diagnose(argv: list[str]) -> int:
     from tcbench.diagnose.cli import diagnose_command
     from tcbench.sensors_cli import CommandError
 
+    if (args := _keyvalue_command("diagnose", argv)) is None:
+        return 0
     try:
-        return diagnose_command(argv)
+        return diagnose_command(args)
     except CommandError as exc:
         raise UserError(str(exc)) from None
 
@@ -308,6 +454,8 @@ COMMANDS = {
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    if len(argv) == 2 and argv[0] == "help" and argv[1] in COMMANDS:  # tcbench help simulate
+        argv = [argv[1], "--help"]
     if not argv or argv[0] in {"-h", "--help", "help"}:
         print(USAGE)
         return 0 if argv else 2
@@ -318,6 +466,10 @@ def main(argv: list[str] | None = None) -> int:
         return COMMANDS[command](rest)
     except UserError as exc:
         return _fail(str(exc))
+    except SystemExit as exc:  # Hydra's --help, --cfg and --info end with sys.exit
+        if exc.code is None or isinstance(exc.code, int):
+            return exc.code or 0
+        raise
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
     except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours

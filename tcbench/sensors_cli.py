@@ -78,15 +78,26 @@ class SimulateConfig:
     model: str | None = None
 
 
-def parse(args: list[str], schema: type) -> Any:
-    """``key=value`` arguments checked against a dataclass schema (types and known keys)."""
+def composed(args: list[str], schema: type) -> Any:
+    """The schema's defaults merged with ``key=value`` arguments, as a DictConfig (types and
+    known keys checked); what ``--cfg job`` prints and :func:`parse` returns as an object."""
     bad = [a for a in args if "=" not in a or a.startswith("=")]
     if bad:
         raise CommandError(f"expected key=value, got {bad[0]!r}")
     if nul := [a for a in args if "\0" in a]:
         raise CommandError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
     try:
-        cfg = OmegaConf.merge(OmegaConf.structured(schema), OmegaConf.from_dotlist(args))
+        return OmegaConf.merge(OmegaConf.structured(schema), OmegaConf.from_dotlist(args))
+    except OmegaConfBaseException as exc:
+        key = getattr(exc, "full_key", None)
+        first = str(exc).strip().splitlines()[0]
+        raise CommandError(f"{key}: {first}" if key else first) from None
+
+
+def parse(args: list[str], schema: type) -> Any:
+    """``key=value`` arguments checked against a dataclass schema (types and known keys)."""
+    cfg = composed(args, schema)
+    try:
         return OmegaConf.to_object(cfg)
     except OmegaConfBaseException as exc:
         key = getattr(exc, "full_key", None)

@@ -1,0 +1,209 @@
+"""Usage text and ``--cfg job`` for tcbench's ``key=value`` commands (simulate, import, metrics,
+diagnose), generated from the dataclass each command parses its arguments into, so the
+parameters and defaults shown are the ones the command uses."""
+
+from __future__ import annotations
+
+import dataclasses
+import textwrap
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+TRACKING = {
+    "tracking.enabled": "log the results to MLflow (false: files only)",
+    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
+    "tracking.experiment": "MLflow experiment the run is filed under",
+}
+# keys of the shared tracking schema that these commands accept and ignore (``tcbench run`` uses them)
+IGNORED = ("tracking.sweep_id", "tracking.plots", "tracking.resume", "tracking.ioh_dir")
+
+
+@dataclass(frozen=True)
+class CommandHelp:
+    """What ``tcbench <name> --help`` says: ``params`` gives the meaning of every key of the
+    command's schema (dotted for nested dataclasses; a dict-valued key is one entry)."""
+
+    name: str
+    summary: str
+    schema: Callable[[], type]
+    params: dict[str, str]
+    examples: tuple[str, ...]
+    output: str
+    positional: str | None = None  # ``tcbench metrics PATH`` means ``recording=PATH``
+    required: tuple[str, ...] = ()
+
+
+def _simulate_schema() -> type:
+    from tcbench.sensors_cli import SimulateConfig
+
+    return SimulateConfig
+
+
+def _metrics_schema() -> type:
+    from tcbench.sensors_cli import MetricsConfig
+
+    return MetricsConfig
+
+
+def _import_schema() -> type:
+    from tcbench.sensors_cli import ImportConfig
+
+    return ImportConfig
+
+
+def _diagnose_schema() -> type:
+    from tcbench.diagnose.cli import DiagnoseConfig
+
+    return DiagnoseConfig
+
+
+SPECS: dict[str, CommandHelp] = {
+    "simulate": CommandHelp(
+        name="simulate",
+        summary="Simulate a recording of one device under a test protocol, then compute its metrics.",
+        schema=_simulate_schema,
+        params={
+            "sensor": "msra (accelerometer) or gyro",
+            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static",
+            "device_seed": "which unit of the device population (integer >= 0)",
+            "seed": "the run's noise draw (integer >= 0)",
+            "out": "output folder",
+            "format": "csv or parquet",
+            "name": "file stem (null: <sensor>-<protocol>-dev<device_seed>-seed<seed>)",
+            "protocol_params": "protocol_params.<keyword>=VALUE overrides a protocol keyword (duration_s=3600)",
+            "effects": "effects.<effect>.<param>=VALUE changes or adds an effect (effects.hysteresis.amplitude=0.02)",
+            "without": "effects to drop, e.g. 'without=[white_noise]'",
+            "metrics": "also compute the metrics, plots and tables",
+            **TRACKING,
+            "model": "simulate a fitted-model file (model.yaml of tcbench diagnose) instead of a device",
+        },
+        examples=(
+            "tcbench simulate sensor=msra protocol=fulltemp device_seed=0 out=recordings",
+            "tcbench simulate sensor=gyro protocol=oven seed=1 format=parquet tracking.enabled=false",
+        ),
+        output="OUT/NAME.csv (or .parquet) with its sidecar OUT/NAME.json, and with metrics=true "
+               "OUT/NAME_metrics/ (metrics.json, plots); MLflow experiment 'simulations' when tracking is on",
+    ),
+    "metrics": CommandHelp(
+        name="metrics",
+        summary="Validate a recording and compute the papers' metrics, with plots.",
+        schema=_metrics_schema,
+        params={
+            "recording": "the recording (.csv or .parquet with its .json sidecar); also the first argument",
+            "out": "output folder (null: <recording stem>_metrics next to the recording)",
+            "scale_factor_hz_per_g": "MSRA scale factor in Hz/g (null: the sidecar's, else the nominal one)",
+            **TRACKING,
+        },
+        examples=(
+            "tcbench metrics recordings/msra-fulltemp-dev0-seed0.csv",
+            "tcbench metrics recording=run.csv out=run_metrics tracking.enabled=false",
+        ),
+        output="OUT/ (metrics.json, overview and Allan deviation plots, nodes.csv for a four-position "
+               "test); MLflow experiment 'recordings' when tracking is on",
+        positional="recording",
+        required=("recording",),
+    ),
+    "import": CommandHelp(
+        name="import",
+        summary="Import your own CSV file as a tcbench recording (validated, with its sidecar).",
+        schema=_import_schema,
+        params={
+            "csv": "the CSV file to import; also the first argument",
+            "sensor": "msra or gyro",
+            "time": "time column, COL[:unit] (s, ms, us, ns, min, h)",
+            "temperature": "temperature column, COL[:unit] (degC, K, degF)",
+            "output": "sensor output column, COL[:unit]",
+            "input": "optional true-input column, COL[:unit]",
+            "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
+            "out": "output folder",
+            "name": "file stem (null: the CSV's)",
+            "device_id": "device id for the sidecar (null: the CSV's stem)",
+            "sample_rate_hz": "sample rate (null: one over the median interval of the time column)",
+        },
+        examples=(
+            "tcbench import csv=log.csv sensor=gyro time=time_s temperature=temp_c:degC "
+            "output=gyro_x_dps:deg/s out=recordings",
+        ),
+        output="OUT/NAME.csv and its sidecar OUT/NAME.json",
+        positional="csv",
+        required=("csv", "sensor", "time", "temperature", "output", "out"),
+    ),
+    "diagnose": CommandHelp(
+        name="diagnose",
+        summary="Find the physics a model leaves out of a recording: a report, plots and a model file.",
+        schema=_diagnose_schema,
+        params={
+            "recording": "the recording to diagnose",
+            "out": "output folder",
+            "sensor": "msra or gyro, for a recording without a sidecar (null: from the sidecar)",
+            "model": "model file of the effects already modelled (null: none)",
+        },
+        examples=(
+            "tcbench diagnose recording=recordings/msra-fulltemp-dev0-seed0.csv out=diagnosis",
+            "tcbench diagnose recording=run.csv out=diag2 model=diagnosis/model.yaml",
+        ),
+        output="OUT/report.json, OUT/report.md, plots and OUT/model.yaml",
+        required=("recording",),
+    ),
+}
+
+
+def _shown(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return str(value).lower()
+    if value == "":
+        return "''"
+    return str(value)
+
+
+def parameters(schema: type) -> list[tuple[str, Any]]:
+    """``(dotted key, default)`` of every parameter of a dataclass schema, nested dataclasses
+    flattened (``tracking.enabled``); a dict- or list-valued field is one entry."""
+    out: list[tuple[str, Any]] = []
+
+    def walk(obj: Any, prefix: str) -> None:
+        for f in dataclasses.fields(obj):
+            value = getattr(obj, f.name)
+            if dataclasses.is_dataclass(value):
+                walk(value, f"{prefix}{f.name}.")
+            else:
+                out.append((f"{prefix}{f.name}", value))
+
+    walk(schema(), "")
+    return out
+
+
+def usage(name: str) -> str:
+    """The ``--help`` text of command ``name``."""
+    spec = SPECS[name]
+    first = f" [{spec.positional.upper()}]" if spec.positional else ""
+    lines = [f"usage: tcbench {name}{first} [key=value ...] [--cfg job] [-h]", "", spec.summary, "",
+             "parameters (key=value, default after =):"]
+    rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", spec.params.get(key, ""))
+            for key, default in parameters(spec.schema()) if key not in IGNORED]
+    width = max(len(left) for left, _ in rows) + 2
+    lines += [f"  {left:{width}s}{meaning}" for left, meaning in rows]
+    if ignored := [k for k, _ in parameters(spec.schema()) if k in IGNORED]:
+        lines.append(f"  (also accepted, unused here: {', '.join(ignored)})")
+    lines += ["", "options:",
+              "  -h, --help   show this help and exit",
+              "  --cfg job    print the config composed from the defaults and the given key=value, "
+              "and exit without running",
+              "", "examples:", *(f"  {e}" for e in spec.examples),
+              "", textwrap.fill(f"output: {spec.output}", width=100, subsequent_indent="  ")]
+    return "\n".join(lines)
+
+
+def composed_yaml(name: str, args: list[str]) -> str:
+    """The config ``tcbench <name> args`` would run with, as YAML (``--cfg job``)."""
+    from omegaconf import OmegaConf
+
+    from tcbench.sensors_cli import composed
+
+    spec = SPECS[name]
+    if spec.positional and args and "=" not in args[0]:
+        args = [f"{spec.positional}={args[0]}", *args[1:]]
+    return OmegaConf.to_yaml(composed(args, spec.schema()))

@@ -1,0 +1,162 @@
+"""Every ``tcbench`` command answers ``--help`` and ``-h`` with its usage (exit 0), the
+``key=value`` commands print their composed config for ``--cfg job`` without running, and an
+unknown option is one line with exit code 2. In process, so the whole file takes seconds."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from tcbench import cli_help
+from tcbench.cli import COMMANDS, main
+
+KEYVALUE = ["simulate", "metrics", "import", "diagnose"]
+# what the help of the other commands must name: their parameters or settings
+NAMED = {
+    "run": ["usage: tcbench run", "seed", "budget", "tracking", "optimiser", "examples:", "output:"],
+    "leaderboard": ["usage: tcbench leaderboard", "--experiment", "--sweep", "--out", "--tracking-uri", "--ecdf",
+                    "examples:", "output:"],
+    "list": ["usage: tcbench list", "no", "output:"],
+    "quickstart": ["usage: tcbench quickstart", "budget: 510", "seed: range(10)", "examples:", "output:"],
+}
+
+
+@pytest.fixture(autouse=True)
+def in_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
+    return tmp_path
+
+
+def test_every_command_is_covered() -> None:
+    assert set(COMMANDS) == set(KEYVALUE) | set(NAMED)
+
+
+@pytest.mark.parametrize("flag", ["--help", "-h"])
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_help_exits_0_and_names_the_parameters(command: str, flag: str, capsys: pytest.CaptureFixture[str],
+                                               tmp_path: Path) -> None:
+    assert main([command, flag]) == 0
+    out = capsys.readouterr().out
+    if command in KEYVALUE:
+        assert out.startswith(f"usage: tcbench {command} ")
+        for key, _ in cli_help.parameters(cli_help.SPECS[command].schema()):
+            if key not in cli_help.IGNORED:
+                assert f"  {key}=" in out, key
+        assert "--cfg job" in out and "examples:" in out and "output:" in out
+    else:
+        for word in NAMED[command]:
+            assert word in out, word
+    assert list(tmp_path.iterdir()) == []  # help runs nothing
+
+
+def test_help_wins_after_arguments(capsys: pytest.CaptureFixture[str]) -> None:
+    """``metrics PATH --help`` used to read ``--help`` as a recording ("unsupported format")."""
+    assert main(["metrics", "rec.csv", "--help"]) == 0
+    assert capsys.readouterr().out.startswith("usage: tcbench metrics")
+
+
+def test_help_shows_the_defaults_the_command_parses() -> None:
+    text = cli_help.usage("simulate")
+    assert "  sensor=msra " in text and "  protocol=fulltemp " in text and "tracking.experiment=simulations" in text
+    assert "  recording=(required) " in cli_help.usage("diagnose") and "  out=diagnosis " in cli_help.usage("diagnose")
+
+
+@pytest.mark.parametrize("command", KEYVALUE)
+def test_every_parameter_has_a_meaning(command: str) -> None:
+    spec = cli_help.SPECS[command]
+    keys = {k for k, _ in cli_help.parameters(spec.schema())} - set(cli_help.IGNORED)
+    assert keys == set(spec.params)
+    assert set(spec.required) <= keys
+
+
+@pytest.mark.parametrize("flag", ["--help", "-h", "help"])
+def test_top_level_help_lists_every_command(flag: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([flag]) == 0
+    out = capsys.readouterr().out
+    listed = [ln.split()[0] for ln in out.split("commands:\n", 1)[1].split("\n\n", 1)[0].splitlines()]
+    assert listed == list(COMMANDS)
+    assert "--help" in out and "--cfg job" in out
+
+
+def test_no_arguments_prints_the_usage_with_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([]) == 2
+    assert "usage: tcbench <command>" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["simulate", "seed=7", "out=sims", "sensor=gyro", "protocol=oven", "--cfg", "job"],
+         {"seed": 7, "out": "sims", "sensor": "gyro", "metrics": True}),
+        (["metrics", "rec.csv", "--cfg=job", "tracking.enabled=false"],
+         {"recording": "rec.csv", "out": None, "tracking": {"enabled": False}}),
+        (["import", "-c", "job", "csv=log.csv", "sensor=gyro", "time=t:ms", "out=imported"],
+         {"csv": "log.csv", "time": "t:ms", "out": "imported", "drop": None}),
+        (["diagnose", "--cfg", "job", "recording=rec.csv", "out=diag", "sensor=msra"],
+         {"recording": "rec.csv", "out": "diag", "sensor": "msra", "model": None}),
+    ],
+)
+def test_cfg_job_prints_the_composed_config_and_writes_nothing(args: list[str], expected: dict,
+                                                               capsys: pytest.CaptureFixture[str],
+                                                               tmp_path: Path) -> None:
+    assert main(args) == 0
+    cfg = yaml.safe_load(capsys.readouterr().out)
+    for key, value in expected.items():
+        if isinstance(value, dict):
+            assert {k: cfg[key][k] for k in value} == value
+        else:
+            assert cfg[key] == value, key
+    defaults = dict(cli_help.parameters(cli_help.SPECS[args[0]].schema()))
+    assert set(cfg) == {k.split(".")[0] for k in defaults}  # the whole config, defaults included
+    assert list(tmp_path.iterdir()) == []  # no output folder, no recording, no MLflow store
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["simulate", "seed=abc", "--cfg", "job"], ["seed", "abc"]),
+        (["diagnose", "colour=red", "--cfg", "job"], ["colour"]),
+        (["simulate", "--cfg", "hydra"], ["--cfg hydra", "tcbench simulate", "--cfg job"]),
+        (["metrics", "--cfg"], ["--cfg without a value", "tcbench metrics"]),
+    ],
+)
+def test_cfg_job_with_a_bad_argument_is_one_line(args: list[str], words: list[str],
+                                                 capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("tcbench: error:") and all(w in err[0] for w in words), err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("flag", ["--bogus", "--bogus=1", "-x"])
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_an_unknown_option_is_one_line_exit_2(command: str, flag: str, capsys: pytest.CaptureFixture[str],
+                                              tmp_path: Path) -> None:
+    assert main([command, flag]) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1, captured.err
+    assert f"unknown option {flag.split('=')[0]!r} for tcbench {command}" in err[0]
+    assert "Traceback" not in captured.err + captured.out
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", ["list", "quickstart"])
+def test_commands_without_parameters_refuse_arguments(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([command, "seed=3"]) == 2
+    assert "takes no arguments" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", KEYVALUE)
+def test_a_sweep_flag_says_only_run_sweeps(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([command, "-m", "seed=1,2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"-m: tcbench {command} does not sweep yet" in err[0]
+
+
+def test_help_command_shows_a_command_s_usage(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["help", "diagnose"]) == 0
+    assert capsys.readouterr().out.startswith("usage: tcbench diagnose")
