@@ -51,7 +51,7 @@ def test_objectives_and_window() -> None:
     f = vmd_objectives(w, 4, 2000.0)
     assert f.shape == (2,) and np.all(np.isfinite(f)) and 0 < f[1] <= 1
     assert decode(np.array([7.6, 1234.5])) == (8, 1234.5)
-    with pytest.raises(ValueError, match="tuning samples"):
+    with pytest.raises(ValueError, match="tuning_samples"):
         tuning_window(y, 10)
 
 

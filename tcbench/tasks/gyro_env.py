@@ -32,16 +32,28 @@ from tcbench.gyro.cache import cached_front
 from tcbench.gyro.data import GyroData, check_effects, check_settings
 from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
-from tcbench.gyro.tuning import PAPER_BEST
+from tcbench.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.ids import GYRO_DRIFTNOISE_ID
+from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
 BASELINES = ("raw", "oracle")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
+
+
+def _check_tuner(name: object) -> None:
+    """The VMD tuner: a registered multi-objective optimiser (its parameters and budget are checked
+    by the job's config validation, which knows the tuning budget it is run with)."""
+    from tcbench.optimisers import registry as optimisers
+
+    if not isinstance(name, str):
+        raise ValueError(f"tuner must be the name of a multi-objective optimiser, got {name!r}")
+    if not optimisers.get(name).multi_objective:
+        raise ValueError(f"tuner: optimiser {name} is single-objective; VMD tuning has 2 objectives")
 
 
 class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
@@ -79,18 +91,20 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
                  tuner: str = "mopso", tuning_budget: int = 440, tuning_samples: int = 2048,
                  tuner_params: dict[str, Any] | None = None) -> None:
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
-            if int(value) != value or value < 0:
+            if not is_integer(value) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value}")
         if (train_files is None) != (test_files is None):
             raise ValueError("give both train_files and test_files, or neither")
-        if int(tuning_budget) != tuning_budget or tuning_budget < 1:
+        if not is_integer(tuning_budget) or tuning_budget < 1:
             raise ValueError(f"tuning_budget must be a positive integer, got {tuning_budget}")
+        tuning_window(np.zeros(1), tuning_samples)  # validates the window length
+        _check_tuner(tuner)
         self.tuning = {"tuner": str(tuner), "params": dict(tuner_params or {}), "budget": int(tuning_budget),
                        "samples": int(tuning_samples)}
-        if not (np.isfinite(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
+        if not (is_real(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
             raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
         try:
             check_settings(sample_rate_hz, hold_s, n_train, n_test)
