@@ -76,7 +76,7 @@ def seed_streams(seed: int) -> tuple[int, np.random.Generator]:
 
 def make_task(task: dict[str, Any], budget: int) -> Any:
     """Build the task environment from its config (``name``, ``dim``, ``shift`` ...)."""
-    kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
+    kwargs = tasks.task_kwargs(task)
     env = gym.make(tasks.task_id(task["name"]), budget=budget, **kwargs)
     return env.unwrapped
 
@@ -280,7 +280,7 @@ def run_compensation(
 
     name = learner["name"]
     baseline = name in BASELINES
-    kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
+    kwargs = tasks.task_kwargs(task)
     params = {k: v for k, v in learner.items() if k not in {"name", "label"}}
     env = gym.make(tasks.task_id(task["name"]), budget=budget, learner=None if baseline else name,
                    learner_params=params, **kwargs).unwrapped

@@ -51,7 +51,7 @@ def test_objectives_and_window() -> None:
     f = vmd_objectives(w, 4, 2000.0)
     assert f.shape == (2,) and np.all(np.isfinite(f)) and 0 < f[1] <= 1
     assert decode(np.array([7.6, 1234.5])) == (8, 1234.5)
-    with pytest.raises(ValueError, match="tuning samples"):
+    with pytest.raises(ValueError, match="tuning_samples"):
         tuning_window(y, 10)
 
 
@@ -94,8 +94,13 @@ def test_driftnoise_env_passes_check_env() -> None:
     assert env.dim == 3 * 2 + 3 * 3 + 3 + 3 + 1
 
 
-def test_env_is_made_by_id_and_needs_vmd_parameters() -> None:
+def test_env_made_by_id_runs_the_papers_vmd_parameters_by_default() -> None:
     env = gym.make("tcbench/Gyro-DriftNoise-v0", learner="poly", **SMALL).unwrapped
+    assert (env.config.k, env.config.alpha) == (8, 9755.0) and not env.needs_tuning
+
+
+def test_env_with_null_vmd_parameters_needs_them_tuned() -> None:
+    env = gym.make("tcbench/Gyro-DriftNoise-v0", learner="poly", k=None, alpha=None, **SMALL).unwrapped
     assert env.needs_tuning
     with pytest.raises(ValueError, match="k and alpha are unset"):
         env.reset(seed=0)

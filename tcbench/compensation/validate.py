@@ -15,6 +15,7 @@ from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.optimisers.protocol import make_params
+from tcbench.tasks import task_kwargs
 
 
 def _error(message: str) -> Exception:
@@ -46,7 +47,7 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
         except (TypeError, ValueError) as exc:
             text = str(exc)
             raise _error(f"learner {text}" if text.startswith(f"{name}") else f"learner {name}: {text}") from None
-    kwargs = {k: v for k, v in task.items() if k != "name" and v is not None}
+    kwargs = task_kwargs(task)
     try:
         if gyro:
             env: Any = GyroDriftNoiseEnv(None if name in BASELINES else name, learner, budget=c["budget"], **kwargs)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import json
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -82,15 +83,19 @@ def check_effects(effects: dict[str, dict[str, float]] | None) -> dict[str, dict
     return {str(k): {str(p): float(v) for p, v in d.items()} for k, d in effects.items()}
 
 
+def _is_real(value: object) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and bool(np.isfinite(value))
+
+
 def check_settings(sample_rate: float, hold_s: float, n_train: int, n_test: int) -> None:
     """Raise :class:`TaskDataError` for settings no oven run can have."""
-    if not (np.isfinite(sample_rate) and 0.1 <= sample_rate <= 1000.0):
+    if not (_is_real(sample_rate) and 0.1 <= sample_rate <= 1000.0):
         raise TaskDataError(f"sample_rate_hz must be in [0.1, 1000] Hz, got {sample_rate}")
-    if not (np.isfinite(hold_s) and 60.0 <= hold_s <= 86400.0):
+    if not (_is_real(hold_s) and 60.0 <= hold_s <= 86400.0):
         raise TaskDataError(f"hold_s must be in [60, 86400] s, got {hold_s}")
     for name, value in (("n_train", n_train), ("n_test", n_test)):
-        if int(value) != value or not 1 <= value <= 10:
-            raise TaskDataError(f"{name} must be an integer in 1..10, got {value}")
+        if not (_is_real(value) and int(value) == value and 1 <= value <= 10):
+            raise TaskDataError(f"{name} must be an integer in 1..10, got {value!r}")
 
 
 def simulated_gyro_data(device_seed: int, recordings_seed: int, n_train: int = 1, n_test: int = 1,

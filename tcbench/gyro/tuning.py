@@ -36,7 +36,7 @@ REF_POINT = (2.5, 1.0)  # hypervolume reference: above white noise's FE (~2.2) a
 def tuning_window(y: np.ndarray, samples: int = 2048) -> np.ndarray:
     """The contiguous ``samples``-long window from the middle of ``y`` (all of ``y`` if shorter)."""
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 64:
-        raise ValueError(f"tuning samples must be an integer >= 64, got {samples!r}")
+        raise ValueError(f"tuning_samples must be an integer >= 64, got {samples!r}")
     y = np.asarray(y, dtype=np.float64)
     start = max(0, (y.size - samples) // 2)
     return y[start:start + samples].copy()

@@ -78,6 +78,13 @@ def task_id(name: str) -> str:
     return mo_env_id(name) if name.lower() in PROBLEMS else env_id(name)
 
 
+def task_kwargs(task: dict[str, Any]) -> dict[str, Any]:
+    """The env's keyword arguments from a task config: every key but ``name``, a null passed as
+    None, which the envs read as documented in the task configs (VMD's ``k``/``alpha`` to be tuned,
+    MSRA recordings drawn from the run seed, a function's own domain, the default split ...)."""
+    return {k: v for k, v in task.items() if k != "name"}
+
+
 def task_class(name: str) -> type[FunctionEnv] | type[MultiObjectiveEnv]:
     """The env class serving a function or multi-objective problem name."""
     return MultiObjectiveEnv if name.lower() in PROBLEMS else FunctionEnv
@@ -118,4 +125,5 @@ __all__ = [
     "register_msra_envs",
     "task_class",
     "task_id",
+    "task_kwargs",
 ]

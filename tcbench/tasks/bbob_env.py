@@ -20,6 +20,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.function_env import FunctionEnv, as_batch, check_budget
 from tcbench.tasks.ids import BBOB_ID
 
@@ -30,7 +31,7 @@ BBOB_MIN_DIM = 2  # ioh refuses BBOB problems in one dimension
 
 
 def _positive_int(name: str, value: Any, minimum: int, what: str = "") -> int:
-    if isinstance(value, bool) or int(value) != value or value < minimum:
+    if not is_integer(value) or value < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}{what}, got {value!r}")
     return int(value)
 
@@ -54,13 +55,13 @@ class BBOBEnv(FunctionEnv):
     ) -> None:
         import ioh
 
-        if isinstance(function, bool) or int(function) != function or int(function) not in BBOB_FUNCTIONS:
+        if not is_integer(function) or int(function) not in BBOB_FUNCTIONS:
             raise ValueError(f"function must be an integer in 1..24 (the BBOB functions), got {function!r}")
         self.function_id = int(function)
         self.dim = _positive_int("dim", dim, BBOB_MIN_DIM, " (ioh's BBOB problems start at 2-D)")
         self.instance = _positive_int("instance", instance, 1)
         self.budget = _positive_int("budget", budget, 1)
-        if not np.isfinite(target_precision) or target_precision <= 0:
+        if not is_real(target_precision) or target_precision <= 0:
             raise ValueError(f"target_precision must be a positive number, got {target_precision}")
         self.target_precision = float(target_precision)
         self.stop_at_target = bool(stop_at_target)

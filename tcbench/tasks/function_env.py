@@ -15,6 +15,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.functions import ObjectiveFunction, get_function
 
 
@@ -69,14 +70,17 @@ class FunctionEnv(gym.Env[np.ndarray, np.ndarray]):
         upper: float | None = None,
     ) -> None:
         self.function: ObjectiveFunction = get_function(function)
-        if int(dim) != dim or dim < self.function.min_dim:
+        if not is_integer(dim) or dim < self.function.min_dim:
             raise ValueError(
                 f"dim must be an integer >= {self.function.min_dim} for {function}, got {dim}"
             )
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
-        if not np.isfinite(target_precision) or target_precision <= 0:
+        if not is_real(target_precision) or target_precision <= 0:
             raise ValueError(f"target_precision must be a positive number, got {target_precision}")
+        for label, value in (("lower", lower), ("upper", upper)):
+            if value is not None and not is_real(value):
+                raise ValueError(f"{label} must be a finite number or None, got {value!r}")
         lo = self.function.lower if lower is None else float(lower)
         hi = self.function.upper if upper is None else float(upper)
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):

@@ -10,8 +10,11 @@ minimise to initialise the learner (BAS-Elman, §3.4.4). :meth:`GyroDriftNoiseEn
 the learner from the best vector and runs the whole pipeline on the test record, scoring it
 before and after with the bandwidth it keeps (:mod:`tcbench.gyro.scoring`).
 
-With ``k``/``alpha`` unset the VMD parameters come from ``reset(options={"k": .., "alpha": ..})``:
-``tcbench run`` first tunes them on ``tcbench/Gyro-VMDTuning-v0`` (MOPSO by default, §3.2).
+By default VMD runs with seed 001's tuned ``[k, alpha] = [8, 9755]`` (§4.2), so
+``gymnasium.make("tcbench/Gyro-DriftNoise-v0")`` is a complete task. With ``k=None`` or
+``alpha=None`` they are to be tuned first and come from
+``reset(options={"k": .., "alpha": ..})``: ``tcbench run`` (whose task config sets them null)
+tunes them on ``tcbench/Gyro-VMDTuning-v0`` (MOPSO by default, §3.2).
 """
 
 from __future__ import annotations
@@ -29,15 +32,28 @@ from tcbench.gyro.cache import cached_front
 from tcbench.gyro.data import GyroData, check_effects, check_settings
 from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
+from tcbench.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.ids import GYRO_DRIFTNOISE_ID
+from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
 BASELINES = ("raw", "oracle")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
+
+
+def _check_tuner(name: object) -> None:
+    """The VMD tuner: a registered multi-objective optimiser (its parameters and budget are checked
+    by the job's config validation, which knows the tuning budget it is run with)."""
+    from tcbench.optimisers import registry as optimisers
+
+    if not isinstance(name, str):
+        raise ValueError(f"tuner must be the name of a multi-objective optimiser, got {name!r}")
+    if not optimisers.get(name).multi_objective:
+        raise ValueError(f"tuner: optimiser {name} is single-objective; VMD tuning has 2 objectives")
 
 
 class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
@@ -52,7 +68,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     train_files, test_files: schema-v1 gyro recordings instead.
     decomposition, k, alpha, denoise, tfpf_window, noise_above, drift_below, inputs,
         rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.gyro.pipeline.PipelineConfig`);
-        ``k``/``alpha`` None: set by ``reset(options=...)`` after tuning.
+        ``k``/``alpha`` default to seed 001's tuned ``[8, 9755]``; None: to be tuned, then set by
+        ``reset(options=...)``.
     bandwidth_amplitude_dps: amplitude of each injected sine of the bandwidth test (deg/s).
     effects: changes of the simulated device's effects, ``{id: {param: value}}`` in deg/s units
         (e.g. ``{"bias_instability": {"b": 8.3e-4}}`` for 3 deg/h of flicker).
@@ -67,24 +84,27 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  budget: int = 1000, device_seed: int = 0, recordings_seed: int = 0, n_train: int = 1,
                  n_test: int = 1, train_files: list[str] | None = None, test_files: list[str] | None = None,
                  sample_rate_hz: float = 10.0, hold_s: float = 3600.0, decomposition: str = "vmd",
-                 k: int | None = None, alpha: float | None = None, denoise: str = "tfpf", tfpf_window: int = 31,
+                 k: int | None = PAPER_BEST[0], alpha: float | None = PAPER_BEST[1], denoise: str = "tfpf",
+                 tfpf_window: int = 31,
                  noise_above: float = 0.5, drift_below: float = 0.15, inputs: str = "t_rate",
                  rate_window_s: float = 120.0, learner_block_s: float = 10.0,
                  bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
                  tuner: str = "mopso", tuning_budget: int = 440, tuning_samples: int = 2048,
                  tuner_params: dict[str, Any] | None = None) -> None:
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
-            if int(value) != value or value < 0:
+            if not is_integer(value) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value}")
         if (train_files is None) != (test_files is None):
             raise ValueError("give both train_files and test_files, or neither")
-        if int(tuning_budget) != tuning_budget or tuning_budget < 1:
+        if not is_integer(tuning_budget) or tuning_budget < 1:
             raise ValueError(f"tuning_budget must be a positive integer, got {tuning_budget}")
+        tuning_window(np.zeros(1), tuning_samples)  # validates the window length
+        _check_tuner(tuner)
         self.tuning = {"tuner": str(tuner), "params": dict(tuner_params or {}), "budget": int(tuning_budget),
                        "samples": int(tuning_samples)}
-        if not (np.isfinite(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
+        if not (is_real(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
             raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
         try:
             check_settings(sample_rate_hz, hold_s, n_train, n_test)

@@ -21,6 +21,7 @@ from tcbench.compensation.data import TaskDataError
 from tcbench.gyro.data import (
     GyroData,
     check_effects,
+    check_settings,
     file_gyro_data,
     simulated_gyro_data,
 )
@@ -33,6 +34,7 @@ from tcbench.gyro.tuning import (
     tuning_window,
     vmd_objectives,
 )
+from tcbench.tasks.checks import is_integer
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.ids import GYRO_VMDTUNING_ID
 from tcbench.tasks.mo_env import record_front
@@ -64,16 +66,17 @@ class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):
     def __init__(self, budget: int = 440, device_seed: int = 0, recordings_seed: int = 0,
                  train_files: list[str] | None = None, sample_rate_hz: float = 10.0, hold_s: float = 3600.0,
                  tuning_samples: int = 2048, effects: dict[str, dict[str, float]] | None = None) -> None:
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
-            if int(value) != value or value < 0:
+            if not is_integer(value) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value}")
         tuning_window(np.zeros(1), tuning_samples)  # validates the window length
         self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), int(recordings_seed)
         self.train_files, self.sample_rate_hz, self.hold_s = train_files, float(sample_rate_hz), float(hold_s)
         self.tuning_samples = int(tuning_samples)
         try:
+            check_settings(sample_rate_hz, hold_s, 1, 1)
             self.effects = check_effects(effects)
         except TaskDataError as exc:
             raise ValueError(str(exc)) from None

@@ -27,6 +27,7 @@ import numpy as np
 
 from tcbench.metrics.multiobjective import hypervolume
 from tcbench.optimisers.pareto import merge_front
+from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.multiobjective import PROBLEMS, MultiObjectiveProblem, get_problem
 from tcbench.tasks.registration import register_tasks
@@ -88,16 +89,16 @@ class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
         self.problem: MultiObjectiveProblem = get_problem(function)
         p = self.problem
         d = p.default_dim if dim is None else dim
-        if int(d) != d or d < p.min_dim:
+        if not is_integer(d) or d < p.min_dim:
             raise ValueError(f"dim must be an integer >= {p.min_dim} for {p.key}, got {dim}")
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         if shift:
             raise ValueError(f"shift is not supported for the multi-objective problem {p.key}")
-        if not np.isfinite(target_precision) or target_precision <= 0:
+        if not is_real(target_precision) or target_precision <= 0:
             raise ValueError(f"target_precision must be a positive number, got {target_precision}")
         for label, value, own in (("lower", lower, p.lower), ("upper", upper, p.upper)):
-            if value is not None and float(value) != own:
+            if value is not None and (not is_real(value) or float(value) != own):
                 raise ValueError(
                     f"{label} must be null or {own} for {p.key} (domain [{p.lower}, {p.upper}]), "
                     f"got {value}"

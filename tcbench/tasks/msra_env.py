@@ -34,6 +34,7 @@ from tcbench.compensation.data import (
 from tcbench.compensation.scoring import Score, score_outputs
 from tcbench.learners import registry as learners
 from tcbench.learners.base import FitHistory, Learner
+from tcbench.tasks.checks import is_integer
 from tcbench.tasks.weight_search import WeightSearch
 from tcbench.tasks.ids import MSRA_ENV_IDS
 
@@ -91,11 +92,11 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if task not in TASKS:
             raise ValueError(f"unknown MSRA task {task!r}; known: {', '.join(TASKS)}")
         self.task, self.protocol = task, TASKS[task]
-        if int(budget) != budget or budget < 1:
+        if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
-        if int(device_seed) != device_seed or device_seed < 0:
+        if not is_integer(device_seed) or device_seed < 0:
             raise ValueError(f"device_seed must be a non-negative integer, got {device_seed}")
-        if recordings_seed is not None and (int(recordings_seed) != recordings_seed or recordings_seed < 0):
+        if recordings_seed is not None and (not is_integer(recordings_seed) or recordings_seed < 0):
             raise ValueError(f"recordings_seed must be a non-negative integer or null, got {recordings_seed}")
         if bias_form not in BIAS_FORMS:
             raise ValueError(f"bias_form must be one of {', '.join(BIAS_FORMS)}, got {bias_form!r}")
