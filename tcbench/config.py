@@ -17,6 +17,7 @@ import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
+from tcbench.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import coerce_param, make_params
@@ -177,8 +178,6 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     if ioh_dir and (problem := folder_problem(ioh_dir)):
         raise ConfigError(f"tracking.ioh_dir={ioh_dir}: {problem}")
     if is_compensation(name):
-        from tcbench.compensation.validate import validate_compensation
-
         validate_compensation(c, checked_task(c["task"], GyroTaskConfig if is_gyro(name) else MSRATaskConfig))
         return
     if c.get("learner"):
