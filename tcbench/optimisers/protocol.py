@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from tcbench.optimisers.pareto import merge_front
+from tcbench.pareto import merge_front
 
 
 class ProtocolError(RuntimeError):
