@@ -15,7 +15,7 @@ from tcbench.errors import ConfigError
 from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
-from tcbench.optimisers.protocol import make_params
+from tcbench.params import make_params
 from tcbench.tasks import GyroDriftNoiseEnv, MSRACompensationEnv, is_gyro
 
 

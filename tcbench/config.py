@@ -20,8 +20,8 @@ from omegaconf import MISSING, DictConfig, OmegaConf
 from tcbench.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
-from tcbench.optimisers.protocol import coerce_param, make_params
 from tcbench.outputs import folder_problem
+from tcbench.params import coerce_param, make_params
 from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
 
 
