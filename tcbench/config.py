@@ -23,6 +23,7 @@ from tcbench.optimisers import registry
 from tcbench.outputs import folder_problem
 from tcbench.params import coerce_param, make_params
 from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
+from tcbench.tracking_config import TrackingConfig
 
 
 @dataclass
@@ -102,19 +103,6 @@ class GyroTaskConfig(GyroTuningTaskConfig):
     rate_window_s: float = 120.0
     learner_block_s: float = 10.0
     bandwidth_amplitude_dps: float = 0.005
-
-
-@dataclass
-class TrackingConfig:
-    """Where and how runs are recorded in MLflow."""
-
-    enabled: bool = True
-    uri: str | None = None  # None: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd
-    experiment: str = "tcbench"
-    sweep_id: str | None = None  # None: derived from the multirun sweep directory
-    plots: bool | None = None  # None: for single runs and compensation runs, not optimisation sweeps
-    resume: bool = False  # skip jobs whose config and seed already FINISHED in this experiment
-    ioh_dir: str | None = None  # also write each run in IOHprofiler's format under this folder
 
 
 @dataclass
