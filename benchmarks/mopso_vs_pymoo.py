@@ -102,7 +102,7 @@ from pymoo.optimize import minimize
 
 from tcbench.metrics.multiobjective import hypervolume, igd
 from tcbench.optimisers import create
-from tcbench.optimisers.pareto import merge_front, nondominated
+from tcbench.pareto import merge_front, nondominated
 from tcbench.tasks.multiobjective import MultiObjectiveProblem, get_problem
 
 BUDGET = 10_000

@@ -3,14 +3,8 @@
 Importing the package registers its tasks with gymnasium under the ``tcbench/`` namespace.
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("tcbench")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
-
-from tcbench import tasks as tasks  # noqa: E402  (registers the gymnasium envs)
-from tcbench.check import OptimizerContractError, check_optimizer  # noqa: E402
+from tcbench import tasks as tasks  # (registers the gymnasium envs)
+from tcbench._version import __version__
+from tcbench.check import OptimizerContractError, check_optimizer
 
 __all__ = ["OptimizerContractError", "__version__", "check_optimizer", "tasks"]

@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.optimisers.pareto import nondominated
 from tcbench.optimisers.protocol import Optimiser
+from tcbench.pareto import nondominated
 
 
 class OptimizerContractError(AssertionError):

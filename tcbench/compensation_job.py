@@ -13,7 +13,7 @@ import yaml
 
 from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
-from tcbench.compensation.validate import learner_of
+from tcbench.compensation_config import learner_of
 from tcbench.config import validate
 from tcbench.runner import CompensationResult, VMDTuning, run_compensation
 from tcbench.tasks import is_gyro

@@ -17,11 +17,13 @@ import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
+from tcbench.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
-from tcbench.optimisers.protocol import coerce_param, make_params
 from tcbench.outputs import folder_problem
+from tcbench.params import coerce_param, make_params
 from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
+from tcbench.tracking_config import TrackingConfig
 
 
 @dataclass
@@ -104,19 +106,6 @@ class GyroTaskConfig(GyroTuningTaskConfig):
 
 
 @dataclass
-class TrackingConfig:
-    """Where and how runs are recorded in MLflow."""
-
-    enabled: bool = True
-    uri: str | None = None  # None: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd
-    experiment: str = "tcbench"
-    sweep_id: str | None = None  # None: derived from the multirun sweep directory
-    plots: bool | None = None  # None: for single runs and compensation runs, not optimisation sweeps
-    resume: bool = False  # skip jobs whose config and seed already FINISHED in this experiment
-    ioh_dir: str | None = None  # also write each run in IOHprofiler's format under this folder
-
-
-@dataclass
 class JobConfig:
     """One optimisation job: task, optimiser, seed and evaluation budget."""
 
@@ -177,8 +166,6 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     if ioh_dir and (problem := folder_problem(ioh_dir)):
         raise ConfigError(f"tracking.ioh_dir={ioh_dir}: {problem}")
     if is_compensation(name):
-        from tcbench.compensation.validate import validate_compensation
-
         validate_compensation(c, checked_task(c["task"], GyroTaskConfig if is_gyro(name) else MSRATaskConfig))
         return
     if c.get("learner"):

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from tcbench.compensation_job import compensation_job_name, compensation_task_key, run_compensation_job
 from tcbench.config import as_dict, validate
 from tcbench.errors import error_line
 from tcbench.runner import RunResult, run_optimisation
@@ -27,8 +28,6 @@ def task_key(task: dict[str, Any]) -> str:
     (``gyro_vmdtuning-dev0`` for the VMD tuning of a gyro, ``bbob-f03-5d`` for BBOB f3 in 5-D,
     whose instances play the part of seeds)."""
     if is_gyro(str(task["name"])):
-        from tcbench.compensation_job import compensation_task_key
-
         return compensation_task_key(task)
     if is_bbob(str(task["name"])):
         return f"bbob-f{task.get('function')!s:0>2}-{task.get('dim')}d"
@@ -104,8 +103,6 @@ def job_name(c: dict[str, Any]) -> str:
     """``<method>-<task key>-s<seed>`` of a job, as its MLflow run is named."""
     try:
         if is_compensation(str(c["task"].get("name"))):
-            from tcbench.compensation_job import compensation_job_name
-
             return compensation_job_name(c)
         return f"{method_label(c['optimiser'])}-{task_key(c['task'])}-s{c['seed']}"
     except Exception:  # noqa: BLE001 - a config too broken to name: its failure still needs a name
@@ -122,8 +119,6 @@ def run_job(cfg: Any) -> RunResult | JobFailure | None:
     try:
         with memory.limited(memory.job_budget_bytes()):
             if is_compensation(str(c["task"].get("name"))):
-                from tcbench.compensation_job import run_compensation_job
-
                 return run_compensation_job(c)  # type: ignore[return-value]
             return _run_optimisation_job(c)
     except (Exception, SystemExit) as exc:  # recorded as FAILED by job_run when tracked

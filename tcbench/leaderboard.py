@@ -17,14 +17,19 @@ shared seeds).
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from tcbench.board_files import (
+    failed_lines,
+    markdown_table,
+    one_run_per_job,
+    search_runs,
+    write_board_files,
+)
 from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
 COLUMNS = [
@@ -47,24 +52,6 @@ class Board:
     runs: pd.DataFrame
     target_precision: float
     f_opt: float
-
-
-def search_runs(client, experiments: list[str], kind: str, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
-    """Every MLflow run of ``kind`` (``optimisation``, ``compensation``) in the experiments,
-    optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
-    ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
-    if not ids:
-        raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
-    query = f"tags.`tcbench.kind` = '{kind}'"
-    if sweep:
-        query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
-    token = None
-    while True:
-        page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)
-        yield from page
-        token = page.token
-        if not token:
-            break
 
 
 def sweep_runs(client, experiments: list[str], sweep: str) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -167,19 +154,6 @@ def is_multiobjective(runs: pd.DataFrame) -> bool:
     return "hypervolume" in runs and bool(runs["hypervolume"].notna().any())
 
 
-def one_run_per_job(runs: pd.DataFrame, keys: tuple[str, ...] = ("task", "method", "config_hash", "seed")
-                    ) -> pd.DataFrame:
-    """Keep one run per job (task, method, config, seed): the latest FINISHED one, else the
-    latest attempt, so a resumed or repeated sweep does not count a seed twice. ``keys`` without
-    ``config_hash`` keeps one run per method and seed even when configs sharing a method name differ
-    (e.g. the gyro oracle, the same whatever the pipeline settings beside it)."""
-    if runs.empty:
-        return runs
-    order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
-    keys = list(keys)
-    return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
-
-
 def boards(runs: pd.DataFrame) -> list[Board]:
     """One :class:`Board` per task in ``runs`` (one run per job, see :func:`one_run_per_job`)."""
     out = []
@@ -236,24 +210,6 @@ def _front_plot(board: Board, client, path: Path) -> bool:  # type: ignore[no-un
     return True
 
 
-def _fmt(value: object) -> str:
-    if isinstance(value, (float, np.floating)):
-        if np.isinf(value):
-            return "∞"
-        if np.isnan(value):
-            return "–"
-        return f"{value:.3g}"
-    return str(value)
-
-
-def markdown_table(table: pd.DataFrame) -> str:
-    """A pandas table as a GitHub markdown table."""
-    head = "| " + " | ".join(table.columns) + " |"
-    rule = "|" + "|".join("---" for _ in table.columns) + "|"
-    body = ["| " + " | ".join(_fmt(v) for v in row) + " |" for row in table.itertuples(index=False)]
-    return "\n".join([head, rule, *body])
-
-
 def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]:  # type: ignore[no-untyped-def]
     """Write ``<task>.md``, ``<task>.csv`` and ``<task>_convergence.png`` into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -299,20 +255,3 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
         lines += [f"![front]({paths['front'].name})", ""]
     write_board_files(lines + failed_lines(failed), board.table, paths)
     return paths
-
-
-def failed_lines(failed: pd.DataFrame) -> list[str]:
-    """Markdown lines listing failed or unfinished runs (none when there are none)."""
-    if not len(failed):
-        return []
-    return ["Failed or unfinished runs:", "",
-            *[f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip() for r in failed.itertuples()], ""]
-
-
-def write_board_files(lines: list[str], table: pd.DataFrame, paths: dict[str, Path]) -> None:
-    """Write the markdown ``lines`` and the ``table`` CSV, each renamed into place when complete."""
-    tmp_md, tmp_csv = paths["md"].with_suffix(".md.tmp"), paths["csv"].with_suffix(".csv.tmp")
-    tmp_md.write_text("\n".join(lines))
-    table.to_csv(tmp_csv, index=False)
-    tmp_md.replace(paths["md"])
-    tmp_csv.replace(paths["csv"])

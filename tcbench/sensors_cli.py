@@ -11,7 +11,7 @@ from typing import Any
 from omegaconf import OmegaConf
 from omegaconf.errors import OmegaConfBaseException
 
-from tcbench.config import TrackingConfig
+from tcbench.tracking_config import TrackingConfig
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 

@@ -26,7 +26,7 @@ import mlflow  # noqa: E402
 from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
-import tcbench  # noqa: E402
+from tcbench._version import __version__  # noqa: E402
 from tcbench.errors import error_line  # noqa: E402
 
 TAG_PREFIX = "tcbench."
@@ -201,7 +201,7 @@ def config_hash(cfg: Mapping[str, Any]) -> str:
 def git_commit() -> str:
     """Commit of the tcbench source tree, or ``unknown`` outside a git checkout (asked once per
     process)."""
-    src = Path(tcbench.__file__).resolve().parent
+    src = Path(__file__).resolve().parent
     try:
         out = subprocess.run(
             ["git", "-C", str(src), "rev-parse", "HEAD"],
@@ -327,7 +327,7 @@ def job_run(
     c = client(uri)
     exp = _experiment_id(uri, track["experiment"])
     all_tags = {
-        f"{TAG_PREFIX}version": tcbench.__version__,
+        f"{TAG_PREFIX}version": __version__,
         f"{TAG_PREFIX}git_commit": git_commit(),
         f"{TAG_PREFIX}config_hash": config_hash(cfg),
         f"{TAG_PREFIX}host": _host(),

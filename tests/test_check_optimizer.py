@@ -113,7 +113,7 @@ def test_not_an_optimiser() -> None:
 
 
 def test_merge_front_equals_full_recomputation() -> None:
-    from tcbench.optimisers.pareto import merge_front, nondominated
+    from tcbench.pareto import merge_front, nondominated
 
     rng = np.random.default_rng(0)
     front_x = np.empty((0, 1))

@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from optimiser_runs import drive
 
 from tcbench.check import check_optimizer
@@ -30,7 +29,7 @@ from tcbench.optimisers.mopso import (
     update_archive,
     velocity,
 )
-from tcbench.optimisers.pareto import nondominated
+from tcbench.pareto import nondominated
 
 CONF = Path(__file__).resolve().parents[1] / "tcbench" / "conf" / "optimiser" / "mopso.yaml"
 

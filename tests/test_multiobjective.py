@@ -13,7 +13,7 @@ import yaml
 from gymnasium.utils.env_checker import check_env
 
 from tcbench.metrics.multiobjective import hypervolume, igd, igd_plus
-from tcbench.optimisers.pareto import dominates, nondominated
+from tcbench.pareto import dominates, nondominated
 from tcbench.tasks.function_env import BudgetExceededError
 from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
 from tcbench.tasks.multiobjective import (

@@ -8,6 +8,7 @@ import statistics
 
 import numpy as np
 import pytest
+from optimiser_runs import drive
 from pymoo.algorithms.moo.moead import MOEAD as PymooMOEAD
 from pymoo.algorithms.moo.nsga2 import NSGA2 as PymooNSGA2
 from pymoo.optimize import minimize
@@ -24,9 +25,8 @@ from tcbench_peers.seeding import library_seed
 
 from tcbench import check_optimizer
 from tcbench.optimisers import available
-from tcbench.optimisers.pareto import nondominated
+from tcbench.pareto import nondominated
 from tcbench.runner import run_optimisation
-from optimiser_runs import drive
 
 
 def two_spheres(x: np.ndarray) -> np.ndarray:

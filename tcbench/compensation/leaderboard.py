@@ -19,14 +19,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench.compensation.scoring import METRIC_NAMES, PRIMARY, TRAIN_RMSE
-from tcbench.leaderboard import (
+from tcbench.board_files import (
     failed_lines,
     markdown_table,
     one_run_per_job,
     search_runs,
     write_board_files,
 )
+from tcbench.compensation.scoring import METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
 PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp", "gyro_driftnoise": "gyro"}

@@ -20,7 +20,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from tcbench.optimisers.protocol import make_params
+from tcbench.params import make_params
 
 
 @dataclass(frozen=True)

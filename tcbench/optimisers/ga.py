@@ -56,8 +56,8 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.optimisers.pareto import dominates
 from tcbench.optimisers.protocol import Optimiser, OptimiserParams
+from tcbench.pareto import dominates
 
 _SAME = 1e-14  # parents closer than this in a variable are not crossed there (NSGA-II code)
 TOURNAMENTS = ("permutation", "random")

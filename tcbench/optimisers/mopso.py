@@ -70,8 +70,8 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.optimisers.pareto import nondominated
 from tcbench.optimisers.protocol import Optimiser, OptimiserParams, ParetoSet
+from tcbench.pareto import nondominated
 
 BOUND_VELOCITY = ("reverse", "zero")
 

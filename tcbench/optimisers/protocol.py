@@ -10,14 +10,14 @@ and the best point seen so far. Subclasses implement :meth:`_ask` and :meth:`_te
 
 from __future__ import annotations
 
-import dataclasses
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from tcbench.optimisers.pareto import merge_front
+from tcbench.params import coerce_param, make_params  # noqa: F401  (plugins import both from here)
+from tcbench.pareto import merge_front
 
 
 class ProtocolError(RuntimeError):
@@ -227,46 +227,3 @@ class Optimiser(ABC):
     def uniform(self, n: int) -> np.ndarray:
         """``n`` points drawn uniformly in the bounds."""
         return self.rng.uniform(self.lower, self.upper, size=(n, self.dim))
-
-
-def make_params(cls: type[Optimiser], params: OptimiserParams | dict[str, Any] | None) -> OptimiserParams:
-    """Build and validate ``cls.Params`` from a dataclass instance, a mapping or ``None``."""
-    if isinstance(params, cls.Params):
-        return params
-    values = dict(params or {})
-    known = {f.name: f for f in dataclasses.fields(cls.Params)}
-    unknown = sorted(set(values) - set(known))
-    if unknown:
-        raise ValueError(
-            f"{cls.name} has no parameter {', '.join(map(repr, unknown))}; "
-            f"known: {', '.join(sorted(known))}"
-        )
-    for key, value in values.items():
-        values[key] = coerce_param(cls.name, key, known[key].type, value)
-    return cls.Params(**values)
-
-
-def coerce_param(owner: str, key: str, annotation: Any, value: Any) -> Any:
-    """Check a parameter value against a simple annotation (int, float, bool, str, optional)."""
-    ann = str(annotation)
-    optional = "None" in ann
-    if value is None:
-        if optional:
-            return None
-        raise ValueError(f"{owner}.{key} must not be null")
-    base = ann.replace("| None", "").replace("Optional[", "").replace("]", "").strip()
-    if base == "bool":
-        if isinstance(value, bool):
-            return value
-    elif base == "int":
-        if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
-            return int(value)
-    elif base == "float":
-        if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
-            return float(value)
-    elif base == "str":
-        if isinstance(value, str):
-            return value
-    else:
-        return value
-    raise ValueError(f"{owner}.{key} must be {base}, got {value!r}")

@@ -26,7 +26,7 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.metrics.multiobjective import hypervolume
-from tcbench.optimisers.pareto import merge_front
+from tcbench.pareto import merge_front
 from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.multiobjective import PROBLEMS, MultiObjectiveProblem, get_problem

@@ -1,4 +1,5 @@
-"""Pareto dominance for minimisation, vectorised over a population."""
+"""Pareto dominance for minimisation, vectorised over a population: a leaf module (numpy only) that
+the optimisers, the multi-objective tasks and the optimiser checks share."""
 
 from __future__ import annotations
 

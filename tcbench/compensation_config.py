@@ -1,4 +1,5 @@
-"""Checks of a compensation job's config before any job starts (one line per problem)."""
+"""Checks of a compensation job's config before any job starts (one line per problem): above the
+compensation, gyro and task layers it checks, below the config and job modules that call it."""
 
 from __future__ import annotations
 
@@ -14,8 +15,8 @@ from tcbench.errors import ConfigError
 from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
-from tcbench.optimisers.protocol import make_params
-from tcbench.tasks import task_kwargs
+from tcbench.params import make_params
+from tcbench.tasks import GyroDriftNoiseEnv, MSRACompensationEnv, is_gyro, task_kwargs
 
 
 def _error(message: str) -> Exception:
@@ -26,13 +27,11 @@ def learner_of(c: dict[str, Any]) -> dict[str, Any]:
     """The job's learner config; ``conf/learner/bp.yaml`` when none is given."""
     if c.get("learner"):
         return dict(c["learner"])
-    return dict(yaml.safe_load((Path(__file__).resolve().parents[1] / "conf" / "learner" / "bp.yaml").read_text()))
+    return dict(yaml.safe_load((Path(__file__).resolve().parent / "conf" / "learner" / "bp.yaml").read_text()))
 
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
     """Learner, optimiser and task of a compensation job; raise ConfigError naming the key."""
-    from tcbench.tasks import GyroDriftNoiseEnv, MSRACompensationEnv, is_gyro
-
     gyro = is_gyro(str(task["name"]))
     learner = learner_of(c)
     name = str(learner.pop("name", None))

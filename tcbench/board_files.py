@@ -1,0 +1,78 @@
+"""What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard`) and compensation
+(:mod:`tcbench.compensation.leaderboard`): the MLflow runs of a kind, one run per job, markdown tables
+and the board files. A leaf module (numpy and pandas only)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+
+def search_runs(client, experiments: list[str], kind: str, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
+    """Every MLflow run of ``kind`` (``optimisation``, ``compensation``) in the experiments,
+    optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
+    ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
+    if not ids:
+        raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
+    query = f"tags.`tcbench.kind` = '{kind}'"
+    if sweep:
+        query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
+    token = None
+    while True:
+        page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)
+        yield from page
+        token = page.token
+        if not token:
+            break
+
+
+def one_run_per_job(runs: pd.DataFrame, keys: tuple[str, ...] = ("task", "method", "config_hash", "seed")
+                    ) -> pd.DataFrame:
+    """Keep one run per job (task, method, config, seed): the latest FINISHED one, else the
+    latest attempt, so a resumed or repeated sweep does not count a seed twice. ``keys`` without
+    ``config_hash`` keeps one run per method and seed even when configs sharing a method name differ
+    (e.g. the gyro oracle, the same whatever the pipeline settings beside it)."""
+    if runs.empty:
+        return runs
+    order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
+    keys = list(keys)
+    return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
+
+
+def _fmt(value: object) -> str:
+    if isinstance(value, (float, np.floating)):
+        if np.isinf(value):
+            return "∞"
+        if np.isnan(value):
+            return "–"
+        return f"{value:.3g}"
+    return str(value)
+
+
+def markdown_table(table: pd.DataFrame) -> str:
+    """A pandas table as a GitHub markdown table."""
+    head = "| " + " | ".join(table.columns) + " |"
+    rule = "|" + "|".join("---" for _ in table.columns) + "|"
+    body = ["| " + " | ".join(_fmt(v) for v in row) + " |" for row in table.itertuples(index=False)]
+    return "\n".join([head, rule, *body])
+
+
+def failed_lines(failed: pd.DataFrame) -> list[str]:
+    """Markdown lines listing failed or unfinished runs (none when there are none)."""
+    if not len(failed):
+        return []
+    return ["Failed or unfinished runs:", "",
+            *[f"- {r.method} seed {r.seed}: {r.status} {r.error_message}".rstrip() for r in failed.itertuples()], ""]
+
+
+def write_board_files(lines: list[str], table: pd.DataFrame, paths: dict[str, Path]) -> None:
+    """Write the markdown ``lines`` and the ``table`` CSV, each renamed into place when complete."""
+    tmp_md, tmp_csv = paths["md"].with_suffix(".md.tmp"), paths["csv"].with_suffix(".csv.tmp")
+    tmp_md.write_text("\n".join(lines))
+    table.to_csv(tmp_csv, index=False)
+    tmp_md.replace(paths["md"])
+    tmp_csv.replace(paths["csv"])
