@@ -20,6 +20,7 @@ tunes them on ``tcbench/Gyro-VMDTuning-v0`` (MOPSO by default, §3.2).
 from __future__ import annotations
 
 import dataclasses
+from importlib.metadata import entry_points
 from typing import Any
 
 import gymnasium as gym
@@ -46,14 +47,12 @@ PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
 def _check_tuner(name: object) -> None:
-    """The VMD tuner: a registered multi-objective optimiser (its parameters and budget are checked
-    by the job's config validation, which knows the tuning budget it is run with)."""
-    from tcbench.optimisers import registry as optimisers
-
-    if not isinstance(name, str):
-        raise ValueError(f"tuner must be the name of a multi-objective optimiser, got {name!r}")
-    if not optimisers.get(name).multi_objective:
-        raise ValueError(f"tuner: optimiser {name} is single-objective; VMD tuning has 2 objectives")
+    """The VMD tuner: the name of a registered optimiser, read from the entry points so that tasks
+    do not import the optimisers (whether it is multi-objective, and its parameters and budget, are
+    checked by the job's config validation, which runs it)."""
+    known = sorted(entry_points(group="tcbench.optimisers").names)
+    if not isinstance(name, str) or name not in known:
+        raise ValueError(f"tuner must be the name of a multi-objective optimiser ({', '.join(known)}), got {name!r}")
 
 
 class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
