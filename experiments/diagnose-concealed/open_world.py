@@ -10,8 +10,9 @@ truth by fixed rules (``tcbench.diagnose.open_world.score``, README.md). Writes,
 ``open_world.csv`` (one row per recording), ``open_world.md`` (targets, per kind, worst cases)
 and ``open_world.png`` (kind x shapes stated); ``--quick`` writes ``open_world_quick.*`` instead.
 
-Seeds: the proof draws from 41 000 000 on; ``--quick`` from 40 900 000 (development seeds, which
-may be looked at while building the detectors; the proof's seeds must not be).
+Seeds: the proof draws from :data:`FIRST_SEED` (44 000 000) on; ``--quick`` from 40 900 000
+(development seeds, which may be looked at while building the detectors; the proof's seeds must
+not be). Earlier proofs, each on fresh seeds before a change: 41 000 000 and 43 000 000 (README).
 
     python experiments/diagnose-concealed/open_world.py --workers 2
     python experiments/diagnose-concealed/open_world.py --quick --workers 1

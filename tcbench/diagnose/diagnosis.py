@@ -243,17 +243,23 @@ def diagnose(
     recording that cannot show anything.
 
     Where the thermometer smoothing fitted to the profile (:func:`~tcbench.diagnose.signals.fitted_window_s`)
-    is shorter than the default, the record is diagnosed at both windows and the one whose final
-    model has the lower held-out error is kept (``statistics.thermometer_smooth_tried_s``): a
-    window short enough to follow the profile's corners can leave the output's model with less
-    to work on (on the tofupilot chamber cycle, 7.5 s against 120 s made the final model 1.5x
-    worse), and held-out error is the judge the diagnosis uses for everything else."""
+    is shorter than the default, the record is diagnosed at both windows, and the default is kept
+    when its final model lowers the held-out squared error by more than the open-world gain
+    threshold (``statistics.thermometer_smooth_tried_s``): a window short enough to follow the
+    profile's corners can leave the output's model with less to work on (on the tofupilot chamber
+    cycle, 7.5 s against 120 s made the final model 1.5x worse), while on a short record with
+    nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
+    paid for like a term, is the judge the diagnosis uses for everything else."""
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     if nonmean.default_smooth_s >= DEFAULT_SMOOTH_S:
         return _diagnose(rec, nonmean, sensor, declared or {}, name, threshold)
     tried = [_diagnose(rec, nm, sensor, declared or {}, name, threshold)
              for nm in (nonmean, NonMean.before(rec, window_s=DEFAULT_SMOOTH_S))]
-    best = min(tried, key=lambda d: d.final["rmse_heldout"])
+    fitted, default = tried
+    # the default window is a model choice like a term: it must pay the open-world gain threshold
+    sse = [d.final["rmse_heldout"] ** 2 * d.noise["samples"] for d in tried]
+    gain = (sse[0] - sse[1]) / fitted.noise["white_sigma"] ** 2
+    best = default if gain > OPEN_THRESHOLD else fitted
     best.statistics["thermometer_smooth_tried_s"] = {
         f"{d.statistics.get('thermometer_smooth_s', DEFAULT_SMOOTH_S):g}": round(float(d.final["rmse_heldout"]), 6)
         for d in tried}
