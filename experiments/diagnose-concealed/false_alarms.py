@@ -9,7 +9,7 @@ except the documented refusal (``DiagnosisDataError``) of a record shorter than 
 minimum (30 min, 200 samples), which is counted as ``refused``. Writes ``false_alarms.md`` and
 ``false_alarms.csv``.
 
-    python experiments/diagnose-concealed/false_alarms.py            # proof: seeds 45 000 000 + i
+    python experiments/diagnose-concealed/false_alarms.py --per-cell 4 --workers 2  # proof: seeds 45 300 000 + i
     python experiments/diagnose-concealed/false_alarms.py --dev      # tuning: seeds 44 900 000 + i
     python experiments/diagnose-concealed/false_alarms.py --high-rate  # 30 min at 200 Hz: 45 500 000 + i
 """
@@ -108,7 +108,7 @@ def cells(df: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
-def summary(df: pd.DataFrame, wall_s: float, seeds: str, proof: bool) -> str:
+def summary(df: pd.DataFrame, wall_s: float, seeds: str, proof: bool, workers: int = 1) -> str:
     """The markdown report."""
     diagnosed = df[df.outcome.isin(["clean", "alarm"])]
     n, alarms = len(diagnosed), int((diagnosed.outcome == "alarm").sum())
@@ -120,7 +120,7 @@ def summary(df: pd.DataFrame, wall_s: float, seeds: str, proof: bool) -> str:
         "",
         f"Controls with nothing hidden (minimal model + white noise; `tcbench.diagnose.forms`), "
         f"{len(df)} records, seeds {seeds} ({'proof seeds, never used while tuning' if proof else 'development seeds'}); "
-        f"wall time {wall_s / 60:.1f} min on one worker. A control is a false alarm when `report.json` names "
+        f"wall time {wall_s / 60:.1f} min on {workers} worker(s). A control is a false alarm when `report.json` names "
         f"any effect (the open-world rule). Records shorter than the diagnosis's 30-min minimum are refused "
         f"with `DiagnosisDataError` by design; any other exception is a crash.",
         "",
@@ -168,7 +168,7 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     df.to_csv(out / f"{stem}.csv", index=False, float_format="%.6g")
-    text = summary(df, wall_s, f"{seed_base}-{seed_base + len(jobs) - 1}", proof=seed_base == PROOF_SEED)
+    text = summary(df, wall_s, f"{seed_base}-{seed_base + len(jobs) - 1}", proof=seed_base == PROOF_SEED, workers=args.workers)
     (out / f"{stem}.md").write_text(text)
     print(text)
     print(f"CPU {os.times().user:.0f} s")
