@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,7 +25,9 @@ def learner_of(c: dict[str, Any]) -> dict[str, Any]:
     """The job's learner config; ``conf/learner/bp.yaml`` when none is given."""
     if c.get("learner"):
         return dict(c["learner"])
-    return dict(yaml.safe_load((Path(__file__).resolve().parents[1] / "conf" / "learner" / "bp.yaml").read_text()))
+    from tcbench.config_dir import conf_dir
+
+    return dict(yaml.safe_load((conf_dir() / "learner" / "bp.yaml").read_text()))
 
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
