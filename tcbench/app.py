@@ -102,6 +102,7 @@ def with_overrides(args: list[str], extra: list[str]) -> list[str]:
 
 def plan(args: list[str]) -> Plan:
     """Compose and validate every job of a command line; raise ConfigError on the first bad one."""
+    conf_dir()  # one line naming the problem when the installed configs are missing
     multirun = "-m" in args or "--multirun" in args
     raw = overrides_of(args)
     parser = OverridesParser.create()

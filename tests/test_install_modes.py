@@ -40,6 +40,15 @@ def test_configs_resolve_in_this_install() -> None:
         assert root.resolve() == (REPO / "conf").resolve()
 
 
+def test_missing_configs_are_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import tcbench.config_dir as where
+    from tcbench.errors import ConfigError
+
+    monkeypatch.setattr(where, "files", lambda _module: tmp_path)  # e.g. a stale tcbench/conf/ folder
+    with pytest.raises(ConfigError, match="leftover tcbench/conf/"):
+        where.conf_dir()
+
+
 def test_primary_config_composes() -> None:
     from hydra import compose, initialize_config_module
 
