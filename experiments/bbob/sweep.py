@@ -77,9 +77,10 @@ def base_configs(methods: list[str], ioh_dir: Path) -> dict[str, dict[str, Any]]
     """The composed job config of each method (``task=bbob optimiser=<m>``, tracking off)."""
     from hydra import compose, initialize_config_module
 
-    from tcbench.config import as_dict
+    from tcbench.config import as_dict, register_schema
     from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME
 
+    register_schema()  # config.yaml's defaults start from the structured schema
     out = {}
     with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
         for m in methods:
