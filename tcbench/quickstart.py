@@ -13,6 +13,7 @@ The sizes are :data:`SIZES`; the test suite runs :data:`TEST_SIZES`.
 
 from __future__ import annotations
 
+import textwrap
 import time
 import uuid
 from dataclasses import dataclass
@@ -59,6 +60,11 @@ def _rule(title: str) -> str:
     return f"\n== {title} " + "=" * max(0, 90 - len(title))
 
 
+def _say(text: str) -> None:
+    """Print a paragraph wrapped to 100 columns."""
+    print(textwrap.fill(text, width=100))
+
+
 def _fmt(x: Any) -> str:
     return f"{x:.3g}" if isinstance(x, float) else str(x)
 
@@ -87,7 +93,7 @@ def run(sizes: Sizes | None = None, out: Path = OUT) -> int:
 
     print(_rule("1. Compensating a sensor: MSRA zero-bias stability (seed 000 §3, Table 1)"))
     n_bp, budget, epochs = sizes.seeds or DEFAULT_SEEDS, sizes.budget or 510, sizes.epochs or 1000
-    print(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
+    _say(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
           f"the paper: 30), each with {budget} evaluations of IFA's weight search (population 10) and {epochs} "
           "gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
     checked = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}", *size_overrides, *seeds])
@@ -111,6 +117,8 @@ def run(sizes: Sizes | None = None, out: Path = OUT) -> int:
     print(f"  browse: mlflow ui --backend-store-uri {uri}")
     print(f"Leaderboard: {', '.join(str(p.resolve()) for p in board_paths)}")
     print(f"Diagnosis report and plots: {', '.join(str(p.resolve()) for p in diag_paths)}")
+    print("Per-run figures (the paper's Fig. 7 for each test recording), scores.json and the training curves are")
+    print("  artifacts of each compensation run in MLflow.")
     print(f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/")
     print(f"Took {compensation_s:.0f} s (compensation) + {diagnosis_s:.0f} s (diagnosis).")
     print()
@@ -132,7 +140,8 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
         t = board.table
         oracle = t.loc[t["method"] == "oracle", f"median_{s}"]
         limit = float(oracle.iloc[0]) if len(oracle) else float("nan")
-        print(f"\nLeaderboard {board.task}: zero-bias stability from power-on ({primary}: 1σ of 10 s means of "
+        print()
+        _say(f"Leaderboard {board.task}: zero-bias stability from power-on ({primary}: 1σ of 10 s means of "
               "the compensated 0 g output, mean of the 2 test recordings, µg; lower is better). "
               "oracle = the simulator's own model at the true die temperature: noise alone, the physical limit.")
         rows = [[r.rank, r.method, r.runs, r.failed, getattr(r, f"median_{s}"), getattr(r, f"ci95_{s}"),
@@ -149,7 +158,8 @@ def _where(where: dict[str, Any]) -> str:
     parts = []
     for k, v in where.items():
         if isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v):
-            parts.append(f"{k} {v[0]:.3g}..{v[1]:.3g}")
+            name, unit = {"temperature_c": ("temperature", " °C"), "time_s": ("time", " s")}.get(k, (k, ""))
+            parts.append(f"{name} {v[0]:.3g}..{v[1]:.3g}{unit}")
         else:
             parts.append(f"{k} {v}")
     return ", ".join(parts) or "the whole record"
@@ -165,7 +175,7 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
 
     rec, hidden = concealed_recording(sizes.diagnose_sensor, sizes.diagnose_effect, sizes.diagnose_seed)
     length = f"{(rec.time_s[-1] - rec.time_s[0]) / 3600:.1f} h"
-    print(f"A simulated {hidden.sensor.upper()} chamber recording ({length} at 1 Hz, seed {hidden.seed}) with one "
+    _say(f"A simulated {hidden.sensor.upper()} chamber recording ({length} at 1 Hz, seed {hidden.seed}) with one "
           f"effect hidden under the noise: {hidden.effect} ({', '.join(f'{k} {v:.4g}' for k, v in hidden.params.items())}). "
           "The diagnosis is not told which; it starts from the minimal model (bias and scale factor "
           "quadratic in the thermometer temperature, white noise) and tests the library's effects.")

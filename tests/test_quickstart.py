@@ -37,7 +37,7 @@ def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
     assert "physical limit" in table
 
     assert "Verdict: missing: thermal_lag" in out and "the hidden effect was thermal_lag: found" in out
-    assert "found thermal_lag" in out and "where: temperature_c" in out and "in sigma" in out
+    assert "found thermal_lag" in out and "where: temperature " in out and "in sigma" in out
     assert "Next steps" in out
 
     named = [Path(p) for line in out.splitlines() if line.startswith(("Leaderboard: ", "Diagnosis report"))
