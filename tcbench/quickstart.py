@@ -27,14 +27,16 @@ tcbench: a benchmark for temperature compensation of MEMS inertial sensors. It s
 weight searches, against the polynomial flight stacks ship and the physical limit), and diagnoses
 what a model or simulator leaves out of a recording. Every job is a run in MLflow."""
 NEXT_STEPS = """\
-Next steps (the full experiments):
-  tcbench run -m experiment=paper_ifa_bp          seed 000 Tables 1-2: 30 trainings per method, both MSRA tasks
-  bash experiments/paper_ifa_bp/run.sh            the same with raw, poly, oracle and the paper's tables
-  tcbench run -m task=msra_fulltemp learner=bp optimiser=fa,ifa seed='range(30)'   full-temperature task
-  tcbench simulate sensor=msra out=rec            a recording of your own; tcbench import csv=... for real data
-  tcbench diagnose recording=rec/<file>.csv out=diagnosis    what a recording shows that the model misses
-  tcbench run -m experiment=paper_fa_ifa          FA against IFA on the paper's benchmark functions
-  tcbench --help                                  every command; tcbench <command> --help for its parameters"""
+Next steps (the full experiments, from the repository root; the paper's studies compare with CMA-ES
+from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
+  bash experiments/paper_ifa_bp/run.sh     seed 000 Tables 1-2: 30 trainings per method on both MSRA tasks,
+                                           with raw, poly, the oracle and the paper's tables
+  tcbench run -m task=msra_fulltemp learner=bp optimiser=fa,ifa seed='range(30)'   the full-temperature task
+  tcbench simulate sensor=msra out=rec     a simulated recording with every effect of the device; then
+  tcbench diagnose recording=rec/msra-fulltemp-dev0-seed0.csv out=diagnosis   (tcbench import: your CSV)
+  python experiments/diagnose-concealed/run.py --workers 2   every hidden effect and controls, 80 recordings
+  tcbench run -m experiment=paper_fa_ifa   FA against IFA on the paper's benchmark functions
+  tcbench --help                           every command; tcbench <command> --help for its parameters"""
 
 
 @dataclass(frozen=True)
