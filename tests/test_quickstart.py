@@ -59,3 +59,17 @@ def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
     m = diag.data.metrics
     assert m["rmse_heldout_after_sigma"] < m["rmse_heldout_before_sigma"] and m["hidden_effect_found"] == 1
     assert {"report.md", "report.json", "model.yaml"} <= {a.path for a in client.list_artifacts(diag.info.run_id)}
+
+
+@pytest.mark.slow
+def test_full_quickstart_ranks_ifa_bp_between_the_oracle_and_poly(workdir: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """The full size (about a minute on 2 cores): the paper's IFA-BP beats the polynomial and stays
+    above the physical limit; the numbers the README quotes."""
+    assert main(["quickstart"]) == 0
+    out = capsys.readouterr().out
+    rows = {ln.split()[1]: ln.split() for ln in out.split("Leaderboard msra_zerobias-dev0")[1].split("== 2.")[0]
+            .splitlines() if re.match(r"\s+\d+\s", ln)}
+    assert [rows[m][0] for m in ("oracle", "IFA-BP-gd", "poly3", "raw")] == ["1", "2", "3", "4"]
+    assert rows["IFA-BP-gd"][4] == "19.1" and rows["poly3"][4] == "21" and rows["oracle"][4] == "6.89"
+    assert "IFA-BP trained 5 times" in out and "minimal + thermal_lag" in out
