@@ -329,7 +329,7 @@ def _quickstart_help() -> str:
         "     what the diagnosis finds, where, and the held-out RMSE before and after in noise sigmas.",
         "Takes no parameters; deterministic (same seeds, same numbers). Run `tcbench run -m",
         "experiment=quickstart` with your own key=value overrides to change the compensation sweep.",
-        "Its settings (tcbench/conf/experiment/quickstart.yaml):", "",
+        "Its settings (conf/experiment/quickstart.yaml):", "",
         *(f"  {ln}" for ln in settings), "",
         "examples:", "  tcbench quickstart", "  tcbench run -m experiment=quickstart 'seed=range(30)'", "",
         "output: runs in MLflow (./mlflow.db, experiment quickstart: one per compensation job and one",
