@@ -5,20 +5,19 @@ from __future__ import annotations
 import itertools
 import logging
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import hydra
-from hydra import compose, initialize_config_dir
+from hydra import compose, initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
 from tcbench.config import ConfigError, as_dict, register_schema, validate
+from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
 from tcbench.job import run_job
 
-CONF_DIR = Path(__file__).resolve().parent / "conf"
 # Hydra flags followed by a value; those that change where configs come from make tcbench
 # skip its up-front check (each job still validates its own config).
 VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
@@ -28,7 +27,7 @@ log = logging.getLogger(__name__)
 register_schema()
 
 
-@hydra.main(version_base="1.3", config_path="conf", config_name="config")
+@hydra.main(version_base="1.3", config_path=SEARCH_PATH, config_name=CONFIG_NAME)
 def hydra_main(cfg: DictConfig) -> None:
     """Hydra task function: one job per call."""
     run_job(cfg)
@@ -47,7 +46,7 @@ class Plan:
 
 
 def _known_options(group: str) -> list[str]:
-    return sorted(p.stem for p in (CONF_DIR / group).glob("*.yaml"))
+    return sorted(p.stem for p in (conf_dir() / group).glob("*.yaml"))
 
 
 def _explain(exc: Exception) -> str:
@@ -68,7 +67,7 @@ def _explain(exc: Exception) -> str:
 
 def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
     try:
-        return compose("config", overrides=overrides, return_hydra_config=hydra_cfg)
+        return compose(CONFIG_NAME, overrides=overrides, return_hydra_config=hydra_cfg)
     except (HydraException, OmegaConfBaseException, ValueError) as exc:
         raise ConfigError(_explain(exc)) from None
 
@@ -103,6 +102,7 @@ def with_overrides(args: list[str], extra: list[str]) -> list[str]:
 
 def plan(args: list[str]) -> Plan:
     """Compose and validate every job of a command line; raise ConfigError on the first bad one."""
+    conf_dir()  # one line naming the problem when the installed configs are missing
     multirun = "-m" in args or "--multirun" in args
     raw = overrides_of(args)
     parser = OverridesParser.create()
@@ -110,7 +110,7 @@ def plan(args: list[str]) -> Plan:
         parsed = parser.parse_overrides(raw)
     except HydraException as exc:
         raise ConfigError(_explain(exc)) from None
-    with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
+    with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
         fixed = [o.input_line for o in parsed if not o.is_sweep_override()]
         sweeps = {o.get_key_element(): list(o.sweep_string_iterator()) for o in parsed if o.is_sweep_override()}
         if sweeps and not multirun:

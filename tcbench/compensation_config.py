@@ -3,7 +3,6 @@ compensation, gyro and task layers it checks, below the config and job modules t
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -11,6 +10,7 @@ import yaml
 
 from tcbench.compensation.data import TaskDataError, file_data
 from tcbench.compensation.methods import BASELINES
+from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
 from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
@@ -27,7 +27,7 @@ def learner_of(c: dict[str, Any]) -> dict[str, Any]:
     """The job's learner config; ``conf/learner/bp.yaml`` when none is given."""
     if c.get("learner"):
         return dict(c["learner"])
-    return dict(yaml.safe_load((Path(__file__).resolve().parent / "conf" / "learner" / "bp.yaml").read_text()))
+    return dict(yaml.safe_load((conf_dir() / "learner" / "bp.yaml").read_text()))
 
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:

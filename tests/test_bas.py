@@ -270,13 +270,12 @@ def test_swarm_of_beetles_converges() -> None:
 
 def test_defaults_mirror_the_yaml() -> None:
     import dataclasses
-    from pathlib import Path
 
     import yaml
 
-    import tcbench
+    from tcbench.config_dir import conf_dir
 
-    conf = Path(tcbench.__file__).parent / "conf" / "optimiser" / "bas.yaml"
+    conf = conf_dir() / "optimiser" / "bas.yaml"
     values = yaml.safe_load(conf.read_text())
     assert values.pop("name") == BeetleAntennaeSearch.name == "bas"
     assert values == dataclasses.asdict(BASParams())

@@ -19,7 +19,7 @@ NAMED = {
     "leaderboard": ["usage: tcbench leaderboard", "--experiment", "--sweep", "--out", "--tracking-uri", "--ecdf",
                     "examples:", "output:"],
     "list": ["usage: tcbench list", "no", "output:"],
-    "quickstart": ["usage: tcbench quickstart", "budget: 510", "seed: range(10)", "examples:", "output:"],
+    "quickstart": ["usage: tcbench quickstart", "budget: 510", "seed: range(5)", "thermal_lag", "examples:", "output:"],
 }
 
 

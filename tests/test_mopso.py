@@ -4,7 +4,6 @@ the ask/tell loop, and convergence on ZDT1."""
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +11,7 @@ import yaml
 from optimiser_runs import drive
 
 from tcbench.check import check_optimizer
+from tcbench.config_dir import conf_dir
 from tcbench.optimisers.mopso import (
     MOPSO,
     MOPSOParams,
@@ -31,7 +31,7 @@ from tcbench.optimisers.mopso import (
 )
 from tcbench.pareto import nondominated
 
-CONF = Path(__file__).resolve().parents[1] / "tcbench" / "conf" / "optimiser" / "mopso.yaml"
+CONF = conf_dir() / "optimiser" / "mopso.yaml"
 
 
 def zdt1(x: np.ndarray) -> np.ndarray:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -12,6 +11,7 @@ import pytest
 import yaml
 from gymnasium.utils.env_checker import check_env
 
+from tcbench.config_dir import conf_dir
 from tcbench.metrics.multiobjective import hypervolume, igd, igd_plus
 from tcbench.pareto import dominates, nondominated
 from tcbench.tasks.function_env import BudgetExceededError
@@ -28,7 +28,7 @@ from tcbench.tasks.multiobjective import (
 )
 
 IDS = ["tcbench/ZDT1-v0", "tcbench/ZDT2-v0", "tcbench/ZDT3-v0", "tcbench/DTLZ2-v0"]
-CONF = Path(__file__).resolve().parents[1] / "tcbench" / "conf" / "task"
+CONF = conf_dir() / "task"
 
 
 def zdt3_curve(t):

@@ -259,9 +259,9 @@ def test_contract_checker() -> None:
 def test_defaults_mirror_the_yaml() -> None:
     import yaml
 
-    import tcbench
+    from tcbench.config_dir import conf_dir
 
-    conf = Path(tcbench.__file__).parent / "conf" / "optimiser" / "sa.yaml"
+    conf = conf_dir() / "optimiser" / "sa.yaml"
     values = yaml.safe_load(conf.read_text())
     assert values.pop("name") == SimulatedAnnealing.name == "sa"
     assert values == dataclasses.asdict(SAParams())

@@ -75,16 +75,17 @@ def parse_budget(item: str) -> tuple[tuple[str, int | None], int]:
 
 def base_configs(methods: list[str], ioh_dir: Path) -> dict[str, dict[str, Any]]:
     """The composed job config of each method (``task=bbob optimiser=<m>``, tracking off)."""
-    from hydra import compose, initialize_config_dir
+    from hydra import compose, initialize_config_module
 
-    from tcbench.app import CONF_DIR
-    from tcbench.config import as_dict
+    from tcbench.config import as_dict, register_schema
+    from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME
 
+    register_schema()  # config.yaml's defaults start from the structured schema
     out = {}
-    with initialize_config_dir(str(CONF_DIR), version_base="1.3"):
+    with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
         for m in methods:
             overrides = ["task=bbob", f"optimiser={m}", "tracking.enabled=false", f"tracking.ioh_dir={ioh_dir}"]
-            out[m] = as_dict(compose("config", overrides=overrides))
+            out[m] = as_dict(compose(CONFIG_NAME, overrides=overrides))
     return out
 
 

@@ -1,0 +1,221 @@
+"""``tcbench quickstart``: the main job in about a minute.
+
+1. Compensation: the paper's IFA-BP (seed 000 §3) on the simulated MSRA zero-bias task, a few
+   trainings (``tcbench run -m experiment=quickstart``), beside raw, the polynomial and the
+   oracle (the physical limit) — every job through the normal runner, one MLflow run each —
+   then a small leaderboard.
+2. Diagnosis: a simulated MSRA recording with one effect hidden under the noise
+   (:func:`~tcbench.diagnose.concealed.concealed_recording`), diagnosed as ``tcbench diagnose``
+   does; the report and plots are written and logged as an MLflow run.
+
+The sizes are :data:`SIZES`; the test suite runs :data:`TEST_SIZES`.
+"""
+
+from __future__ import annotations
+
+import textwrap
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+OUT = Path("tcbench-quickstart")
+HEADER = """\
+tcbench: a benchmark for temperature compensation of MEMS inertial sensors. It simulates sensors
+(MSRA accelerometer, gyroscope) in temperature chambers, compensates them (learners and their
+weight searches, against the polynomial flight stacks ship and the physical limit), and diagnoses
+what a model or simulator leaves out of a recording. Every job is a run in MLflow."""
+NEXT_STEPS = """\
+Next steps (the full experiments, from the repository root; the paper's studies compare with CMA-ES
+from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
+  bash experiments/paper_ifa_bp/run.sh     seed 000 Tables 1-2: 30 trainings per method on both MSRA tasks,
+                                           with raw, poly, the oracle and the paper's tables
+  tcbench run -m task=msra_fulltemp learner=bp optimiser=fa,ifa seed='range(30)'   the full-temperature task
+  tcbench simulate sensor=msra out=rec     a simulated recording with every effect of the device; then
+  tcbench diagnose recording=rec/msra-fulltemp-dev0-seed0.csv out=diagnosis   (tcbench import: your CSV)
+  python experiments/diagnose-concealed/run.py --workers 2   every hidden effect and controls, 80 recordings
+  tcbench run -m experiment=paper_fa_ifa   FA against IFA on the paper's benchmark functions
+  tcbench --help                           every command; tcbench <command> --help for its parameters"""
+
+
+@dataclass(frozen=True)
+class Sizes:
+    """How much the quickstart runs. ``None``: quickstart.yaml's value (budget 510, the paper's
+    search; BP's 1000 gradient-descent epochs; 5 trainings)."""
+
+    seeds: int | None = None
+    budget: int | None = None
+    epochs: int | None = None
+    diagnose_sensor: str = "msra"
+    diagnose_effect: str = "thermal_lag"
+    diagnose_seed: int = 0
+
+
+DEFAULT_SEEDS = 5  # quickstart.yaml's seed: range(5)
+SIZES = Sizes()  # what `tcbench quickstart` runs
+# The test suite's size: two short trainings.
+TEST_SIZES = Sizes(seeds=2, budget=60, epochs=100)
+
+
+def _rule(title: str) -> str:
+    return f"\n== {title} " + "=" * max(0, 90 - len(title))
+
+
+def _say(text: str) -> None:
+    """Print a paragraph wrapped to 100 columns."""
+    print(textwrap.fill(text, width=100))
+
+
+def _fmt(x: Any) -> str:
+    return f"{x:.3g}" if isinstance(x, float) else str(x)
+
+
+def _print_table(header: list[str], rows: list[list[Any]]) -> None:
+    cells = [header, *[[_fmt(v) for v in r] for r in rows]]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    for k, r in enumerate(cells):
+        print("  " + "  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in enumerate(zip(r, widths, strict=True))))
+        if k == 0:
+            print("  " + "  ".join("-" * w for w in widths))
+
+
+def run(sizes: Sizes | None = None, out: Path = OUT) -> int:
+    """Run the quickstart from the working directory; 0 if every job finished."""
+    from tcbench.cli import _run_sweep, _sweep_report
+
+    sizes = sizes or SIZES
+    started = time.monotonic()
+    sweep = uuid.uuid4().hex[:12]
+    out = Path(out)
+    size_overrides = [f"{k}={v}" for k, v in (("budget", sizes.budget), ("learner.epochs", sizes.epochs))
+                      if v is not None]
+    seeds = [f"seed=range({sizes.seeds})"] if sizes.seeds is not None else []
+    print(HEADER)
+
+    print(_rule("1. Compensating a sensor: MSRA zero-bias stability (seed 000 §3, Table 1)"))
+    n_bp, budget, epochs = sizes.seeds or DEFAULT_SEEDS, sizes.budget or 510, sizes.epochs or 1000
+    _say(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
+          f"the paper: 30), each with {budget} evaluations of IFA's weight search (population 10) and {epochs} "
+          "gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
+    checked = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}", *size_overrides, *seeds])
+    assert checked is not None
+    _run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,oracle", "optimiser=none", "seed=0",
+                f"tracking.sweep_id={sweep}"])
+    status = _sweep_report(sweep, checked.experiment, checked.tracking_uri)
+    board_paths = _leaderboard(checked.experiment, sweep, checked.tracking_uri, out / "leaderboard")
+    compensation_s = time.monotonic() - started
+
+    print(_rule("2. Diagnosing a recording: what does the model leave out?"))
+    diag_paths, run_id = _diagnosis(sizes, sweep, checked.experiment, checked.tracking_uri, out / "diagnosis")
+    diagnosis_s = time.monotonic() - started - compensation_s
+
+    from tcbench import tracking
+
+    uri = tracking.tracking_uri(checked.tracking_uri)
+    print(_rule("Where everything is"))
+    print(f"MLflow store: {uri} (experiment {checked.experiment!r}, sweep {sweep}: "
+          f"{n_bp + 3} compensation runs and the diagnosis run {run_id})")
+    print(f"  browse: mlflow ui --backend-store-uri {uri}")
+    print(f"Leaderboard: {', '.join(str(p.resolve()) for p in board_paths)}")
+    print(f"Diagnosis report and plots: {', '.join(str(p.resolve()) for p in diag_paths)}")
+    print("Per-run figures (the paper's Fig. 7 for each test recording), scores.json and the training curves are")
+    print("  artifacts of each compensation run in MLflow.")
+    print(f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/")
+    print(f"Took {compensation_s:.0f} s (compensation) + {diagnosis_s:.0f} s (diagnosis).")
+    print()
+    print(NEXT_STEPS)
+    return status
+
+
+def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> list[Path]:
+    """Print the small table and write the full board; the paths written."""
+    from tcbench import tracking
+    from tcbench.compensation import leaderboard as comp_board
+
+    runs = comp_board.load_runs(tracking.client(uri), [experiment], sweep)
+    boards = comp_board.boards(runs)
+    written: list[Path] = []
+    for board in boards:
+        primary = comp_board.PRIMARY[board.protocol]
+        s = comp_board.SHORT[primary]
+        t = board.table
+        oracle = t.loc[t["method"] == "oracle", f"median_{s}"]
+        limit = float(oracle.iloc[0]) if len(oracle) else float("nan")
+        print()
+        _say(f"Leaderboard {board.task}: zero-bias stability from power-on ({primary}: 1σ of 10 s means of "
+              "the compensated 0 g output, mean of the 2 test recordings, µg; lower is better). "
+              "oracle = the simulator's own model at the true die temperature: noise alone, the physical limit.")
+        rows = [[r.rank, r.method, r.runs, r.failed, getattr(r, f"median_{s}"), getattr(r, f"ci95_{s}"),
+                 getattr(r, f"median_{s}") / limit, getattr(r, f"gain_{s}")]
+                for r in t.itertuples(index=False)]
+        _print_table(["rank", "method", "runs", "failed", "median (µg)", "95% CI (µg)", "x physical limit",
+                      "gain over raw"], rows)
+        paths = comp_board.write(board, out, f"MLflow experiment {experiment}, sweep {sweep} (tcbench quickstart)")
+        written += list(paths.values())
+    return written
+
+
+def _where(where: dict[str, Any]) -> str:
+    parts = []
+    for k, v in where.items():
+        if isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v):
+            name, unit = {"temperature_c": ("temperature", " °C"), "time_s": ("time", " s")}.get(k, (k, ""))
+            parts.append(f"{name} {v[0]:.3g}..{v[1]:.3g}{unit}")
+        else:
+            parts.append(f"{k} {v}")
+    return ", ".join(parts) or "the whole record"
+
+
+def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: Path) -> tuple[list[Path], str]:
+    """Simulate a recording with a hidden effect, diagnose it, print what was found, write the
+    report and log it as an MLflow run; the paths written and the run id."""
+    from tcbench import tracking
+    from tcbench.diagnose.concealed import concealed_recording
+    from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.report import write_report
+
+    rec, hidden = concealed_recording(sizes.diagnose_sensor, sizes.diagnose_effect, sizes.diagnose_seed)
+    length = f"{(rec.time_s[-1] - rec.time_s[0]) / 3600:.1f} h"
+    _say(f"A simulated {hidden.sensor.upper()} chamber recording ({length} at 1 Hz, seed {hidden.seed}) with one "
+          f"effect hidden under the noise: {hidden.effect} ({', '.join(f'{k} {v:.4g}' for k, v in hidden.params.items())}). "
+          "The diagnosis is not told which; it starts from the minimal model (bias and scale factor "
+          "quadratic in the thermometer temperature, white noise) and tests the library's effects.")
+    diag = diagnose(rec, sensor=hidden.sensor, name=f"concealed-{hidden.sensor}-{hidden.effect}-{hidden.seed}")
+    sigma = float(diag.noise["white_sigma"])
+    before, after = float(diag.baseline["rmse_heldout"]), float(diag.final["rmse_heldout"])
+    print(f"\nVerdict: {diag.verdict}")
+    for e in diag.effects:
+        params = ", ".join(f"{k} {v:.4g}" for k, v in e.get("params", {}).items())
+        ev = e.get("evidence", {})
+        evidence = (f"dropping it raises the held-out squared error by {ev['gain_sigma2']:.4g} sigma^2 "
+                    f"(threshold {ev.get('threshold_sigma2', float('nan')):g}; {ev.get('test', 'test')})"
+                    if "gain_sigma2" in ev else ", ".join(f"{k} {_fmt(v)}" for k, v in ev.items()))
+        print(f"  found {e['id']} ({e.get('shape', '')}){': ' + params if params else ''}")
+        print(f"    where: {_where(e.get('where', {}))}")
+        print(f"    evidence: {evidence}")
+    hit = sizes.diagnose_effect in diag.effect_ids
+    print(f"  the hidden effect was {hidden.effect}: {'found' if hit else 'NOT found'}")
+    print(f"Held-out RMSE (white noise sigma {sigma:.4g} {diag.unit}; a model that misses nothing reaches ~1 sigma):")
+    _print_table(["model", f"RMSE held-out ({diag.unit})", "in sigma"],
+                 [[" + ".join(diag.baseline["model"]), before, before / sigma],
+                  [" + ".join(diag.final["model"]), after, after / sigma]])
+    written = write_report(diag, out)
+    paths = list(written.values())
+
+    cfg = {"tracking": {"uri": uri, "experiment": experiment},
+           "diagnose": {"sensor": hidden.sensor, "hidden_effect": hidden.effect, "seed": hidden.seed}}
+    with tracking.job_run(cfg, f"diagnose-concealed-{hidden.sensor}-{hidden.effect}-s{hidden.seed}", {
+        "tcbench.kind": "diagnosis", "tcbench.sweep_id": sweep, "tcbench.sensor": hidden.sensor,
+        "tcbench.effects_found": ",".join(diag.effect_ids) or "none",
+        "tcbench.hidden_effect": str(hidden.effect), "tcbench.verdict": diag.verdict[:4900],
+    }) as job:
+        job.log_params({f"found.{e['id']}.{k}": f"{v:.6g}" for e in diag.effects
+                        for k, v in e.get("params", {}).items()})
+        job.log_metrics({"rmse_heldout_before": before, "rmse_heldout_after": after, "white_sigma": sigma,
+                         "rmse_heldout_before_sigma": before / sigma, "rmse_heldout_after_sigma": after / sigma,
+                         "hidden_effect_found": float(hit)})
+        for p in paths:
+            job.log_artifact(p)
+        run_id = job.run_id
+    return paths, run_id

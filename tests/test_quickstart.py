@@ -1,0 +1,75 @@
+"""``tcbench quickstart`` end to end at the test size: the compensation table with the oracle
+row, the diagnosis naming the hidden effect, the files it names, and its runs in MLflow."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import mlflow
+import pytest
+import yaml
+
+from tcbench import quickstart
+from tcbench.cli import main
+
+
+def test_the_yaml_runs_the_seeds_the_quickstart_says() -> None:
+    from importlib.resources import files
+
+    cfg = yaml.safe_load(files("tcbench.conf").joinpath("experiment/quickstart.yaml").read_text())
+    assert cfg["hydra"]["sweeper"]["params"]["seed"] == f"range({quickstart.DEFAULT_SEEDS})"
+    assert cfg["budget"] == 510
+
+
+def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
+                               capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(quickstart, "SIZES", quickstart.TEST_SIZES)
+    assert main(["quickstart"]) == 0
+    out = capsys.readouterr().out
+
+    assert out.startswith("tcbench: a benchmark for temperature compensation")
+    assert "IFA-BP trained 2 times" in out and "not the paper's result" in out
+    table = out.split("Leaderboard msra_zerobias-dev0")[1].split("== 2.")[0]
+    methods = [ln.split()[1] for ln in table.splitlines() if re.match(r"\s+\d+\s", ln)]
+    assert sorted(methods) == ["IFA-BP-gd", "oracle", "poly3", "raw"]
+    assert re.search(r"\n\s+\d+\s+oracle\s+1\s+0\s+\S+\s+–\s+1\s", table), table
+    assert "physical limit" in table
+
+    assert "Verdict: missing: thermal_lag" in out and "the hidden effect was thermal_lag: found" in out
+    assert "found thermal_lag" in out and "where: temperature " in out and "in sigma" in out
+    assert "Next steps" in out
+
+    named = [Path(p) for line in out.splitlines() if line.startswith(("Leaderboard: ", "Diagnosis report"))
+             for p in line.split(": ", 1)[1].split(", ")]
+    names = {p.name for p in named}
+    assert {"msra_zerobias-dev0.md", "msra_zerobias-dev0.png", "report.md", "report.json", "residuals.png"} <= names
+    assert all(p.is_file() and p.stat().st_size > 0 for p in named)
+    assert all(p.is_relative_to(workdir / "tcbench-quickstart") for p in named)
+
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    exp = client.get_experiment_by_name("quickstart")
+    runs = client.search_runs([exp.experiment_id])
+    assert all(r.info.status == "FINISHED" for r in runs)
+    kinds = sorted(r.data.tags["tcbench.kind"] for r in runs)
+    assert kinds == ["compensation"] * 5 + ["diagnosis"]
+    assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1
+    (diag,) = [r for r in runs if r.data.tags["tcbench.kind"] == "diagnosis"]
+    assert diag.data.tags["tcbench.effects_found"] == "thermal_lag"
+    m = diag.data.metrics
+    assert m["rmse_heldout_after_sigma"] < m["rmse_heldout_before_sigma"] and m["hidden_effect_found"] == 1
+    assert {"report.md", "report.json", "model.yaml"} <= {a.path for a in client.list_artifacts(diag.info.run_id)}
+
+
+@pytest.mark.slow
+def test_full_quickstart_ranks_ifa_bp_between_the_oracle_and_poly(workdir: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """The full size (about a minute on 2 cores): the paper's IFA-BP beats the polynomial and stays
+    above the physical limit; the numbers the README quotes."""
+    assert main(["quickstart"]) == 0
+    out = capsys.readouterr().out
+    rows = {ln.split()[1]: ln.split() for ln in out.split("Leaderboard msra_zerobias-dev0")[1].split("== 2.")[0]
+            .splitlines() if re.match(r"\s+\d+\s", ln)}
+    assert [rows[m][0] for m in ("oracle", "IFA-BP-gd", "poly3", "raw")] == ["1", "2", "3", "4"]
+    assert rows["IFA-BP-gd"][4] == "19.1" and rows["poly3"][4] == "21" and rows["oracle"][4] == "6.89"
+    assert "IFA-BP trained 5 times" in out and "minimal + thermal_lag" in out
