@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from joblib import Parallel, delayed
 
 from tcbench.diagnose.attribute import (
     DETECTION_THRESHOLD,
@@ -253,8 +254,9 @@ def diagnose(
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     if nonmean.default_smooth_s >= DEFAULT_SMOOTH_S:
         return _diagnose(rec, nonmean, sensor, declared or {}, name, threshold)
-    tried = [_diagnose(rec, nm, sensor, declared or {}, name, threshold)
-             for nm in (nonmean, NonMean.before(rec, window_s=DEFAULT_SMOOTH_S))]
+    # the two diagnoses are independent: one per core (same results as in turn, in about half the time)
+    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, nm, sensor, declared or {}, name, threshold)
+                               for nm in (nonmean, NonMean.before(rec, window_s=DEFAULT_SMOOTH_S)))
     fitted, default = tried
     # the default window is a model choice like a term: it must pay the open-world gain threshold
     sse = [d.final["rmse_heldout"] ** 2 * d.noise["samples"] for d in tried]
