@@ -355,7 +355,7 @@ def cmd_quickstart(argv: list[str]) -> int:
         return 0
     from tcbench import quickstart
 
-    return quickstart.run()
+    return quickstart.run(_run_sweep, _sweep_report)
 
 
 def cmd_list(argv: list[str]) -> int:

@@ -14,6 +14,7 @@ The sizes are :data:`SIZES`; the test suite runs :data:`TEST_SIZES`.
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable
 import time
 import uuid
 from dataclasses import dataclass
@@ -80,10 +81,11 @@ def _print_table(header: list[str], rows: list[list[Any]]) -> None:
             print("  " + "  ".join("-" * w for w in widths))
 
 
-def run(sizes: Sizes | None = None, out: Path = OUT) -> int:
-    """Run the quickstart from the working directory; 0 if every job finished."""
-    from tcbench.cli import _run_sweep, _sweep_report
-
+def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int], sizes: Sizes | None = None,
+        out: Path = OUT) -> int:
+    """Run the quickstart from the working directory with the command line's sweep launcher
+    ``run_sweep`` and end-of-sweep report ``sweep_report`` (passed in, so this module does not
+    import the command line that calls it); 0 if every job finished."""
     sizes = sizes or SIZES
     started = time.monotonic()
     sweep = uuid.uuid4().hex[:12]
@@ -98,11 +100,11 @@ def run(sizes: Sizes | None = None, out: Path = OUT) -> int:
     _say(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
           f"the paper: 30), each with {budget} evaluations of IFA's weight search (population 10) and {epochs} "
           "gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
-    checked = _run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}", *size_overrides, *seeds])
+    checked = run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}", *size_overrides, *seeds])
     assert checked is not None
-    _run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,oracle", "optimiser=none", "seed=0",
+    run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,oracle", "optimiser=none", "seed=0",
                 f"tracking.sweep_id={sweep}"])
-    status = _sweep_report(sweep, checked.experiment, checked.tracking_uri)
+    status = sweep_report(sweep, checked.experiment, checked.tracking_uri)
     board_paths = _leaderboard(checked.experiment, sweep, checked.tracking_uri, out / "leaderboard")
     compensation_s = time.monotonic() - started
 
