@@ -274,6 +274,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
         return shown.status
     from tcbench import leaderboard, tracking
     from tcbench.compensation import leaderboard as comp_board
+    from tcbench.tasks.specs import protocols
     from tcbench.outputs import folder_problem
 
     if problem := folder_problem(ns.out):
@@ -297,7 +298,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
         print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
         print(leaderboard.markdown_table(board.table))
         print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-    for cboard in comp_board.boards(comp) if not comp.empty else []:
+    for cboard in comp_board.boards(comp, protocols()) if not comp.empty else []:
         paths = comp_board.write(cboard, Path(ns.out), source)
         print(f"\n## {cboard.task}  (compensation)\n")
         print(leaderboard.markdown_table(cboard.table))
@@ -362,24 +363,12 @@ def cmd_list(argv: list[str]) -> int:
     if _no_arguments("list", argv, LIST_HELP):
         return 0
     from tcbench.optimisers import registry
-    from tcbench.tasks import BBOB_ID, FUNCTIONS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
+    from tcbench.tasks import TASKS
 
-    print("tasks (single objective):")
-    for key, fn in FUNCTIONS.items():
-        print(f"  {env_id(key):26s} task={key:11s} {fn.title}, domain [{fn.lower:g}, {fn.upper:g}]^d, x*={fn.x_opt:g}")
-    print(f"  {BBOB_ID:26s} task=bbob        COCO's 24 noiseless BBOB functions through ioh (task.function, "
-          "task.dim, task.instance), domain [-5, 5]^d")
-    print("tasks (multi-objective):")
-    for key, p in PROBLEMS.items():
-        print(f"  {mo_env_id(key):26s} task={key:11s} {p.title}, {p.n_objectives} objectives, "
-              f"{p.default_dim} variables in [{p.lower:g}, {p.upper:g}]")
-    print("tasks (compensation):")
-    for key, eid in MSRA_ENV_IDS.items():
-        print(f"  {eid:26s} task={key:14s} MSRA {'four-position runs -40..60 °C' if 'full' in key else 'zero-bias runs at room temperature'}")
-    print(f"  {'tcbench/Gyro-DriftNoise-v0':26s} task=gyro_driftnoise seed 001 parallel model on gyro oven runs "
-          "(decomposition, denoiser, drift learner; bandwidth kept)")
-    print(f"  {'tcbench/Gyro-VMDTuning-v0':26s} task=gyro_vmdtuning VMD [k, alpha] against fuzzy and permutation "
-          "entropy (2 objectives)")
+    for family in dict.fromkeys(spec.family for spec in TASKS.values()):
+        print(f"tasks ({family}):")
+        for spec in (s for s in TASKS.values() if s.family == family):
+            print(f"  {spec.gym_id:26s} task={spec.name:{14 if spec.is_compensation else 11}s} {spec.summary}")
     print("optimisers:")
     for name, entry in registry.available().items():
         kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective), ("multi", entry.cls.multi_objective)) if ok)

@@ -8,15 +8,16 @@ from typing import Any
 import numpy as np
 import yaml
 
-from tcbench.compensation.data import TaskDataError, file_data
+import gymnasium as gym
+
+from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.methods import BASELINES
 from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
-from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.params import make_params
-from tcbench.tasks import GyroDriftNoiseEnv, MSRACompensationEnv, is_gyro, task_kwargs
+from tcbench.tasks import task_kwargs, task_spec
 
 
 def _error(message: str) -> Exception:
@@ -32,7 +33,7 @@ def learner_of(c: dict[str, Any]) -> dict[str, Any]:
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
     """Learner, optimiser and task of a compensation job; raise ConfigError naming the key."""
-    gyro = is_gyro(str(task["name"]))
+    spec = task_spec(str(task["name"]))
     learner = learner_of(c)
     name = str(learner.pop("name", None))
     learner.pop("label", None)
@@ -48,23 +49,15 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
             raise _error(f"learner {text}" if text.startswith(f"{name}") else f"learner {name}: {text}") from None
     kwargs = task_kwargs(task)
     try:
-        if gyro:
-            env: Any = GyroDriftNoiseEnv(None if name in BASELINES else name, learner, budget=c["budget"], **kwargs)
-        else:
-            env = MSRACompensationEnv(task["name"], None if name in BASELINES else name, learner,
-                                      budget=c["budget"], **kwargs)
+        env: Any = gym.make(spec.gym_id, learner=None if name in BASELINES else name, learner_params=learner,
+                            budget=c["budget"], **kwargs).unwrapped
     except ValueError as exc:
         raise _error(f"task {task['name']}: {exc}") from None
-    if kwargs.get("train_files"):
-        try:
-            if gyro:
-                file_gyro_data(list(kwargs["train_files"]), list(kwargs["test_files"]))
-            else:
-                file_data(env.protocol, list(kwargs["train_files"]), list(kwargs["test_files"]),
-                          env.train_on, env.rate_window_s)
-        except TaskDataError as exc:
-            raise _error(str(exc)) from None
-    if gyro and env.needs_tuning:
+    try:
+        env.check_files()
+    except TaskDataError as exc:
+        raise _error(str(exc)) from None
+    if getattr(env, "needs_tuning", False):
         _check_tuner(task)
     opt = dict(c["optimiser"])
     oname = str(opt.pop("name", None))

@@ -13,6 +13,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
@@ -22,87 +23,15 @@ from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.outputs import folder_problem
 from tcbench.params import coerce_param, make_params
-from tcbench.tasks import is_bbob, is_compensation, is_gyro, task_class
+from tcbench.tasks import TASKS, UnknownTaskError, task_kwargs, task_spec
+from tcbench.tasks.schemas import (  # noqa: F401 - the schemas' home before tasks/schemas.py
+    BBOBTaskConfig,
+    GyroTaskConfig,
+    GyroTuningTaskConfig,
+    MSRATaskConfig,
+    TaskConfig,
+)
 from tcbench.tracking_config import TrackingConfig
-
-
-@dataclass
-class TaskConfig:
-    """Which function task to solve and how (see :class:`tcbench.tasks.FunctionEnv`)."""
-
-    name: str = MISSING
-    dim: int = 2
-    shift: bool = False
-    target_precision: float = 1e-8
-    lower: float | None = None
-    upper: float | None = None
-
-
-@dataclass
-class BBOBTaskConfig:
-    """A BBOB function from ioh (see :class:`tcbench.tasks.bbob_env.BBOBEnv`)."""
-
-    name: str = MISSING
-    function: int = 1
-    dim: int = 5
-    instance: int = 1
-    target_precision: float = 1e-8
-    stop_at_target: bool = True
-
-
-@dataclass
-class MSRATaskConfig:
-    """An MSRA compensation task (see :class:`tcbench.tasks.MSRACompensationEnv`)."""
-
-    name: str = MISSING
-    device_seed: int = 0
-    recordings_seed: int | None = 0
-    n_train: int | None = None
-    n_test: int | None = None
-    train_files: list | None = None
-    test_files: list | None = None
-    train_on: str = "positions"
-    rate_window_s: float = 120.0
-    bias_form: str = "plus"
-
-
-@dataclass
-class GyroTuningTaskConfig:
-    """VMD tuning on a gyro oven record (see :class:`tcbench.tasks.GyroVMDTuningEnv`)."""
-
-    name: str = MISSING
-    device_seed: int = 0
-    recordings_seed: int = 0
-    train_files: list | None = None
-    sample_rate_hz: float = 10.0
-    hold_s: float = 3600.0
-    tuning_samples: int = 2048
-    effects: dict | None = None
-
-
-@dataclass
-class GyroTaskConfig(GyroTuningTaskConfig):
-    """The gyro drift/noise task (see :class:`tcbench.tasks.GyroDriftNoiseEnv`); ``tuner``,
-    ``tuner_params`` and ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]``
-    when they are null."""
-
-    n_train: int = 1
-    n_test: int = 1
-    test_files: list | None = None
-    decomposition: str = "vmd"
-    k: int | None = None
-    alpha: float | None = None
-    tuner: str = "mopso"
-    tuner_params: dict | None = None
-    tuning_budget: int = 440
-    denoise: str = "tfpf"
-    tfpf_window: int = 31
-    noise_above: float = 0.5
-    drift_below: float = 0.15
-    inputs: str = "t_rate"
-    rate_window_s: float = 120.0
-    learner_block_s: float = 10.0
-    bandwidth_amplitude_dps: float = 0.005
 
 
 @dataclass
@@ -157,36 +86,30 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     if track.get("enabled", True) and not str(track.get("experiment") or "").strip():
         raise ConfigError("tracking.experiment: give the MLflow experiment a name (default: tcbench)")
     name = str(c["task"].get("name"))
+    try:
+        spec = task_spec(name)
+    except UnknownTaskError as exc:
+        raise ConfigError(f"task: {exc}") from None
     ioh_dir = c.get("tracking", {}).get("ioh_dir")
     if ioh_dir is not None and not str(ioh_dir).strip():
         raise ConfigError("tracking.ioh_dir: give a folder, or null for no IOHprofiler log")
-    if ioh_dir and is_compensation(name):
+    if ioh_dir and spec.is_compensation:
         raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are written for optimisation tasks, "
                           f"not for task {name}")
     if ioh_dir and (problem := folder_problem(ioh_dir)):
         raise ConfigError(f"tracking.ioh_dir={ioh_dir}: {problem}")
-    if is_compensation(name):
-        validate_compensation(c, checked_task(c["task"], GyroTaskConfig if is_gyro(name) else MSRATaskConfig))
+    task = checked_task(c["task"], spec.schema)
+    if spec.is_compensation:
+        validate_compensation(c, task)
         return
     if c.get("learner"):
         raise ConfigError(f"learner={c['learner'].get('name')}: learners apply to compensation tasks "
-                          f"(msra_fulltemp, msra_zerobias, gyro_driftnoise), not to task {c['task'].get('name')}")
+                          f"({', '.join(n for n, s in TASKS.items() if s.is_compensation)}), not to task {name}")
+    kwargs = task_kwargs(task)
+    if spec.sized:
+        check_job_memory(c, kwargs.get("dim", 2))
     try:
-        if is_gyro(name):
-            task = {k: v for k, v in checked_task(c["task"], GyroTuningTaskConfig).items() if k != "name"}
-            from tcbench.tasks.gyro_vmd_env import GyroVMDTuningEnv
-
-            env = GyroVMDTuningEnv(budget=c["budget"], **task)
-        elif is_bbob(name):
-            from tcbench.tasks.bbob_env import BBOBEnv
-
-            task = {k: v for k, v in checked_task(c["task"], BBOBTaskConfig).items() if k != "name"}
-            check_job_memory(c, task["dim"])
-            env = BBOBEnv(budget=c["budget"], **task)
-        else:
-            task = {k: v for k, v in checked_task(c["task"], TaskConfig).items() if k != "name"}
-            check_job_memory(c, task["dim"])
-            env = task_class(name)(function=name, budget=c["budget"], **task)
+        env = gym.make(spec.gym_id, budget=c["budget"], **kwargs).unwrapped
     except ConfigError:
         raise
     except (KeyError, ValueError) as exc:

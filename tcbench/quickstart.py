@@ -134,9 +134,10 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
     """Print the small table and write the full board; the paths written."""
     from tcbench import tracking
     from tcbench.compensation import leaderboard as comp_board
+    from tcbench.tasks.specs import protocols
 
     runs = comp_board.load_runs(tracking.client(uri), [experiment], sweep)
-    boards = comp_board.boards(runs)
+    boards = comp_board.boards(runs, protocols())
     written: list[Path] = []
     for board in boards:
         primary = comp_board.PRIMARY[board.protocol]

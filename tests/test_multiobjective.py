@@ -15,7 +15,8 @@ from tcbench.config_dir import conf_dir
 from tcbench.metrics.multiobjective import hypervolume, igd, igd_plus
 from tcbench.pareto import dominates, nondominated
 from tcbench.tasks.function_env import BudgetExceededError
-from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id, register_mo_envs
+from tcbench.tasks import register_specs
+from tcbench.tasks.mo_env import MultiObjectiveEnv, mo_env_id
 from tcbench.tasks.multiobjective import (
     PROBLEMS,
     dtlz2,
@@ -288,8 +289,8 @@ def test_igd_and_igd_plus() -> None:
 
 @pytest.fixture(scope="module", autouse=True)
 def _registered() -> None:
-    register_mo_envs()
-    register_mo_envs()  # idempotent
+    register_specs()
+    register_specs()  # idempotent
 
 
 def test_ids() -> None:

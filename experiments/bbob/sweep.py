@@ -125,7 +125,7 @@ def main(argv: list[str] | None = None) -> int:
                          f"{', '.join(f'{k} {v} in total' for k, v in FIXED_BUDGET.items())})")
     ns = ap.parse_args(argv)
     from tcbench.config import ConfigError, validate
-    from tcbench.job import ioh_folder
+    from tcbench.kinds.optimisation import ioh_folder
     from tcbench.optimisers import registry
 
     try:

@@ -17,6 +17,7 @@ import pandas as pd
 
 from tcbench import tracking
 from tcbench.compensation import leaderboard as board
+from tcbench.tasks.specs import protocols
 from tcbench.leaderboard import markdown_table, one_run_per_job
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
@@ -117,7 +118,7 @@ def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:  # noqa: C901
             out.append({"claim": claim, "metric": metric, "selection": f"{ifa} {how}", "worst-test gain": _fmt(g),
                         "reproduced": verdict})
     for task in ("msra_zerobias", "msra_fulltemp"):
-        metric = board.PRIMARY[board.PROTOCOL_OF_TASK[task]]
+        metric = board.PRIMARY[protocols()[task]]
         a = runs[(runs["task_name"] == task) & (runs["method"] == ifa)]
         b = runs[(runs["task_name"] == task) & (runs["method"] == fa)]
         if a.empty or b.empty:

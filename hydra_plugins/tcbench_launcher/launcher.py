@@ -42,7 +42,7 @@ from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from hydra_plugins.tcbench_launcher.pool import run_jobs
-from tcbench.tasks import is_compensation
+from tcbench.job import plots_default
 
 log = logging.getLogger(__name__)
 
@@ -108,7 +108,7 @@ class GroupedLauncher(Launcher):
             if not track.get("sweep_id"):
                 track["sweep_id"] = sweep_id
             if track.get("plots") is None:  # one convergence PNG per run of an optimisation sweep is
-                track["plots"] = is_compensation(str(task["task"]["name"]))  # noise: the leaderboard draws them
+                track["plots"] = plots_default(task)  # per kind: a PNG per optimisation run is noise
             for i in indices:
                 num = initial_job_idx + i
                 overrides = list(job_overrides[i])

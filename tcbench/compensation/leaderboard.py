@@ -29,7 +29,6 @@ from tcbench.board_files import (
 from tcbench.compensation.scoring import METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
-PROTOCOL_OF_TASK = {"msra_fulltemp": "fulltemp", "msra_zerobias": "roomtemp", "gyro_driftnoise": "gyro"}
 METRICS = METRIC_NAMES
 SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
          "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug", "drift_dph": "drift_dph",
@@ -149,11 +148,12 @@ def _gyro_notes(table: pd.DataFrame) -> list[str]:
     return notes
 
 
-def boards(runs: pd.DataFrame) -> list[CompensationBoard]:
-    """One board per compensation task in ``runs`` (one run per job)."""
+def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[CompensationBoard]:
+    """One board per compensation task in ``runs`` (one run per job); ``protocol_of`` maps a
+    task name to its protocol (:func:`tcbench.tasks.specs.protocols`)."""
     out = []
     for task, g in one_run_per_job(runs, ("task", "method", "seed")).groupby("task", sort=True):
-        protocol = PROTOCOL_OF_TASK[str(g["task_name"].iloc[0])]
+        protocol = protocol_of[str(g["task_name"].iloc[0])]
         out.append(CompensationBoard(str(task), protocol, summarise(g, protocol), g))
     return out
 

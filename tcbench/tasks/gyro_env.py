@@ -137,6 +137,13 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self._x = self._y = None
         self._reset_counters()
 
+    def check_files(self) -> None:
+        """Read the user's recordings (``train_files``/``test_files``) as the task will; a
+        :class:`~tcbench.compensation.data.TaskDataError` naming what is wrong. No-op when simulated."""
+        if self.train_files:
+            load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
+                           self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects)
+
     def _make_learner(self, rng: np.random.Generator) -> Learner:
         form = "bias_rate" if self.config.inputs == "t_rate" else "bias"
         return make_learner(str(self.learner_name), self.learner_params, form, rng, self.config.n_inputs)

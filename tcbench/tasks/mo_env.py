@@ -15,7 +15,7 @@ non-dominated set of everything evaluated so far in the episode (``front_f`` ``(
 ``hypervolume_ratio``, that hypervolume divided by the true front's (at most 1).
 
 Register the ids ``tcbench/ZDT1-v0``, ``tcbench/ZDT2-v0``, ``tcbench/ZDT3-v0`` and
-``tcbench/DTLZ2-v0`` with :func:`register_mo_envs`.
+``tcbench/DTLZ2-v0`` (:mod:`tcbench.tasks.specs`).
 """
 
 from __future__ import annotations
@@ -29,8 +29,7 @@ from tcbench.metrics.multiobjective import hypervolume
 from tcbench.pareto import merge_front
 from tcbench.tasks.checks import is_integer, is_real
 from tcbench.tasks.function_env import as_batch, check_budget
-from tcbench.tasks.multiobjective import PROBLEMS, MultiObjectiveProblem, get_problem
-from tcbench.tasks.registration import register_tasks
+from tcbench.tasks.multiobjective import MultiObjectiveProblem, get_problem
 
 MO_ENV_VERSION = "v0"
 
@@ -173,8 +172,3 @@ class MultiObjectiveEnv(gym.Env[np.ndarray, np.ndarray]):
 def mo_env_id(problem_key: str) -> str:
     """Gymnasium id of a multi-objective task, e.g. ``tcbench/ZDT1-v0``."""
     return f"tcbench/{get_problem(problem_key).name}-{MO_ENV_VERSION}"
-
-
-def register_mo_envs() -> None:
-    """Register every multi-objective task with gymnasium (idempotent)."""
-    register_tasks(PROBLEMS, mo_env_id, "tcbench.tasks.mo_env:MultiObjectiveEnv")

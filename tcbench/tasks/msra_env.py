@@ -130,6 +130,12 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self._x = self._y = None
         self._reset_counters()
 
+    def check_files(self) -> None:
+        """Read the user's recordings (``train_files``/``test_files``) as the task will; a
+        :class:`~tcbench.compensation.data.TaskDataError` naming what is wrong. No-op when simulated."""
+        if self.train_files is not None and self.test_files is not None:
+            self._load()
+
     # -- episode ---------------------------------------------------------------------------
     def _load(self) -> MSRAData:
         if self.train_files is not None and self.test_files is not None:

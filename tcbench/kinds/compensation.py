@@ -1,36 +1,21 @@
-"""One compensation job: run it, record it in MLflow with the paper's figures."""
+"""The compensation job kind: a learner (or a baseline) compensating an MSRA or gyro task,
+scored with the paper's metrics and figures."""
 
 from __future__ import annotations
 
 import json
-import logging
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.compensation_config import learner_of
 from tcbench.config import validate
+from tcbench.kinds import JobKind, JobNames
 from tcbench.runner import CompensationResult, VMDTuning, run_compensation
-from tcbench.tasks import is_gyro
-
-log = logging.getLogger(__name__)
-
-
-def compensation_task_key(task: dict[str, Any]) -> str:
-    """Leaderboard key of a compensation task, e.g. ``msra_fulltemp-dev0``."""
-    if task.get("train_files"):
-        return f"{task['name']}-files"
-    key = f"{task['name']}-dev{task.get('device_seed', 0)}"
-    if task.get("recordings_seed", 0) != 0:
-        key += f"-rec{task.get('recordings_seed')}"
-    for effect, params in sorted((task.get("effects") or {}).items()):
-        key += "-" + "-".join(f"{effect}.{p}={v:g}" for p, v in sorted(params.items()))
-    return key
+from tcbench.tasks import task_spec
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
@@ -46,12 +31,10 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
         prefix = "random" if opt == "none" else opt.upper()
         label = f"{prefix}-{name.upper() if name == 'bp' else name}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
-    if task is None or not is_gyro(str(task.get("name"))) or name == "oracle":
+    pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
+    if pipeline is None or name == "oracle":
         return label
-    decomposition = task.get("decomposition", "vmd")
-    front = {"vmd": "MOVMD" if task.get("k") is None or task.get("alpha") is None else "VMD",
-             "emd": "EMD", "none": ""}[decomposition]
-    front = "-".join(p for p in (front, {"tfpf": "TFPF", "wavelet": "WTD", "none": ""}[task.get("denoise", "tfpf")]) if p)
+    front = pipeline(task)  # type: ignore[arg-type]
     back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
     return "+".join(p for p in (front, back) if p) or "raw"
 
@@ -122,41 +105,26 @@ def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:
     return files
 
 
-def compensation_job_name(c: dict[str, Any]) -> str:
-    """``<method>-<task key>-s<seed>`` of a compensation job, as its MLflow run is named."""
-    learner = learner_of(c)
-    return f"{compensation_label(learner, c['optimiser'], c['task'])}-{compensation_task_key(c['task'])}-s{c['seed']}"
+class CompensationKind(JobKind):
+    name = "compensation"
 
+    def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
+        return {**c, "learner": learner_of(c)}  # the default learner made explicit: logged and hashed
 
-def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
-    """Run one compensation job (None when resume skips it); what it raises, tracked jobs
-    record as FAILED before it propagates (:func:`tcbench.job.run_job` reports it)."""
-    learner = learner_of(c)
-    c = {**c, "learner": learner}  # the default learner made explicit, so it is logged and hashed
-    optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
-    learner_cfg = {k: v for k, v in learner.items() if k != "label"}
-    if not c["tracking"]["enabled"]:
+    def names(self, c: dict[str, Any]) -> JobNames:
+        learner = learner_of(c)
+        tkey = task_spec(str(c["task"]["name"])).key(c["task"])
+        method = compensation_label(learner, c["optimiser"], c["task"])
+        return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
+                        {"tcbench.task_name": str(c["task"]["name"])})
+
+    def execute(self, c: dict[str, Any]) -> CompensationResult:
         validate(c)
-        return run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
+        optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
+        learner = {k: v for k, v in learner_of(c).items() if k != "label"}
+        return run_compensation(c["task"], learner, optimiser, c["budget"], c["seed"], c["progress"])
 
-    from tcbench import tracking
-
-    sweep = c["tracking"].get("sweep_id") or tracking.sweep_id_from_hydra()
-    tkey, method = compensation_task_key(c["task"]), compensation_label(learner, c["optimiser"], c["task"])
-    name = f"{method}-{tkey}-s{c['seed']}"
-    if c["tracking"].get("resume"):
-        done = tracking.finished_run(c)
-        if done is not None:
-            log.info("%s already FINISHED in run %s; skipped", name, done)
-            return None
-    tags = {
-        "tcbench.sweep_id": sweep, "tcbench.task": tkey, "tcbench.method": method,
-        "tcbench.seed": str(c["seed"]), "tcbench.task_name": str(c["task"]["name"]),
-        "tcbench.kind": "compensation",
-    }
-    with tracking.job_run(c, name, tags) as run:
-        validate(c)
-        result = run_compensation(c["task"], learner_cfg, optimiser, c["budget"], c["seed"], c["progress"])
+    def record(self, run: Any, result: CompensationResult, c: dict[str, Any], where: Path) -> list[Path]:
         summary = result.score.summary()
         primary = PRIMARY[result.score.protocol]
         tuned = {"vmd_k": float(result.tuning.k), "vmd_alpha": result.tuning.alpha,
@@ -172,23 +140,23 @@ def run_compensation_job(c: dict[str, Any]) -> CompensationResult | None:
         loss = result.history.loss if result.history else None
         if loss:
             run.log_series("train_loss", loss, list(range(len(loss))))
-        with tempfile.TemporaryDirectory() as tmp:
-            where = Path(tmp)
-            (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))
-            (where / "scores.json").write_text(json.dumps(score_document(result.score), indent=2))
-            files = [where / "config.yaml", where / "scores.json"]
-            for i, r in enumerate(result.score.recordings, start=1):
-                if r.nodes_after is not None:
-                    nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
-                    nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
-                    files.append(where / f"nodes_test{i}.csv")
-            files += gyro_tables(result, where)
-            if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
-                files += figures(result.score, loss, where, f"{method} on {tkey}, seed {c['seed']}",
-                                 result.tuning)
-            for f in files:
-                run.log_artifact(f)
-    s = result.score.summary()
-    log.info("%s: %s %.4g (raw %.4g), %s %.3g", name, primary, s[primary], s[f"raw_{primary}"],
-             result.score.train_key, s[result.score.train_key])
-    return result
+        (where / "scores.json").write_text(json.dumps(score_document(result.score), indent=2))
+        files = [where / "scores.json"]
+        for i, r in enumerate(result.score.recordings, start=1):
+            if r.nodes_after is not None:
+                nodes = r.nodes_after.add_suffix("_after").join(r.nodes_before.add_suffix("_before"))
+                nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
+                files.append(where / f"nodes_test{i}.csv")
+        files += gyro_tables(result, where)
+        if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
+            n = self.names(c)
+            files += figures(result.score, loss, where, f"{n.method} on {n.task}, seed {c['seed']}", result.tuning)
+        return files
+
+    def summary(self, result: CompensationResult, c: dict[str, Any]) -> str:
+        s, primary = result.score.summary(), PRIMARY[result.score.protocol]
+        return (f"{self.names(c).run}: {primary} {s[primary]:.4g} (raw {s[f'raw_{primary}']:.4g}), "
+                f"{result.score.train_key} {s[result.score.train_key]:.3g}")
+
+
+KINDS = {"compensation": CompensationKind()}

@@ -1,0 +1,92 @@
+"""Job kinds: what differs between the jobs one runner (:func:`tcbench.job.run_job`) runs.
+
+A kind says how a job is named (:meth:`JobKind.names`), runs it (:meth:`JobKind.execute`) and
+what of its outcome goes to MLflow (:meth:`JobKind.record`); the runner does the rest the same
+way for every kind: the memory limit, resume, the run's tags and params, the config artifact,
+the FAILED path. A job's kind is its config's ``kind`` key (``simulate``, ``metrics``,
+``import``, ``diagnose``: the primary configs ``conf/<command>.yaml``) or, for ``tcbench run``,
+the job kind of its task's spec (:mod:`tcbench.tasks.specs`). A new kind is one module here
+and one entry in :data:`KIND_MODULES`.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tcbench.errors import ConfigError
+
+# kind name -> module holding its ``KIND`` (imported when a job of that kind runs)
+KIND_MODULES = {
+    "optimisation": "tcbench.kinds.optimisation",
+    "compensation": "tcbench.kinds.compensation",
+    "simulate": "tcbench.kinds.recordings",
+    "metrics": "tcbench.kinds.recordings",
+    "import": "tcbench.kinds.recordings",
+    "diagnose": "tcbench.kinds.diagnosis",
+}
+
+
+@dataclass(frozen=True)
+class JobNames:
+    """How a job is filed: its MLflow run name and the tags the leaderboards group by."""
+
+    run: str
+    task: str
+    method: str
+    seed: int | None = None
+    tags: dict[str, str] = field(default_factory=dict)
+
+
+class JobKind:
+    """One kind of job; subclasses override what differs."""
+
+    name = ""
+    tag = ""  # ``tcbench.kind`` of its MLflow runs (the leaderboards select by it); default: name
+    plots_in_sweeps = True  # ``tracking.plots: null`` in a sweep draws the figures
+
+    def __init__(self) -> None:
+        self.tag = self.tag or self.name
+
+    def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
+        """The config as it will run and be logged (defaults made explicit); nothing is run."""
+        return c
+
+    def names(self, c: dict[str, Any]) -> JobNames:
+        raise NotImplementedError
+
+    def execute(self, c: dict[str, Any]) -> Any:
+        """Check the config and run the job; its outcome. User errors raise one line."""
+        raise NotImplementedError
+
+    def record(self, run: Any, outcome: Any, c: dict[str, Any], where: Path) -> list[Path]:
+        """Log the outcome's metrics and series on ``run`` (:class:`tcbench.tracking.JobRun`);
+        the artifact files, written into ``where``."""
+        return []
+
+    def summary(self, outcome: Any, c: dict[str, Any]) -> str:
+        """One line for the log when the job ends."""
+        return f"{self.names(c).run} done"
+
+
+def kind_name(c: dict[str, Any]) -> str:
+    """The kind of a composed job config: its ``kind`` key, else its task's job kind."""
+    if c.get("kind"):
+        return str(c["kind"])
+    from tcbench.tasks import UnknownTaskError, task_spec
+
+    try:
+        return task_spec(str((c.get("task") or {}).get("name"))).job_kind
+    except UnknownTaskError as exc:
+        raise ConfigError(f"task: {exc}") from None
+
+
+def kind_of(c: dict[str, Any]) -> JobKind:
+    """The :class:`JobKind` that runs config ``c``; ConfigError for an unknown kind."""
+    name = kind_name(c)
+    if name not in KIND_MODULES:
+        raise ConfigError(f"kind: unknown job kind {name!r}; known: {', '.join(KIND_MODULES)}")
+    kinds = importlib.import_module(KIND_MODULES[name]).KINDS
+    return kinds[name]
