@@ -9,10 +9,10 @@ import numpy as np
 import yaml
 
 from tcbench.compensation.data import TaskDataError, file_data
+from tcbench.compensation.gyro.data import file_gyro_data
 from tcbench.compensation.methods import BASELINES
 from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
-from tcbench.gyro.data import file_gyro_data
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.params import make_params
