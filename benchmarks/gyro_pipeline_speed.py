@@ -33,7 +33,7 @@ TARGET_S = 300.0
 
 
 def one_run() -> dict[str, float]:
-    from tcbench.gyro import cache
+    from tcbench.compensation.gyro import cache
     from tcbench.runner import _tune, run_compensation
 
     cache.clear()

@@ -5,10 +5,9 @@ from __future__ import annotations
 
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import yaml
-
-import gymnasium as gym
 
 from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.methods import BASELINES

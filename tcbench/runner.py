@@ -231,7 +231,7 @@ def _tune(env_kwargs_json: str, tuner: str, params_json: str, budget: int, sampl
     env.reset(seed=0)
     opt = registry.create(tuner, env.lower, env.upper, budget, np.random.default_rng(0), json.loads(params_json), 2)
     ask_tell(opt, env, budget, progress)
-    from tcbench.gyro.tuning import compromise, decode
+    from tcbench.compensation.gyro.tuning import compromise, decode
 
     i = compromise(env.front_x, env.front_f)
     k, alpha = decode(env.front_x[i])

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from tcbench.gyro import (
+from tcbench.compensation.gyro import (
     ParallelPipeline,
     PipelineConfig,
     PipelineOutput,

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tcbench.gyro import plots
-from tcbench.gyro.pipeline import ModeClasses
+from tcbench.compensation.gyro import plots
+from tcbench.compensation.gyro.pipeline import ModeClasses
 from tcbench.signal.allan import allan_deviation
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

@@ -11,7 +11,7 @@ from gymnasium.utils.env_checker import check_env
 
 import tcbench  # noqa: F401  (registers the envs)
 from tcbench.compensation.data import TaskDataError
-from tcbench.gyro.tuning import compromise, decode, tuning_window, vmd_objectives
+from tcbench.compensation.gyro.tuning import compromise, decode, tuning_window, vmd_objectives
 from tcbench.learners.polynomial import PolynomialModel
 from tcbench.runner import _tune, run_compensation, tune_vmd
 from tcbench.sensors.recording import make_recording, write_recording

@@ -19,7 +19,7 @@ import pandas as pd
 
 from tcbench import tracking
 from tcbench.compensation import leaderboard as board
-from tcbench.gyro.plots import allan_methods_figure
+from tcbench.compensation.gyro.plots import allan_methods_figure
 from tcbench.leaderboard import markdown_table, one_run_per_job
 from tcbench.signal.allan import AllanDeviation
 

@@ -57,7 +57,7 @@ def figures(score: Score, history_loss: list[float] | None, where: Path, title: 
     from tcbench.compensation import plots as cplots
 
     if score.protocol == "gyro":
-        from tcbench.gyro.plots import run_figures
+        from tcbench.compensation.gyro.plots import run_figures
 
         paths = run_figures(score, tuning, where, title)
     else:

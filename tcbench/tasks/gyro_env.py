@@ -2,13 +2,13 @@
 
 Two oven runs of one gyro, one to train and one to test (§4.1). ``reset`` decomposes the
 training record with the task's pipeline (VMD with ``[k, alpha]``, sample-entropy classes, see
-:mod:`tcbench.gyro.pipeline`) and builds the learner's training set: block means of
+:mod:`tcbench.compensation.gyro.pipeline`) and builds the learner's training set: block means of
 ``[T, dT/dt]`` (or ``[T]``) against the drift part. The action is a candidate vector of the
 learner's initial weights and thresholds (or a batch ``(n, d)``); the observation its training
 error (eq. 3 in normalised units; eq. 36's MSE up to the factor 2), which BAS, PSO, FA ...
 minimise to initialise the learner (BAS-Elman, §3.4.4). :meth:`GyroDriftNoiseEnv.score` trains
 the learner from the best vector and runs the whole pipeline on the test record, scoring it
-before and after with the bandwidth it keeps (:mod:`tcbench.gyro.scoring`).
+before and after with the bandwidth it keeps (:mod:`tcbench.compensation.gyro.scoring`).
 
 By default VMD runs with seed 001's tuned ``[k, alpha] = [8, 9755]`` (§4.2), so
 ``gymnasium.make("tcbench/Gyro-DriftNoise-v0")`` is a complete task. With ``k=None`` or
@@ -27,13 +27,13 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.compensation.data import TaskDataError
+from tcbench.compensation.gyro.cache import cached_front
+from tcbench.compensation.gyro.data import GyroData, check_effects, check_settings
+from tcbench.compensation.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
+from tcbench.compensation.gyro.scoring import DPS_TO_DPH, Method, score_record
+from tcbench.compensation.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.compensation.oracle import oracle_inverse
 from tcbench.compensation.scoring import Score
-from tcbench.gyro.cache import cached_front
-from tcbench.gyro.data import GyroData, check_effects, check_settings
-from tcbench.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
-from tcbench.gyro.scoring import DPS_TO_DPH, Method, score_record
-from tcbench.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.ids import GYRO_DRIFTNOISE_ID
@@ -66,7 +66,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks).
     train_files, test_files: schema-v1 gyro recordings instead.
     decomposition, k, alpha, denoise, tfpf_window, noise_above, drift_below, inputs,
-        rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.gyro.pipeline.PipelineConfig`);
+        rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.compensation.gyro.pipeline.PipelineConfig`);
         ``k``/``alpha`` default to seed 001's tuned ``[8, 9755]``; None: to be tuned, then set by
         ``reset(options=...)``.
     bandwidth_amplitude_dps: amplitude of each injected sine of the bandwidth test (deg/s).

@@ -3,7 +3,7 @@
 The action is a candidate ``[k, alpha]`` in ``[4, 12] x [1000, 10000]`` (or a batch ``(n, 2)``;
 ``k`` is rounded to the nearest integer); the observation is its two objectives, the mean fuzzy
 and mean permutation entropy of the VMD modes of a window of the training record
-(:mod:`tcbench.gyro.tuning` states the reading of the seed). ``reset(seed=...)`` builds the
+(:mod:`tcbench.compensation.gyro.tuning` states the reading of the seed). ``reset(seed=...)`` builds the
 training record (simulated oven run of one gyro, or ``train_files``); ``info`` carries the
 non-dominated set so far, its hypervolume against ``ref_point`` and ``chosen``, the compromise
 point of that set. Registered as ``tcbench/Gyro-VMDTuning-v0``; MOPSO with the seed's settings
@@ -18,14 +18,14 @@ import gymnasium as gym
 import numpy as np
 
 from tcbench.compensation.data import TaskDataError
-from tcbench.gyro.data import (
+from tcbench.compensation.gyro.data import (
     GyroData,
     check_effects,
     check_settings,
     file_gyro_data,
     simulated_gyro_data,
 )
-from tcbench.gyro.tuning import (
+from tcbench.compensation.gyro.tuning import (
     ALPHA_RANGE,
     K_RANGE,
     REF_POINT,

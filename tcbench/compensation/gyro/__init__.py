@@ -1,6 +1,6 @@
 """Gyro temperature-drift compensation: VMD, sample-entropy mode classes, TFPF and a learner."""
 
-from tcbench.gyro.pipeline import (
+from tcbench.compensation.gyro.pipeline import (
     ModeClasses,
     ParallelPipeline,
     PipelineConfig,

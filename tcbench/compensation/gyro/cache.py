@@ -13,7 +13,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from tcbench.gyro.pipeline import FrontEnd, PipelineConfig, front_end
+from tcbench.compensation.gyro.pipeline import FrontEnd, PipelineConfig, front_end
 
 MAX_ENTRIES = 6  # a train record, a test record and its injected copy for two settings
 _fronts: OrderedDict[tuple[object, ...], FrontEnd] = OrderedDict()
@@ -28,7 +28,7 @@ def digest(x: np.ndarray) -> str:
 
 
 def cached_front(y: np.ndarray, fs_hz: float, config: PipelineConfig) -> FrontEnd:
-    """:func:`tcbench.gyro.pipeline.front_end` of ``y``, remembered for the last few inputs."""
+    """:func:`tcbench.compensation.gyro.pipeline.front_end` of ``y``, remembered for the last few inputs."""
     key = (digest(y), float(fs_hz), config)
     if key in _fronts:
         _fronts.move_to_end(key)

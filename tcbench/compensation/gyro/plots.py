@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Patch
 
-from tcbench.gyro.pipeline import ModeClasses
+from tcbench.compensation.gyro.pipeline import ModeClasses
 from tcbench.signal.allan import AllanDeviation
 
 DPI = 110
