@@ -1,9 +1,13 @@
-"""The Hydra application behind ``tcbench run`` and the checks made before any job starts."""
+"""The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``,
+``tcbench simulate|metrics|import|diagnose`` on ``conf/<command>.yaml``) and the checks made
+before any job starts. Every job of every command runs through :func:`tcbench.job.run_job`."""
 
 from __future__ import annotations
 
 import itertools
 import logging
+import os
+from pathlib import Path
 from dataclasses import dataclass
 from typing import Any
 
@@ -14,9 +18,11 @@ from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
-from tcbench.config import ConfigError, as_dict, register_schema, validate
+from tcbench import command_schemas
+from tcbench.config import ConfigError, as_dict, register_schema
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
 from tcbench.job import run_job
+from tcbench.kinds import kind_of
 
 # Hydra flags followed by a value; those that change where configs come from make tcbench
 # skip its up-front check (each job still validates its own config).
@@ -25,12 +31,20 @@ CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "-
 log = logging.getLogger(__name__)
 
 register_schema()
+command_schemas.register()
 
 
-@hydra.main(version_base="1.3", config_path=SEARCH_PATH, config_name=CONFIG_NAME)
-def hydra_main(cfg: DictConfig) -> None:
+def _task(cfg: DictConfig) -> None:
     """Hydra task function: one job per call."""
     run_job(cfg)
+
+
+def hydra_app(config_name: str = CONFIG_NAME) -> Any:
+    """The Hydra application of a primary config (``config`` for ``tcbench run``, ``simulate`` ...)."""
+    return hydra.main(version_base="1.3", config_path=SEARCH_PATH, config_name=config_name)(_task)
+
+
+hydra_main = hydra_app(CONFIG_NAME)
 
 
 @dataclass
@@ -65,9 +79,11 @@ def _explain(exc: Exception) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
-def _compose(overrides: list[str], hydra_cfg: bool = False) -> DictConfig:
+def compose_job(overrides: list[str], config_name: str = CONFIG_NAME, hydra_cfg: bool = False) -> DictConfig:
+    """The composed config of one job (call inside ``initialize_config_module``); ConfigError
+    with one line when it does not compose."""
     try:
-        return compose(CONFIG_NAME, overrides=overrides, return_hydra_config=hydra_cfg)
+        return compose(config_name, overrides=overrides, return_hydra_config=hydra_cfg)
     except (HydraException, OmegaConfBaseException, ValueError) as exc:
         raise ConfigError(_explain(exc)) from None
 
@@ -100,8 +116,26 @@ def with_overrides(args: list[str], extra: list[str]) -> list[str]:
     return [*args[:at], *extra, *args[at:]]
 
 
-def plan(args: list[str]) -> Plan:
-    """Compose and validate every job of a command line; raise ConfigError on the first bad one."""
+def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None = None) -> dict[str, Any]:
+    """A composed job config, checked by its kind before anything runs (:meth:`JobKind.plan_check`);
+    the plain config. ``written`` collects the outputs of a sweep's jobs: a second job writing
+    the same file or folder is a ConfigError."""
+    c = as_dict(cfg)
+    kind = kind_of(c)
+    kind.plan_check(kind.prepare(c))
+    if written is not None:
+        for path in kind.outputs(c):
+            key = Path(os.path.abspath(path))
+            if key in written:
+                raise ConfigError(f"jobs {written[key] + 1} and {len(written) + 1} of the sweep would both write "
+                                  f"{path}; give each its own out= (e.g. 'out=results/${{stem:recording}}')")
+            written[key] = len(written)
+    return c
+
+
+def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
+    """Compose and check every job of a command line; raise ConfigError (or the kind's one-line
+    error) on the first bad one."""
     conf_dir()  # one line naming the problem when the installed configs are missing
     multirun = "-m" in args or "--multirun" in args
     raw = overrides_of(args)
@@ -118,7 +152,7 @@ def plan(args: list[str]) -> Plan:
             raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
         if multirun:
             first = [f"{k}={v[0]}" for k, v in sweeps.items()]
-            base = _compose(fixed + first, hydra_cfg=True)
+            base = compose_job(fixed + first, config_name, hydra_cfg=True)
             given = {o.get_key_element() for o in parsed}  # the command line wins over the config's params
             for key, value in (base.hydra.sweeper.get("params") or {}).items():
                 if key not in given:
@@ -129,10 +163,10 @@ def plan(args: list[str]) -> Plan:
         keys = list(sweeps)
         combos = list(itertools.product(*sweeps.values())) or [()]
         last: dict[str, Any] = {}
+        written: dict[Path, int] = {}
         for combo in combos:
-            cfg = _compose(fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)])
-            validate(cfg)
-            last = as_dict(cfg)
+            cfg = compose_job(fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)], config_name)
+            last = check_job(cfg, written)
         for s in seeds or []:
             if not s.lstrip("-").isdigit() or int(s) < 0:
                 raise ConfigError(f"seed must be a non-negative integer, got {s!r}")

@@ -12,15 +12,16 @@ import numpy as np
 import pandas as pd
 
 
-def search_runs(client, experiments: list[str], kind: str, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
-    """Every MLflow run of ``kind`` (``optimisation``, ``compensation``) in the experiments,
-    optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
+def search_runs(client, experiments: list[str], kind: str | None, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
+    """Every MLflow run of ``kind`` (``optimisation``, ``compensation``; None: every tcbench run)
+    in the experiments, optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
     ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
     if not ids:
         raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
-    query = f"tags.`tcbench.kind` = '{kind}'"
+    terms = [f"tags.`tcbench.kind` = '{kind}'" if kind else "tags.`tcbench.kind` != ''"]
     if sweep:
-        query += f" and tags.`tcbench.sweep_id` = '{sweep}'"
+        terms.append(f"tags.`tcbench.sweep_id` = '{sweep}'")
+    query = " and ".join(terms)
     token = None
     while True:
         page = client.search_runs(ids, filter_string=query, max_results=1000, page_token=token)

@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import logging
 import os
+import re
 import sys
 import uuid
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -69,17 +73,66 @@ def _no_arguments(command: str, argv: list[str], help_text: str) -> bool:
     return False
 
 
-def _keyvalue_command(command: str, argv: list[str]) -> list[str] | None:
-    """The ``key=value`` arguments of a command parsed by :mod:`tcbench.sensors_cli`, or None
-    when ``--help`` or ``--cfg job`` was answered here (nothing is run or written)."""
+def _hydra_value(arg: str) -> str:
+    """``key=value`` as Hydra's override grammar reads it as that literal string: quoted when
+    the value would not parse (``out=run(1)``) or would be a sweep (``drop=a,b``). One job only:
+    with ``-m`` the user writes Hydra's grammar (``recording=a.csv,b.csv`` sweeps)."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.errors import HydraException
+
+    key, _, value = arg.partition("=")
+    try:
+        (override,) = OverridesParser.create().parse_overrides([arg])
+        if not override.is_sweep_override():
+            return arg
+    except HydraException:
+        pass
+    quoted = re.sub(r"(\\*)('|$)", lambda m: m.group(1) * 2 + ("\\'" if m.group(2) else ""), value)
+    return f"{key}='{quoted}'"
+
+
+def _open_key(arg: str, command: str) -> str:
+    """``protocol_params.duration_s=3600`` as ``++protocol_params.duration_s=3600``: a key inside a
+    free-form dict of the schema (``protocol_params``, ``effects``) is added or replaced."""
+    import dataclasses
+
+    from tcbench.command_schemas import SCHEMAS
+
+    if arg.startswith(("+", "~")):
+        return arg
+    open_dicts = {f.name for f in dataclasses.fields(SCHEMAS[command]) if str(f.type).startswith("dict")}
+    return f"++{arg}" if arg.split("=", 1)[0].split(".", 1)[0] in open_dicts and "." in arg.split("=", 1)[0] else arg
+
+
+@contextlib.contextmanager
+def _quiet_job_log() -> Iterator[None]:
+    """The runner's own failure log line off: one job's command reports its error itself."""
+    logger = logging.getLogger("tcbench.job")
+    disabled, logger.disabled = logger.disabled, True
+    try:
+        yield
+    finally:
+        logger.disabled = disabled
+
+
+def _recording_command(command: str, argv: list[str]) -> int:
+    """``tcbench simulate|metrics|import|diagnose``: a Hydra app on ``conf/<command>.yaml``. One
+    job runs here (no Hydra output folder); ``-m`` sweeps run through Hydra's launcher like
+    ``tcbench run``'s. Every job is checked before the first starts."""
+    from hydra import initialize_config_module
+
     from tcbench import cli_help
-    from tcbench.sensors_cli import CommandError
+    from tcbench.app import check_job, compose_job
+    from tcbench.config import ConfigError
+    from tcbench.config_dir import CONFIG_MODULE
+    from tcbench.job import FAILURES, JobFailure, run_job
 
     if any(a in HELP_FLAGS for a in argv):
         print(cli_help.usage(command))
-        return None
+        return 0
     args: list[str] = []
     cfg: str | None = None
+    multirun = False
     it = iter(argv)
     for a in it:
         flag = _flag_name(a)
@@ -91,25 +144,66 @@ def _keyvalue_command(command: str, argv: list[str]) -> list[str] | None:
                 what = f"--cfg {cfg}" if cfg else "--cfg without a value"
                 raise UserError(f"{what}: tcbench {command} prints only its job config; use --cfg job")
         elif flag in {"-m", "--multirun"}:
-            raise UserError(f"{flag}: tcbench {command} does not sweep yet (only tcbench run does); "
-                            "run it once per value")
+            multirun = True
         else:
             raise _unknown_option(command, flag)
-    if cfg is None:
-        return args
+    positional = cli_help.SPECS[command].positional
+    if positional and args and "=" not in args[0]:
+        args = [f"{positional}={args[0]}", *args[1:]]
+    if bad := [a for a in args if "=" not in a or a.startswith("=")]:
+        raise UserError(f"expected key=value, got {bad[0]!r}")
+    if nul := [a for a in args if "\0" in a]:
+        raise UserError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
+    args = [_open_key(a, command) for a in args]
+    if multirun and cfg is None:
+        checked = _run_sweep(["-m", *args], command)
+        assert checked is not None
+        if not checked.tracking_enabled:
+            return _failures_report(checked.jobs)
+        return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri,
+                             None if checked.resume else checked.jobs)
+    args = [_hydra_value(a) for a in args]
     try:
-        print(cli_help.composed_yaml(command, args), end="")
-    except CommandError as exc:
+        with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
+            composed = compose_job(args, command)
+        if cfg is not None:
+            from omegaconf import OmegaConf
+
+            print(OmegaConf.to_yaml(composed), end="")
+            return 0
+        c = check_job(composed)
+    except ConfigError as exc:
         raise UserError(str(exc)) from None
-    return None
+    c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
+    FAILURES.clear()
+    with _quiet_job_log():
+        outcome = run_job(c)
+    if isinstance(outcome, JobFailure):
+        if outcome.user:
+            raise UserError(outcome.error)
+        return _fail(f"{command} failed: {outcome.error}", 1)
+    return 0
 
 
-def _run_sweep(args: list[str]) -> Plan | None:
-    """Validate every job, then run them through Hydra; the plan, or None if not checked."""
+def _prepare_store(uri: str | None, experiment: str) -> None:
+    """The MLflow store and experiment made before any job runs (a store that cannot be made is
+    one line, and leaves no half-made database)."""
+    from tcbench import tracking
+
+    try:
+        tracking.check_store(uri, create=True)
+        tracking.prepare_store(uri, experiment)
+    except tracking.StoreError as exc:
+        raise UserError(str(exc)) from None
+
+
+def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
+    """Validate every job of the Hydra app ``config_name`` (``config``: ``tcbench run``), then run
+    them through Hydra; the plan, or None if not checked."""
     from hydra.errors import HydraException
     from omegaconf.errors import OmegaConfBaseException
 
-    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_main, plan, with_overrides
+    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_app, plan, with_overrides
     from tcbench.config import ConfigError
 
     info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
@@ -120,17 +214,13 @@ def _run_sweep(args: list[str]) -> Plan | None:
         print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)
     elif not info:
         try:
-            checked = plan(args)
+            checked = plan(args, config_name)
         except ConfigError as exc:
             raise UserError(str(exc)) from None
         if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
             from tcbench import tracking
 
-            try:
-                tracking.check_store(checked.tracking_uri, create=True)
-                tracking.prepare_store(checked.tracking_uri, checked.experiment)
-            except tracking.StoreError as exc:
-                raise UserError(str(exc)) from None
+            _prepare_store(checked.tracking_uri, checked.experiment)
             if checked.resume and (dead := tracking.mark_dead_runs(checked.tracking_uri, checked.experiment,
                                                                    checked.sweep_id)):
                 print(f"tcbench: {dead} run{'s' * (dead != 1)} of sweep {checked.sweep_id} left RUNNING by a "
@@ -141,7 +231,7 @@ def _run_sweep(args: list[str]) -> Plan | None:
     sys.argv = ["tcbench", *args]
     os.environ["HYDRA_FULL_ERROR"] = "1"  # Hydra's errors reach us whole instead of as its traceback
     try:
-        hydra_main()
+        hydra_app(config_name)()
     except OSError as exc:  # a job folder or Hydra's own files cannot be written (a full disk)
         where = f" {exc.filename}" if exc.filename else ""
         raise UserError(f"cannot write{where} ({exc.strerror or exc}); nothing more was run") from None
@@ -388,48 +478,19 @@ def cmd_list(argv: list[str]) -> int:
 
 
 def cmd_simulate(argv: list[str]) -> int:
-    from tcbench.sensors_cli import CommandError, simulate
-
-    if (args := _keyvalue_command("simulate", argv)) is None:
-        return 0
-    try:
-        return simulate(args)
-    except CommandError as exc:
-        raise UserError(str(exc)) from None
+    return _recording_command("simulate", argv)
 
 
 def cmd_import(argv: list[str]) -> int:
-    from tcbench.sensors_cli import CommandError, import_command
-
-    if (args := _keyvalue_command("import", argv)) is None:
-        return 0
-    try:
-        return import_command(args)
-    except CommandError as exc:
-        raise UserError(str(exc)) from None
+    return _recording_command("import", argv)
 
 
 def cmd_metrics(argv: list[str]) -> int:
-    from tcbench.sensors_cli import CommandError, metrics
-
-    if (args := _keyvalue_command("metrics", argv)) is None:
-        return 0
-    try:
-        return metrics(args)
-    except CommandError as exc:
-        raise UserError(str(exc)) from None
+    return _recording_command("metrics", argv)
 
 
 def cmd_diagnose(argv: list[str]) -> int:
-    from tcbench.diagnose.cli import diagnose_command
-    from tcbench.sensors_cli import CommandError
-
-    if (args := _keyvalue_command("diagnose", argv)) is None:
-        return 0
-    try:
-        return diagnose_command(args)
-    except CommandError as exc:
-        raise UserError(str(exc)) from None
+    return _recording_command("diagnose", argv)
 
 
 COMMANDS = {

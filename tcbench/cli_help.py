@@ -1,5 +1,5 @@
-"""Usage text and ``--cfg job`` for tcbench's ``key=value`` commands (simulate, import, metrics,
-diagnose), generated from the dataclass each command parses its arguments into, so the
+"""Usage text of tcbench's recording commands (simulate, import, metrics, diagnose), generated
+from the schema of each command's primary config (:mod:`tcbench.command_schemas`), so the
 parameters and defaults shown are the ones the command uses."""
 
 from __future__ import annotations
@@ -14,9 +14,12 @@ TRACKING = {
     "tracking.enabled": "log the results to MLflow (false: files only)",
     "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
     "tracking.experiment": "MLflow experiment the run is filed under",
+    "tracking.sweep_id": "the sweep's id in MLflow (null: a new one per command)",
+    "tracking.resume": "skip a job whose config already FINISHED in the experiment (re-run a killed sweep)",
 }
-# keys of the shared tracking schema that these commands accept and ignore (``tcbench run`` uses them)
-IGNORED = ("tracking.sweep_id", "tracking.plots", "tracking.resume", "tracking.ioh_dir")
+# keys of the shared schema that these commands accept and ignore (``tcbench run`` uses them)
+IGNORED = ("tracking.plots", "tracking.ioh_dir")
+HIDDEN = ("kind",)  # the job kind the primary config names, not a parameter
 
 
 @dataclass(frozen=True)
@@ -35,25 +38,25 @@ class CommandHelp:
 
 
 def _simulate_schema() -> type:
-    from tcbench.sensors_cli import SimulateConfig
+    from tcbench.command_schemas import SimulateConfig
 
     return SimulateConfig
 
 
 def _metrics_schema() -> type:
-    from tcbench.sensors_cli import MetricsConfig
+    from tcbench.command_schemas import MetricsConfig
 
     return MetricsConfig
 
 
 def _import_schema() -> type:
-    from tcbench.sensors_cli import ImportConfig
+    from tcbench.command_schemas import ImportConfig
 
     return ImportConfig
 
 
 def _diagnose_schema() -> type:
-    from tcbench.diagnose.cli import DiagnoseConfig
+    from tcbench.command_schemas import DiagnoseConfig
 
     return DiagnoseConfig
 
@@ -64,7 +67,7 @@ SPECS: dict[str, CommandHelp] = {
         summary="Simulate a recording of one device under a test protocol, then compute its metrics.",
         schema=_simulate_schema,
         params={
-            "sensor": "msra (accelerometer) or gyro",
+            "sensor": "msra (accelerometer) or gyro (null: msra, or the model file's)",
             "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static",
             "device_seed": "which unit of the device population (integer >= 0)",
             "seed": "the run's noise draw (integer >= 0)",
@@ -81,6 +84,7 @@ SPECS: dict[str, CommandHelp] = {
         examples=(
             "tcbench simulate sensor=msra protocol=fulltemp device_seed=0 out=recordings",
             "tcbench simulate sensor=gyro protocol=oven seed=1 format=parquet tracking.enabled=false",
+            "tcbench simulate -m device_seed='range(100)' out=population   (a population, one job per device)",
         ),
         output="OUT/NAME.csv (or .parquet) with its sidecar OUT/NAME.json, and with metrics=true "
                "OUT/NAME_metrics/ (metrics.json, plots); MLflow experiment 'simulations' when tracking is on",
@@ -120,12 +124,13 @@ SPECS: dict[str, CommandHelp] = {
             "name": "file stem (null: the CSV's)",
             "device_id": "device id for the sidecar (null: the CSV's stem)",
             "sample_rate_hz": "sample rate (null: one over the median interval of the time column)",
+            **TRACKING,
         },
         examples=(
             "tcbench import csv=log.csv sensor=gyro time=time_s temperature=temp_c:degC "
             "output=gyro_x_dps:deg/s out=recordings",
         ),
-        output="OUT/NAME.csv and its sidecar OUT/NAME.json",
+        output="OUT/NAME.csv and its sidecar OUT/NAME.json; MLflow experiment 'recordings' when tracking is on",
         positional="csv",
         required=("csv", "sensor", "time", "temperature", "output", "out"),
     ),
@@ -138,12 +143,15 @@ SPECS: dict[str, CommandHelp] = {
             "out": "output folder",
             "sensor": "msra or gyro, for a recording without a sidecar (null: from the sidecar)",
             "model": "model file of the effects already modelled (null: none)",
+            **TRACKING,
         },
         examples=(
             "tcbench diagnose recording=recordings/msra-fulltemp-dev0-seed0.csv out=diagnosis",
             "tcbench diagnose recording=run.csv out=diag2 model=diagnosis/model.yaml",
+            "tcbench diagnose -m recording=a.csv,b.csv 'out=diagnoses/${stem:recording}' hydra.launcher.n_jobs=2",
         ),
-        output="OUT/report.json, OUT/report.md, plots and OUT/model.yaml",
+        output="OUT/report.json, OUT/report.md, plots and OUT/model.yaml; MLflow experiment 'diagnoses' "
+               "(effects found, held-out RMSEs, the report) when tracking is on",
         required=("recording",),
     ),
 }
@@ -180,10 +188,10 @@ def usage(name: str) -> str:
     """The ``--help`` text of command ``name``."""
     spec = SPECS[name]
     first = f" [{spec.positional.upper()}]" if spec.positional else ""
-    lines = [f"usage: tcbench {name}{first} [key=value ...] [--cfg job] [-h]", "", spec.summary, "",
+    lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "", spec.summary, "",
              "parameters (key=value, default after =):"]
     rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", spec.params.get(key, ""))
-            for key, default in parameters(spec.schema()) if key not in IGNORED]
+            for key, default in parameters(spec.schema()) if key not in IGNORED + HIDDEN]
     width = max(len(left) for left, _ in rows) + 2
     lines += [f"  {left:{width}s}{meaning}" for left, meaning in rows]
     if ignored := [k for k, _ in parameters(spec.schema()) if k in IGNORED]:
@@ -192,18 +200,10 @@ def usage(name: str) -> str:
               "  -h, --help   show this help and exit",
               "  --cfg job    print the config composed from the defaults and the given key=value, "
               "and exit without running",
+              "  -m           sweep (--multirun): one job per combination of comma-separated values",
+              "               or range(...), in Hydra's override grammar (quote a path holding , ( ) [ ] { }",
+              "               or quotes: \"recording='run (1).csv'\"); the jobs run on tcbench run's launcher",
+              "               (hydra.launcher.n_jobs=2 for two workers) and the sweep is reported at the end",
               "", "examples:", *(f"  {e}" for e in spec.examples),
               "", textwrap.fill(f"output: {spec.output}", width=100, subsequent_indent="  ")]
     return "\n".join(lines)
-
-
-def composed_yaml(name: str, args: list[str]) -> str:
-    """The config ``tcbench <name> args`` would run with, as YAML (``--cfg job``)."""
-    from omegaconf import OmegaConf
-
-    from tcbench.sensors_cli import composed
-
-    spec = SPECS[name]
-    if spec.positional and args and "=" not in args[0]:
-        args = [f"{spec.positional}={args[0]}", *args[1:]]
-    return OmegaConf.to_yaml(composed(args, spec.schema()))

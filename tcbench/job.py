@@ -21,7 +21,7 @@ from typing import Any
 import yaml
 
 from tcbench.config import as_dict
-from tcbench.errors import error_line
+from tcbench.errors import ConfigError, error_line
 from tcbench.kinds import JobKind, kind_of
 
 log = logging.getLogger(__name__)
@@ -42,20 +42,16 @@ class JobFailure:
 FAILURES: list[JobFailure] = []
 
 
-def _is_user_error(exc: BaseException) -> bool:
-    from tcbench.errors import ConfigError
-
-    return isinstance(exc, ConfigError) or type(exc).__name__ == "CommandError"
-
-
 def failed(name: str, exc: BaseException) -> JobFailure:
     """Log and remember a job's failure; the sweep goes on."""
-    error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+    user = isinstance(exc, ConfigError)
+    error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else str(exc) if user else \
+        f"{type(exc).__name__}: {exc}"
     if isinstance(exc, MemoryError):
         from tcbench.memory import ENV
 
         error += f" (more than one job may use here: the memory free when it started, or ${ENV})"
-    failure = JobFailure(name, error_line(error), _is_user_error(exc))
+    failure = JobFailure(name, error_line(error), user)
     log.error("job %s failed: %s", name, failure.error)
     log.debug("%s", traceback.format_exc())
     FAILURES.append(failure)
@@ -117,8 +113,21 @@ def _run(kind: JobKind, c: dict[str, Any]) -> Any:
         "tcbench.kind": kind.tag,
         **names.tags,
     }
+    if kind.opens_run_after_work:
+        try:
+            outcome = kind.execute(c)
+        except ConfigError:
+            raise  # the user's mistake: one line, no run
+        except BaseException:
+            with tracking.job_run(c, names.run, tags):
+                raise  # a crash: recorded FAILED with its error
+        try:  # the store made now, after the work: a store that cannot be made is not left half-made
+            tracking.prepare_store(track.get("uri"), str(track["experiment"]))
+        except tracking.StoreError as exc:
+            raise ConfigError(f"the files are written, but MLflow could not record them: {exc}") from None
     with tracking.job_run(c, names.run, tags) as run:
-        outcome = kind.execute(c)
+        if not kind.opens_run_after_work:
+            outcome = kind.execute(c)
         with tempfile.TemporaryDirectory() as tmp:
             where = Path(tmp)
             (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))

@@ -55,14 +55,13 @@ class Board:
 
 
 def sweep_runs(client, experiments: list[str], sweep: str) -> pd.DataFrame:  # type: ignore[no-untyped-def]
-    """Status, method, task, seed and error of every run of one sweep, optimisation and
-    compensation alike (what the end-of-sweep report needs, without either board's columns)."""
+    """Status, method, task, seed and error of every run of one sweep, of every job kind (what the
+    end-of-sweep report needs, without any board's columns)."""
     columns = ["status", "method", "task", "seed", "config_hash", "start_time", "error_message"]
     rows = [{"status": r.info.status, "method": t.get("tcbench.method"), "task": t.get("tcbench.task"),
              "seed": int(t.get("tcbench.seed", -1)), "config_hash": t.get("tcbench.config_hash"),
              "start_time": r.info.start_time, "error_message": t.get("tcbench.error", "")}
-            for kind in ("optimisation", "compensation")
-            for r in search_runs(client, experiments, kind, sweep) for t in (r.data.tags,)]
+            for r in search_runs(client, experiments, None, sweep) for t in (r.data.tags,)]
     return pd.DataFrame(rows, columns=columns)
 
 

@@ -171,12 +171,17 @@ def _where(where: dict[str, Any]) -> str:
 
 
 def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: Path) -> tuple[list[Path], str]:
-    """Simulate a recording with a hidden effect, diagnose it, print what was found, write the
-    report and log it as an MLflow run; the paths written and the run id."""
+    """Simulate a recording with a hidden effect, write it, diagnose it as ``tcbench diagnose``
+    does (:func:`tcbench.job.run_job`: the report, and a run in MLflow) and print what was found;
+    the paths written and the run id."""
+    from omegaconf import OmegaConf
+
     from tcbench import tracking
+    from tcbench.command_schemas import DiagnoseConfig
+    from tcbench.config import as_dict
     from tcbench.diagnose.concealed import concealed_recording
-    from tcbench.diagnose.diagnosis import diagnose
-    from tcbench.diagnose.report import write_report
+    from tcbench.job import JobFailure, run_job
+    from tcbench.sensors.recording import write_recording
 
     rec, hidden = concealed_recording(sizes.diagnose_sensor, sizes.diagnose_effect, sizes.diagnose_seed)
     length = f"{(rec.time_s[-1] - rec.time_s[0]) / 3600:.1f} h"
@@ -184,7 +189,14 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
           f"effect hidden under the noise: {hidden.effect} ({', '.join(f'{k} {v:.4g}' for k, v in hidden.params.items())}). "
           "The diagnosis is not told which; it starts from the minimal model (bias and scale factor "
           "quadratic in the thermometer temperature, white noise) and tests the library's effects.")
-    diag = diagnose(rec, sensor=hidden.sensor, name=f"concealed-{hidden.sensor}-{hidden.effect}-{hidden.seed}")
+    (out.parent / "recordings").mkdir(parents=True, exist_ok=True)
+    path = write_recording(rec, out.parent / "recordings" / f"concealed-{hidden.sensor}-{hidden.effect}-{hidden.seed}.csv")
+    c = as_dict(OmegaConf.structured(DiagnoseConfig(recording=str(path), out=str(out))))
+    c["tracking"] |= {"uri": uri, "experiment": experiment, "sweep_id": sweep}
+    outcome = run_job(c)  # the job tcbench diagnose runs: its report, and its run in MLflow
+    if isinstance(outcome, JobFailure):
+        raise RuntimeError(f"the diagnosis failed: {outcome.error}")
+    diag, written = outcome.diagnosis, outcome.written
     sigma = float(diag.noise["white_sigma"])
     before, after = float(diag.baseline["rmse_heldout"]), float(diag.final["rmse_heldout"])
     print(f"\nVerdict: {diag.verdict}")
@@ -203,22 +215,10 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
     _print_table(["model", f"RMSE held-out ({diag.unit})", "in sigma"],
                  [[" + ".join(diag.baseline["model"]), before, before / sigma],
                   [" + ".join(diag.final["model"]), after, after / sigma]])
-    written = write_report(diag, out)
     paths = list(written.values())
-
-    cfg = {"tracking": {"uri": uri, "experiment": experiment},
-           "diagnose": {"sensor": hidden.sensor, "hidden_effect": hidden.effect, "seed": hidden.seed}}
-    with tracking.job_run(cfg, f"diagnose-concealed-{hidden.sensor}-{hidden.effect}-s{hidden.seed}", {
-        "tcbench.kind": "diagnosis", "tcbench.sweep_id": sweep, "tcbench.sensor": hidden.sensor,
-        "tcbench.effects_found": ",".join(diag.effect_ids) or "none",
-        "tcbench.hidden_effect": str(hidden.effect), "tcbench.verdict": diag.verdict[:4900],
-    }) as job:
-        job.log_params({f"found.{e['id']}.{k}": f"{v:.6g}" for e in diag.effects
-                        for k, v in e.get("params", {}).items()})
-        job.log_metrics({"rmse_heldout_before": before, "rmse_heldout_after": after, "white_sigma": sigma,
-                         "rmse_heldout_before_sigma": before / sigma, "rmse_heldout_after_sigma": after / sigma,
-                         "hidden_effect_found": float(hit)})
-        for p in paths:
-            job.log_artifact(p)
-        run_id = job.run_id
+    client = tracking.client(uri)
+    exp = client.get_experiment_by_name(experiment)
+    (run,) = client.search_runs([exp.experiment_id], filter_string=(
+        f"tags.`tcbench.kind` = 'diagnosis' and tags.`tcbench.sweep_id` = '{sweep}'"), max_results=1)
+    run_id = run.info.run_id
     return paths, run_id

@@ -21,6 +21,13 @@ def _cache_dir(tmp_path_factory):  # type: ignore[no-untyped-def]
         os.environ["TCBENCH_CACHE_DIR"] = old
 
 
+@pytest.fixture(autouse=True)
+def _tracking_store(tmp_path_factory, monkeypatch):  # type: ignore[no-untyped-def]
+    """Every command a test runs tracks into a store of its own, never the checkout's ./mlflow.db
+    (``workdir`` and tests of the default store unset it)."""
+    monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path_factory.mktemp('mlflow') / 'mlflow.db'}")
+
+
 @pytest.fixture
 def workdir(tmp_path, monkeypatch):
     """Run in an empty directory with no tracking server configured."""

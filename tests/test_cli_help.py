@@ -43,7 +43,7 @@ def test_help_exits_0_and_names_the_parameters(command: str, flag: str, capsys: 
     if command in KEYVALUE:
         assert out.startswith(f"usage: tcbench {command} ")
         for key, _ in cli_help.parameters(cli_help.SPECS[command].schema()):
-            if key not in cli_help.IGNORED:
+            if key not in cli_help.IGNORED + cli_help.HIDDEN:
                 assert f"  {key}=" in out, key
         assert "--cfg job" in out and "examples:" in out and "output:" in out
     else:
@@ -60,14 +60,14 @@ def test_help_wins_after_arguments(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_help_shows_the_defaults_the_command_parses() -> None:
     text = cli_help.usage("simulate")
-    assert "  sensor=msra " in text and "  protocol=fulltemp " in text and "tracking.experiment=simulations" in text
+    assert "  sensor=null " in text and "  protocol=fulltemp " in text and "tracking.experiment=simulations" in text
     assert "  recording=(required) " in cli_help.usage("diagnose") and "  out=diagnosis " in cli_help.usage("diagnose")
 
 
 @pytest.mark.parametrize("command", KEYVALUE)
 def test_every_parameter_has_a_meaning(command: str) -> None:
     spec = cli_help.SPECS[command]
-    keys = {k for k, _ in cli_help.parameters(spec.schema())} - set(cli_help.IGNORED)
+    keys = {k for k, _ in cli_help.parameters(spec.schema())} - set(cli_help.IGNORED + cli_help.HIDDEN)
     assert keys == set(spec.params)
     assert set(spec.required) <= keys
 
@@ -151,10 +151,13 @@ def test_commands_without_parameters_refuse_arguments(command: str, capsys: pyte
 
 
 @pytest.mark.parametrize("command", KEYVALUE)
-def test_a_sweep_flag_says_only_run_sweeps(command: str, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main([command, "-m", "seed=1,2"]) == 2
+def test_a_sweep_with_a_bad_value_is_one_line_before_any_job(command: str, capsys: pytest.CaptureFixture[str],
+                                                             tmp_path: Path) -> None:
+    """``-m`` sweeps through Hydra's launcher; every job is checked before the first starts."""
+    assert main([command, "-m", "colour=red,blue"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and f"-m: tcbench {command} does not sweep yet" in err[0]
+    assert len(err) == 1 and "colour" in err[0], err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_help_command_shows_a_command_s_usage(capsys: pytest.CaptureFixture[str]) -> None:

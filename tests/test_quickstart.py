@@ -57,7 +57,7 @@ def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
     (diag,) = [r for r in runs if r.data.tags["tcbench.kind"] == "diagnosis"]
     assert diag.data.tags["tcbench.effects_found"] == "thermal_lag"
     m = diag.data.metrics
-    assert m["rmse_heldout_after_sigma"] < m["rmse_heldout_before_sigma"] and m["hidden_effect_found"] == 1
+    assert m["rmse_heldout_after_sigma"] < m["rmse_heldout_before_sigma"] and m["effects_found"] == 1
     assert {"report.md", "report.json", "model.yaml"} <= {a.path for a in client.list_artifacts(diag.info.run_id)}
 
 

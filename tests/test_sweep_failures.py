@@ -228,8 +228,9 @@ def test_job_folders_on_a_full_disk_stop_the_sweep_in_one_line(site: Path, small
 
 
 def test_simulate_on_a_full_store_disk_is_one_line(site: Path, tmp_path: Path, small_disk) -> None:  # type: ignore[no-untyped-def]
-    """simulate and metrics log to MLflow after writing their files: a store that cannot be made
-    is one line naming it, and leaves no half-made database."""
+    """simulate and metrics open their MLflow run after writing their files (a bad input leaves
+    neither): a store that cannot be made then is one line naming it, and leaves no half-made
+    database."""
     disk = small_disk("500k")
     run = tcbench("simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=200",
                   "protocol_params.sample_rate_hz=1", "out=o", f"tracking.uri=sqlite:///{disk / 'mlflow.db'}",

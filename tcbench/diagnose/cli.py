@@ -1,43 +1,41 @@
-"""``tcbench diagnose recording=PATH out=DIR [sensor=msra|gyro] [model=PATH]``."""
+"""What ``tcbench diagnose`` does with its config: the checks made before any work
+(:func:`check_diagnose`) and the diagnosis with its report (:func:`diagnose_recording`). It runs
+as a job of :mod:`tcbench.kinds.diagnosis` through :func:`tcbench.job.run_job`."""
 
 from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from tcbench.sensors_cli import CommandError, cannot_write, overwrite_error, parse, writable_folder
+from tcbench.command_schemas import DiagnoseConfig
+from tcbench.commands import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
 
 log = logging.getLogger(__name__)
 
 
 @dataclass
-class DiagnoseConfig:
-    """``tcbench diagnose`` arguments: the recording, the output directory, the sensor kind for
-    a recording without a sidecar, and the model file of effects already modelled."""
+class DiagnosisOutcome:
+    """A diagnosis and the files of its report (``report.json``, ``report.md``, ``model.yaml``, plots)."""
 
-    recording: str = ""
-    out: str = "diagnosis"
-    sensor: str | None = None
-    model: str | None = None
+    diagnosis: Any
+    written: dict[str, Path]
 
 
-def diagnose_command(args: list[str]) -> int:
-    """Run a diagnosis and write its report; user errors raise :class:`CommandError`."""
-    from tcbench.diagnose.diagnosis import diagnose
+def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, float]]]:
+    """Every argument before any work: the recording (read and validated), its sensor and the
+    effects the model file declares already modelled."""
     from tcbench.diagnose.model_file import ModelFileError, read_model
-    from tcbench.diagnose.report import write_report
-    from tcbench.diagnose.signals import DiagnosisDataError
-    from tcbench.sensors.recording import read_recording, sidecar_path
-    from tcbench.staging import InputOverwriteError
+    from tcbench.sensors.recording import read_recording
     from tcbench.sensors.recording_schema import RecordingError
 
-    cfg: DiagnoseConfig = parse(args, DiagnoseConfig)
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
     if cfg.sensor not in (None, "msra", "gyro"):
         raise CommandError(f"sensor must be msra or gyro, got {cfg.sensor!r}")
     writable_folder(cfg.out)
+    checked_store(cfg.tracking)
     try:
         rec = read_recording(cfg.recording)
     except RecordingError as exc:
@@ -58,6 +56,18 @@ def diagnose_command(args: list[str]) -> int:
         if spec.sensor != sensor:
             raise CommandError(f"{cfg.model}: a model of a {spec.sensor}, but the recording is from a {sensor}")
         declared = spec.effects
+    return rec, sensor, declared
+
+
+def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
+    """Diagnose the recording, write its report and print the verdict."""
+    from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.report import write_report
+    from tcbench.diagnose.signals import DiagnosisDataError
+    from tcbench.sensors.recording import sidecar_path
+    from tcbench.staging import InputOverwriteError
+
+    rec, sensor, declared = check_diagnose(cfg)
     try:
         diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
     except DiagnosisDataError as exc:
@@ -73,4 +83,4 @@ def diagnose_command(args: list[str]) -> int:
     print(f"  baseline RMSE held-out {diag.baseline['rmse_heldout']:.4g} {diag.unit}, final "
           f"{diag.final['rmse_heldout']:.4g} {diag.unit}, white noise {diag.noise['white_sigma']:.4g} {diag.unit}")
     print(f"  wrote {', '.join(str(p) for p in written.values())}")
-    return 0
+    return DiagnosisOutcome(diag, written)

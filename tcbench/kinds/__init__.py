@@ -46,6 +46,10 @@ class JobKind:
     name = ""
     tag = ""  # ``tcbench.kind`` of its MLflow runs (the leaderboards select by it); default: name
     plots_in_sweeps = True  # ``tracking.plots: null`` in a sweep draws the figures
+    # True: the MLflow run opens when the work is done (a user error, such as a malformed input
+    # found while working, leaves no run; a crash still leaves a FAILED one); False: it opens
+    # first and shows RUNNING while the job works (the long jobs of ``tcbench run``)
+    opens_run_after_work = False
 
     def __init__(self) -> None:
         self.tag = self.tag or self.name
@@ -53,6 +57,18 @@ class JobKind:
     def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
         """The config as it will run and be logged (defaults made explicit); nothing is run."""
         return c
+
+    def check(self, c: dict[str, Any]) -> None:
+        """The checks of the job's arguments and inputs that need no work (:meth:`execute` makes
+        them again when it runs)."""
+
+    def plan_check(self, c: dict[str, Any]) -> None:
+        """What a command checks of every job of a sweep before the first one starts."""
+        self.check(c)
+
+    def outputs(self, c: dict[str, Any]) -> list[Path]:
+        """The files or folders the job writes outside MLflow: no two jobs of a sweep may share one."""
+        return []
 
     def names(self, c: dict[str, Any]) -> JobNames:
         raise NotImplementedError
@@ -69,6 +85,15 @@ class JobKind:
     def summary(self, outcome: Any, c: dict[str, Any]) -> str:
         """One line for the log when the job ends."""
         return f"{self.names(c).run} done"
+
+
+def announce(run: Any, c: dict[str, Any]) -> None:
+    """Print where a command's run is logged (the recording commands, whose output is the user's)."""
+    from tcbench import tracking
+
+    track = c["tracking"]
+    print(f"logged to MLflow run {run.run_id} in {tracking.tracking_uri(track.get('uri'))} "
+          f"(experiment {track['experiment']!r})")
 
 
 def kind_name(c: dict[str, Any]) -> str:

@@ -111,6 +111,9 @@ class CompensationKind(JobKind):
     def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
         return {**c, "learner": learner_of(c)}  # the default learner made explicit: logged and hashed
 
+    def plan_check(self, c: dict[str, Any]) -> None:
+        validate(c)
+
     def names(self, c: dict[str, Any]) -> JobNames:
         learner = learner_of(c)
         tkey = task_spec(str(c["task"]["name"])).key(c["task"])

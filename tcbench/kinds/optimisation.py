@@ -58,6 +58,9 @@ class OptimisationKind(JobKind):
     name = "optimisation"
     plots_in_sweeps = False  # a convergence PNG per run costs more than the run; the leaderboard draws them
 
+    def plan_check(self, c: dict[str, Any]) -> None:
+        validate(c)
+
     def names(self, c: dict[str, Any]) -> JobNames:
         tkey, method = task_key(c["task"]), method_label(c["optimiser"])
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),

@@ -1,0 +1,106 @@
+"""Config schemas of the recording commands (``tcbench simulate|metrics|import|diagnose``): each
+is the structured base of its primary config ``conf/<command>.yaml``, registered with Hydra's
+ConfigStore as ``<command>_schema`` so types and known keys are checked at composition.
+``kind`` names the job kind that runs it (:mod:`tcbench.kinds`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from tcbench.tracking_config import TrackingConfig
+
+
+@dataclass
+class SimulateConfig:
+    """``tcbench simulate``. ``protocol_params.<name>=`` overrides a protocol keyword
+    (``protocol_params.duration_s=3600``); ``effects.<id>.<param>=`` changes or adds an effect
+    (``effects.hysteresis.amplitude=0.02``); ``without=[white_noise]`` drops some. ``model=PATH``
+    simulates a fitted-model file (:mod:`tcbench.diagnose.model_file`) instead of a device: the
+    sensor comes from the file (``sensor`` null), effect changes and ``without`` still apply."""
+
+    kind: str = "simulate"
+    sensor: str | None = None  # null: msra, or the model file's sensor
+    protocol: str = "fulltemp"
+    device_seed: int = 0
+    seed: int = 0
+    out: str = "recordings"
+    format: str = "csv"
+    name: str | None = None
+    protocol_params: dict[str, Any] = field(default_factory=dict)
+    effects: dict[str, dict[str, Any]] = field(default_factory=dict)
+    without: list[str] = field(default_factory=list)
+    metrics: bool = True
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="simulations"))
+    model: str | None = None
+
+
+@dataclass
+class MetricsConfig:
+    """``tcbench metrics``: ``recording=PATH`` and options."""
+
+    kind: str = "metrics"
+    recording: str = ""
+    out: str | None = None
+    scale_factor_hz_per_g: float | None = None
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
+
+
+@dataclass
+class ImportConfig:
+    """``tcbench import``: the CSV, the sensor kind, the column map (``time=COL[:unit]`` ...), rows
+    to drop (``drop=flag`` or ``drop=a,b``: rows where a column is nonzero) and the output
+    directory; ``name`` is the recording's stem (default: the CSV's)."""
+
+    kind: str = "import"
+    csv: str = ""
+    sensor: str = ""
+    time: str = ""
+    temperature: str = ""
+    output: str = ""
+    input: str | None = None
+    drop: str | None = None
+    out: str = ""
+    name: str | None = None
+    device_id: str | None = None
+    sample_rate_hz: float | None = None
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
+
+
+@dataclass
+class DiagnoseConfig:
+    """``tcbench diagnose``: the recording, the output directory, the sensor kind for a recording
+    without a sidecar, and the model file of effects already modelled."""
+
+    kind: str = "diagnose"
+    recording: str = ""
+    out: str = "diagnosis"
+    sensor: str | None = None
+    model: str | None = None
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
+
+
+SCHEMAS: dict[str, type] = {"simulate": SimulateConfig, "metrics": MetricsConfig, "import": ImportConfig,
+                            "diagnose": DiagnoseConfig}
+
+
+def register() -> None:
+    """Make the schemas available to Hydra as ``<command>_schema``, and the resolver ``stem``:
+    ``${stem:KEY}`` is the file stem of the path at config key ``KEY`` (``out=diagnoses/${stem:recording}``:
+    a folder per recording of a sweep)."""
+    from pathlib import PurePath
+
+    from hydra.core.config_store import ConfigStore
+    from omegaconf import OmegaConf
+
+    for name, schema in SCHEMAS.items():
+        ConfigStore.instance().store(name=f"{name}_schema", node=schema)
+    if not OmegaConf.has_resolver("stem"):
+        OmegaConf.register_new_resolver("stem", lambda key, _root_: PurePath(str(OmegaConf.select(_root_, key))).stem)
+
+
+def as_schema(c: dict[str, Any], schema: type) -> Any:
+    """A composed config (plain dict) as the schema's dataclass, types checked."""
+    from omegaconf import OmegaConf
+
+    return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(schema), c))

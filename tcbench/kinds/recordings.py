@@ -1,0 +1,109 @@
+"""The recording job kinds: ``simulate`` (a device under a protocol), ``metrics`` (a recording's
+papers' metrics) and ``import`` (a user's CSV as a recording). Their work is in
+:mod:`tcbench.sensors_cli`; here is how they are named and what goes to MLflow: the metrics, the
+plots and tables, the sidecar, and tags naming the sensor, device and recording."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tcbench import sensors_cli
+from tcbench.command_schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
+from tcbench.kinds import JobKind, JobNames, announce
+
+
+class RecordingKind(JobKind):
+    """What the three recording kinds share: the record of a :class:`~tcbench.sensors_cli.RecordingOutcome`."""
+
+    schema: type = SimulateConfig
+    opens_run_after_work = True  # a bad protocol parameter or file leaves no run, as it leaves no file
+
+    def config(self, c: dict[str, Any]) -> Any:
+        return as_schema(c, self.schema)
+
+    def record(self, run: Any, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any], where: Path) -> list[Path]:
+        rec, report = outcome.rec, outcome.report
+        extra = rec.meta.extra or {}
+        run.set_tag("tcbench.sensor", str(rec.meta.sensor))
+        run.set_tag("tcbench.device_id", str(rec.meta.device_id))
+        run.set_tag("tcbench.recording", str(outcome.path.resolve()))
+        run.log_params({"recording.sample_rate_hz": str(rec.meta.sample_rate_hz),
+                        "recording.samples": str(len(rec.data))})
+        files = []
+        if report is not None:
+            run.log_metrics({k: v for k, v in report.metrics.items() if not math.isnan(v)})
+            files += list(report.files.values())
+        sidecar = where / "sidecar.json"
+        sidecar.write_text(yaml.safe_dump(extra, sort_keys=False) if extra else "{}")
+        announce(run, c)
+        return [*files, sidecar]
+
+
+class SimulateKind(RecordingKind):
+    name, tag, schema = "simulate", "simulation", SimulateConfig
+
+    def check(self, c: dict[str, Any]) -> None:
+        sensors_cli.check_simulate(self.config(c))
+
+    def names(self, c: dict[str, Any]) -> JobNames:
+        cfg: SimulateConfig = self.config(c)
+        return JobNames(sensors_cli.simulation_stem(cfg), f"{cfg.sensor or 'msra'}-{cfg.protocol}", "simulate",
+                        int(cfg.seed), {"tcbench.device_seed": str(cfg.device_seed)})
+
+    def outputs(self, c: dict[str, Any]) -> list[Path]:
+        cfg: SimulateConfig = self.config(c)
+        return [Path(cfg.out) / f"{sensors_cli.simulation_stem(cfg)}.{cfg.format}"]
+
+    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
+        return sensors_cli.simulate(self.config(c))
+
+    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+        return f"simulated {outcome.path}"
+
+
+class MetricsKind(RecordingKind):
+    name, schema = "metrics", MetricsConfig
+
+    def check(self, c: dict[str, Any]) -> None:
+        sensors_cli.check_metrics(self.config(c))
+
+    def names(self, c: dict[str, Any]) -> JobNames:
+        path = Path(str(c.get("recording") or "recording"))
+        return JobNames(f"metrics-{path.stem}", path.stem, "metrics")
+
+    def outputs(self, c: dict[str, Any]) -> list[Path]:
+        return [sensors_cli.metrics_folder(self.config(c))]
+
+    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
+        return sensors_cli.metrics(self.config(c))
+
+    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+        return f"metrics of {outcome.path}"
+
+
+class ImportKind(RecordingKind):
+    name, schema = "import", ImportConfig
+
+    def check(self, c: dict[str, Any]) -> None:
+        sensors_cli.check_import(self.config(c))
+
+    def names(self, c: dict[str, Any]) -> JobNames:
+        cfg: ImportConfig = self.config(c)
+        return JobNames(f"import-{sensors_cli.import_stem(cfg)}", Path(cfg.csv).name, "import")
+
+    def outputs(self, c: dict[str, Any]) -> list[Path]:
+        cfg: ImportConfig = self.config(c)
+        return [Path(cfg.out) / f"{sensors_cli.import_stem(cfg)}.csv"]
+
+    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
+        return sensors_cli.import_recording(self.config(c))
+
+    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+        return f"imported {outcome.path}"
+
+
+KINDS = {"simulate": SimulateKind(), "metrics": MetricsKind(), "import": ImportKind()}
