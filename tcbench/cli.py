@@ -177,7 +177,7 @@ def _recording_command(command: str, argv: list[str]) -> int:
     c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
     FAILURES.clear()
     with _quiet_job_log():
-        outcome = run_job(c)
+        outcome = run_job(c, record_user_errors=False)
     if isinstance(outcome, JobFailure):
         if outcome.user:
             raise UserError(outcome.error)

@@ -74,10 +74,11 @@ def plots_default(c: dict[str, Any]) -> bool:
         return True
 
 
-def run_job(cfg: Any) -> Any:
+def run_job(cfg: Any, *, record_user_errors: bool = True) -> Any:
     """Run one configured job of any kind: its outcome, None when resume skipped it, or a
     :class:`JobFailure` when it raised or called ``sys.exit`` (recorded FAILED when tracked);
-    never raises but for ``KeyboardInterrupt``."""
+    never raises but for ``KeyboardInterrupt``. ``record_user_errors=False`` (one job of a
+    recording command): a bad input the work finds leaves no MLflow run, as it leaves no file."""
     from tcbench import memory
 
     c = as_dict(cfg)
@@ -85,12 +86,12 @@ def run_job(cfg: Any) -> Any:
         kind = kind_of(c)
         c = kind.prepare(c)
         with memory.limited(memory.job_budget_bytes()):
-            return _run(kind, c)
+            return _run(kind, c, record_user_errors)
     except (Exception, SystemExit) as exc:  # recorded as FAILED by job_run when tracked
         return failed(job_name(c), exc)
 
 
-def _run(kind: JobKind, c: dict[str, Any]) -> Any:
+def _run(kind: JobKind, c: dict[str, Any], record_user_errors: bool = True) -> Any:
     track = c.get("tracking") or {}
     if not track.get("enabled"):
         outcome = kind.execute(c)
@@ -116,11 +117,11 @@ def _run(kind: JobKind, c: dict[str, Any]) -> Any:
     if kind.opens_run_after_work:
         try:
             outcome = kind.execute(c)
-        except ConfigError:
-            raise  # the user's mistake: one line, no run
-        except BaseException:
+        except BaseException as exc:
+            if isinstance(exc, ConfigError) and not record_user_errors:
+                raise  # the user's mistake in a single command: one line, no run
             with tracking.job_run(c, names.run, tags):
-                raise  # a crash: recorded FAILED with its error
+                raise  # recorded FAILED with its error (a sweep's record, or a crash)
         try:  # the store made now, after the work: a store that cannot be made is not left half-made
             tracking.prepare_store(track.get("uri"), str(track["experiment"]))
         except tracking.StoreError as exc:
