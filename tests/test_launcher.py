@@ -4,6 +4,7 @@ worker processes, and the per-run convergence PNG left to the leaderboard in a s
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import mlflow
@@ -122,3 +123,15 @@ def test_the_plan_counts_a_command_line_value_over_the_configs_params() -> None:
 
     assert plan(["-m", "experiment=optim_suite_mo", "task=zdt1", "seed=range(2)"]).jobs == 8
     assert plan(["-m", "experiment=optim_suite_mo"]).jobs == 4 * 4 * 15
+
+
+def test_the_sweep_progress_counts_every_kind_of_job_and_its_failures(caplog: pytest.LogCaptureFixture) -> None:
+    from hydra_plugins.tcbench_launcher.launcher import Progress
+
+    progress = Progress(3)
+    with caplog.at_level(logging.INFO, logger="hydra_plugins.tcbench_launcher.launcher"):
+        for i, ok in enumerate((True, False, True)):
+            progress(i, ok)
+    lines = [r.getMessage() for r in caplog.records]
+    assert [ln.split(" jobs done")[0] for ln in lines] == ["sweep: 1/3", "sweep: 2/3", "sweep: 3/3"]
+    assert "(1 failed)" in lines[-1] and "about 0 s left" in lines[-1]

@@ -30,6 +30,7 @@ import copy
 import hashlib
 import logging
 import os
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -125,10 +126,14 @@ class GroupedLauncher(Launcher):
         jobs.sort(key=lambda j: j[0])
         log.info("Launching %d jobs (%d configs composed) %s", len(jobs), len(groups(job_overrides)),
                  "in this process" if self.n_jobs == 1 else f"on {self.n_jobs} worker processes")
+        progress = Progress(len(jobs))
         if self.n_jobs == 1 or len(jobs) == 1:
-            outcomes = [_run_one(cfg) for _, _, cfg, _ in jobs]
+            outcomes = []
+            for i, (_, _, cfg, _) in enumerate(jobs):
+                outcomes.append(_run_one(cfg))
+                progress(i, outcomes[-1][0])
         else:
-            outcomes = _run_parallel([cfg for _, _, cfg, _ in jobs], self.n_jobs)
+            outcomes = _run_parallel([cfg for _, _, cfg, _ in jobs], self.n_jobs, progress)
         returns = []
         for (_, overrides, cfg, out), (_ok, value) in zip(jobs, outcomes, strict=True):
             # COMPLETED either way: a failed job's JobFailure is no exception for Hydra to raise,
@@ -138,6 +143,23 @@ class GroupedLauncher(Launcher):
             ret.return_value = value
             returns.append(ret)
         return returns
+
+
+class Progress:
+    """The sweep's one progress display, the same for every job kind: a log line as each job
+    ends with the jobs done, failed, the time taken and the time left at this pace."""
+
+    def __init__(self, total: int) -> None:
+        self.total, self.done, self.failed = total, 0, 0
+        self.started = time.monotonic()
+
+    def __call__(self, index: int, ok: bool) -> None:
+        self.done += 1
+        self.failed += not ok
+        elapsed = time.monotonic() - self.started
+        left = elapsed / self.done * (self.total - self.done)
+        log.info("sweep: %d/%d jobs done (%d failed), %.0f s so far, about %.0f s left",
+                 self.done, self.total, self.failed, elapsed, left)
 
 
 def _resolved(cfg: DictConfig, key: str) -> Any:
@@ -179,7 +201,8 @@ def _worker_init() -> None:
     logging.basicConfig(level=logging.INFO, format="[%(asctime)s][%(name)s][%(levelname)s] - %(message)s")
 
 
-def _run_parallel(configs: list[dict[str, Any]], n_jobs: int) -> list[tuple[bool, Any]]:
+def _run_parallel(configs: list[dict[str, Any]], n_jobs: int,
+                  on_done: Any = None) -> list[tuple[bool, Any]]:
     """Run the configs on ``n_jobs`` fresh worker processes (spawned: no inherited database
     connections), results in order; a worker that dies fails its job only
     (:func:`.pool.run_jobs`). The workers' failures join this process's :data:`tcbench.job.FAILURES`."""
@@ -191,7 +214,7 @@ def _run_parallel(configs: list[dict[str, Any]], n_jobs: int) -> list[tuple[bool
         tracking.mark_failed(tracking.client((configs[index].get("tracking") or {}).get("uri")), run_id, why)
 
     workers = min(n_jobs, len(configs), os.cpu_count() or n_jobs)
-    outcomes = run_jobs(configs, workers, _worker_job, init=_worker_init, on_lost_run=lost)
+    outcomes = run_jobs(configs, workers, _worker_job, init=_worker_init, on_lost_run=lost, on_done=on_done)
     for cfg, (ok, value) in zip(configs, outcomes, strict=True):
         if not ok:
             if not isinstance(value, JobFailure):

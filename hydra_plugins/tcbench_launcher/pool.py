@@ -79,10 +79,12 @@ def _died(proc: multiprocessing.process.BaseProcess) -> str:
 
 def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
              init: Callable[[], None] | None = None,
-             on_lost_run: Callable[[int, str, str], None] | None = None) -> list[tuple[bool, Any]]:
+             on_lost_run: Callable[[int, str, str], None] | None = None,
+             on_done: Callable[[int, bool], None] | None = None) -> list[tuple[bool, Any]]:
     """Run ``job(cfg)`` for every config on ``n_workers`` spawned processes; the ``(ok, value)``
     of each, in order. A job whose worker died gets ``(False, WorkerDied(...))`` and, if it had
-    opened an MLflow run, ``on_lost_run(index, run_id, why)`` is called for it."""
+    opened an MLflow run, ``on_lost_run(index, run_id, why)`` is called for it. ``on_done(index,
+    ok)`` is called as each job ends (the sweep's progress)."""
     context = multiprocessing.get_context("spawn")
     pending = deque(enumerate(configs))
     results: list[tuple[bool, Any] | None] = [None] * len(configs)
@@ -126,6 +128,8 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
                     busy[conn] = (proc, index, message[2])
                 elif message is not None:
                     results[message[1]] = (message[2], message[3])
+                    if on_done is not None:
+                        on_done(message[1], bool(message[2]))
                     give(conn)
                 else:  # the worker is gone
                     why = _died(proc)
@@ -134,6 +138,8 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
                     if index is not None:
                         log.error("the worker running job %d %s; the sweep goes on", index, why)
                         results[index] = (False, WorkerDied(f"the worker process running the job {why}"))
+                        if on_done is not None:
+                            on_done(index, False)
                         if run_id is not None and on_lost_run is not None:
                             on_lost_run(index, run_id, f"WorkerDied: the worker process running the job {why}")
                     if pending:
