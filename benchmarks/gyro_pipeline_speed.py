@@ -34,7 +34,7 @@ TARGET_S = 300.0
 
 def one_run() -> dict[str, float]:
     from tcbench.compensation.gyro import cache
-    from tcbench.runner import _tune, run_compensation
+    from tcbench.runner.loop import _tune, run_compensation
 
     cache.clear()
     _tune.cache_clear()

@@ -35,7 +35,7 @@ DEFAULT_JSON = Path(__file__).with_name("paper_protocol_speed.json")
 
 def one(optimiser: str, seed: int, training: str) -> dict[str, float | str | int]:
     with threadpool_limits(1):
-        from tcbench.runner import run_compensation
+        from tcbench.runner.loop import run_compensation
 
         t0 = time.perf_counter()
         r = run_compensation({"name": "msra_fulltemp"}, {"name": "bp", "training": training},

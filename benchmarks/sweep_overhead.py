@@ -11,7 +11,7 @@ seed='range(N)'``, each command in a fresh temporary folder. Two launchers, same
 Measured per command: the wall time of the whole command; the time to the first job, from the
 command's start to the start time MLflow recorded for its first run; and the overhead per job,
 ``(wall - time to first job - N * compute) / N``, where ``compute`` is the median time of one
-run's optimisation measured in this process (``tcbench.runner.run_optimisation``, no tracking).
+run's optimisation measured in this process (``tcbench.runner.loop.run_optimisation``, no tracking).
 Every run must be recorded FINISHED, once. The time to the first job is also measured alone, on
 2-job sweeps repeated ``--first-repeats`` times: with tcbench's user cache empty (``cold``: the
 first sweep on a machine, which builds the migrated empty store every new store is copied from)
@@ -44,7 +44,7 @@ TARGET_OVERHEAD_S = 0.2
 
 def compute_s(runs: int = 20) -> float:
     """Median seconds of one job's optimisation alone (no tracking), in this process."""
-    from tcbench.runner import run_optimisation
+    from tcbench.runner.loop import run_optimisation
 
     task = {"name": "rastrigin", "dim": 2, "shift": False, "target_precision": 1e-8, "lower": None, "upper": None}
     optimiser = {"name": "ifa"}

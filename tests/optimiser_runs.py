@@ -42,7 +42,7 @@ def drive(opt: Any, f: Callable[[np.ndarray], np.ndarray]) -> list[np.ndarray]:
 def assert_initialises_bp(optimiser: str, searches: int = 60) -> None:
     """``optimiser`` searching BP's initial weights on MSRA full-temperature (X-BP): the best of
     ``searches`` starts beats one random start, and the result compensates."""
-    from tcbench.runner import run_compensation
+    from tcbench.runner.loop import run_compensation
 
     task, bp = {"name": "msra_fulltemp"}, {"name": "bp", "training": "lm", "epochs": 20}
     searched = run_compensation(task, bp, {"name": optimiser}, searches, 0)

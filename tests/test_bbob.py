@@ -16,7 +16,7 @@ from gymnasium.utils.env_checker import check_env
 
 import tcbench  # noqa: F401  (registers the envs)
 from tcbench.cli import main
-from tcbench.iohprofiler import (
+from tcbench.leaderboard.iohprofiler import (
     HEADER,
     IOHFormatError,
     RunLogger,
@@ -25,7 +25,7 @@ from tcbench.iohprofiler import (
     read_json,
     read_runs,
 )
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 from tcbench.tasks import BBOB_ID, FunctionEnv
 from tcbench.tasks.bbob_env import BBOBEnv
 
@@ -246,7 +246,7 @@ def test_leaderboard_pairs_bbob_runs_by_instance_and_seed() -> None:
     by (instance, seed) instead of failing on repeated seeds."""
     import pandas as pd
 
-    from tcbench.leaderboard import summarise
+    from tcbench.leaderboard.optimisation import summarise
 
     rng = np.random.default_rng(0)
     rows = [{"method": m, "status": "FINISHED", "seed": 0, "instance": i, "final_error": e,

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from tcbench import cli_help
+from tcbench.cli import help as cli_help
 from tcbench.cli import COMMANDS, main
 
 KEYVALUE = ["simulate", "metrics", "import", "diagnose"]

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from tcbench.optimisers import registry
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 from tcbench.sensors.recording import write_recording
 from tcbench.sensors.simulate import simulate_recording
 

@@ -7,9 +7,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench import leaderboard, tracking
-from tcbench.ecdf import TARGETS, ecdf_curves, hitting_evaluations, write_ecdf_plots
-from tcbench.job import run_job
+from tcbench.leaderboard import optimisation as leaderboard
+from tcbench.tracking import store as tracking
+from tcbench.leaderboard.ecdf import TARGETS, ecdf_curves, hitting_evaluations, write_ecdf_plots
+from tcbench.runner.job import run_job
 
 
 def test_hitting_evaluations_by_hand() -> None:

@@ -13,7 +13,7 @@ import tcbench  # noqa: F401  (registers the envs)
 from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.gyro.tuning import compromise, decode, tuning_window, vmd_objectives
 from tcbench.learners.polynomial import PolynomialModel
-from tcbench.runner import _tune, run_compensation, tune_vmd
+from tcbench.runner.loop import _tune, run_compensation, tune_vmd
 from tcbench.sensors.recording import make_recording, write_recording
 from tcbench.sensors.simulate import simulate_recording
 from tcbench.tasks import GyroDriftNoiseEnv, GyroVMDTuningEnv

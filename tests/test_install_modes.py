@@ -52,7 +52,7 @@ def test_missing_configs_are_one_line(tmp_path: Path, monkeypatch: pytest.Monkey
 def test_primary_config_composes() -> None:
     from hydra import compose, initialize_config_module
 
-    from tcbench.config import register_schema
+    from tcbench.runner.config import register_schema
 
     register_schema()  # the structured schema config.yaml's defaults start from
     with initialize_config_module(CONFIG_MODULE, version_base="1.3"):

@@ -119,7 +119,7 @@ def test_sweeps_leave_the_convergence_png_to_the_leaderboard(workdir: Path) -> N
 def test_the_plan_counts_a_command_line_value_over_the_configs_params() -> None:
     """``experiment=optim_suite_mo`` sweeps 4 tasks x 4 optimisers x 15 seeds from its params;
     ``task=zdt1 seed='range(2)'`` on the command line replaces two of them, as Hydra does."""
-    from tcbench.app import plan
+    from tcbench.cli.app import plan
 
     assert plan(["-m", "experiment=optim_suite_mo", "task=zdt1", "seed=range(2)"]).jobs == 8
     assert plan(["-m", "experiment=optim_suite_mo"]).jobs == 4 * 4 * 15

@@ -10,10 +10,11 @@ import pandas as pd
 import pytest
 
 import tcbench  # noqa: F401
-from tcbench import leaderboard, tracking
-from tcbench.config import ConfigError, validate
-from tcbench.job import run_job
-from tcbench.runner import run_optimisation
+from tcbench.leaderboard import optimisation as leaderboard
+from tcbench.tracking import store as tracking
+from tcbench.runner.config import ConfigError, validate
+from tcbench.runner.job import run_job
+from tcbench.runner.loop import run_optimisation
 
 TRACK = {"enabled": True, "uri": None, "experiment": "mo", "sweep_id": "s", "plots": False, "resume": False}
 

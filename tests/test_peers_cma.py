@@ -7,7 +7,7 @@ import pytest
 
 from tcbench import check_optimizer
 from tcbench.optimisers import available
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 from tcbench_peers.cma_es import CMAES, IPOPCMAES
 from optimiser_runs import assert_initialises_bp
 

@@ -18,7 +18,7 @@ from tcbench_peers.nevergrad_opt import NevergradDE, NGOpt
 
 from tcbench import check_optimizer
 from tcbench.optimisers import available
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 
 
 def sphere(x: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from tcbench_peers.seeding import library_seed
 from tcbench import check_optimizer
 from tcbench.optimisers import available
 from tcbench.pareto import nondominated
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 
 
 def two_spheres(x: np.ndarray) -> np.ndarray:

@@ -18,7 +18,7 @@ from tcbench_peers.scipy_opt import DualAnnealing, ScipyDE
 
 from tcbench import check_optimizer
 from tcbench.optimisers import available
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 from optimiser_runs import drive
 
 

@@ -10,7 +10,7 @@ import mlflow
 import pytest
 import yaml
 
-from tcbench import quickstart
+from tcbench.cli import quickstart
 from tcbench.cli import main
 
 

@@ -303,7 +303,7 @@ def test_registered_under_sa() -> None:
 
 
 def test_sa_bp_initialises_and_compensates() -> None:
-    from tcbench.runner import run_compensation
+    from tcbench.runner.loop import run_compensation
 
     learner = {"name": "bp", "training": "lm", "epochs": 20}
     result = run_compensation({"name": "msra_fulltemp"}, learner, {"name": "sa"}, 200, 1)

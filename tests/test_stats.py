@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tcbench.leaderboard import summarise
+from tcbench.leaderboard.optimisation import summarise
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 

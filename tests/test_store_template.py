@@ -9,7 +9,8 @@ from pathlib import Path
 import mlflow
 import pytest
 
-from tcbench import store_template, tracking
+from tcbench.tracking import template as store_template
+from tcbench.tracking import store as tracking
 
 
 def _schema_and_rows(db: Path) -> tuple[list[tuple], list[tuple], list[tuple]]:

@@ -9,8 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tcbench import leaderboard, tracking
-from tcbench.job import JobFailure, run_job
+from tcbench.leaderboard import optimisation as leaderboard
+from tcbench.tracking import store as tracking
+from tcbench.runner.job import JobFailure, run_job
 from tcbench.optimisers import register
 from tcbench.optimisers.fa import FireflyAlgorithm
 from tcbench.tasks.function_env import FunctionEnv

@@ -13,7 +13,7 @@ import pytest
 
 from tcbench.learners import available
 from tcbench.learners.bp import BPNetwork
-from tcbench.runner import run_compensation
+from tcbench.runner.loop import run_compensation
 
 TASK = {"name": "msra_fulltemp"}
 

@@ -23,9 +23,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench.ecdf import TARGETS, ecdf_curves, hitting_evaluations
-from tcbench.iohprofiler import IOHRun, read_runs, write_merged
-from tcbench.leaderboard import expected_running_time, markdown_table
+from tcbench.leaderboard.ecdf import TARGETS, ecdf_curves, hitting_evaluations
+from tcbench.leaderboard.iohprofiler import IOHRun, read_runs, write_merged
+from tcbench.leaderboard.optimisation import expected_running_time, markdown_table
 
 GROUPS = {
     "separable (f1-f5)": range(1, 6),
@@ -118,7 +118,7 @@ def solved_table(funcs: pd.DataFrame, runs: pd.DataFrame, missing: pd.DataFrame)
 
 
 def ecdf_table(runs: pd.DataFrame) -> pd.DataFrame:
-    """(method, dim, task, evaluations / dim) per run and target, as :func:`tcbench.ecdf.ecdf_curves` takes."""
+    """(method, dim, task, evaluations / dim) per run and target, as :func:`tcbench.leaderboard.ecdf.ecdf_curves` takes."""
     n = TARGETS.size
     return pd.DataFrame({
         "method": np.repeat(runs["method"].to_numpy(), n), "dim": np.repeat(runs["dim"].to_numpy(), n),

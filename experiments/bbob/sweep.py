@@ -3,7 +3,7 @@
 Each job is what ``tcbench run task=bbob task.function=F task.dim=D task.instance=I seed=I
 optimiser=M budget=B tracking.enabled=false tracking.ioh_dir=OUT/ioh`` does (the same config,
 composed by Hydra once per method, validated once per method and dimension, and the same
-``tcbench.job.run_job``), run in a process pool instead of one Hydra job each: Hydra's
+``tcbench.runner.job.run_job``), run in a process pool instead of one Hydra job each: Hydra's
 per-job start costs about 0.5-1 s, as much as a whole run of most methods at d = 5.
 
 Writes ``OUT/plan.json`` (the grid), ``OUT/ioh/<method>/<task>-s<seed>-<hash>/`` (one IOHprofiler
@@ -77,7 +77,7 @@ def base_configs(methods: list[str], ioh_dir: Path) -> dict[str, dict[str, Any]]
     """The composed job config of each method (``task=bbob optimiser=<m>``, tracking off)."""
     from hydra import compose, initialize_config_module
 
-    from tcbench.config import as_dict, register_schema
+    from tcbench.runner.config import as_dict, register_schema
     from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME
 
     register_schema()  # config.yaml's defaults start from the structured schema
@@ -99,7 +99,7 @@ def job_config(base: dict[str, Any], function: int, dim: int, instance: int, bud
 
 def run_one(c: dict[str, Any]) -> tuple[float, int | None, str | None]:
     """Run one job in a worker: CPU seconds, evaluations used (None if it failed), the error."""
-    from tcbench.job import run_job
+    from tcbench.runner.job import run_job
 
     t0 = time.process_time()
     try:
@@ -124,8 +124,8 @@ def main(argv: list[str] | None = None) -> int:
                          f"(default {BUDGET_PER_DIM}; {', '.join(reduced)}; "
                          f"{', '.join(f'{k} {v} in total' for k, v in FIXED_BUDGET.items())})")
     ns = ap.parse_args(argv)
-    from tcbench.config import ConfigError, validate
-    from tcbench.kinds.optimisation import ioh_folder
+    from tcbench.runner.config import ConfigError, validate
+    from tcbench.runner.kinds.optimisation import ioh_folder
     from tcbench.optimisers import registry
 
     try:

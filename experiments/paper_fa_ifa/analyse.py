@@ -12,7 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from tcbench import leaderboard, tracking  # noqa: E402
+from tcbench.leaderboard import optimisation as leaderboard  # noqa: E402
+from tcbench.tracking import store as tracking  # noqa: E402
 
 POPULATION = 10
 GENERATIONS = 50

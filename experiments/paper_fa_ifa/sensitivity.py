@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-from tcbench.runner import run_optimisation
+from tcbench.runner.loop import run_optimisation
 
 TASK = {"name": "rastrigin", "dim": 2, "target_precision": 1e-3}
 SEEDS = range(30)

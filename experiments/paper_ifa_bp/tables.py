@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench import tracking
+from tcbench.tracking import store as tracking
 from tcbench.compensation import leaderboard as board
 from tcbench.tasks.specs import protocols
-from tcbench.leaderboard import markdown_table, one_run_per_job
+from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 
 # Seed 000 Table 1 (zero bias, µg) and Table 2 (full temperature): test dataset 1, 2.

@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench import tracking
+from tcbench.tracking import store as tracking
 from tcbench.compensation import leaderboard as board
 from tcbench.compensation.gyro.plots import allan_methods_figure
-from tcbench.leaderboard import markdown_table, one_run_per_job
+from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.signal.allan import AllanDeviation
 
 PAPER = {"raw": (0.531076, 32.7364), "MOVMD-TFPF+BAS-elman-adam": (5.22502e-3, 0.140403)}  # Fig. 19

@@ -43,7 +43,7 @@ from hydra.types import HydraContext, TaskFunction
 from omegaconf import DictConfig, OmegaConf, open_dict
 
 from hydra_plugins.tcbench_launcher.pool import run_jobs
-from tcbench.job import plots_default
+from tcbench.runner.job import plots_default
 
 log = logging.getLogger(__name__)
 
@@ -185,8 +185,8 @@ def _write_job_dir(out: Path, subdir: str | None, cfg: dict[str, Any], overrides
 
 
 def _run_one(cfg: dict[str, Any]) -> tuple[bool, Any]:
-    """Run one job's config; (True, result), or (False, its :class:`~tcbench.job.JobFailure`)."""
-    from tcbench.job import JobFailure, run_job
+    """Run one job's config; (True, result), or (False, its :class:`~tcbench.runner.job.JobFailure`)."""
+    from tcbench.runner.job import JobFailure, run_job
 
     value = run_job(cfg)  # never raises: a failure comes back as a JobFailure
     return not isinstance(value, JobFailure), value
@@ -205,11 +205,11 @@ def _run_parallel(configs: list[dict[str, Any]], n_jobs: int,
                   on_done: Any = None) -> list[tuple[bool, Any]]:
     """Run the configs on ``n_jobs`` fresh worker processes (spawned: no inherited database
     connections), results in order; a worker that dies fails its job only
-    (:func:`.pool.run_jobs`). The workers' failures join this process's :data:`tcbench.job.FAILURES`."""
-    from tcbench.job import FAILURES, JobFailure, job_name
+    (:func:`.pool.run_jobs`). The workers' failures join this process's :data:`tcbench.runner.job.FAILURES`."""
+    from tcbench.runner.job import FAILURES, JobFailure, job_name
 
     def lost(index: int, run_id: str, why: str) -> None:
-        from tcbench import tracking
+        from tcbench.tracking import store as tracking
 
         tracking.mark_failed(tracking.client((configs[index].get("tracking") or {}).get("uri")), run_id, why)
 

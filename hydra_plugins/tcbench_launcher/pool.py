@@ -50,7 +50,7 @@ def _worker(conn: Connection, job: Job, init: Callable[[], None] | None) -> None
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     if init is not None:
         init()
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     current = [-1]
     tracking.on_run_created = lambda run_id: conn.send(("run", current[0], run_id))

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from tcbench.board_files import (
+from tcbench.leaderboard.files import (
     failed_lines,
     markdown_table,
     one_run_per_job,

@@ -1,6 +1,6 @@
 """What ``tcbench diagnose`` does with its config: the checks made before any work
 (:func:`check_diagnose`) and the diagnosis with its report (:func:`diagnose_recording`). It runs
-as a job of :mod:`tcbench.kinds.diagnosis` through :func:`tcbench.job.run_job`."""
+as a job of :mod:`tcbench.runner.kinds.diagnosis` through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tcbench.command_schemas import DiagnoseConfig
-from tcbench.commands import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
+from tcbench.cli.schemas import DiagnoseConfig
+from tcbench.cli.errors import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
 
 log = logging.getLogger(__name__)
 

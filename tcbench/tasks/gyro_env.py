@@ -74,7 +74,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         (e.g. ``{"bias_instability": {"b": 8.3e-4}}`` for 3 deg/h of flicker).
     tuner, tuner_params, tuning_budget, tuning_samples: the multi-objective search of
         ``[k, alpha]`` that the runner does before ``reset`` when they are unset
-        (:func:`tcbench.runner.tune_vmd`); ``tuner_params`` None takes the tuner's defaults.
+        (:func:`tcbench.runner.loop.tune_vmd`); ``tuner_params`` None takes the tuner's defaults.
     """
 
     metadata = {"render_modes": []}

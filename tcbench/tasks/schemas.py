@@ -1,5 +1,5 @@
 """Config schemas of the task kinds: the keys a ``task:`` config may hold, with their types and
-defaults (checked by :func:`tcbench.config.checked_task`)."""
+defaults (checked by :func:`tcbench.runner.config.checked_task`)."""
 
 from __future__ import annotations
 

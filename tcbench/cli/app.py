@@ -1,6 +1,6 @@
 """The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``,
 ``tcbench simulate|metrics|import|diagnose`` on ``conf/<command>.yaml``) and the checks made
-before any job starts. Every job of every command runs through :func:`tcbench.job.run_job`."""
+before any job starts. Every job of every command runs through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
@@ -18,11 +18,11 @@ from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
-from tcbench import command_schemas
-from tcbench.config import ConfigError, as_dict, register_schema
+from tcbench.cli import schemas as command_schemas
+from tcbench.runner.config import ConfigError, as_dict, register_schema
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
-from tcbench.job import run_job
-from tcbench.kinds import kind_of
+from tcbench.runner.job import run_job
+from tcbench.runner.kinds import kind_of
 
 # Hydra flags followed by a value; those that change where configs come from make tcbench
 # skip its up-front check (each job still validates its own config).

@@ -11,10 +11,10 @@ import numpy as np
 
 from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
-from tcbench.compensation_config import learner_of
-from tcbench.config import validate
-from tcbench.kinds import JobKind, JobNames
-from tcbench.runner import CompensationResult, VMDTuning, run_compensation
+from tcbench.runner.compensation_config import learner_of
+from tcbench.runner.config import validate
+from tcbench.runner.kinds import JobKind, JobNames
+from tcbench.runner.loop import CompensationResult, VMDTuning, run_compensation
 from tcbench.tasks import task_spec
 
 

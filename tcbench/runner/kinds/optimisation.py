@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.config import validate
-from tcbench.kinds import JobKind, JobNames
-from tcbench.runner import RunResult, run_optimisation
+from tcbench.runner.config import validate
+from tcbench.runner.kinds import JobKind, JobNames
+from tcbench.runner.loop import RunResult, run_optimisation
 from tcbench.tasks import task_spec
 
 

@@ -112,7 +112,7 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     diag_paths, run_id = _diagnosis(sizes, sweep, checked.experiment, checked.tracking_uri, out / "diagnosis")
     diagnosis_s = time.monotonic() - started - compensation_s
 
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     uri = tracking.tracking_uri(checked.tracking_uri)
     print(_rule("Where everything is"))
@@ -132,7 +132,7 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
 
 def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> list[Path]:
     """Print the small table and write the full board; the paths written."""
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
     from tcbench.compensation import leaderboard as comp_board
     from tcbench.tasks.specs import protocols
 
@@ -172,15 +172,15 @@ def _where(where: dict[str, Any]) -> str:
 
 def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: Path) -> tuple[list[Path], str]:
     """Simulate a recording with a hidden effect, write it, diagnose it as ``tcbench diagnose``
-    does (:func:`tcbench.job.run_job`: the report, and a run in MLflow) and print what was found;
+    does (:func:`tcbench.runner.job.run_job`: the report, and a run in MLflow) and print what was found;
     the paths written and the run id."""
     from omegaconf import OmegaConf
 
-    from tcbench import tracking
-    from tcbench.command_schemas import DiagnoseConfig
-    from tcbench.config import as_dict
+    from tcbench.tracking import store as tracking
+    from tcbench.cli.schemas import DiagnoseConfig
+    from tcbench.runner.config import as_dict
     from tcbench.diagnose.concealed import concealed_recording
-    from tcbench.job import JobFailure, run_job
+    from tcbench.runner.job import JobFailure, run_job
     from tcbench.sensors.recording import write_recording
 
     rec, hidden = concealed_recording(sizes.diagnose_sensor, sizes.diagnose_effect, sizes.diagnose_seed)

@@ -179,7 +179,7 @@ def run_optimisation(
     opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, params, n_objectives)
     ioh_log = None
     if ioh_folder is not None:
-        from tcbench.iohprofiler import RunLogger, problem_meta
+        from tcbench.leaderboard.iohprofiler import RunLogger, problem_meta
 
         ioh_log = RunLogger(ioh_folder, problem_meta(env, seed), algorithm or optimiser["name"],
                             json.dumps(params, sort_keys=True, default=str), seed, {"budget": budget})

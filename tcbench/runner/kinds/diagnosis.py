@@ -8,9 +8,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tcbench.command_schemas import DiagnoseConfig, as_schema
+from tcbench.cli.schemas import DiagnoseConfig, as_schema
 from tcbench.diagnose.cli import DiagnosisOutcome, check_diagnose, diagnose_recording
-from tcbench.kinds import JobKind, JobNames, announce
+from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 def diagnosis_metrics(diag: Any) -> dict[str, float]:

@@ -1,4 +1,4 @@
-"""What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard`) and compensation
+"""What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard.optimisation`) and compensation
 (:mod:`tcbench.compensation.leaderboard`): the MLflow runs of a kind, one run per job, markdown tables
 and the board files. A leaf module (numpy and pandas only)."""
 

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.errors import ConfigError
-from tcbench.tracking_config import TrackingConfig
+from tcbench.tracking.config import TrackingConfig
 
 
 class CommandError(ConfigError):
@@ -49,13 +49,13 @@ def overwrite_error(exc: Any) -> CommandError:
 
 def checked_store(track: TrackingConfig) -> None:
     """With tracking on: the experiment has a name and the store can be used, checked before any
-    work and without making anything (:func:`tcbench.tracking.check_store`); a
+    work and without making anything (:func:`tcbench.tracking.store.check_store`); a
     :class:`CommandError` otherwise."""
     if not track.enabled:
         return
     if not str(track.experiment or "").strip():
         raise CommandError("tracking.experiment: give the MLflow experiment a name, or tracking.enabled=false")
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     try:
         tracking.check_store(track.uri, create=True)  # made when the results are logged

@@ -1,4 +1,4 @@
-"""Job kinds: what differs between the jobs one runner (:func:`tcbench.job.run_job`) runs.
+"""Job kinds: what differs between the jobs one runner (:func:`tcbench.runner.job.run_job`) runs.
 
 A kind says how a job is named (:meth:`JobKind.names`), runs it (:meth:`JobKind.execute`) and
 what of its outcome goes to MLflow (:meth:`JobKind.record`); the runner does the rest the same
@@ -20,12 +20,12 @@ from tcbench.errors import ConfigError
 
 # kind name -> module holding its ``KIND`` (imported when a job of that kind runs)
 KIND_MODULES = {
-    "optimisation": "tcbench.kinds.optimisation",
-    "compensation": "tcbench.kinds.compensation",
-    "simulate": "tcbench.kinds.recordings",
-    "metrics": "tcbench.kinds.recordings",
-    "import": "tcbench.kinds.recordings",
-    "diagnose": "tcbench.kinds.diagnosis",
+    "optimisation": "tcbench.runner.kinds.optimisation",
+    "compensation": "tcbench.runner.kinds.compensation",
+    "simulate": "tcbench.runner.kinds.recordings",
+    "metrics": "tcbench.runner.kinds.recordings",
+    "import": "tcbench.runner.kinds.recordings",
+    "diagnose": "tcbench.runner.kinds.diagnosis",
 }
 
 
@@ -78,7 +78,7 @@ class JobKind:
         raise NotImplementedError
 
     def record(self, run: Any, outcome: Any, c: dict[str, Any], where: Path) -> list[Path]:
-        """Log the outcome's metrics and series on ``run`` (:class:`tcbench.tracking.JobRun`);
+        """Log the outcome's metrics and series on ``run`` (:class:`tcbench.tracking.store.JobRun`);
         the artifact files, written into ``where``."""
         return []
 
@@ -89,7 +89,7 @@ class JobKind:
 
 def announce(run: Any, c: dict[str, Any]) -> None:
     """Print where a command's run is logged (the recording commands, whose output is the user's)."""
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     track = c["tracking"]
     print(f"logged to MLflow run {run.run_id} in {tracking.tracking_uri(track.get('uri'))} "

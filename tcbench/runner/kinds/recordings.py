@@ -1,6 +1,6 @@
 """The recording job kinds: ``simulate`` (a device under a protocol), ``metrics`` (a recording's
 papers' metrics) and ``import`` (a user's CSV as a recording). Their work is in
-:mod:`tcbench.sensors_cli`; here is how they are named and what goes to MLflow: the metrics, the
+:mod:`tcbench.cli.recordings`; here is how they are named and what goes to MLflow: the metrics, the
 plots and tables, the sidecar, and tags naming the sensor, device and recording."""
 
 from __future__ import annotations
@@ -11,13 +11,13 @@ from typing import Any
 
 import yaml
 
-from tcbench import sensors_cli
-from tcbench.command_schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
-from tcbench.kinds import JobKind, JobNames, announce
+from tcbench.cli import recordings as sensors_cli
+from tcbench.cli.schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
+from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 class RecordingKind(JobKind):
-    """What the three recording kinds share: the record of a :class:`~tcbench.sensors_cli.RecordingOutcome`."""
+    """What the three recording kinds share: the record of a :class:`~tcbench.cli.recordings.RecordingOutcome`."""
 
     schema: type = SimulateConfig
     opens_run_after_work = True  # a bad protocol parameter or file leaves no run, as it leaves no file

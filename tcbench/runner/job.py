@@ -1,7 +1,7 @@
 """The one job runner: every kind of job (optimisation, compensation, simulate, metrics, import,
 diagnose) runs through :func:`run_job`, with one MLflow run shape, one failure path, one resume.
 
-What differs between kinds (naming, running, what is logged) is the :class:`~tcbench.kinds.JobKind`
+What differs between kinds (naming, running, what is logged) is the :class:`~tcbench.runner.kinds.JobKind`
 of the job's config; here is what is the same for all: the memory limit, resume (skip a job whose
 config and seed already FINISHED), the run's tags (sweep, task, method, seed, kind) and params
 (the flattened config), ``config.yaml`` as an artifact, and the failure path: a job that raises
@@ -20,9 +20,9 @@ from typing import Any
 
 import yaml
 
-from tcbench.config import as_dict
+from tcbench.runner.config import as_dict
 from tcbench.errors import ConfigError, error_line
-from tcbench.kinds import JobKind, kind_of
+from tcbench.runner.kinds import JobKind, kind_of
 
 log = logging.getLogger(__name__)
 
@@ -48,7 +48,7 @@ def failed(name: str, exc: BaseException) -> JobFailure:
     error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else str(exc) if user else \
         f"{type(exc).__name__}: {exc}"
     if isinstance(exc, MemoryError):
-        from tcbench.memory import ENV
+        from tcbench.runner.memory import ENV
 
         error += f" (more than one job may use here: the memory free when it started, or ${ENV})"
     failure = JobFailure(name, error_line(error), user)
@@ -79,7 +79,7 @@ def run_job(cfg: Any, *, record_user_errors: bool = True) -> Any:
     :class:`JobFailure` when it raised or called ``sys.exit`` (recorded FAILED when tracked);
     never raises but for ``KeyboardInterrupt``. ``record_user_errors=False`` (one job of a
     recording command): a bad input the work finds leaves no MLflow run, as it leaves no file."""
-    from tcbench import memory
+    from tcbench.runner import memory
 
     c = as_dict(cfg)
     try:
@@ -98,7 +98,7 @@ def _run(kind: JobKind, c: dict[str, Any], record_user_errors: bool = True) -> A
         log.info("%s", kind.summary(outcome, c))
         return outcome
 
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     names = kind.names(c)
     if track.get("resume"):

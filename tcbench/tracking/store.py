@@ -85,7 +85,7 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
     if db is None:
         yield
         return
-    from tcbench.filelock import locked
+    from tcbench.tracking.filelock import locked
 
     with locked(db):
         yield
@@ -167,7 +167,7 @@ def prepare_store(uri: str | None, experiment: str) -> str:
     try:
         with store_lock(uri):
             if db is not None and (not db.exists() or db.stat().st_size == 0):
-                from tcbench.store_template import create_store
+                from tcbench.tracking.template import create_store
 
                 create_store(db)  # a copy of a migrated empty store; MLflow builds it if this fails
             return experiment_id(client(uri), experiment)

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from tcbench.app import Plan
+    from tcbench.cli.app import Plan
 
 USAGE = """usage: tcbench <command> [args]
 
@@ -96,7 +96,7 @@ def _open_key(arg: str, command: str) -> str:
     free-form dict of the schema (``protocol_params``, ``effects``) is added or replaced."""
     import dataclasses
 
-    from tcbench.command_schemas import SCHEMAS
+    from tcbench.cli.schemas import SCHEMAS
 
     if arg.startswith(("+", "~")):
         return arg
@@ -107,7 +107,7 @@ def _open_key(arg: str, command: str) -> str:
 @contextlib.contextmanager
 def _quiet_job_log() -> Iterator[None]:
     """The runner's own failure log line off: one job's command reports its error itself."""
-    logger = logging.getLogger("tcbench.job")
+    logger = logging.getLogger("tcbench.runner.job")
     disabled, logger.disabled = logger.disabled, True
     try:
         yield
@@ -121,11 +121,11 @@ def _recording_command(command: str, argv: list[str]) -> int:
     ``tcbench run``'s. Every job is checked before the first starts."""
     from hydra import initialize_config_module
 
-    from tcbench import cli_help
-    from tcbench.app import check_job, compose_job
-    from tcbench.config import ConfigError
+    from tcbench.cli import help as cli_help
+    from tcbench.cli.app import check_job, compose_job
+    from tcbench.runner.config import ConfigError
     from tcbench.config_dir import CONFIG_MODULE
-    from tcbench.job import FAILURES, JobFailure, run_job
+    from tcbench.runner.job import FAILURES, JobFailure, run_job
 
     if any(a in HELP_FLAGS for a in argv):
         print(cli_help.usage(command))
@@ -188,7 +188,7 @@ def _recording_command(command: str, argv: list[str]) -> int:
 def _prepare_store(uri: str | None, experiment: str) -> None:
     """The MLflow store and experiment made before any job runs (a store that cannot be made is
     one line, and leaves no half-made database)."""
-    from tcbench import tracking
+    from tcbench.tracking import store as tracking
 
     try:
         tracking.check_store(uri, create=True)
@@ -203,8 +203,8 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     from hydra.errors import HydraException
     from omegaconf.errors import OmegaConfBaseException
 
-    from tcbench.app import CONFIG_SOURCE_FLAGS, hydra_app, plan, with_overrides
-    from tcbench.config import ConfigError
+    from tcbench.cli.app import CONFIG_SOURCE_FLAGS, hydra_app, plan, with_overrides
+    from tcbench.runner.config import ConfigError
 
     info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
     if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
@@ -218,7 +218,7 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         except ConfigError as exc:
             raise UserError(str(exc)) from None
         if checked.tracking_enabled:  # create the store and experiment once, before parallel jobs
-            from tcbench import tracking
+            from tcbench.tracking import store as tracking
 
             _prepare_store(checked.tracking_uri, checked.experiment)
             if checked.resume and (dead := tracking.mark_dead_runs(checked.tracking_uri, checked.experiment,
@@ -250,7 +250,8 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
     """Print how the jobs of a sweep ended (the latest run of each job: a resumed sweep's re-run
     replaces the attempt it repeats); 1 if any job's latest run did not finish or, when
     ``expected`` is given, if fewer jobs than planned left a run."""
-    from tcbench import leaderboard, tracking
+    from tcbench.leaderboard import optimisation as leaderboard
+    from tcbench.tracking import store as tracking
 
     tracking.mark_dead_runs(uri, experiment, sweep, frozenset({os.getpid()}))
     runs = leaderboard.sweep_runs(tracking.client(uri), [experiment], sweep)
@@ -269,7 +270,7 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
         print(f"  {r.status} {r.method} on {r.task} seed {r.seed}: {_first_line(r.error_message)}")
     missing = (expected - len(latest)) if expected is not None else 0
     if missing > 0:
-        from tcbench.job import FAILURES
+        from tcbench.runner.job import FAILURES
 
         print(f"  {missing} job{'s' if missing != 1 else ''} left no run in MLflow "
               f"(skipped by resume, or the tracking store failed: see the job logs)")
@@ -286,7 +287,7 @@ def _first_line(text: str) -> str:
 
 def _failures_report(jobs: int) -> int:
     """Untracked jobs: print the failures this process saw; 1 if any."""
-    from tcbench.job import FAILURES
+    from tcbench.runner.job import FAILURES
 
     if not FAILURES:
         return 0
@@ -297,8 +298,8 @@ def _failures_report(jobs: int) -> int:
 
 
 def cmd_run(args: list[str]) -> int:
-    from tcbench.app import VALUE_FLAGS
-    from tcbench.job import FAILURES
+    from tcbench.cli.app import VALUE_FLAGS
+    from tcbench.runner.job import FAILURES
 
     after_value_flag = False
     for a in args:
@@ -362,7 +363,8 @@ def cmd_leaderboard(argv: list[str]) -> int:
         ns = ap.parse_args(argv)
     except _HelpShown as shown:
         return shown.status
-    from tcbench import leaderboard, tracking
+    from tcbench.leaderboard import optimisation as leaderboard
+    from tcbench.tracking import store as tracking
     from tcbench.compensation import leaderboard as comp_board
     from tcbench.tasks.specs import protocols
     from tcbench.outputs import folder_problem
@@ -394,7 +396,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
         print(leaderboard.markdown_table(cboard.table))
         print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
     if ns.ecdf and not runs.empty:
-        from tcbench.ecdf import write_ecdf_plots
+        from tcbench.leaderboard.ecdf import write_ecdf_plots
 
         written = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), Path(ns.out))
         print(f"\nECDF plots: {', '.join(map(str, written)) or 'none (no single-objective runs)'}")
@@ -404,7 +406,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
 def _quickstart_help() -> str:
     from importlib.resources import files
 
-    from tcbench.quickstart import Sizes
+    from tcbench.cli.quickstart import Sizes
 
     settings = [ln for ln in files("tcbench.conf").joinpath("experiment/quickstart.yaml").read_text().splitlines()
                 if ln.strip() and not ln.lstrip().startswith("#")]
@@ -444,7 +446,7 @@ output: stdout only."""
 def cmd_quickstart(argv: list[str]) -> int:
     if _no_arguments("quickstart", argv, _quickstart_help()):
         return 0
-    from tcbench import quickstart
+    from tcbench.cli import quickstart
 
     return quickstart.run(_run_sweep, _sweep_report)
 

@@ -23,7 +23,7 @@ from collections.abc import Iterator
 from contextlib import closing, contextmanager
 from pathlib import Path
 
-from tcbench.filelock import locked
+from tcbench.tracking.filelock import locked
 
 log = logging.getLogger(__name__)
 

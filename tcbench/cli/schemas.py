@@ -1,14 +1,14 @@
 """Config schemas of the recording commands (``tcbench simulate|metrics|import|diagnose``): each
 is the structured base of its primary config ``conf/<command>.yaml``, registered with Hydra's
 ConfigStore as ``<command>_schema`` so types and known keys are checked at composition.
-``kind`` names the job kind that runs it (:mod:`tcbench.kinds`)."""
+``kind`` names the job kind that runs it (:mod:`tcbench.runner.kinds`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
 
-from tcbench.tracking_config import TrackingConfig
+from tcbench.tracking.config import TrackingConfig
 
 
 @dataclass

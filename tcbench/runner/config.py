@@ -18,7 +18,7 @@ import numpy as np
 from hydra.core.config_store import ConfigStore
 from omegaconf import MISSING, DictConfig, OmegaConf
 
-from tcbench.compensation_config import validate_compensation
+from tcbench.runner.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.outputs import folder_problem
@@ -31,7 +31,7 @@ from tcbench.tasks.schemas import (  # noqa: F401 - the schemas' home before tas
     MSRATaskConfig,
     TaskConfig,
 )
-from tcbench.tracking_config import TrackingConfig
+from tcbench.tracking.config import TrackingConfig
 
 
 @dataclass
@@ -122,9 +122,9 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
 
 def check_job_memory(c: dict[str, Any], dim: Any) -> None:
     """Refuse a job whose optimiser's own estimate (:meth:`Optimiser.memory_bytes`) in ``dim``
-    dimensions exceeds what one job may use here (:func:`tcbench.memory.job_budget_bytes`),
+    dimensions exceeds what one job may use here (:func:`tcbench.runner.memory.job_budget_bytes`),
     before the task or the optimiser allocates anything."""
-    from tcbench.memory import ENV, human, job_budget_bytes
+    from tcbench.runner.memory import ENV, human, job_budget_bytes
 
     opt = {k: v for k, v in c["optimiser"].items() if k not in {"name", "label"}}
     name = str(c["optimiser"].get("name"))

@@ -1,5 +1,5 @@
 """Usage text of tcbench's recording commands (simulate, import, metrics, diagnose), generated
-from the schema of each command's primary config (:mod:`tcbench.command_schemas`), so the
+from the schema of each command's primary config (:mod:`tcbench.cli.schemas`), so the
 parameters and defaults shown are the ones the command uses."""
 
 from __future__ import annotations
@@ -38,25 +38,25 @@ class CommandHelp:
 
 
 def _simulate_schema() -> type:
-    from tcbench.command_schemas import SimulateConfig
+    from tcbench.cli.schemas import SimulateConfig
 
     return SimulateConfig
 
 
 def _metrics_schema() -> type:
-    from tcbench.command_schemas import MetricsConfig
+    from tcbench.cli.schemas import MetricsConfig
 
     return MetricsConfig
 
 
 def _import_schema() -> type:
-    from tcbench.command_schemas import ImportConfig
+    from tcbench.cli.schemas import ImportConfig
 
     return ImportConfig
 
 
 def _diagnose_schema() -> type:
-    from tcbench.command_schemas import DiagnoseConfig
+    from tcbench.cli.schemas import DiagnoseConfig
 
     return DiagnoseConfig
 

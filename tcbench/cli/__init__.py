@@ -1,0 +1,13 @@
+"""The command line: every command (:mod:`.main`), its --help (:mod:`.help`), the Hydra apps and
+the checks made before any job starts (:mod:`.app`), the quickstart, the work of the recording
+commands (:mod:`.recordings`), their config schemas (:mod:`.schemas`) and one-line errors
+(:mod:`.errors`).
+
+Kept light: ``tcbench --help`` imports none of the scientific libraries. ``tcbench.cli:main`` is
+the console script. The name ``main`` here is the function; the module is
+``sys.modules["tcbench.cli.main"]`` (``from tcbench.cli.main import ...`` reaches it).
+"""
+
+from tcbench.cli.main import COMMANDS, UserError, main
+
+__all__ = ["COMMANDS", "UserError", "main"]

@@ -1,0 +1,6 @@
+"""Leaderboards of finished runs: the optimisation boards (:mod:`.optimisation`), the files every
+board writes (:mod:`.files`, a leaf shared with :mod:`tcbench.compensation.leaderboard`), the
+ECDF plots (:mod:`.ecdf`) and IOHprofiler's format (:mod:`.iohprofiler`).
+
+Nothing is imported here: import the submodules.
+"""
