@@ -13,10 +13,10 @@ quickstart: venv
 	$(VENV)/bin/tcbench quickstart
 
 test: venv
-	$(PY) -m pytest -m "not slow" -q
+	$(PY) -m pytest -m "not slow" -q -n 2
 
 test-all: venv
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2
 
 paper-fa-ifa: venv
 	PATH=$(VENV)/bin:$$PATH bash experiments/paper_fa_ifa/run.sh

@@ -5,8 +5,17 @@ from __future__ import annotations
 import os
 
 import pytest
+from threadpoolctl import threadpool_limits
 
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
+
+# BLAS at one thread, in the test processes and in the commands they start (inherited): the
+# tests run on two workers (pytest -n 2) and the code has its own process pools (joblib), so
+# OpenBLAS's threads only spin against them on two cores (the diagnosis tests took 82 s on two
+# workers with its default two threads, 49 s with one).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+threadpool_limits(1)  # where a plugin loaded numpy before this file
 
 
 @pytest.fixture(autouse=True, scope="session")

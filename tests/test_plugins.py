@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -24,9 +25,13 @@ def tcbench(*args: str, cwd: Path, path: Path) -> subprocess.CompletedProcess[st
 def site(tmp_path_factory) -> Path:
     """The example plugin installed (not editable) into a directory put on PYTHONPATH."""
     target = tmp_path_factory.mktemp("site")
+    # built from a copy: the build's build/ and *.egg-info stay out of the clone, and test
+    # workers that each install it (pytest -n) do not build in the same folder at once
+    src = tmp_path_factory.mktemp("example") / EXAMPLE.name
+    shutil.copytree(EXAMPLE, src, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
     subprocess.run(
         [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
-         "--target", str(target), str(EXAMPLE)],
+         "--target", str(target), str(src)],
         check=True, capture_output=True, text=True, timeout=300,
     )
     return target

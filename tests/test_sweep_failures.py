@@ -98,7 +98,8 @@ def test_untracked_failures_are_listed_and_the_sweep_goes_on(site: Path, tmp_pat
     assert not (tmp_path / "mlflow.db").exists()
 
 
-def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, tmp_path: Path) -> None:
+def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, tmp_path: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     """``task.dim=100000000`` grew to 24 GB and was killed by the kernel without a word: a job too
     big by its optimiser's estimate is refused before it starts, and one that allocates past the
     budget anyway fails with a MemoryError while the sweep goes on."""
@@ -106,12 +107,9 @@ def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, 
     before = tcbench(*env_args, cwd=tmp_path, site=site)
     assert before.returncode == 2 and "Traceback" not in before.stderr
     assert "task.dim=100000000: a run of optimiser ifa would need about" in before.stderr
-    os.environ["TCBENCH_JOB_MEMORY_MB"] = "200"
-    try:
-        run = tcbench("run", "-m", "task=sphere", "task.dim=7,2", "optimiser=fa", "optimiser.name=crashy",
-                      "seed=0", "budget=60", cwd=tmp_path, site=site)
-    finally:
-        del os.environ["TCBENCH_JOB_MEMORY_MB"]
+    monkeypatch.setenv("TCBENCH_JOB_MEMORY_MB", "200")
+    run = tcbench("run", "-m", "task=sphere", "task.dim=7,2", "optimiser=fa", "optimiser.name=crashy",
+                  "seed=0", "budget=60", cwd=tmp_path, site=site)
     assert run.returncode == 1, run.stdout + run.stderr
     assert "Traceback" not in run.stderr
     assert statuses(tmp_path) == {"sphere-7d": ["FAILED"], "sphere-2d": ["FINISHED"]}
