@@ -18,7 +18,7 @@ from typing import Any
 
 from tcbench.errors import ConfigError
 
-# kind name -> module holding its ``KIND`` (imported when a job of that kind runs)
+# kind name -> module whose ``KINDS`` dict holds it (imported when a job of that kind runs)
 KIND_MODULES = {
     "optimisation": "tcbench.runner.kinds.optimisation",
     "compensation": "tcbench.runner.kinds.compensation",
