@@ -144,7 +144,7 @@ def test_a_method_that_crashes_on_most_seeds_does_not_rank_first() -> None:
 
 
 def test_a_compensation_method_that_crashes_on_most_restarts_does_not_rank_first() -> None:
-    from tcbench.compensation.leaderboard import summarise
+    from tcbench.leaderboard.compensation import summarise
     from tcbench.compensation.scoring import METRIC_NAMES as METRICS
     from tcbench.compensation.scoring import PRIMARY
 

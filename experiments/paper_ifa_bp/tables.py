@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from tcbench.tracking import store as tracking
-from tcbench.compensation import leaderboard as board
+from tcbench.leaderboard import compensation as board
 from tcbench.tasks.specs import protocols
 from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.stats import bootstrap_median_ci, paired_p_value

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from tcbench.tracking import store as tracking
-from tcbench.compensation import leaderboard as board
+from tcbench.leaderboard import compensation as board
 from tcbench.compensation.gyro.plots import allan_methods_figure
 from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.signal.allan import AllanDeviation

@@ -18,7 +18,7 @@ from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
 
-from tcbench.cli import schemas as command_schemas
+from tcbench.commands import schemas as command_schemas
 from tcbench.runner.config import ConfigError, as_dict, register_schema
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
 from tcbench.runner.job import run_job

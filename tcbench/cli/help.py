@@ -1,5 +1,5 @@
 """Usage text of tcbench's recording commands (simulate, import, metrics, diagnose), generated
-from the schema of each command's primary config (:mod:`tcbench.cli.schemas`), so the
+from the schema of each command's primary config (:mod:`tcbench.commands.schemas`), so the
 parameters and defaults shown are the ones the command uses."""
 
 from __future__ import annotations
@@ -38,25 +38,25 @@ class CommandHelp:
 
 
 def _simulate_schema() -> type:
-    from tcbench.cli.schemas import SimulateConfig
+    from tcbench.commands.schemas import SimulateConfig
 
     return SimulateConfig
 
 
 def _metrics_schema() -> type:
-    from tcbench.cli.schemas import MetricsConfig
+    from tcbench.commands.schemas import MetricsConfig
 
     return MetricsConfig
 
 
 def _import_schema() -> type:
-    from tcbench.cli.schemas import ImportConfig
+    from tcbench.commands.schemas import ImportConfig
 
     return ImportConfig
 
 
 def _diagnose_schema() -> type:
-    from tcbench.cli.schemas import DiagnoseConfig
+    from tcbench.commands.schemas import DiagnoseConfig
 
     return DiagnoseConfig
 

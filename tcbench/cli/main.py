@@ -96,7 +96,7 @@ def _open_key(arg: str, command: str) -> str:
     free-form dict of the schema (``protocol_params``, ``effects``) is added or replaced."""
     import dataclasses
 
-    from tcbench.cli.schemas import SCHEMAS
+    from tcbench.commands.schemas import SCHEMAS
 
     if arg.startswith(("+", "~")):
         return arg
@@ -365,7 +365,7 @@ def cmd_leaderboard(argv: list[str]) -> int:
         return shown.status
     from tcbench.leaderboard import optimisation as leaderboard
     from tcbench.tracking import store as tracking
-    from tcbench.compensation import leaderboard as comp_board
+    from tcbench.leaderboard import compensation as comp_board
     from tcbench.tasks.specs import protocols
     from tcbench.outputs import folder_problem
 

@@ -133,7 +133,7 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
 def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> list[Path]:
     """Print the small table and write the full board; the paths written."""
     from tcbench.tracking import store as tracking
-    from tcbench.compensation import leaderboard as comp_board
+    from tcbench.leaderboard import compensation as comp_board
     from tcbench.tasks.specs import protocols
 
     runs = comp_board.load_runs(tracking.client(uri), [experiment], sweep)
@@ -177,7 +177,7 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
     from omegaconf import OmegaConf
 
     from tcbench.tracking import store as tracking
-    from tcbench.cli.schemas import DiagnoseConfig
+    from tcbench.commands.schemas import DiagnoseConfig
     from tcbench.runner.config import as_dict
     from tcbench.diagnose.concealed import concealed_recording
     from tcbench.runner.job import JobFailure, run_job

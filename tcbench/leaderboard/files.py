@@ -1,5 +1,5 @@
 """What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard.optimisation`) and compensation
-(:mod:`tcbench.compensation.leaderboard`): the MLflow runs of a kind, one run per job, markdown tables
+(:mod:`tcbench.leaderboard.compensation`): the MLflow runs of a kind, one run per job, markdown tables
 and the board files. A leaf module (numpy and pandas only)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The diagnosis job kind: ``tcbench diagnose`` on one recording (:mod:`tcbench.diagnose.cli`).
+"""The diagnosis job kind: ``tcbench diagnose`` on one recording (:mod:`tcbench.commands.diagnosis`).
 Its MLflow run carries the effects found (tag ``tcbench.effects_found``, their parameters as
 params ``found.<effect>.<param>``), the verdict, the held-out RMSEs before and after (also in
 white-noise sigmas) and the report, plots and ``model.yaml`` as artifacts."""
@@ -8,8 +8,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tcbench.cli.schemas import DiagnoseConfig, as_schema
-from tcbench.diagnose.cli import DiagnosisOutcome, check_diagnose, diagnose_recording
+from tcbench.commands.schemas import DiagnoseConfig, as_schema
+from tcbench.commands.diagnosis import DiagnosisOutcome, check_diagnose, diagnose_recording
 from tcbench.runner.kinds import JobKind, JobNames, announce
 
 

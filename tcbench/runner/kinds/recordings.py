@@ -1,6 +1,6 @@
 """The recording job kinds: ``simulate`` (a device under a protocol), ``metrics`` (a recording's
 papers' metrics) and ``import`` (a user's CSV as a recording). Their work is in
-:mod:`tcbench.cli.recordings`; here is how they are named and what goes to MLflow: the metrics, the
+:mod:`tcbench.commands.recordings`; here is how they are named and what goes to MLflow: the metrics, the
 plots and tables, the sidecar, and tags naming the sensor, device and recording."""
 
 from __future__ import annotations
@@ -11,13 +11,13 @@ from typing import Any
 
 import yaml
 
-from tcbench.cli import recordings as sensors_cli
-from tcbench.cli.schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
+from tcbench.commands import recordings
+from tcbench.commands.schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
 from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 class RecordingKind(JobKind):
-    """What the three recording kinds share: the record of a :class:`~tcbench.cli.recordings.RecordingOutcome`."""
+    """What the three recording kinds share: the record of a :class:`~tcbench.commands.recordings.RecordingOutcome`."""
 
     schema: type = SimulateConfig
     opens_run_after_work = True  # a bad protocol parameter or file leaves no run, as it leaves no file
@@ -25,7 +25,7 @@ class RecordingKind(JobKind):
     def config(self, c: dict[str, Any]) -> Any:
         return as_schema(c, self.schema)
 
-    def record(self, run: Any, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any], where: Path) -> list[Path]:
+    def record(self, run: Any, outcome: recordings.RecordingOutcome, c: dict[str, Any], where: Path) -> list[Path]:
         rec, report = outcome.rec, outcome.report
         extra = rec.meta.extra or {}
         run.set_tag("tcbench.sensor", str(rec.meta.sensor))
@@ -47,21 +47,21 @@ class SimulateKind(RecordingKind):
     name, tag, schema = "simulate", "simulation", SimulateConfig
 
     def check(self, c: dict[str, Any]) -> None:
-        sensors_cli.check_simulate(self.config(c))
+        recordings.check_simulate(self.config(c))
 
     def names(self, c: dict[str, Any]) -> JobNames:
         cfg: SimulateConfig = self.config(c)
-        return JobNames(sensors_cli.simulation_stem(cfg), f"{cfg.sensor or 'msra'}-{cfg.protocol}", "simulate",
+        return JobNames(recordings.simulation_stem(cfg), f"{cfg.sensor or 'msra'}-{cfg.protocol}", "simulate",
                         int(cfg.seed), {"tcbench.device_seed": str(cfg.device_seed)})
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
         cfg: SimulateConfig = self.config(c)
-        return [Path(cfg.out) / f"{sensors_cli.simulation_stem(cfg)}.{cfg.format}"]
+        return [Path(cfg.out) / f"{recordings.simulation_stem(cfg)}.{cfg.format}"]
 
-    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
-        return sensors_cli.simulate(self.config(c))
+    def execute(self, c: dict[str, Any]) -> recordings.RecordingOutcome:
+        return recordings.simulate(self.config(c))
 
-    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+    def summary(self, outcome: recordings.RecordingOutcome, c: dict[str, Any]) -> str:
         return f"simulated {outcome.path}"
 
 
@@ -69,19 +69,19 @@ class MetricsKind(RecordingKind):
     name, schema = "metrics", MetricsConfig
 
     def check(self, c: dict[str, Any]) -> None:
-        sensors_cli.check_metrics(self.config(c))
+        recordings.check_metrics(self.config(c))
 
     def names(self, c: dict[str, Any]) -> JobNames:
         path = Path(str(c.get("recording") or "recording"))
         return JobNames(f"metrics-{path.stem}", path.stem, "metrics")
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
-        return [sensors_cli.metrics_folder(self.config(c))]
+        return [recordings.metrics_folder(self.config(c))]
 
-    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
-        return sensors_cli.metrics(self.config(c))
+    def execute(self, c: dict[str, Any]) -> recordings.RecordingOutcome:
+        return recordings.metrics(self.config(c))
 
-    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+    def summary(self, outcome: recordings.RecordingOutcome, c: dict[str, Any]) -> str:
         return f"metrics of {outcome.path}"
 
 
@@ -89,20 +89,20 @@ class ImportKind(RecordingKind):
     name, schema = "import", ImportConfig
 
     def check(self, c: dict[str, Any]) -> None:
-        sensors_cli.check_import(self.config(c))
+        recordings.check_import(self.config(c))
 
     def names(self, c: dict[str, Any]) -> JobNames:
         cfg: ImportConfig = self.config(c)
-        return JobNames(f"import-{sensors_cli.import_stem(cfg)}", Path(cfg.csv).name, "import")
+        return JobNames(f"import-{recordings.import_stem(cfg)}", Path(cfg.csv).name, "import")
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
         cfg: ImportConfig = self.config(c)
-        return [Path(cfg.out) / f"{sensors_cli.import_stem(cfg)}.csv"]
+        return [Path(cfg.out) / f"{recordings.import_stem(cfg)}.csv"]
 
-    def execute(self, c: dict[str, Any]) -> sensors_cli.RecordingOutcome:
-        return sensors_cli.import_recording(self.config(c))
+    def execute(self, c: dict[str, Any]) -> recordings.RecordingOutcome:
+        return recordings.import_recording(self.config(c))
 
-    def summary(self, outcome: sensors_cli.RecordingOutcome, c: dict[str, Any]) -> str:
+    def summary(self, outcome: recordings.RecordingOutcome, c: dict[str, Any]) -> str:
         return f"imported {outcome.path}"
 
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tcbench.cli.schemas import DiagnoseConfig
-from tcbench.cli.errors import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
+from tcbench.commands.schemas import DiagnoseConfig
+from tcbench.commands.errors import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
 
 log = logging.getLogger(__name__)
 

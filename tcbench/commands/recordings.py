@@ -1,5 +1,5 @@
 """What ``tcbench simulate``, ``tcbench metrics`` and ``tcbench import`` do with their config:
-the checks made before any work (``check_*``: one-line :class:`~tcbench.cli.errors.CommandError`),
+the checks made before any work (``check_*``: one-line :class:`~tcbench.commands.errors.CommandError`),
 and the work itself (``simulate``, ``metrics``, ``import_recording``), which prints what it
 wrote. They run as jobs of :mod:`tcbench.runner.kinds.recordings` through :func:`tcbench.runner.job.run_job`."""
 
@@ -10,8 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tcbench.cli.schemas import ImportConfig, MetricsConfig, SimulateConfig
-from tcbench.cli.errors import CommandError, cannot_write, checked_store, file_stem, overwrite_error, writable_folder
+from tcbench.commands.schemas import ImportConfig, MetricsConfig, SimulateConfig
+from tcbench.commands.errors import CommandError, cannot_write, checked_store, file_stem, overwrite_error, writable_folder
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
