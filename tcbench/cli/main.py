@@ -122,8 +122,8 @@ def _recording_command(command: str, argv: list[str]) -> int:
     from hydra import initialize_config_module
 
     from tcbench.cli import help as cli_help
-    from tcbench.cli.app import check_job, compose_job
-    from tcbench.runner.config import ConfigError
+    from tcbench.cli.app import compose_job
+    from tcbench.runner.config import ConfigError, as_dict
     from tcbench.config_dir import CONFIG_MODULE
     from tcbench.runner.job import FAILURES, JobFailure, run_job
 
@@ -171,7 +171,7 @@ def _recording_command(command: str, argv: list[str]) -> int:
 
             print(OmegaConf.to_yaml(composed), end="")
             return 0
-        c = check_job(composed)
+        c = as_dict(composed)  # one job: its work makes the checks once (run_job), no check ahead
     except ConfigError as exc:
         raise UserError(str(exc)) from None
     c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
