@@ -60,6 +60,23 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
     assert (workdir / "lb" / "sphere-2d_convergence.png").stat().st_size > 5000
     assert "| rank | method |" in (workdir / "lb" / "sphere-2d.md").read_text()
 
+    # a sweep of leaderboards: one board folder per experiment, each filed as a run when asked
+    assert tcbench("run", "task=sphere", "optimiser=pso", "budget=100", "tracking.experiment=t2",
+                   cwd=workdir).returncode == 0
+    boards = tcbench("leaderboard", "-m", "experiments=t,t2", "out=boards/${experiments}", "tracking.enabled=true",
+                     cwd=workdir)
+    assert boards.returncode == 0, boards.stderr
+    assert sorted(pd.read_csv(workdir / "boards" / "t" / "sphere-2d.csv")["method"]) == ["fa", "ifa"]
+    assert pd.read_csv(workdir / "boards" / "t2" / "sphere-2d.csv")["method"].tolist() == ["pso"]
+    filed = client.search_runs([client.get_experiment_by_name("leaderboards").experiment_id])
+    assert sorted(r.data.tags["tcbench.task"] for r in filed) == ["t", "t2"]
+    assert all(r.info.status == "FINISHED" and r.data.tags["tcbench.kind"] == "leaderboard" for r in filed)
+    assert {"config.yaml", "sphere-2d.md", "sphere-2d.csv"} <= {a.path for a in client.list_artifacts(filed[0].info.run_id)}
+    # the board runs are not optimisation runs: the board of every experiment stays as it was
+    again = tcbench("leaderboard", "--experiment", "t", "--experiment", "leaderboards", "--out", "lb2", cwd=workdir)
+    assert again.returncode == 0, again.stderr
+    assert pd.read_csv(workdir / "lb2" / "sphere-2d.csv")["seeds"].tolist() == [3, 3]
+
 
 @pytest.mark.parametrize(
     ("args", "message"),

@@ -12,14 +12,16 @@ import yaml
 from tcbench.cli import help as cli_help
 from tcbench.cli import COMMANDS, main
 
-KEYVALUE = ["simulate", "metrics", "import", "diagnose"]
+KEYVALUE = ["simulate", "metrics", "import", "diagnose", "leaderboard", "list", "quickstart"]
 # what the help of the other commands must name: their parameters or settings
 NAMED = {
     "run": ["usage: tcbench run", "seed", "budget", "tracking", "optimiser", "examples:", "output:"],
-    "leaderboard": ["usage: tcbench leaderboard", "--experiment", "--sweep", "--out", "--tracking-uri", "--ecdf",
-                    "examples:", "output:"],
-    "list": ["usage: tcbench list", "no", "output:"],
-    "quickstart": ["usage: tcbench quickstart", "budget: 510", "seed: range(5)", "thermal_lag", "examples:", "output:"],
+}
+# further words a key=value command's help must hold (flags kept as aliases, the sizes it runs)
+ALSO = {
+    "leaderboard": ["--experiment", "--sweep", "--out", "--tracking-uri", "--ecdf"],
+    "quickstart": ["budget: 510", "seed: range(5)", "thermal_lag", "one after another"],
+    "list": ["one after another"],
 }
 
 
@@ -46,6 +48,8 @@ def test_help_exits_0_and_names_the_parameters(command: str, flag: str, capsys: 
             if key not in cli_help.IGNORED + cli_help.HIDDEN:
                 assert f"  {key}=" in out, key
         assert "--cfg job" in out and "examples:" in out and "output:" in out
+        for word in ALSO.get(command, []):
+            assert word in " ".join(out.split()), word
     else:
         for word in NAMED[command]:
             assert word in out, word
@@ -144,10 +148,49 @@ def test_an_unknown_option_is_one_line_exit_2(command: str, flag: str, capsys: p
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("command", ["list", "quickstart"])
-def test_commands_without_parameters_refuse_arguments(command: str, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main([command, "seed=3"]) == 2
-    assert "takes no arguments" in capsys.readouterr().err
+@pytest.mark.parametrize(("command", "arg", "words"), [
+    ("list", "seed=3", ["seed"]),
+    ("list", "what=tools", ["what=tools", "tasks, optimisers, learners"]),
+    ("quickstart", "seeds=0", ["seeds=0", "at least 1"]),
+    ("quickstart", "diagnose_effect=glitch", ["diagnose_effect=glitch", "thermal_lag"]),
+    ("leaderboard", "--ecdf=yes", ["--ecdf takes no value"]),
+])
+def test_a_bad_parameter_is_one_line_and_runs_nothing(command: str, arg: str, words: list[str],
+                                                      capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert main([command, arg]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and all(w in err[0] for w in words), err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_list_prints_the_list_asked_for_and_sweeps_in_turn(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["list", "what=learners"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("learners:") and "optimisers:" not in out and "tasks (" not in out
+    assert main(["list", "-m", "what=optimisers,learners"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.index("optimisers:") < captured.out.index("learners:") and "tasks (" not in captured.out
+    assert "job 1/2: what=optimisers" in captured.err and "job 2/2: what=learners" in captured.err
+
+
+def test_leaderboard_flags_are_aliases_of_its_keys(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["leaderboard", "--cfg", "job", "--experiment", "a", "--experiment", "b, c's", "--sweep", "s1",
+                 "--out=lb", "--tracking-uri", "sqlite:///x.db", "--ecdf"]) == 0
+    flagged = yaml.safe_load(capsys.readouterr().out)
+    assert main(["leaderboard", "--cfg", "job", "experiments=[a,'b, c\\'s']", "sweep=s1", "out=lb",
+                 "tracking.uri=sqlite:///x.db", "ecdf=true"]) == 0
+    keyed = yaml.safe_load(capsys.readouterr().out)
+    assert flagged == keyed
+    assert flagged["experiments"] == ["a", "b, c's"] and flagged["sweep"] == "s1" and flagged["ecdf"] is True
+    assert flagged["tracking"]["uri"] == "sqlite:///x.db" and flagged["tracking"]["enabled"] is False
+
+
+def test_quickstart_sweep_refuses_two_quickstarts_in_one_folder(capsys: pytest.CaptureFixture[str],
+                                                                 tmp_path: Path) -> None:
+    assert main(["quickstart", "-m", "diagnose_effect=thermal_lag,hysteresis"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "jobs 1 and 2" in err[0] and "out=" in err[0], err
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("command", KEYVALUE)

@@ -63,7 +63,7 @@ def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
         (["import", "csv=in.csv", "sensor=gyro", "time=t", "temperature=T", "output=w", "out=blocker"],
          "out=blocker: is not a folder"),
         (["diagnose", "recording=in.csv", "out=blocker/d"], "out=blocker/d: cannot be made: blocker is not a folder"),
-        (["leaderboard", "--out", "blocker"], "--out blocker: is not a folder"),
+        (["leaderboard", "--out", "blocker"], "out=blocker: is not a folder"),
     ],
 )
 def test_commands_refuse_an_unusable_output_folder(workdir: Path, args: list[str], message: str) -> None:

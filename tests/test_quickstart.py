@@ -10,22 +10,22 @@ import mlflow
 import pytest
 import yaml
 
-from tcbench.cli import quickstart
 from tcbench.cli import main
+from tcbench.commands.schemas import QuickstartConfig
 
 
-def test_the_yaml_runs_the_seeds_the_quickstart_says() -> None:
+def test_the_quickstart_defaults_are_the_experiment_s() -> None:
+    """``tcbench quickstart`` and ``tcbench run -m experiment=quickstart`` run the same sweep."""
     from importlib.resources import files
 
     cfg = yaml.safe_load(files("tcbench.conf").joinpath("experiment/quickstart.yaml").read_text())
-    assert cfg["hydra"]["sweeper"]["params"]["seed"] == f"range({quickstart.DEFAULT_SEEDS})"
-    assert cfg["budget"] == 510
+    defaults = QuickstartConfig()
+    assert cfg["hydra"]["sweeper"]["params"]["seed"] == f"range({defaults.seeds})"
+    assert cfg["budget"] == defaults.budget == 510
 
 
-def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
-                               capsys: pytest.CaptureFixture[str]) -> None:
-    monkeypatch.setattr(quickstart, "SIZES", quickstart.TEST_SIZES)
-    assert main(["quickstart"]) == 0
+def test_quickstart_end_to_end(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["quickstart", "seeds=2", "budget=60", "epochs=100"]) == 0  # two short trainings
     out = capsys.readouterr().out
 
     assert out.startswith("tcbench: a benchmark for temperature compensation")
@@ -53,6 +53,8 @@ def test_quickstart_end_to_end(workdir: Path, monkeypatch: pytest.MonkeyPatch,
     assert all(r.info.status == "FINISHED" for r in runs)
     kinds = sorted(r.data.tags["tcbench.kind"] for r in runs)
     assert kinds == ["compensation"] * 5 + ["diagnosis"]
+    trained = [r for r in runs if r.data.tags["tcbench.method"] == "IFA-BP-gd"]
+    assert {r.data.params["budget"] for r in trained} == {"60"} and {r.data.params["learner.epochs"] for r in trained} == {"100"}
     assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1
     (diag,) = [r for r in runs if r.data.tags["tcbench.kind"] == "diagnosis"]
     assert diag.data.tags["tcbench.effects_found"] == "thermal_lag"

@@ -1,6 +1,6 @@
 """The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``,
-``tcbench simulate|metrics|import|diagnose`` on ``conf/<command>.yaml``) and the checks made
-before any job starts. Every job of every command runs through :func:`tcbench.runner.job.run_job`."""
+``tcbench simulate|metrics|import|diagnose|leaderboard|list|quickstart`` on ``conf/<command>.yaml``)
+and the checks made before any job starts. Every job of every command runs through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
@@ -128,37 +128,58 @@ def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None 
             key = Path(os.path.abspath(path))
             if key in written:
                 raise ConfigError(f"jobs {written[key] + 1} and {len(written) + 1} of the sweep would both write "
-                                  f"{path}; give each its own out= (e.g. 'out=results/${{stem:recording}}')")
+                                  f"{path}; give each its own out=, named after what the sweep varies (e.g. "
+                                  "'out=results/${stem:recording}', 'out=lb/${experiments}')")
             written[key] = len(written)
     return c
+
+
+def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list[str]]]:
+    """The fixed overrides of a command line and its swept keys with their values (the config's
+    own ``hydra.sweeper.params`` included, the command line winning); call inside
+    ``initialize_config_module``."""
+    multirun = "-m" in args or "--multirun" in args
+    parser = OverridesParser.create()
+    try:
+        parsed = parser.parse_overrides(overrides_of(args))
+    except HydraException as exc:
+        raise ConfigError(_explain(exc)) from None
+    fixed = [o.input_line for o in parsed if not o.is_sweep_override()]
+    sweeps = {o.get_key_element(): list(o.sweep_string_iterator()) for o in parsed if o.is_sweep_override()}
+    if sweeps and not multirun:
+        key = next(iter(sweeps))
+        raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
+    if multirun:
+        first = [f"{k}={v[0]}" for k, v in sweeps.items()]
+        base = compose_job(fixed + first, config_name, hydra_cfg=True)
+        given = {o.get_key_element() for o in parsed}  # the command line wins over the config's params
+        for key, value in (base.hydra.sweeper.get("params") or {}).items():
+            if key not in given:
+                (o,) = parser.parse_overrides([f"{key}={value}"])
+                vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
+                sweeps[key] = [str(v) for v in vals]
+    return fixed, sweeps
+
+
+def expand(args: list[str], config_name: str) -> list[tuple[list[str], dict[str, Any]]]:
+    """Every job of a command line, composed: its swept ``key=value`` and its plain config."""
+    conf_dir()
+    with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
+        fixed, sweeps = _sweep(args, config_name)
+        keys = list(sweeps)
+        jobs = []
+        for combo in itertools.product(*sweeps.values()):
+            chosen = [f"{k}={v}" for k, v in zip(keys, combo, strict=True)]
+            jobs.append((chosen, as_dict(compose_job(fixed + chosen, config_name))))
+    return jobs
 
 
 def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
     """Compose and check every job of a command line; raise ConfigError (or the kind's one-line
     error) on the first bad one."""
     conf_dir()  # one line naming the problem when the installed configs are missing
-    multirun = "-m" in args or "--multirun" in args
-    raw = overrides_of(args)
-    parser = OverridesParser.create()
-    try:
-        parsed = parser.parse_overrides(raw)
-    except HydraException as exc:
-        raise ConfigError(_explain(exc)) from None
     with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
-        fixed = [o.input_line for o in parsed if not o.is_sweep_override()]
-        sweeps = {o.get_key_element(): list(o.sweep_string_iterator()) for o in parsed if o.is_sweep_override()}
-        if sweeps and not multirun:
-            key = next(iter(sweeps))
-            raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
-        if multirun:
-            first = [f"{k}={v[0]}" for k, v in sweeps.items()]
-            base = compose_job(fixed + first, config_name, hydra_cfg=True)
-            given = {o.get_key_element() for o in parsed}  # the command line wins over the config's params
-            for key, value in (base.hydra.sweeper.get("params") or {}).items():
-                if key not in given:
-                    (o,) = parser.parse_overrides([f"{key}={value}"])
-                    vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
-                    sweeps[key] = [str(v) for v in vals]
+        fixed, sweeps = _sweep(args, config_name)
         seeds = sweeps.pop("seed", None)
         keys = list(sweeps)
         combos = list(itertools.product(*sweeps.values())) or [()]

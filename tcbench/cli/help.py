@@ -1,6 +1,7 @@
-"""Usage text of tcbench's recording commands (simulate, import, metrics, diagnose), generated
-from the schema of each command's primary config (:mod:`tcbench.commands.schemas`), so the
-parameters and defaults shown are the ones the command uses."""
+"""Usage text of tcbench's key=value commands (simulate, import, metrics, diagnose, leaderboard,
+list, quickstart), generated from the schema of each command's primary config
+(:mod:`tcbench.commands.schemas`), so the parameters and defaults shown are the ones the command
+uses. ``tcbench run``'s help is Hydra's."""
 
 from __future__ import annotations
 
@@ -35,6 +36,9 @@ class CommandHelp:
     output: str
     positional: str | None = None  # ``tcbench metrics PATH`` means ``recording=PATH``
     required: tuple[str, ...] = ()
+    options: tuple[str, ...] = ()  # further lines of the options section (flags kept as aliases)
+    sweep: str = ("the jobs run on tcbench run's launcher (hydra.launcher.n_jobs=2 for two workers) and "
+                  "the sweep is reported at the end")
 
 
 def _simulate_schema() -> type:
@@ -59,6 +63,27 @@ def _diagnose_schema() -> type:
     from tcbench.commands.schemas import DiagnoseConfig
 
     return DiagnoseConfig
+
+
+def _leaderboard_schema() -> type:
+    from tcbench.commands.schemas import LeaderboardConfig
+
+    return LeaderboardConfig
+
+
+def _list_schema() -> type:
+    from tcbench.commands.schemas import ListConfig
+
+    return ListConfig
+
+
+def _quickstart_schema() -> type:
+    from tcbench.commands.schemas import QuickstartConfig
+
+    return QuickstartConfig
+
+
+IN_TURN = "the jobs run one after another in this process"
 
 
 SPECS: dict[str, CommandHelp] = {
@@ -154,6 +179,78 @@ SPECS: dict[str, CommandHelp] = {
                "(effects found, held-out RMSEs, the report) when tracking is on",
         required=("recording",),
     ),
+    "leaderboard": CommandHelp(
+        name="leaderboard",
+        summary="Aggregate the finished runs of MLflow experiments into leaderboards (optimisation and "
+                "compensation): tables, convergence plots, ECDFs.",
+        schema=_leaderboard_schema,
+        params={
+            "experiments": "MLflow experiment whose runs are ranked; several: experiments=[a,b]",
+            "sweep": "only the runs of this sweep id (null: every run of the experiment)",
+            "out": "output folder",
+            "ecdf": "also write COCO-style ECDF plots per dimension",
+            "tracking.uri": "MLflow store to read (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
+            "tracking.enabled": "also file the board files as a run in the store (false: files only)",
+            "tracking.experiment": "experiment that run is filed under",
+            "tracking.sweep_id": TRACKING["tracking.sweep_id"],
+            "tracking.resume": TRACKING["tracking.resume"],
+        },
+        examples=(
+            "tcbench leaderboard                                         all runs of experiment tcbench",
+            "tcbench leaderboard experiments=quickstart sweep=SWEEP_ID out=lb ecdf=true",
+            "tcbench leaderboard --experiment quickstart --sweep SWEEP_ID --out lb --ecdf   (the same)",
+            "tcbench leaderboard -m experiments=paper-fa-ifa,paper-ifa-bp 'out=lb/${experiments}'   (a board per experiment)",
+        ),
+        output="OUT/<task>.md, OUT/<task>.csv and OUT/<task>_convergence.png per task (compensation tasks too), "
+               "the tables also printed; ecdf=true adds OUT/ecdf_<d>d.png. Reads the MLflow store and writes "
+               "nothing to it unless tracking.enabled=true",
+        options=("  --experiment NAME   experiments=NAME (repeatable: experiments=[a,b])",
+                 "  --sweep ID          sweep=ID",
+                 "  --out DIR           out=DIR",
+                 "  --tracking-uri URI  tracking.uri=URI",
+                 "  --ecdf              ecdf=true"),
+    ),
+    "list": CommandHelp(
+        name="list",
+        summary="Print the registered tasks (their gymnasium env id and task= name), optimisers (with the "
+                "package that provides them: tcbench or a plugin), learners and broken plugins.",
+        schema=_list_schema,
+        params={"what": "which list: all, tasks, optimisers or learners"},
+        examples=("tcbench list", "tcbench list what=optimisers", "tcbench list -m what=tasks,learners"),
+        output="stdout only",
+        sweep=f"{IN_TURN}, each list printed in turn",
+    ),
+    "quickstart": CommandHelp(
+        name="quickstart",
+        summary="The main job in about a minute (2 cores), at demonstration sizes, not the paper's: "
+                "1. compensation: the paper's IFA-BP on the simulated MSRA zero-bias task (`tcbench run -m "
+                "experiment=quickstart`, conf/experiment/quickstart.yaml: seed: range(5), budget: 510), beside "
+                "raw, poly and the oracle (the physical limit), then a small leaderboard; 2. diagnosis: a "
+                "simulated recording with one hidden effect (thermal_lag by default), what the diagnosis finds, "
+                "where, and the held-out RMSE before and after in noise sigmas. Deterministic: same "
+                "parameters, same numbers.",
+        schema=_quickstart_schema,
+        params={
+            "seeds": "IFA-BP trainings (seeds 0..seeds-1; the paper: 30)",
+            "budget": "evaluations of IFA's weight search per training (the paper's search: 510)",
+            "epochs": "BP gradient-descent epochs per training",
+            "diagnose_sensor": "msra or gyro: the simulated recording diagnosed",
+            "diagnose_effect": "the effect hidden in it (an effect of tcbench.diagnose.concealed, e.g. hysteresis)",
+            "diagnose_seed": "its draw",
+            "out": "output folder (leaderboard/, diagnosis/, recordings/)",
+            "tracking.uri": TRACKING["tracking.uri"],
+            "tracking.experiment": "MLflow experiment the quickstart's runs are filed under",
+            "tracking.sweep_id": "the quickstart's sweep id in MLflow (null: a new one)",
+        },
+        examples=("tcbench quickstart",
+                  "tcbench quickstart seeds=30             the paper's 30 trainings (about 5 min)",
+                  "tcbench quickstart -m diagnose_effect=thermal_lag,hysteresis 'out=qs/${diagnose_effect}'",
+                  "tcbench run -m experiment=quickstart 'seed=range(30)' learner.epochs=3000   the sweep alone"),
+        output="runs in MLflow (./mlflow.db, experiment quickstart: one per compensation job and one for the "
+               "diagnosis), the leaderboard in OUT/leaderboard/, the diagnosis report and plots in "
+               "OUT/diagnosis/, Hydra job logs and resolved configs in multirun/",
+        sweep=f"{IN_TURN} (each quickstart runs its own sweeps on tcbench run's launcher)",
+    ),
 }
 
 
@@ -188,7 +285,8 @@ def usage(name: str) -> str:
     """The ``--help`` text of command ``name``."""
     spec = SPECS[name]
     first = f" [{spec.positional.upper()}]" if spec.positional else ""
-    lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "", spec.summary, "",
+    lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "",
+             textwrap.fill(spec.summary, width=100), "",
              "parameters (key=value, default after =):"]
     rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", spec.params.get(key, ""))
             for key, default in parameters(spec.schema()) if key not in IGNORED + HIDDEN]
@@ -200,10 +298,11 @@ def usage(name: str) -> str:
               "  -h, --help   show this help and exit",
               "  --cfg job    print the config composed from the defaults and the given key=value, "
               "and exit without running",
-              "  -m           sweep (--multirun): one job per combination of comma-separated values",
-              "               or range(...), in Hydra's override grammar (quote a path holding , ( ) [ ] { }",
-              "               or quotes: \"recording='run (1).csv'\"); the jobs run on tcbench run's launcher",
-              "               (hydra.launcher.n_jobs=2 for two workers) and the sweep is reported at the end",
+              *textwrap.wrap("sweep (--multirun): one job per combination of comma-separated values or "
+                             "range(...), in Hydra's override grammar (quote a path holding , ( ) [ ] { } or "
+                             f"quotes: \"recording='run (1).csv'\"); {spec.sweep}", width=98,
+                             initial_indent="  -m           ", subsequent_indent=" " * 15),
+              *spec.options,
               "", "examples:", *(f"  {e}" for e in spec.examples),
               "", textwrap.fill(f"output: {spec.output}", width=100, subsequent_indent="  ")]
     return "\n".join(lines)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import logging
 import os
@@ -10,7 +9,6 @@ import re
 import sys
 import uuid
 from collections.abc import Iterator
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -20,16 +18,17 @@ USAGE = """usage: tcbench <command> [args]
 
 commands:
   run          one job, or a Hydra sweep with -m (e.g. tcbench run -m optimiser=fa,ifa seed='range(30)')
-  leaderboard  aggregate finished runs into leaderboards/<task>.md/.csv/.png
+  leaderboard  aggregate finished runs into leaderboards/<task>.md/.csv/.png (experiments=NAME out=DIR)
   quickstart   the main job in a minute: compensate a simulated MSRA, diagnose a recording
-  list         registered tasks, optimisers and learners
+  list         registered tasks, optimisers and learners (what=all|tasks|optimisers|learners)
   simulate     simulate a recording (sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR) and its metrics
   import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL[:unit] ... out=DIR)
   metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
   diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
 
-`tcbench <command> --help` (or -h) shows a command's parameters, their defaults, examples and
-where its output goes; `--cfg job` prints the config a command would run with, and runs nothing.
+Every command is a Hydra app: `tcbench <command> --help` (or -h) shows its parameters, their
+defaults, examples and where its output goes; `--cfg job` prints the config a command would run
+with, and runs nothing; -m sweeps.
 """
 
 
@@ -57,20 +56,6 @@ def _flag_name(arg: str) -> str | None:
 
 def _unknown_option(command: str, flag: str) -> UserError:
     return UserError(f"unknown option {flag!r} for tcbench {command}; see `tcbench {command} --help`")
-
-
-def _no_arguments(command: str, argv: list[str], help_text: str) -> bool:
-    """For a command without parameters: True after printing its help for -h/--help; a
-    :class:`UserError` for anything else given."""
-    if any(a in HELP_FLAGS for a in argv):
-        print(help_text)
-        return True
-    for a in argv:
-        if (flag := _flag_name(a)) is not None:
-            raise _unknown_option(command, flag)
-    if argv:
-        raise UserError(f"tcbench {command} takes no arguments, got {argv[0]!r}; see `tcbench {command} --help`")
-    return False
 
 
 def _hydra_value(arg: str) -> str:
@@ -115,10 +100,11 @@ def _quiet_job_log() -> Iterator[None]:
         logger.disabled = disabled
 
 
-def _recording_command(command: str, argv: list[str]) -> int:
-    """``tcbench simulate|metrics|import|diagnose``: a Hydra app on ``conf/<command>.yaml``. One
-    job runs here (no Hydra output folder); ``-m`` sweeps run through Hydra's launcher like
-    ``tcbench run``'s. Every job is checked before the first starts."""
+def _app_command(command: str, argv: list[str]) -> int:
+    """``tcbench simulate|metrics|import|diagnose|leaderboard|list|quickstart``: a Hydra app on
+    ``conf/<command>.yaml``. One job runs here (no Hydra output folder); ``-m`` sweeps run through
+    Hydra's launcher like ``tcbench run``'s, but those of :data:`IN_TURN` one after another here.
+    Every job is checked before the first starts."""
     from hydra import initialize_config_module
 
     from tcbench.cli import help as cli_help
@@ -155,6 +141,8 @@ def _recording_command(command: str, argv: list[str]) -> int:
     if nul := [a for a in args if "\0" in a]:
         raise UserError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
     args = [_open_key(a, command) for a in args]
+    if multirun and cfg is None and command in IN_TURN:
+        return _in_turn(command, args)
     if multirun and cfg is None:
         checked = _run_sweep(["-m", *args], command)
         assert checked is not None
@@ -174,6 +162,13 @@ def _recording_command(command: str, argv: list[str]) -> int:
         c = as_dict(composed)  # one job: its work makes the checks once (run_job), no check ahead
     except ConfigError as exc:
         raise UserError(str(exc)) from None
+    if command in IN_TURN:
+        check, work = IN_TURN[command]
+        try:
+            check(c)
+            return work(c)
+        except ConfigError as exc:
+            raise UserError(str(exc)) from None
     c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
     FAILURES.clear()
     with _quiet_job_log():
@@ -317,182 +312,164 @@ def cmd_run(args: list[str]) -> int:
     return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri, expected)
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse whose usage errors are one line (a :class:`UserError`) and whose ``--help``
-    returns instead of exiting the process."""
+def _in_turn(command: str, args: list[str]) -> int:
+    """A ``-m`` sweep of a command of :data:`IN_TURN`: every job checked, then each run here in
+    turn; the worst exit code."""
+    from tcbench.cli.app import expand
+    from tcbench.runner.config import ConfigError
 
-    def error(self, message: str) -> None:  # type: ignore[override]
-        if message.startswith("unrecognized arguments: "):
-            flag = message.split(": ", 1)[1].split()[0].split("=", 1)[0]
-            raise _unknown_option(self.prog.split()[-1], flag) if flag.startswith("-") else \
-                UserError(f"{self.prog}: unexpected argument {flag!r}; see `{self.prog} --help`")
-        raise UserError(f"{self.prog}: {message}")
+    check, work = IN_TURN[command]
+    try:
+        jobs = expand(["-m", *args], command)
+        outs: dict[str, int] = {}
+        for i, (_, c) in enumerate(jobs):
+            check(c)
+            if "out" in c:
+                key = os.path.abspath(str(c["out"]))
+                if key in outs:
+                    raise ConfigError(f"jobs {outs[key] + 1} and {i + 1} of the sweep would both write {c['out']}; "
+                                      "give each its own out= (e.g. 'out=qs/${diagnose_effect}')")
+                outs[key] = i
+    except ConfigError as exc:
+        raise UserError(str(exc)) from None
+    status = 0
+    for i, (overrides, c) in enumerate(jobs):
+        print(f"tcbench: job {i + 1}/{len(jobs)}: {' '.join(overrides) or '(defaults)'}", file=sys.stderr)
+        try:
+            status = max(status, work(c))
+        except ConfigError as exc:
+            raise UserError(f"job {i + 1}: {exc}") from None
+    return status
 
-    def exit(self, status: int = 0, message: str | None = None) -> None:  # type: ignore[override]
-        if message:
-            print(message, file=sys.stderr, end="")
-        raise _HelpShown(status)
+
+def _check_list(c: dict[str, object]) -> None:
+    from tcbench.commands.schemas import LISTS
+    from tcbench.runner.config import ConfigError
+
+    if c.get("what") not in LISTS:
+        raise ConfigError(f"what={c.get('what')}: expected one of {', '.join(LISTS)}")
 
 
-class _HelpShown(Exception):
-    """argparse printed its help: the command ends with this exit code."""
+def _list(c: dict[str, object]) -> int:
+    """Print the registered tasks, optimisers and learners (``what``: one of them, or all)."""
+    what = c.get("what", "all")
+    if what in {"all", "tasks"}:
+        from tcbench.tasks import TASKS
 
-    def __init__(self, status: int) -> None:
-        super().__init__(status)
-        self.status = status
+        for family in dict.fromkeys(spec.family for spec in TASKS.values()):
+            print(f"tasks ({family}):")
+            for spec in (s for s in TASKS.values() if s.family == family):
+                print(f"  {spec.gym_id:26s} task={spec.name:{14 if spec.is_compensation else 11}s} {spec.summary}")
+    if what in {"all", "optimisers"}:
+        from tcbench.optimisers import registry
+
+        print("optimisers:")
+        for name, entry in registry.available().items():
+            kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective),
+                                             ("multi", entry.cls.multi_objective)) if ok)
+            print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package}; {kinds}-objective)")
+        for name, err in registry.broken().items():
+            print(f"  {name:10s} BROKEN: {err}")
+    if what in {"all", "learners"}:
+        from tcbench.learners import registry as learners
+
+        print("learners:")
+        for name, lentry in learners.available().items():
+            kind = "initial weights searchable" if lentry.cls.searchable else "closed form"
+            print(f"  {name:10s} {lentry.cls.__module__}.{lentry.cls.__name__}  (from {lentry.package}; {kind})")
+        for name, err in learners.broken().items():
+            print(f"  {name:10s} BROKEN: {err}")
+        print("  raw, oracle  baselines: no compensation; the simulator's truth (physical limit)")
+    return 0
 
 
-LEADERBOARD_EPILOG = """examples:
-  tcbench leaderboard                                         all runs of experiment tcbench
-  tcbench leaderboard --experiment quickstart --sweep SWEEP_ID --out lb --ecdf
+def _quickstart_config(c: dict[str, object]) -> object:
+    from tcbench.commands.schemas import QuickstartConfig, as_schema
 
-output: OUT/<task>.md, OUT/<task>.csv and OUT/<task>_convergence.png per task (compensation
-tasks too), the tables also printed; --ecdf adds OUT/ecdf_<d>d.png. Reads the MLflow store, writes
-nothing to it."""
+    return as_schema(c, QuickstartConfig)
+
+
+def _check_quickstart(c: dict[str, object]) -> None:
+    from tcbench.cli import quickstart
+
+    quickstart.check(_quickstart_config(c))  # type: ignore[arg-type]
+
+
+def _quickstart(c: dict[str, object]) -> int:
+    from tcbench.cli import quickstart
+
+    return quickstart.run(_run_sweep, _sweep_report, _quickstart_config(c))  # type: ignore[arg-type]
+
+
+# commands whose jobs run here, not on the launcher: a listing is instant, and each quickstart
+# runs sweeps of its own on the launcher; name -> (check before any job, the job)
+IN_TURN = {"list": (_check_list, _list), "quickstart": (_check_quickstart, _quickstart)}
+
+# ``tcbench leaderboard``'s flags, kept as aliases of its keys
+LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--out": "out", "--tracking-uri": "tracking.uri"}
+
+
+def _hydra_string(value: str) -> str:
+    """``value`` as one quoted string of Hydra's override grammar."""
+    return "'" + value.replace("\\", "\\\\").replace("'", "\\'") + "'"
 
 
 def cmd_leaderboard(argv: list[str]) -> int:
-    ap = _Parser(prog="tcbench leaderboard", description="Aggregate finished runs into leaderboards.",
-                 epilog=LEADERBOARD_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--experiment", action="append", help="MLflow experiment (repeatable; default: tcbench)")
-    ap.add_argument("--sweep", help="only runs of this sweep id")
-    ap.add_argument("--out", default="leaderboards", help="output directory (default: leaderboards)")
-    ap.add_argument("--tracking-uri", help="MLflow store (default: $MLFLOW_TRACKING_URI or ./mlflow.db)")
-    ap.add_argument("--ecdf", action="store_true", help="also write COCO-style ECDF plots per dimension")
-    try:
-        ns = ap.parse_args(argv)
-    except _HelpShown as shown:
-        return shown.status
-    from tcbench.leaderboard import optimisation as leaderboard
-    from tcbench.tracking import store as tracking
-    from tcbench.leaderboard import compensation as comp_board
-    from tcbench.tasks.specs import protocols
-    from tcbench.outputs import folder_problem
-
-    if problem := folder_problem(ns.out):
-        raise UserError(f"--out {ns.out}: {problem}")
-
-    experiments = ns.experiment or ["tcbench"]
-    try:
-        client = tracking.client(tracking.check_store(ns.tracking_uri, create=False))
-    except tracking.StoreError as exc:
-        raise UserError(str(exc)) from None
-    try:
-        runs = leaderboard.load_runs(client, experiments, ns.sweep)
-        comp = comp_board.load_runs(client, experiments, ns.sweep)
-    except LookupError as exc:
-        raise UserError(f"{exc} in {tracking.tracking_uri(ns.tracking_uri)}") from None
-    if runs.empty and comp.empty:
-        raise UserError(f"no tcbench runs in experiment {', '.join(experiments)}")
-    source = f"MLflow experiment {', '.join(experiments)}" + (f", sweep {ns.sweep}" if ns.sweep else "")
-    for board in leaderboard.boards(runs) if not runs.empty else []:
-        paths = leaderboard.write(board, Path(ns.out), client, source)
-        print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
-        print(leaderboard.markdown_table(board.table))
-        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-    for cboard in comp_board.boards(comp, protocols()) if not comp.empty else []:
-        paths = comp_board.write(cboard, Path(ns.out), source)
-        print(f"\n## {cboard.task}  (compensation)\n")
-        print(leaderboard.markdown_table(cboard.table))
-        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-    if ns.ecdf and not runs.empty:
-        from tcbench.leaderboard.ecdf import write_ecdf_plots
-
-        written = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), Path(ns.out))
-        print(f"\nECDF plots: {', '.join(map(str, written)) or 'none (no single-objective runs)'}")
-    return 0
-
-
-def _quickstart_help() -> str:
-    from importlib.resources import files
-
-    from tcbench.cli.quickstart import Sizes
-
-    settings = [ln for ln in files("tcbench.conf").joinpath("experiment/quickstart.yaml").read_text().splitlines()
-                if ln.strip() and not ln.lstrip().startswith("#")]
-    d = Sizes()
-    return "\n".join([
-        "usage: tcbench quickstart [-h]", "",
-        "The main job in about a minute (2 cores), at demonstration sizes, not the paper's:",
-        "  1. compensation: the paper's IFA-BP on the simulated MSRA zero-bias task, 5 trainings",
-        "     (`tcbench run -m experiment=quickstart`), beside raw, poly and the oracle (the physical",
-        "     limit; learner=raw,poly,oracle optimiser=none), then a small leaderboard;",
-        f"  2. diagnosis: a simulated {d.diagnose_sensor.upper()} recording with one hidden effect "
-        f"({d.diagnose_effect}, seed {d.diagnose_seed}),",
-        "     what the diagnosis finds, where, and the held-out RMSE before and after in noise sigmas.",
-        "Takes no parameters; deterministic (same seeds, same numbers). Run `tcbench run -m",
-        "experiment=quickstart` with your own key=value overrides to change the compensation sweep.",
-        "Its settings (conf/experiment/quickstart.yaml):", "",
-        *(f"  {ln}" for ln in settings), "",
-        "examples:", "  tcbench quickstart", "  tcbench run -m experiment=quickstart 'seed=range(30)'", "",
-        "output: runs in MLflow (./mlflow.db, experiment quickstart: one per compensation job and one",
-        "for the diagnosis), the leaderboard in tcbench-quickstart/leaderboard/, the diagnosis report",
-        "and plots in tcbench-quickstart/diagnosis/, Hydra job logs and resolved configs in multirun/.",
-    ])
-
-
-LIST_HELP = """usage: tcbench list [-h]
-
-Print the registered tasks (their gymnasium env id and task= name), optimisers (with the
-package that provides them: tcbench or a plugin), learners and broken plugins. Takes no
-parameters.
-
-example:
-  tcbench list
-
-output: stdout only."""
+    """``tcbench leaderboard``: its key=value (``conf/leaderboard.yaml``), or the flags
+    ``--experiment`` (repeatable), ``--sweep``, ``--out``, ``--tracking-uri`` and ``--ecdf``."""
+    args: list[str] = []
+    experiments: list[str] = []
+    it = iter(argv)
+    for a in it:
+        flag, eq, value = a.partition("=")
+        if flag in LEADERBOARD_FLAGS:
+            if not eq:
+                given = next(it, None)
+                if given is None or given in HELP_FLAGS:
+                    if given in HELP_FLAGS:
+                        args.append(given)
+                        continue
+                    raise UserError(f"tcbench leaderboard: {flag} needs a value; see `tcbench leaderboard --help`")
+                value = given
+            if flag == "--experiment":
+                experiments.append(value)
+            else:
+                args.append(f"{LEADERBOARD_FLAGS[flag]}={value}")
+        elif flag == "--ecdf":
+            if eq:
+                raise UserError("tcbench leaderboard: --ecdf takes no value (or give ecdf=true)")
+            args.append("ecdf=true")
+        else:
+            args.append(a)
+    if len(experiments) == 1:
+        args.append(f"experiments={experiments[0]}")
+    elif experiments:
+        args.append(f"experiments=[{','.join(_hydra_string(e) for e in experiments)}]")
+    return _app_command("leaderboard", args)
 
 
 def cmd_quickstart(argv: list[str]) -> int:
-    if _no_arguments("quickstart", argv, _quickstart_help()):
-        return 0
-    from tcbench.cli import quickstart
-
-    return quickstart.run(_run_sweep, _sweep_report)
+    return _app_command("quickstart", argv)
 
 
 def cmd_list(argv: list[str]) -> int:
-    if _no_arguments("list", argv, LIST_HELP):
-        return 0
-    from tcbench.optimisers import registry
-    from tcbench.tasks import TASKS
-
-    for family in dict.fromkeys(spec.family for spec in TASKS.values()):
-        print(f"tasks ({family}):")
-        for spec in (s for s in TASKS.values() if s.family == family):
-            print(f"  {spec.gym_id:26s} task={spec.name:{14 if spec.is_compensation else 11}s} {spec.summary}")
-    print("optimisers:")
-    for name, entry in registry.available().items():
-        kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective), ("multi", entry.cls.multi_objective)) if ok)
-        print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package}; {kinds}-objective)")
-    for name, err in registry.broken().items():
-        print(f"  {name:10s} BROKEN: {err}")
-    from tcbench.learners import registry as learners
-
-    print("learners:")
-    for name, lentry in learners.available().items():
-        kind = "initial weights searchable" if lentry.cls.searchable else "closed form"
-        print(f"  {name:10s} {lentry.cls.__module__}.{lentry.cls.__name__}  (from {lentry.package}; {kind})")
-    for name, err in learners.broken().items():
-        print(f"  {name:10s} BROKEN: {err}")
-    print("  raw, oracle  baselines: no compensation; the simulator's truth (physical limit)")
-    return 0
+    return _app_command("list", argv)
 
 
 def cmd_simulate(argv: list[str]) -> int:
-    return _recording_command("simulate", argv)
+    return _app_command("simulate", argv)
 
 
 def cmd_import(argv: list[str]) -> int:
-    return _recording_command("import", argv)
+    return _app_command("import", argv)
 
 
 def cmd_metrics(argv: list[str]) -> int:
-    return _recording_command("metrics", argv)
+    return _app_command("metrics", argv)
 
 
 def cmd_diagnose(argv: list[str]) -> int:
-    return _recording_command("diagnose", argv)
+    return _app_command("diagnose", argv)
 
 
 COMMANDS = {

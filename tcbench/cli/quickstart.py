@@ -8,20 +8,22 @@
    (:func:`~tcbench.diagnose.concealed.concealed_recording`), diagnosed as ``tcbench diagnose``
    does; the report and plots are written and logged as an MLflow run.
 
-The sizes are :data:`SIZES`; the test suite runs :data:`TEST_SIZES`.
+Its parameters are :class:`tcbench.commands.schemas.QuickstartConfig` (``conf/quickstart.yaml``);
+the test suite runs it with two short trainings.
 """
 
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Callable
 import time
 import uuid
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-OUT = Path("tcbench-quickstart")
+from tcbench.commands.schemas import QuickstartConfig
+from tcbench.errors import ConfigError
+
 HEADER = """\
 tcbench: a benchmark for temperature compensation of MEMS inertial sensors. It simulates sensors
 (MSRA accelerometer, gyroscope) in temperature chambers, compensates them (learners and their
@@ -40,23 +42,9 @@ from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
   tcbench --help                           every command; tcbench <command> --help for its parameters"""
 
 
-@dataclass(frozen=True)
-class Sizes:
-    """How much the quickstart runs. ``None``: quickstart.yaml's value (budget 510, the paper's
-    search; BP's 1000 gradient-descent epochs; 5 trainings)."""
-
-    seeds: int | None = None
-    budget: int | None = None
-    epochs: int | None = None
-    diagnose_sensor: str = "msra"
-    diagnose_effect: str = "thermal_lag"
-    diagnose_seed: int = 0
-
-
-DEFAULT_SEEDS = 5  # quickstart.yaml's seed: range(5)
-SIZES = Sizes()  # what `tcbench quickstart` runs
-# The test suite's size: two short trainings.
-TEST_SIZES = Sizes(seeds=2, budget=60, epochs=100)
+def _quoted(value: str) -> str:
+    """``value`` as one literal string of Hydra's override grammar."""
+    return "'" + str(value).replace("\\", "\\\\").replace("'", "\\'") + "'"
 
 
 def _rule(title: str) -> str:
@@ -81,35 +69,56 @@ def _print_table(header: list[str], rows: list[list[Any]]) -> None:
             print("  " + "  ".join("-" * w for w in widths))
 
 
-def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int], sizes: Sizes | None = None,
-        out: Path = OUT) -> int:
-    """Run the quickstart from the working directory with the command line's sweep launcher
-    ``run_sweep`` and end-of-sweep report ``sweep_report`` (passed in, so this module does not
-    import the command line that calls it); 0 if every job finished."""
-    sizes = sizes or SIZES
+def check(cfg: QuickstartConfig) -> None:
+    """The quickstart's own parameters, checked before anything runs (the compensation sweep's
+    are checked by ``tcbench run``): ConfigError with one line."""
+    from tcbench.diagnose.concealed import EFFECTS_BY_SENSOR
+
+    for key in ("seeds", "budget", "epochs"):
+        if getattr(cfg, key) < 1:
+            raise ConfigError(f"{key}={getattr(cfg, key)}: must be at least 1")
+    if cfg.diagnose_sensor not in EFFECTS_BY_SENSOR:
+        raise ConfigError(f"diagnose_sensor={cfg.diagnose_sensor}: unknown; known: {', '.join(EFFECTS_BY_SENSOR)}")
+    if cfg.diagnose_effect not in EFFECTS_BY_SENSOR[cfg.diagnose_sensor]:
+        raise ConfigError(f"diagnose_effect={cfg.diagnose_effect}: not an effect tcbench hides in a "
+                          f"{cfg.diagnose_sensor} recording; known: {', '.join(EFFECTS_BY_SENSOR[cfg.diagnose_sensor])}")
+    if cfg.diagnose_seed < 0:
+        raise ConfigError(f"diagnose_seed={cfg.diagnose_seed}: must be a non-negative integer")
+    if not str(cfg.tracking.experiment).strip():
+        raise ConfigError("tracking.experiment: give the MLflow experiment a name")
+    from tcbench.outputs import folder_problem
+
+    if problem := folder_problem(cfg.out):
+        raise ConfigError(f"out={cfg.out}: {problem}")
+
+
+def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int], cfg: QuickstartConfig) -> int:
+    """Run the quickstart ``cfg`` from the working directory with the command line's sweep
+    launcher ``run_sweep`` and end-of-sweep report ``sweep_report`` (passed in, so this module does
+    not import the command line that calls it); 0 if every job finished."""
+    check(cfg)
     started = time.monotonic()
-    sweep = uuid.uuid4().hex[:12]
-    out = Path(out)
-    size_overrides = [f"{k}={v}" for k, v in (("budget", sizes.budget), ("learner.epochs", sizes.epochs))
-                      if v is not None]
-    seeds = [f"seed=range({sizes.seeds})"] if sizes.seeds is not None else []
+    sweep = cfg.tracking.sweep_id or uuid.uuid4().hex[:12]
+    out = Path(cfg.out)
+    tracked = [f"tracking.sweep_id={sweep}", f"tracking.experiment={_quoted(cfg.tracking.experiment)}",
+               *([f"tracking.uri={_quoted(cfg.tracking.uri)}"] if cfg.tracking.uri else [])]
     print(HEADER)
 
     print(_rule("1. Compensating a sensor: MSRA zero-bias stability (seed 000 §3, Table 1)"))
-    n_bp, budget, epochs = sizes.seeds or DEFAULT_SEEDS, sizes.budget or 510, sizes.epochs or 1000
+    n_bp = cfg.seeds
     _say(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
-          f"the paper: 30), each with {budget} evaluations of IFA's weight search (population 10) and {epochs} "
-          "gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
-    checked = run_sweep(["-m", "experiment=quickstart", f"tracking.sweep_id={sweep}", *size_overrides, *seeds])
+          f"the paper: 30), each with {cfg.budget} evaluations of IFA's weight search (population 10) and "
+          f"{cfg.epochs} gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
+    checked = run_sweep(["-m", "experiment=quickstart", *tracked, f"budget={cfg.budget}",
+                         f"learner.epochs={cfg.epochs}", f"seed=range({n_bp})"])
     assert checked is not None
-    run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,oracle", "optimiser=none", "seed=0",
-                f"tracking.sweep_id={sweep}"])
+    run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,oracle", "optimiser=none", "seed=0", *tracked])
     status = sweep_report(sweep, checked.experiment, checked.tracking_uri)
     board_paths = _leaderboard(checked.experiment, sweep, checked.tracking_uri, out / "leaderboard")
     compensation_s = time.monotonic() - started
 
     print(_rule("2. Diagnosing a recording: what does the model leave out?"))
-    diag_paths, run_id = _diagnosis(sizes, sweep, checked.experiment, checked.tracking_uri, out / "diagnosis")
+    diag_paths, run_id = _diagnosis(cfg, sweep, checked.experiment, checked.tracking_uri, out / "diagnosis")
     diagnosis_s = time.monotonic() - started - compensation_s
 
     from tcbench.tracking import store as tracking
@@ -170,7 +179,7 @@ def _where(where: dict[str, Any]) -> str:
     return ", ".join(parts) or "the whole record"
 
 
-def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: Path) -> tuple[list[Path], str]:
+def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | None, out: Path) -> tuple[list[Path], str]:
     """Simulate a recording with a hidden effect, write it, diagnose it as ``tcbench diagnose``
     does (:func:`tcbench.runner.job.run_job`: the report, and a run in MLflow) and print what was found;
     the paths written and the run id."""
@@ -183,7 +192,7 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
     from tcbench.runner.job import JobFailure, run_job
     from tcbench.sensors.recording import write_recording
 
-    rec, hidden = concealed_recording(sizes.diagnose_sensor, sizes.diagnose_effect, sizes.diagnose_seed)
+    rec, hidden = concealed_recording(cfg.diagnose_sensor, cfg.diagnose_effect, cfg.diagnose_seed)
     length = f"{(rec.time_s[-1] - rec.time_s[0]) / 3600:.1f} h"
     _say(f"A simulated {hidden.sensor.upper()} chamber recording ({length} at 1 Hz, seed {hidden.seed}) with one "
           f"effect hidden under the noise: {hidden.effect} ({', '.join(f'{k} {v:.4g}' for k, v in hidden.params.items())}). "
@@ -209,7 +218,7 @@ def _diagnosis(sizes: Sizes, sweep: str, experiment: str, uri: str | None, out: 
         print(f"  found {e['id']} ({e.get('shape', '')}){': ' + params if params else ''}")
         print(f"    where: {_where(e.get('where', {}))}")
         print(f"    evidence: {evidence}")
-    hit = sizes.diagnose_effect in diag.effect_ids
+    hit = cfg.diagnose_effect in diag.effect_ids
     print(f"  the hidden effect was {hidden.effect}: {'found' if hit else 'NOT found'}")
     print(f"Held-out RMSE (white noise sigma {sigma:.4g} {diag.unit}; a model that misses nothing reaches ~1 sigma):")
     _print_table(["model", f"RMSE held-out ({diag.unit})", "in sigma"],

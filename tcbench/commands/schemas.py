@@ -1,4 +1,5 @@
-"""Config schemas of the recording commands (``tcbench simulate|metrics|import|diagnose``): each
+"""Config schemas of the key=value commands (``tcbench simulate|metrics|import|diagnose|leaderboard|
+list|quickstart``; ``tcbench run``'s is :mod:`tcbench.runner.config`): each
 is the structured base of its primary config ``conf/<command>.yaml``, registered with Hydra's
 ConfigStore as ``<command>_schema`` so types and known keys are checked at composition.
 ``kind`` names the job kind that runs it (:mod:`tcbench.runner.kinds`)."""
@@ -80,8 +81,57 @@ class DiagnoseConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
 
 
+@dataclass
+class LeaderboardConfig:
+    """``tcbench leaderboard``: the boards of the runs in ``experiments`` (a name, or a list
+    ``[a,b]``), optionally of one ``sweep``, written into ``out``. It reads the store
+    ``tracking.uri``; ``tracking.enabled=true`` also files the board files as a run there."""
+
+    kind: str = "leaderboard"
+    experiments: Any = "tcbench"
+    sweep: str | None = None
+    out: str = "leaderboards"
+    ecdf: bool = False
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(enabled=False, experiment="leaderboards"))
+
+
+LISTS = ("all", "tasks", "optimisers", "learners")
+
+
+@dataclass
+class ListConfig:
+    """``tcbench list``: what to list (one of :data:`LISTS`)."""
+
+    what: str = "all"
+
+
+@dataclass
+class QuickstartTracking:
+    """Where the quickstart's runs go (it is tracked whole: its leaderboard reads them back)."""
+
+    uri: str | None = None
+    experiment: str = "quickstart"
+    sweep_id: str | None = None
+
+
+@dataclass
+class QuickstartConfig:
+    """``tcbench quickstart``: the sizes of its compensation sweep (``tcbench run -m
+    experiment=quickstart``), the hidden effect of its diagnosis and where its files go."""
+
+    seeds: int = 5
+    budget: int = 510
+    epochs: int = 1000
+    diagnose_sensor: str = "msra"
+    diagnose_effect: str = "thermal_lag"
+    diagnose_seed: int = 0
+    out: str = "tcbench-quickstart"
+    tracking: QuickstartTracking = field(default_factory=QuickstartTracking)
+
+
 SCHEMAS: dict[str, type] = {"simulate": SimulateConfig, "metrics": MetricsConfig, "import": ImportConfig,
-                            "diagnose": DiagnoseConfig}
+                            "diagnose": DiagnoseConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
+                            "quickstart": QuickstartConfig}
 
 
 def register() -> None:

@@ -4,7 +4,7 @@ A kind says how a job is named (:meth:`JobKind.names`), runs it (:meth:`JobKind.
 what of its outcome goes to MLflow (:meth:`JobKind.record`); the runner does the rest the same
 way for every kind: the memory limit, resume, the run's tags and params, the config artifact,
 the FAILED path. A job's kind is its config's ``kind`` key (``simulate``, ``metrics``,
-``import``, ``diagnose``: the primary configs ``conf/<command>.yaml``) or, for ``tcbench run``,
+``import``, ``diagnose``, ``leaderboard``: the primary configs ``conf/<command>.yaml``) or, for ``tcbench run``,
 the job kind of its task's spec (:mod:`tcbench.tasks.specs`). A new kind is one module here
 and one entry in :data:`KIND_MODULES`.
 """
@@ -26,6 +26,7 @@ KIND_MODULES = {
     "metrics": "tcbench.runner.kinds.recordings",
     "import": "tcbench.runner.kinds.recordings",
     "diagnose": "tcbench.runner.kinds.diagnosis",
+    "leaderboard": "tcbench.runner.kinds.leaderboards",
 }
 
 
