@@ -41,46 +41,15 @@ class CommandHelp:
                   "the sweep is reported at the end")
 
 
-def _simulate_schema() -> type:
-    from tcbench.commands.schemas import SimulateConfig
+def _schema(command: str) -> Callable[[], type]:
+    """The schema of ``command``'s primary config, imported when the help is shown."""
 
-    return SimulateConfig
+    def schema() -> type:
+        from tcbench.commands.schemas import SCHEMAS
 
+        return SCHEMAS[command]
 
-def _metrics_schema() -> type:
-    from tcbench.commands.schemas import MetricsConfig
-
-    return MetricsConfig
-
-
-def _import_schema() -> type:
-    from tcbench.commands.schemas import ImportConfig
-
-    return ImportConfig
-
-
-def _diagnose_schema() -> type:
-    from tcbench.commands.schemas import DiagnoseConfig
-
-    return DiagnoseConfig
-
-
-def _leaderboard_schema() -> type:
-    from tcbench.commands.schemas import LeaderboardConfig
-
-    return LeaderboardConfig
-
-
-def _list_schema() -> type:
-    from tcbench.commands.schemas import ListConfig
-
-    return ListConfig
-
-
-def _quickstart_schema() -> type:
-    from tcbench.commands.schemas import QuickstartConfig
-
-    return QuickstartConfig
+    return schema
 
 
 IN_TURN = "the jobs run one after another in this process"
@@ -90,7 +59,7 @@ SPECS: dict[str, CommandHelp] = {
     "simulate": CommandHelp(
         name="simulate",
         summary="Simulate a recording of one device under a test protocol, then compute its metrics.",
-        schema=_simulate_schema,
+        schema=_schema("simulate"),
         params={
             "sensor": "msra (accelerometer) or gyro (null: msra, or the model file's)",
             "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static",
@@ -117,7 +86,7 @@ SPECS: dict[str, CommandHelp] = {
     "metrics": CommandHelp(
         name="metrics",
         summary="Validate a recording and compute the papers' metrics, with plots.",
-        schema=_metrics_schema,
+        schema=_schema("metrics"),
         params={
             "recording": "the recording (.csv or .parquet with its .json sidecar); also the first argument",
             "out": "output folder (null: <recording stem>_metrics next to the recording)",
@@ -136,7 +105,7 @@ SPECS: dict[str, CommandHelp] = {
     "import": CommandHelp(
         name="import",
         summary="Import your own CSV file as a tcbench recording (validated, with its sidecar).",
-        schema=_import_schema,
+        schema=_schema("import"),
         params={
             "csv": "the CSV file to import; also the first argument",
             "sensor": "msra or gyro",
@@ -162,7 +131,7 @@ SPECS: dict[str, CommandHelp] = {
     "diagnose": CommandHelp(
         name="diagnose",
         summary="Find the physics a model leaves out of a recording: a report, plots and a model file.",
-        schema=_diagnose_schema,
+        schema=_schema("diagnose"),
         params={
             "recording": "the recording to diagnose",
             "out": "output folder",
@@ -183,7 +152,7 @@ SPECS: dict[str, CommandHelp] = {
         name="leaderboard",
         summary="Aggregate the finished runs of MLflow experiments into leaderboards (optimisation and "
                 "compensation): tables, convergence plots, ECDFs.",
-        schema=_leaderboard_schema,
+        schema=_schema("leaderboard"),
         params={
             "experiments": "MLflow experiment whose runs are ranked; several: experiments=[a,b]",
             "sweep": "only the runs of this sweep id (null: every run of the experiment)",
@@ -214,7 +183,7 @@ SPECS: dict[str, CommandHelp] = {
         name="list",
         summary="Print the registered tasks (their gymnasium env id and task= name), optimisers (with the "
                 "package that provides them: tcbench or a plugin), learners and broken plugins.",
-        schema=_list_schema,
+        schema=_schema("list"),
         params={"what": "which list: all, tasks, optimisers or learners"},
         examples=("tcbench list", "tcbench list what=optimisers", "tcbench list -m what=tasks,learners"),
         output="stdout only",
@@ -229,7 +198,7 @@ SPECS: dict[str, CommandHelp] = {
                 "simulated recording with one hidden effect (thermal_lag by default), what the diagnosis finds, "
                 "where, and the held-out RMSE before and after in noise sigmas. Deterministic: same "
                 "parameters, same numbers.",
-        schema=_quickstart_schema,
+        schema=_schema("quickstart"),
         params={
             "seeds": "IFA-BP trainings (seeds 0..seeds-1; the paper: 30)",
             "budget": "evaluations of IFA's weight search per training (the paper's search: 510)",
