@@ -79,6 +79,68 @@ def test_round_trip_msra_units_and_defaults(tmp_path: Path, capsys: pytest.Captu
     assert rec.meta.device_id == "m" and rec.meta.sample_rate_hz == 2.0
 
 
+@pytest.mark.parametrize("delimiter", ["\t", ";"])
+def test_tab_and_semicolon_tables_import_as_the_comma_table(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                            delimiter: str) -> None:
+    """The delimiter is read from the header (tab, ';' or ','), for the data and for the errors."""
+    _gyro_csv(tmp_path / "log.csv")
+    pd.read_csv(tmp_path / "log.csv").to_csv(tmp_path / "other.csv", sep=delimiter, index=False)
+    args = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_k:K", "output=rate_mdps:mdps", "drop=bad")
+    for name in ("log", "other"):
+        code, _, err = run(capsys, "import", f"csv={tmp_path / name}.csv", *args, f"out={tmp_path / name}-rec")
+        assert code == 0, err
+    comma, other = read_recording(tmp_path / "log-rec" / "log.csv"), read_recording(tmp_path / "other-rec" / "other.csv")
+    pd.testing.assert_frame_equal(comma.data, other.data)
+    assert other.meta.extra["source"]["delimiter"] == delimiter
+    bad = (tmp_path / "other.csv").read_text().replace(f"{delimiter}1500", f"{delimiter}x1500", 1)
+    (tmp_path / "bad.csv").write_text(bad)
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'bad.csv'}", *args, f"out={tmp_path / 'bad-rec'}")
+    assert code == 2 and len(err) == 1 and "column 'rate_mdps': 'x1500" in err[0] and "is not a number" in err[0], err
+
+
+def test_any_unit_pint_knows(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """mrad/s, an epoch clock in microseconds and degF through pint; the MSRA's input in m/s^2."""
+    n = 100
+    clock_us = 1_700_000_000_000_000 + 500_000 * np.arange(n)  # an epoch clock at 2 Hz
+    temp_f = np.linspace(-4.0, 158.0, n)
+    rate_mrads = np.random.default_rng(0).normal(0.8, 0.05, n)
+    pd.DataFrame({"t": clock_us, "T": temp_f, "w": rate_mrads}).to_csv(tmp_path / "g.csv", sep="\t", index=False)
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'g.csv'}", "sensor=gyro", "time=t:us", "temperature=T:degF",
+                       "output=w:mrad/s", f"out={tmp_path / 'o'}")
+    assert code == 0, err
+    rec = read_recording(tmp_path / "o" / "g.csv")
+    np.testing.assert_allclose(np.diff(rec.time_s), 0.5, rtol=1e-9)
+    np.testing.assert_allclose(rec.temperature_c, (temp_f - 32.0) * 5.0 / 9.0, atol=1e-9)
+    np.testing.assert_allclose(rec.output, np.degrees(rate_mrads / 1000.0), rtol=1e-12)
+    assert rec.meta.sample_rate_hz == 2.0
+
+    accel = pd.DataFrame({"t": np.arange(n) * 0.5, "T": np.full(n, 25.0), "f": np.full(n, 12_000.0),
+                          "a": np.full(n, 9.80665)})
+    accel.to_csv(tmp_path / "m.csv", sep=";", index=False)
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'm.csv'}", "sensor=msra", "time=t", "temperature=T",
+                       "output=f", "input=a:m/s2", f"out={tmp_path / 'o'}")
+    assert code == 0, err
+    np.testing.assert_allclose(read_recording(tmp_path / "o" / "m.csv").input, 1.0, rtol=1e-15)  # 1 g
+
+
+def test_the_tofupilot_chamber_cycle_imports_as_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The real tab-separated IMU log, byte for byte as upstream (PROVENANCE.md: a microsecond
+    clock, rad/s): imported with one command, the values tcbench's own reader of it gives."""
+    from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
+
+    code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                         "temperature=imu.temperature", "output=imu.gyro.y:rad/s", f"out={tmp_path / 'rec'}",
+                         "name=tofupilot-gyro-y", "tracking.enabled=false")
+    assert code == 0, err
+    rec = read_recording(tmp_path / "rec" / "tofupilot-gyro-y.csv")
+    known = tofupilot_gyro("y")  # drops the start-up sample and starts the clock at 0
+    assert len(rec.data) == 8400 and len(known.data) == 8399
+    np.testing.assert_allclose(rec.output[1:], known.output, rtol=1e-14)
+    np.testing.assert_allclose(np.diff(rec.time_s[1:]), np.diff(known.time_s), rtol=1e-9)
+    np.testing.assert_array_equal(rec.temperature_c[1:], known.temperature_c)
+    assert rec.meta.extra["source"]["delimiter"] == "\t" and 1.9 < rec.meta.sample_rate_hz < 2.1
+
+
 # -- bad input: one line, exit 2, nothing written --------------------------------------------------
 GOOD = "clock_ms,temp_c,rate_dps,flag\n0,25.0,0.1,0\n20,25.0,0.2,0\n40,25.1,0.3,0\n60,25.1,0.2,0\n"
 ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dps")
@@ -94,8 +156,9 @@ ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dp
                                                   "to 0.01 (after converting ms to s)"),
         (GOOD.replace("25.", "298."), (), "log.csv: row 1, column 'temp_c': 298 degC is not plausible for a gyro "
                                           "recording (expected -100..200 degC) (kelvin?)"),
-        (GOOD, ("output=rate_dps:furlong/s",), "column 'rate_dps': unknown unit 'furlong/s' for output of a gyro "
-                                               "recording (accepted: deg/s, dps, rad/s"),
+        (GOOD, ("output=rate_dps:furlong/s",), "column 'rate_dps': unit 'furlong/s' is a unit of [length] / [time], "
+                                               "not an angular rate (e.g. deg/s, rad/s"),
+        (GOOD, ("output=rate_dps:wibble",), "column 'rate_dps': unknown unit 'wibble': not a unit pint knows"),
         (None, (), "log.csv: no such file"),
         (GOOD, ("sensor=imu",), "unknown sensor 'imu' (expected 'msra' or 'gyro')"),
         (GOOD.replace("20,25.0,0.2", "20,25.0,abc"), (), "log.csv: row 2, column 'rate_dps': 'abc' is not a number"),
@@ -104,7 +167,7 @@ ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dp
         (GOOD, ("drop=flags",), "log.csv: no column 'flags' (for drop)"),
         (GOOD, ("sample_rate_hz=100",), "log.csv: sample_rate_hz 100 does not match the table"),
     ],
-    ids=["unknown-column", "nan", "time-back", "kelvin-as-degC", "unknown-unit", "missing-file", "unknown-sensor",
+    ids=["unknown-column", "nan", "time-back", "kelvin-as-degC", "unit-of-another-quantity", "unknown-unit", "missing-file", "unknown-sensor",
          "text", "empty-cell", "blank-line", "unknown-drop-column", "rate-mismatch"],
 )
 def test_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str | None, args: tuple[str, ...],

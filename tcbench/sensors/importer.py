@@ -1,8 +1,9 @@
 """Bring your own data: a CSV table with columns of any name and common units, as a schema-v1 recording.
 
 A column map names the file's column for each schema column, with the unit after a colon
-(``sensor_time_ms:ms``, ``gyro_x_rads:rad/s``); without a unit the column is taken to be in the
-schema unit. Values are converted to the schema units (:data:`UNITS`), rows can be dropped where
+(``sensor_time_ms:ms``, ``gyro_x_rads:rad/s``, ``gyro_x:mrad/s``); without a unit the column is
+taken to be in the schema unit. Values are converted to the schema units through pint
+(:mod:`tcbench.sensors.units`: any unit of the right dimension), rows can be dropped where
 a flag column is nonzero, and the result goes through every check of the schema
 (:func:`~tcbench.sensors.recording.make_recording`: finite values, strictly increasing time,
 plausible values for the unit, sample rate). Every problem raises :class:`RecordingError` in one
@@ -36,36 +37,19 @@ from tcbench.sensors.recording import (
     make_recording,
     write_recording,
 )
-from tcbench.sensors.recording_files import CHUNK_BYTES, _check_fields, _diagnose_csv, _header_names, _scan_text
+from tcbench.sensors.recording_files import (
+    CHUNK_BYTES,
+    _check_fields,
+    _diagnose_csv,
+    _header_names,
+    _scan_text,
+    sniff_delimiter,
+)
 from tcbench.sensors.segments import GAP_FACTOR, bounds, segments, within_rate_hz
+from tcbench.sensors.units import Conversion, UnitError, conversion
 from tcbench.staging import staged_dir
 
 
-@dataclass(frozen=True)
-class Unit:
-    """A unit and its conversion to the schema unit: ``schema = value * mul / div + offset``."""
-
-    mul: float = 1.0
-    div: float = 1.0
-    offset: float = 0.0
-
-    def to_schema(self, x: np.ndarray) -> np.ndarray:
-        """``x`` in the schema unit (an identity leaves the values bit for bit)."""
-        y = x * self.mul if self.mul != 1.0 else x
-        y = y / self.div if self.div != 1.0 else y
-        return y + self.offset if self.offset else y
-
-
-_RATE = {"deg/s": Unit(), "dps": Unit(), "rad/s": Unit(180.0, math.pi), "mdeg/s": Unit(1.0, 1e3),
-         "mdps": Unit(1.0, 1e3), "deg/h": Unit(1.0, 3600.0)}
-UNITS: dict[str, dict[str, Unit]] = {  # schema unit -> accepted units of a file's column
-    "s": {"s": Unit(), "ms": Unit(1.0, 1e3), "us": Unit(1.0, 1e6), "ns": Unit(1.0, 1e9), "min": Unit(60.0),
-          "h": Unit(3600.0)},
-    "degC": {"degC": Unit(), "K": Unit(offset=-273.15), "degF": Unit(5.0, 9.0, -160.0 / 9.0)},
-    "deg/s": _RATE,
-    "Hz": {"Hz": Unit(), "mHz": Unit(1.0, 1e3), "kHz": Unit(1e3)},
-    "g": {"g": Unit(), "mg": Unit(1.0, 1e3), "m/s^2": Unit(1.0, 9.80665), "m/s2": Unit(1.0, 9.80665)},
-}
 REQUIRED = ("time_s", "temperature_c", "output")
 
 
@@ -76,6 +60,7 @@ class Column:
     target: str
     name: str
     unit: str
+    convert: Conversion = Conversion()
 
     def describe(self) -> str:
         """``name [unit]`` as the sidecar records it."""
@@ -89,35 +74,37 @@ def parse_column(target: str, spec: str, sensor: str, available: Sequence[str]) 
     name, unit = spec, schema_unit
     if spec not in available and ":" in spec:
         name, unit = spec.rsplit(":", 1)
-    accepted = UNITS[schema_unit]
-    if unit not in accepted:
-        raise RecordingError(f"unknown unit {unit!r} for {target} of a {sensor} recording "
-                             f"(accepted: {', '.join(accepted)})", column=name)
+    try:
+        convert = conversion(unit, schema_unit)
+    except UnitError as exc:
+        raise RecordingError(f"{exc}, for {target} of a {sensor} recording (in {schema_unit})", column=name) from None
     if name not in available:
         raise RecordingError(f"no column {name!r} (for {target}); the file has: "
                              f"{', '.join(map(str, available))}")
-    return Column(target, name, unit)
+    return Column(target, name, unit, convert)
 
 
-def _read(path: Path, used: Sequence[str], header: Sequence[str]) -> tuple[dict[str, np.ndarray], np.ndarray]:
-    """The ``used`` columns of a CSV file as float64 (empty cells NaN) and a mask of the empty
-    cells (rows x ``used``), read with pyarrow; a line with the wrong number of fields, a blank
-    line or a cell that is not a number is located as the schema's reader does."""
+def _read(path: Path, used: Sequence[str], header: Sequence[str], delimiter: str = ","
+          ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The ``used`` columns of a table (fields separated by ``delimiter``) as float64 (empty
+    cells NaN) and a mask of the empty cells (rows x ``used``), read with pyarrow; a line with the
+    wrong number of fields, a blank line or a cell that is not a number is located as the
+    schema's reader does."""
     try:
         table = pcsv.read_csv(
             path,
             read_options=pcsv.ReadOptions(column_names=list(header), skip_rows=1, block_size=CHUNK_BYTES),
-            parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+            parse_options=pcsv.ParseOptions(ignore_empty_lines=False, delimiter=delimiter),
             convert_options=pcsv.ConvertOptions(column_types=dict.fromkeys(used, pa.float64()),
                                                 include_columns=list(used), null_values=[""],
                                                 strings_can_be_null=True, quoted_strings_can_be_null=False),
         )
     except pa.ArrowInvalid as exc:
-        _diagnose_csv(path, list(header), list(used))
+        _diagnose_csv(path, list(header), list(used), delimiter)
         raise RecordingError(f"cannot parse the table ({str(exc).splitlines()[0]})") from None
     empty = np.zeros((table.num_rows, len(used)), dtype=bool)
     if any(table[c].null_count for c in used):  # an empty cell, or a short or blank line
-        _check_fields(path, list(header))
+        _check_fields(path, list(header), delimiter)
         empty = np.column_stack([table[c].is_null().to_numpy(zero_copy_only=False) for c in used])
     return {c: table[c].to_numpy() for c in used}, empty
 
@@ -171,7 +158,7 @@ def import_csv(
     """A schema-v1 recording from the CSV table at ``path``.
 
     ``columns`` maps ``time_s``, ``temperature_c``, ``output`` and optionally ``input`` to a
-    file column, ``name`` or ``name:unit`` (:data:`UNITS`); a missing ``input`` is 0. Rows where a
+    file column, ``name`` or ``name:unit`` (:mod:`tcbench.sensors.units`); a missing ``input`` is 0. Rows where a
     ``drop`` column is nonzero are left out before any check. ``device_id`` defaults to the
     file's stem, ``sample_rate_hz`` to the rate inside the segments (one over the median
     interval). Raises :class:`RecordingError` naming the file, row and column.
@@ -191,8 +178,9 @@ def import_csv(
             raise RecordingError("is a directory, not a CSV file")
         if not path.is_file():
             raise RecordingError("no such file")
-        header = _header_names(path)
-        _scan_text(path, header)
+        delimiter = sniff_delimiter(path)
+        header = _header_names(path, delimiter)
+        _scan_text(path, header, delimiter)
         spec = {k: parse_column(k, v, sensor, header) for k, v in columns.items() if v}
         for flag in drop:
             if flag not in header:
@@ -201,12 +189,11 @@ def import_csv(
         twice = [c for c in used if header.count(c) > 1]
         if twice:
             raise RecordingError(f"the header names column {twice[0]!r} more than once")
-        raw, empty = _read(path, used, header)
+        raw, empty = _read(path, used, header, delimiter)
         keep = ~_dropped(raw, drop, empty.shape[0])
         _check_filled(empty, used, keep)
         rows = np.flatnonzero(keep) + 1
-        table = {c.target: UNITS[STANDARD_UNITS[sensor][c.target]][c.unit].to_schema(raw[c.name][keep])
-                 for c in spec.values()}
+        table = {c.target: c.convert.to_schema(raw[c.name][keep]) for c in spec.values()}
     except RecordingError as err:
         raise err.located(name) from None
     table.setdefault("input", np.zeros(rows.size))
@@ -219,7 +206,7 @@ def import_csv(
     seg = segments(t) if clock_ok else np.zeros(t.size, dtype=np.int64)
     starts, stops = bounds(seg)
     extra = {
-        "source": {"file": path.name, "columns": {k: c.describe() for k, c in spec.items()},
+        "source": {"file": path.name, "delimiter": delimiter, "columns": {k: c.describe() for k, c in spec.items()},
                    **({"input": "0 (no column given)"} if "input" not in spec else {}),
                    "drop": list(drop), "rows_read": int(keep.size), "rows_dropped": int((~keep).sum())},
         "segments": {"count": int(starts.size), "gap_factor": GAP_FACTOR, "first_rows": (starts + 1).tolist(),

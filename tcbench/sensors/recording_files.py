@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 import os
 import secrets
 from collections.abc import Callable, Sequence
@@ -54,9 +55,11 @@ def _load_json(path: Path) -> Any:
         raise RecordingError("invalid JSON: not UTF-8 text") from None
 
 
-def _header_names(path: Path) -> list[str]:
-    """Column names from the first line of a CSV file, whatever they are (at most
-    :data:`MAX_HEADER_BYTES` of it are read)."""
+DELIMITERS = (",", "\t", ";")  # what a table's fields may be separated by (the header decides)
+
+
+def _header_line(path: Path) -> str:
+    """The first line of a CSV file as text (at most :data:`MAX_HEADER_BYTES` of it are read)."""
     with path.open("rb") as f:
         line = f.readline(MAX_HEADER_BYTES + 1)
     if b"\0" in line:
@@ -69,13 +72,28 @@ def _header_names(path: Path) -> list[str]:
         raise RecordingError("the header is not UTF-8 text") from None
     if not text:
         raise RecordingError("empty file (no header)")
+    return text
+
+
+def sniff_delimiter(path: Path) -> str:
+    """The field delimiter of a table (one of :data:`DELIMITERS`): the one its header line holds
+    most often outside quotes (a comma when it holds none)."""
+    text = re.sub(r'"[^"]*"', "", _header_line(path))
+    counts = [text.count(d) for d in DELIMITERS]
+    return DELIMITERS[int(np.argmax(counts))] if max(counts) else ","
+
+
+def _header_names(path: Path, delimiter: str = ",") -> list[str]:
+    """Column names from the first line of a table, whatever they are (at most
+    :data:`MAX_HEADER_BYTES` of it are read)."""
+    text = _header_line(path)
     try:
-        return [c.strip() for c in next(csv.reader([text]))]
+        return [c.strip() for c in next(csv.reader([text], delimiter=delimiter))]
     except csv.Error as exc:
         raise RecordingError(f"the header cannot be read as CSV ({exc})") from None
 
 
-def _scan_text(path: Path, names: list[str]) -> None:
+def _scan_text(path: Path, names: list[str], delimiter: str = ",") -> None:
     """Raise at the first NUL byte or line longer than :data:`MAX_LINE_BYTES` of a CSV file,
     reading it in pieces of :data:`CHUNK_BYTES` (a binary or sparse file of any size costs one
     piece of memory), before any parser sees it."""
@@ -88,23 +106,23 @@ def _scan_text(path: Path, names: list[str]) -> None:
             starts = np.concatenate(([line_start], ends[:-1] + 1))
             long = np.flatnonzero(ends - starts > MAX_LINE_BYTES)
             if long.size:
-                _long_line(f, int(starts[long[0]]), line + int(long[0]), names)
+                _long_line(f, int(starts[long[0]]), line + int(long[0]), names, delimiter)
             if ends.size:
                 line, line_start = line + ends.size, int(ends[-1]) + 1
             if offset + len(text) - line_start > MAX_LINE_BYTES:
-                _long_line(f, line_start, line, names)
+                _long_line(f, line_start, line, names, delimiter)
             if nul >= 0:
                 f.seek(line_start)
-                j = f.read(offset + nul - line_start).count(b",")
+                j = f.read(offset + nul - line_start).count(delimiter.encode())
                 raise RecordingError("a NUL byte: a binary file, not CSV text", row=line or None,
                                      column=names[j] if j < len(names) else f"field {j + 1}")
             offset += len(piece)
 
 
-def _long_line(f: BinaryIO, start: int, line: int, names: list[str]) -> None:
+def _long_line(f: BinaryIO, start: int, line: int, names: list[str], delimiter: str = ",") -> None:
     """Raise for the over-long line ``line`` starting at byte ``start``, naming its longest cell."""
     f.seek(start)
-    cells = f.read(MAX_LINE_BYTES + 1).split(b",")
+    cells = f.read(MAX_LINE_BYTES + 1).split(delimiter.encode())
     j = int(np.argmax([len(c) for c in cells]))
     column = names[j] if j < len(names) else f"field {j + 1}"
     raise RecordingError(f"a line longer than {MAX_LINE_BYTES >> 20} MiB ({len(cells[j])} bytes or more in this "
@@ -149,24 +167,25 @@ def _arrow_csv(path: Path, names: list[str], types: dict[str, pa.DataType]) -> p
     )
 
 
-def _diagnose_csv(path: Path, names: list[str], numeric: Sequence[str] = NUMERIC_COLUMNS) -> None:
+def _diagnose_csv(path: Path, names: list[str], numeric: Sequence[str] = NUMERIC_COLUMNS,
+                  delimiter: str = ",") -> None:
     """Raise the first structural or cell problem (in the ``numeric`` columns) of a CSV table;
     return if none is found. The file is read in pieces, never whole."""
-    _check_fields(path, names)
+    _check_fields(path, names, delimiter)
     try:
-        _first_bad_row(path, names, numeric)
+        _first_bad_row(path, names, numeric, delimiter)
     except pa.ArrowInvalid:  # a problem the field count does not show: the caller's message stands
         return
 
 
-def _first_bad_row(path: Path, names: list[str], numeric: Sequence[str]) -> None:
+def _first_bad_row(path: Path, names: list[str], numeric: Sequence[str], delimiter: str = ",") -> None:
     """Raise at the first cell of the ``numeric`` columns that is empty, not a number or not
     finite, reading the table in batches."""
     complete = _ends_with_newline(path)
     reader = pcsv.open_csv(
         path,
         read_options=pcsv.ReadOptions(column_names=names, skip_rows=1, block_size=CHUNK_BYTES),
-        parse_options=pcsv.ParseOptions(ignore_empty_lines=False),
+        parse_options=pcsv.ParseOptions(ignore_empty_lines=False, delimiter=delimiter),
         convert_options=pcsv.ConvertOptions(column_types=dict.fromkeys(names, pa.string()), null_values=[""],
                                             strings_can_be_null=True, quoted_strings_can_be_null=False),
     )
@@ -201,7 +220,7 @@ def _next_batch(reader: pcsv.CSVStreamingReader) -> pa.RecordBatch | None:
     return None
 
 
-def _check_fields(path: Path, names: list[str]) -> None:
+def _check_fields(path: Path, names: list[str], delimiter: str = ",") -> None:
     """Raise at the first line of the CSV file below the header that is blank, cut short or has
     a number of fields other than the header's (read in pieces of whole lines)."""
     row0, rest = 0, b""
@@ -213,16 +232,16 @@ def _check_fields(path: Path, names: list[str]) -> None:
             cut = len(text) if not piece else text.rfind(b"\n") + 1
             block, rest = text[:cut], text[cut:]
             if block:
-                _check_block(block, names, row0, last=not piece)
+                _check_block(block, names, row0, last=not piece, delimiter=delimiter)
                 row0 += block.count(b"\n") + (not block.endswith(b"\n"))
             if not piece:
                 return
 
 
-def _check_block(block: bytes, names: list[str], row0: int, *, last: bool) -> None:
+def _check_block(block: bytes, names: list[str], row0: int, *, last: bool, delimiter: str = ",") -> None:
     """:func:`_check_fields` on whole lines ``block`` whose first line is data row ``row0 + 1``;
     ``last`` when the block ends the file."""
-    fields = _fields_per_line(block)
+    fields = _fields_per_line(block, delimiter)
     wrong = np.flatnonzero(fields != len(names))
     if wrong.size:
         i = int(wrong[0])
@@ -234,14 +253,14 @@ def _check_block(block: bytes, names: list[str], row0: int, *, last: bool) -> No
         raise RecordingError(f"{n} fields, the header has {len(names)}", row=row0 + i + 1)
 
 
-def _fields_per_line(raw: bytes) -> np.ndarray:
-    """Number of comma-separated fields on each line of ``raw`` (0 for a blank line)."""
+def _fields_per_line(raw: bytes, delimiter: str = ",") -> np.ndarray:
+    """Number of ``delimiter``-separated fields on each line of ``raw`` (0 for a blank line)."""
     buf = np.frombuffer(raw, dtype=np.uint8)
     ends = np.flatnonzero(buf == ord("\n"))
     if not raw.endswith(b"\n"):
         ends = np.append(ends, buf.size)
     starts = np.concatenate(([0], ends[:-1] + 1))
-    commas = np.flatnonzero(buf == ord(","))
+    commas = np.flatnonzero(buf == ord(delimiter))
     count = np.searchsorted(commas, ends) - np.searchsorted(commas, starts)
     length = ends - starts
     length = length - ((length > 0) & (buf[np.maximum(ends - 1, 0)] == ord("\r")))
