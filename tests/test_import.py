@@ -141,6 +141,37 @@ def test_the_tofupilot_chamber_cycle_imports_as_written(tmp_path: Path, capsys: 
     assert rec.meta.extra["source"]["delimiter"] == "\t" and 1.9 < rec.meta.sample_rate_hz < 2.1
 
 
+def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``output=imu.gyro.x:rad/s,imu.gyro.y:rad/s,imu.gyro.z:rad/s`` on the real tofupilot log: one
+    recording per axis sharing the clock and temperature, one MLflow run naming them all."""
+    import mlflow
+
+    from tcbench.diagnose.real_records import TOFUPILOT_CSV
+
+    axes = ",".join(f"imu.gyro.{a}:rad/s" for a in "xyz")
+    code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                         "temperature=imu.temperature", f"output={axes}", "out=rec", "name=imu")
+    assert code == 0, err
+    recs = {a: read_recording(workdir / "rec" / f"imu-imu.gyro.{a}.csv") for a in "xyz"}
+    table = pd.read_csv(TOFUPILOT_CSV, sep="\t")
+    for a, rec in recs.items():
+        np.testing.assert_allclose(rec.output, np.degrees(table[f"imu.gyro.{a}"].to_numpy()), rtol=1e-14)
+        np.testing.assert_array_equal(rec.time_s, recs["x"].time_s)
+        np.testing.assert_array_equal(rec.temperature_c, recs["x"].temperature_c)
+    assert out.count("tcbench: wrote ") == 3
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    (r,) = client.search_runs([client.get_experiment_by_name("recordings").experiment_id])
+    assert sorted(Path(p).name for p in r.data.tags["tcbench.recordings"].split(",")) == \
+        [f"imu-imu.gyro.{a}.csv" for a in "xyz"]
+
+    # an axis that fails leaves no recording of the others
+    code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                       "temperature=imu.temperature", "output=imu.gyro.x:rad/s,imu.gyro.w:rad/s", "out=rec2",
+                       "tracking.enabled=false")
+    assert code == 2 and len(err) == 1 and "no column 'imu.gyro.w'" in err[0], err
+    assert not (workdir / "rec2").exists()
+
+
 # -- bad input: one line, exit 2, nothing written --------------------------------------------------
 GOOD = "clock_ms,temp_c,rate_dps,flag\n0,25.0,0.1,0\n20,25.0,0.2,0\n40,25.1,0.3,0\n60,25.1,0.2,0\n"
 ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dps")

@@ -111,7 +111,8 @@ SPECS: dict[str, CommandHelp] = {
             "sensor": "msra or gyro",
             "time": "time column, COL[:unit] (any time unit pint knows: s, ms, us, ns, min, h)",
             "temperature": "temperature column, COL[:unit] (degC, K, degF)",
-            "output": "sensor output column, COL[:unit] (gyro: deg/s, rad/s, mrad/s, mdps ...; msra: Hz, kHz ...)",
+            "output": "sensor output column, COL[:unit] (gyro: deg/s, rad/s, mrad/s, mdps ...; msra: Hz, kHz ...); "
+                      "several axes: COL[:unit],COL[:unit],... (one recording each, NAME-COL)",
             "input": "optional true-input column, COL[:unit]",
             "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
             "out": "output folder",

@@ -6,7 +6,7 @@ wrote. They run as jobs of :mod:`tcbench.runner.kinds.recordings` through :func:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ class RecordingOutcome:
     path: Path
     rec: Any
     report: Any = None
+    also: list[RecordingOutcome] = field(default_factory=list)  # further recordings of the command (axes)
 
 
 # -- simulate ------------------------------------------------------------------------------------
@@ -171,6 +172,23 @@ def import_stem(cfg: ImportConfig) -> str:
     return cfg.name if cfg.name is not None else Path(cfg.csv).stem
 
 
+def import_axes(cfg: ImportConfig) -> list[str]:
+    """The ``output=`` columns, ``COL[:unit]`` each: several axes are separated by commas."""
+    return [a.strip() for a in str(cfg.output).split(",") if a.strip()]
+
+
+def import_stems(cfg: ImportConfig) -> list[str]:
+    """The file stem of each axis's recording: ``name`` for one axis, ``name-COL`` for several."""
+    axes = import_axes(cfg)
+    stem = import_stem(cfg)
+    if len(axes) == 1:
+        return [stem]
+    columns = [a.rsplit(":", 1)[0] if ":" in a else a for a in axes]
+    if len(set(columns)) < len(columns):
+        raise CommandError(f"output={cfg.output}: a column is named twice")
+    return [f"{stem}-{c}" for c in columns]
+
+
 def check_import(cfg: ImportConfig) -> None:
     """Every argument of ``tcbench import`` before any work."""
     from tcbench.outputs import overwritten_input
@@ -178,47 +196,54 @@ def check_import(cfg: ImportConfig) -> None:
     needed = [k for k in ("csv", "sensor", "time", "temperature", "output", "out") if not getattr(cfg, k)]
     if needed:
         raise CommandError(f"missing {needed[0]}=; {IMPORT_USAGE}")
-    stem = file_stem(import_stem(cfg))
+    stems = [file_stem(import_stem(cfg))] + [file_stem(s, "output") for s in import_stems(cfg)]
     writable_folder(cfg.out)
-    targets = [Path(cfg.out) / f"{stem}.csv", Path(cfg.out) / f"{stem}.json"]
+    targets = [Path(cfg.out) / f"{stem}.{ext}" for stem in stems[1:] for ext in ("csv", "json")]
     if clash := overwritten_input(targets, [Path(cfg.csv)]):
         raise overwrite_error(InputOverwriteError(*clash))
     checked_store(cfg.tracking)
 
 
 def import_recording(cfg: ImportConfig) -> RecordingOutcome:
-    """Import a CSV as a validated recording with its sidecar; print what was written."""
-    from tcbench.sensors.importer import import_csv, save
+    """Import a table as validated recordings with their sidecars, one per ``output=`` axis
+    (sharing the clock and temperature columns), all written or none; print what was written."""
+    from tcbench.sensors.importer import import_csv, save_all
     from tcbench.sensors.recording import RecordingError
 
     check_import(cfg)
-    columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, "output": cfg.output}
-    if cfg.input:
-        columns["input"] = cfg.input
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
+    recs = {}
+    for stem, axis in zip(import_stems(cfg), import_axes(cfg), strict=True):
+        columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, "output": axis}
+        if cfg.input:
+            columns["input"] = cfg.input
+        try:
+            recs[stem] = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
+                                    sample_rate_hz=cfg.sample_rate_hz)
+        except RecordingError as exc:
+            raise CommandError(str(exc)) from None
+        except OSError as exc:
+            raise CommandError(f"{csv}: cannot read the file ({exc.strerror or exc})") from None
     try:
-        rec = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
-                         sample_rate_hz=cfg.sample_rate_hz)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except OSError as exc:
-        raise CommandError(f"{csv}: cannot read the file ({exc.strerror or exc})") from None
-    try:
-        path = save(rec, cfg.out, import_stem(cfg), inputs=[csv])
+        paths = save_all(recs, cfg.out, inputs=[csv])
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
     except OSError as exc:
         raise cannot_write(cfg.out, exc) from None
-    source, seg = rec.meta.extra["source"], rec.meta.extra["segments"]
-    n_drop = source["rows_dropped"]
-    dropped = f", {n_drop} row{'s' * (n_drop != 1)} dropped where {' or '.join(drop)} is nonzero" if drop else ""
-    kind = f"in {seg['count']} segments " if seg["count"] > 1 else ""
-    print(f"tcbench: wrote {path} ({len(rec.data)} samples {kind}at {rec.meta.sample_rate_hz:g} Hz{dropped}) "
-          f"and its sidecar {path.with_suffix('.json')}")
-    return RecordingOutcome(path, rec)
+    outcomes = [RecordingOutcome(path, rec) for path, rec in zip(paths, recs.values(), strict=True)]
+    for o in outcomes:
+        source, seg = o.rec.meta.extra["source"], o.rec.meta.extra["segments"]
+        n_drop = source["rows_dropped"]
+        dropped = f", {n_drop} row{'s' * (n_drop != 1)} dropped where {' or '.join(drop)} is nonzero" if drop else ""
+        kind = f"in {seg['count']} segments " if seg["count"] > 1 else ""
+        print(f"tcbench: wrote {o.path} ({len(o.rec.data)} samples {kind}at {o.rec.meta.sample_rate_hz:g} Hz{dropped}) "
+              f"and its sidecar {o.path.with_suffix('.json')}")
+    first, *rest = outcomes
+    first.also = rest
+    return first
 
 
 # -- shared --------------------------------------------------------------------------------------

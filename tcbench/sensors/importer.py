@@ -226,6 +226,12 @@ def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path
     """Write ``rec`` as ``out/<stem>.csv`` and its sidecar, all or nothing (``out`` is not even
     created when writing fails); neither may replace one of ``inputs``
     (:class:`~tcbench.staging.InputOverwriteError`)."""
+    return save_all({stem: rec}, out, inputs)[0]
+
+
+def save_all(recs: Mapping[str, Recording], out: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
+    """Write each recording as ``out/<stem>.csv`` with its sidecar, all of them or none."""
     with staged_dir(out, inputs) as tmp:
-        write_recording(rec, tmp / f"{stem}.csv")
-    return Path(out) / f"{stem}.csv"
+        for stem, rec in recs.items():
+            write_recording(rec, tmp / f"{stem}.csv")
+    return [Path(out) / f"{stem}.csv" for stem in recs]

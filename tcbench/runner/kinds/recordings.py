@@ -39,6 +39,12 @@ class RecordingKind(JobKind):
             files += list(report.files.values())
         sidecar = where / "sidecar.json"
         sidecar.write_text(yaml.safe_dump(extra, sort_keys=False) if extra else "{}")
+        for other in outcome.also:  # the further axes of one import: their paths and sidecars
+            side = where / f"sidecar-{other.path.stem}.json"
+            side.write_text(yaml.safe_dump(other.rec.meta.extra or {}, sort_keys=False))
+            files.append(side)
+        if outcome.also:
+            run.set_tag("tcbench.recordings", ",".join(str(o.path.resolve()) for o in [outcome, *outcome.also]))
         announce(run, c)
         return [*files, sidecar]
 
@@ -97,7 +103,7 @@ class ImportKind(RecordingKind):
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
         cfg: ImportConfig = self.config(c)
-        return [Path(cfg.out) / f"{recordings.import_stem(cfg)}.csv"]
+        return [Path(cfg.out) / f"{stem}.csv" for stem in recordings.import_stems(cfg)]
 
     def execute(self, c: dict[str, Any]) -> recordings.RecordingOutcome:
         return recordings.import_recording(self.config(c))
