@@ -172,6 +172,43 @@ def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixtur
     assert not (workdir / "rec2").exists()
 
 
+PX4_LOG = REAL / "px4_ulog_samples" / "sample_log_small.ulg"
+
+
+def test_a_px4_log_imports_every_gyro_instance_and_axis(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The real PX4 sample log: sensor_gyro's three instances, each axis a recording with the
+    topic's own sample clock (us) and temperature, in deg/s from PX4's rad/s."""
+    from pyulog import ULog
+
+    code, out, err = run(capsys, "import", f"csv={PX4_LOG}", "sensor=gyro", "out=rec", "name=px4")
+    assert code == 0, err
+    log = ULog(str(PX4_LOG), ["sensor_gyro"])
+    instances = {d.multi_id: d.data for d in log.data_list}
+    assert sorted(instances) == [0, 1, 2]
+    for i, data in instances.items():
+        for axis in "xyz":
+            rec = read_recording(workdir / "rec" / f"px4-sensor_gyro-{i}-{axis}.csv")
+            np.testing.assert_allclose(rec.output, np.degrees(data[axis].astype(np.float64)), rtol=1e-6)
+            np.testing.assert_allclose(rec.time_s, data["timestamp_sample"] * 1e-6, rtol=1e-15)
+            np.testing.assert_array_equal(rec.temperature_c, data["temperature"].astype(np.float64))
+            source = rec.meta.extra["source"]
+            assert source["topic"] == "sensor_gyro" and source["instance"] == i and source["format"] == "PX4 ULog"
+            assert 28.0 < rec.temperature_c.mean() < 41.0 and 0.99 < rec.meta.sample_rate_hz < 1.01
+    assert out.count("tcbench: wrote ") == 9
+
+    # one axis, another clock; a log without the topic, or a file that is no log: one line each
+    code, _, err = run(capsys, "import", f"csv={PX4_LOG}", "sensor=gyro", "output=z:rad/s", "time=timestamp:us",
+                       "out=rec-z", "tracking.enabled=false")
+    assert code == 0 and sorted(p.name for p in (workdir / "rec-z").glob("*.csv")) == \
+        [f"sample_log_small-sensor_gyro-{i}-z.csv" for i in range(3)]
+    (workdir / "fake.ulg").write_text("not a log\n")
+    for args, words in (((f"csv={PX4_LOG}", "sensor=msra"), "no topic tcbench reads for sensor 'msra'"),
+                        (("csv=fake.ulg", "sensor=gyro"), "cannot read the file as a PX4 ULog")):
+        code, _, err = run(capsys, "import", *args, "out=bad", "tracking.enabled=false")
+        assert code == 2 and len(err) == 1 and words in err[0], err
+    assert not (workdir / "bad").exists()
+
+
 # -- bad input: one line, exit 2, nothing written --------------------------------------------------
 GOOD = "clock_ms,temp_c,rate_dps,flag\n0,25.0,0.1,0\n20,25.0,0.2,0\n40,25.1,0.3,0\n60,25.1,0.2,0\n"
 ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dps")

@@ -107,7 +107,8 @@ SPECS: dict[str, CommandHelp] = {
         summary="Import your own CSV file as a tcbench recording (validated, with its sidecar).",
         schema=_schema("import"),
         params={
-            "csv": "the table to import (fields separated by commas, tabs or semicolons); also the first argument",
+            "csv": "the table to import (fields separated by commas, tabs or semicolons), or a PX4 log (.ulg: "
+                   "every instance and axis of the sensor's topic, sensor_gyro for a gyro); also the first argument",
             "sensor": "msra or gyro",
             "time": "time column, COL[:unit] (any time unit pint knows: s, ms, us, ns, min, h)",
             "temperature": "temperature column, COL[:unit] (degC, K, degF)",
@@ -124,6 +125,7 @@ SPECS: dict[str, CommandHelp] = {
         examples=(
             "tcbench import csv=log.csv sensor=gyro time=time_s temperature=temp_c:degC "
             "output=gyro_x_dps:deg/s out=recordings",
+            "tcbench import csv=flight.ulg sensor=gyro out=recordings   (NAME-sensor_gyro-<instance>-<axis>.csv)",
         ),
         output="OUT/NAME.csv and its sidecar OUT/NAME.json; MLflow experiment 'recordings' when tracking is on",
         positional="csv",

@@ -165,11 +165,16 @@ def metrics(cfg: MetricsConfig) -> RecordingOutcome:
 # -- import --------------------------------------------------------------------------------------
 
 IMPORT_USAGE = ("usage: tcbench import csv=PATH sensor=msra|gyro time=COL[:unit] temperature=COL[:unit] "
-                "output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR")
+                "output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR, or csv=LOG.ulg sensor=gyro out=DIR")
 
 
 def import_stem(cfg: ImportConfig) -> str:
     return cfg.name if cfg.name is not None else Path(cfg.csv).stem
+
+
+def is_ulog(cfg: ImportConfig) -> bool:
+    """True for a PX4 log (``.ulg``): its sensor topic's instances and axes are imported."""
+    return Path(str(cfg.csv)).suffix.lower() == ".ulg"
 
 
 def import_axes(cfg: ImportConfig) -> list[str]:
@@ -193,9 +198,15 @@ def check_import(cfg: ImportConfig) -> None:
     """Every argument of ``tcbench import`` before any work."""
     from tcbench.outputs import overwritten_input
 
-    needed = [k for k in ("csv", "sensor", "time", "temperature", "output", "out") if not getattr(cfg, k)]
+    keys = ("csv", "sensor", "out") if is_ulog(cfg) else ("csv", "sensor", "time", "temperature", "output", "out")
+    needed = [k for k in keys if not getattr(cfg, k)]
     if needed:
         raise CommandError(f"missing {needed[0]}=; {IMPORT_USAGE}")
+    if is_ulog(cfg):
+        file_stem(import_stem(cfg))
+        writable_folder(cfg.out)
+        checked_store(cfg.tracking)
+        return
     stems = [file_stem(import_stem(cfg))] + [file_stem(s, "output") for s in import_stems(cfg)]
     writable_folder(cfg.out)
     targets = [Path(cfg.out) / f"{stem}.{ext}" for stem in stems[1:] for ext in ("csv", "json")]
@@ -213,8 +224,8 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     check_import(cfg)
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
-    recs = {}
-    for stem, axis in zip(import_stems(cfg), import_axes(cfg), strict=True):
+    recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else {}
+    for stem, axis in zip([] if is_ulog(cfg) else import_stems(cfg), import_axes(cfg), strict=False):
         columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, "output": axis}
         if cfg.input:
             columns["input"] = cfg.input
@@ -244,6 +255,40 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     first, *rest = outcomes
     first.also = rest
     return first
+
+
+def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
+    """One recording per instance and axis of the sensor's topic in a PX4 log, named
+    ``NAME-<topic>-<instance>-<axis>``; ``time=``, ``temperature=``, ``output=`` name other fields."""
+    from tcbench.sensors.importer import import_table
+    from tcbench.sensors.recording import RecordingError
+    from tcbench.sensors.ulog import default_axes, default_columns, read_topic
+
+    path = Path(cfg.csv)
+    try:
+        instances = read_topic(path, cfg.sensor)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    axes = import_axes(cfg) or default_axes(cfg.sensor)
+    recs = {}
+    for inst in instances:
+        columns = default_columns(cfg.sensor, list(inst.fields))
+        columns |= {k: v for k, v in (("time_s", cfg.time), ("temperature_c", cfg.temperature),
+                                      ("input", cfg.input)) if v}
+        about = {"file": path.name, "format": "PX4 ULog", "topic": inst.topic, "instance": inst.instance,
+                 "px4_device_id": inst.device_id}
+        for axis in axes:
+            field_name = axis.rsplit(":", 1)[0] if ":" in axis else axis
+            stem = file_stem(f"{import_stem(cfg)}-{inst.topic}-{inst.instance}-{field_name}", "output")
+            try:
+                recs[stem] = import_table(
+                    inst.fields, cfg.sensor, {**columns, "output": axis}, drop=drop,
+                    source=f"{path} ({inst.topic} instance {inst.instance})", about=about,
+                    device_id=cfg.device_id or f"{path.stem}-{inst.topic}-{inst.instance}",
+                    sample_rate_hz=cfg.sample_rate_hz)
+            except RecordingError as exc:
+                raise CommandError(str(exc)) from None
+    return recs
 
 
 # -- shared --------------------------------------------------------------------------------------

@@ -165,14 +165,7 @@ def import_csv(
     """
     path = Path(path)
     name = str(path)
-    if sensor not in SENSORS:
-        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
-    unknown = [k for k in columns if k not in NUMERIC_COLUMNS]
-    if unknown:
-        raise RecordingError(f"unknown schema column {unknown[0]!r} (expected {', '.join(NUMERIC_COLUMNS)})")
-    missing = [k for k in REQUIRED if not columns.get(k)]
-    if missing:
-        raise RecordingError(f"say which column holds {missing[0]} ({', '.join(REQUIRED)} are required)")
+    _check_request(sensor, columns)
     try:
         if path.is_dir():
             raise RecordingError("is a directory, not a CSV file")
@@ -181,15 +174,61 @@ def import_csv(
         delimiter = sniff_delimiter(path)
         header = _header_names(path, delimiter)
         _scan_text(path, header, delimiter)
-        spec = {k: parse_column(k, v, sensor, header) for k, v in columns.items() if v}
-        for flag in drop:
-            if flag not in header:
-                raise RecordingError(f"no column {flag!r} (for drop); the file has: {', '.join(header)}")
-        used = list(dict.fromkeys([c.name for c in spec.values()] + list(drop)))
+        spec, used = _spec(columns, drop, sensor, header)
         twice = [c for c in used if header.count(c) > 1]
         if twice:
             raise RecordingError(f"the header names column {twice[0]!r} more than once")
         raw, empty = _read(path, used, header, delimiter)
+    except RecordingError as err:
+        raise err.located(name) from None
+    return _recording(raw, empty, spec, drop, sensor, name, {"file": path.name, "delimiter": delimiter},
+                      device_id or path.stem, sample_rate_hz)
+
+
+def import_table(table: Mapping[str, np.ndarray], sensor: str, columns: Mapping[str, str], *, source: str,
+                 drop: Sequence[str] = (), device_id: str | None = None, sample_rate_hz: float | None = None,
+                 about: Mapping[str, object] | None = None) -> Recording:
+    """A schema-v1 recording from columns already read (a log's topic): as :func:`import_csv`,
+    ``source`` naming them in errors and ``about`` describing them in the sidecar."""
+    _check_request(sensor, columns)
+    try:
+        spec, used = _spec(columns, drop, sensor, list(table))
+        raw = {c: np.asarray(table[c], dtype=np.float64) for c in used}
+        empty = np.zeros((len(next(iter(raw.values()))), len(used)), dtype=bool)
+    except RecordingError as err:
+        raise err.located(source) from None
+    return _recording(raw, empty, spec, drop, sensor, source, dict(about or {}), device_id or source,
+                      sample_rate_hz)
+
+
+def _check_request(sensor: str, columns: Mapping[str, str]) -> None:
+    if sensor not in SENSORS:
+        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    unknown = [k for k in columns if k not in NUMERIC_COLUMNS]
+    if unknown:
+        raise RecordingError(f"unknown schema column {unknown[0]!r} (expected {', '.join(NUMERIC_COLUMNS)})")
+    missing = [k for k in REQUIRED if not columns.get(k)]
+    if missing:
+        raise RecordingError(f"say which column holds {missing[0]} ({', '.join(REQUIRED)} are required)")
+
+
+def _spec(columns: Mapping[str, str], drop: Sequence[str], sensor: str, header: Sequence[str]
+          ) -> tuple[dict[str, Column], list[str]]:
+    """The parsed column map and the source columns it reads (drop flags included)."""
+    spec = {k: parse_column(k, v, sensor, header) for k, v in columns.items() if v}
+    for flag in drop:
+        if flag not in header:
+            raise RecordingError(f"no column {flag!r} (for drop); the file has: {', '.join(header)}")
+    return spec, list(dict.fromkeys([c.name for c in spec.values()] + list(drop)))
+
+
+def _recording(raw: Mapping[str, np.ndarray], empty: np.ndarray, spec: Mapping[str, Column], drop: Sequence[str],
+               sensor: str, name: str, source: dict[str, object], device_id: str,
+               sample_rate_hz: float | None) -> Recording:
+    """The recording of the columns ``raw`` read from ``name`` (rows to drop, units, segments,
+    every check of the schema), its errors in the source's terms."""
+    used = list(raw)
+    try:
         keep = ~_dropped(raw, drop, empty.shape[0])
         _check_filled(empty, used, keep)
         rows = np.flatnonzero(keep) + 1
@@ -206,7 +245,7 @@ def import_csv(
     seg = segments(t) if clock_ok else np.zeros(t.size, dtype=np.int64)
     starts, stops = bounds(seg)
     extra = {
-        "source": {"file": path.name, "delimiter": delimiter, "columns": {k: c.describe() for k, c in spec.items()},
+        "source": {**source, "columns": {k: c.describe() for k, c in spec.items()},
                    **({"input": "0 (no column given)"} if "input" not in spec else {}),
                    "drop": list(drop), "rows_read": int(keep.size), "rows_dropped": int((~keep).sum())},
         "segments": {"count": int(starts.size), "gap_factor": GAP_FACTOR, "first_rows": (starts + 1).tolist(),
@@ -217,7 +256,7 @@ def import_csv(
         rate = float(sample_rate_hz) if sample_rate_hz is not None else (
             float(f"{within_rate_hz(t, seg):.6g}") if clock_ok else math.nan)
         return make_recording(table["time_s"], table["temperature_c"], table["input"], table["output"],
-                              sensor=sensor, sample_rate_hz=rate, device_id=device_id or path.stem, extra=extra)
+                              sensor=sensor, sample_rate_hz=rate, device_id=device_id, extra=extra)
     except RecordingError as err:
         raise _in_csv(err, name, rows, spec, table, sensor) from None
 

@@ -103,6 +103,8 @@ class ImportKind(RecordingKind):
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
         cfg: ImportConfig = self.config(c)
+        if recordings.is_ulog(cfg):  # its recordings are known once the log is read: NAME-<topic>-...
+            return [Path(cfg.out) / f"{recordings.import_stem(cfg)}-ulog"]
         return [Path(cfg.out) / f"{stem}.csv" for stem in recordings.import_stems(cfg)]
 
     def execute(self, c: dict[str, Any]) -> recordings.RecordingOutcome:

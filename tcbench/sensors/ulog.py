@@ -1,0 +1,73 @@
+"""PX4 ULog files (``.ulg``, read with pyulog) as recordings: the sensor topic of a kind
+(``sensor_gyro`` for a gyro), every instance (one per physical sensor), each axis a recording
+with the topic's own clock and temperature.
+
+A topic instance is a table of fields (``timestamp``, ``timestamp_sample`` in µs since boot,
+``x``, ``y``, ``z``, ``temperature`` in °C, ...); the default column map reads the sample clock,
+the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``), and any field can
+be named instead, with a unit, as for a CSV file (:func:`tcbench.sensors.importer.import_table`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tcbench.sensors.recording import RecordingError
+
+# sensor kind -> its PX4 topic and the unit PX4 logs its axes in (an accelerometer kind's
+# sensor_accel, in m/s^2, joins when tcbench has one)
+TOPICS = {"gyro": ("sensor_gyro", "rad/s")}
+AXES = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class TopicInstance:
+    """One instance of a sensor topic: its fields as float64 arrays, and the ``device_id`` PX4 logged."""
+
+    topic: str
+    instance: int
+    fields: dict[str, np.ndarray]
+    device_id: int | None
+
+
+def default_columns(sensor: str, fields: list[str]) -> dict[str, str]:
+    """The column map of a topic in PX4's units: the sample clock (else the publication clock),
+    the temperature; the axes are :func:`default_axes`."""
+    clock = "timestamp_sample" if "timestamp_sample" in fields else "timestamp"
+    return {"time_s": f"{clock}:us", "temperature_c": "temperature:degC"}
+
+
+def default_axes(sensor: str) -> list[str]:
+    """``x:UNIT``, ``y:UNIT``, ``z:UNIT`` in the unit PX4 logs the sensor's topic in."""
+    unit = TOPICS[sensor][1]
+    return [f"{a}:{unit}" for a in AXES]
+
+
+def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
+    """Every instance of ``sensor``'s topic in the ULog file ``path``, in instance order;
+    :class:`RecordingError` (one line, the file named) when the file cannot be read or holds none."""
+    path = Path(path)
+    if sensor not in TOPICS:
+        raise RecordingError(f"a PX4 log has no topic tcbench reads for sensor {sensor!r} "
+                             f"(it reads: {', '.join(f'{k} from {v[0]}' for k, v in TOPICS.items())})", file=str(path))
+    topic = TOPICS[sensor][0]
+    if not path.is_file():
+        raise RecordingError("no such file" if not path.exists() else "is a directory, not a ULog file", file=str(path))
+    from pyulog import ULog
+
+    try:
+        log = ULog(str(path), [topic])
+    except Exception as exc:  # noqa: BLE001 - pyulog raises many kinds for a file that is not a ULog
+        raise RecordingError(f"cannot read the file as a PX4 ULog ({type(exc).__name__}: {exc})", file=str(path)) from None
+    found = sorted((d for d in log.data_list if d.name == topic), key=lambda d: d.multi_id)
+    if not found:
+        raise RecordingError(f"the log has no {topic} topic", file=str(path))
+    out = []
+    for d in found:
+        ids = d.data.get("device_id")
+        out.append(TopicInstance(topic, int(d.multi_id), {k: np.asarray(v, dtype=np.float64) for k, v in d.data.items()},
+                                 int(ids[0]) if ids is not None and len(ids) else None))
+    return out
