@@ -1,0 +1,101 @@
+"""PX4 thermal calibration: a sensor's offset as the 3rd-order polynomial PX4 ships, fitted to
+a recording and exported as its ``TC_*`` parameters.
+
+PX4's documented compensation (docs.px4.io, "Thermal Calibration and Compensation"): for sensor
+type ``G`` (rate gyro) or ``A`` (accelerometer), instance ``i`` and axis ``a`` (0, 1, 2 = X, Y,
+Z in the board frame), the temperature is held to the calibrated range ``[TC_<t><i>_TMIN,
+TC_<t><i>_TMAX]``, ``dT = T - TC_<t><i>_TREF``, the offset is ``X0 + X1 dT + X2 dT^2 + X3 dT^3``
+with ``Xn = TC_<t><i>_X<n>_<a>``, and it is subtracted from the reading. PX4 keeps the values as
+32-bit floats, in its units: rad/s for a gyro, m/s^2 for an accelerometer. ``TC_<t><i>_ID`` names
+the sensor (its ``device_id``); ``TC_<t>_ENABLE`` switches the compensation on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ORDER = 3
+TYPES = {"gyro": ("G", "rad/s"), "accel": ("A", "m/s^2")}
+
+
+@dataclass(frozen=True)
+class OffsetPolynomial:
+    """One axis's offset: ``x[n]`` the coefficient of ``dT**n`` (in the sensor unit), ``dT = T -
+    tref_c`` with ``T`` held to ``[tmin_c, tmax_c]``."""
+
+    x: tuple[float, float, float, float]
+    tref_c: float
+    tmin_c: float
+    tmax_c: float
+
+    def offset(self, temp_c: np.ndarray) -> np.ndarray:
+        """The offset at ``temp_c`` (°C) by PX4's formula."""
+        dt = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c) - self.tref_c
+        return self.x[0] + dt * (self.x[1] + dt * (self.x[2] + dt * self.x[3]))
+
+
+def fit_offset(temp_c: np.ndarray, reading: np.ndarray, tref_c: float | None = None) -> OffsetPolynomial:
+    """The least-squares cubic offset of ``reading`` over ``temp_c``; ``tref_c`` defaults to the
+    middle of the temperatures seen, ``tmin_c``/``tmax_c`` are their extremes (beyond them PX4
+    holds the offset at the edge instead of extrapolating a cubic)."""
+    t = np.asarray(temp_c, dtype=np.float64)
+    y = np.asarray(reading, dtype=np.float64)
+    if t.shape != y.shape or t.ndim != 1 or t.size <= ORDER:
+        raise ValueError(f"need matching 1-D temperature and reading arrays of more than {ORDER} samples")
+    if not (np.isfinite(t).all() and np.isfinite(y).all()):
+        raise ValueError("temperature and reading must be finite")
+    tmin, tmax = float(t.min()), float(t.max())
+    if tmax - tmin <= 0.0:
+        raise ValueError("the temperature does not vary: no offset polynomial can be fitted")
+    tref = 0.5 * (tmin + tmax) if tref_c is None else float(tref_c)
+    coef = np.polynomial.polynomial.polyfit(t - tref, y, ORDER)
+    return OffsetPolynomial(tuple(float(c) for c in coef), tref, tmin, tmax)  # type: ignore[arg-type]
+
+
+def px4_parameters(axes: Sequence[OffsetPolynomial], sensor: str = "gyro", instance: int = 0,
+                   device_id: int = 0, to_px4_unit: float = 1.0) -> dict[str, float | int]:
+    """The ``TC_*`` parameters of up to three axes (X, Y, Z) of one sensor instance, the
+    coefficients multiplied by ``to_px4_unit`` (e.g. pi/180 from deg/s to PX4's rad/s) and
+    rounded to 32-bit floats as PX4 stores them. The axes share one reference and range: the
+    first axis's (fit them on the same record)."""
+    if sensor not in TYPES:
+        raise ValueError(f"PX4 thermal calibration covers {', '.join(TYPES)}, not {sensor!r}")
+    if not 1 <= len(axes) <= 3 or not 0 <= instance <= 3:
+        raise ValueError("one to three axes, instance 0..3")
+    if any((a.tref_c, a.tmin_c, a.tmax_c) != (axes[0].tref_c, axes[0].tmin_c, axes[0].tmax_c) for a in axes):
+        raise ValueError("the axes of one instance share TREF, TMIN and TMAX: fit them on the same record")
+    t = TYPES[sensor][0]
+    head = f"TC_{t}{instance}"
+    params: dict[str, float | int] = {f"{head}_ID": int(device_id)}
+    for a, poly in enumerate(axes):
+        for n, c in enumerate(poly.x):
+            params[f"{head}_X{n}_{a}"] = float(np.float32(c * to_px4_unit))
+    params |= {f"{head}_TREF": float(np.float32(axes[0].tref_c)), f"{head}_TMIN": float(np.float32(axes[0].tmin_c)),
+               f"{head}_TMAX": float(np.float32(axes[0].tmax_c))}
+    return params
+
+
+def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: str = "gyro", instance: int = 0,
+               axis: int = 0) -> np.ndarray:
+    """The offset PX4 subtracts, in PX4's unit, evaluated from the parameters alone (32-bit, as
+    on the flight controller)."""
+    head = f"TC_{TYPES[sensor][0]}{instance}"
+    f32 = np.float32
+    tmin, tmax, tref = (f32(params[f"{head}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
+    x = [f32(params[f"{head}_X{n}_{axis}"]) for n in range(ORDER + 1)]
+    dt = np.clip(np.asarray(temp_c, dtype=f32), tmin, tmax) - tref
+    return x[0] + x[1] * dt + x[2] * dt ** 2 + x[3] * dt ** 3
+
+
+def write_parameters(params: Mapping[str, float | int], path: str | Path, sensor: str = "gyro") -> Path:
+    """``params`` as a PX4 console script (``param set NAME VALUE`` per line, then the enable
+    switch), to paste into the NuttX shell or run from the SD card."""
+    lines = [f"param set {k} {v:d}" if isinstance(v, int) else f"param set {k} {v:.9g}" for k, v in params.items()]
+    lines.append(f"param set TC_{TYPES[sensor][0]}_ENABLE 1")
+    path = Path(path)
+    path.write_text("\n".join(lines) + "\n")
+    return path
