@@ -1,0 +1,98 @@
+"""Calibration on a user's own record: fit an offset model on some temperature branches of a
+static record (the sensor at rest, its true input known: 0 for a gyro, or the ``input`` column)
+and score it on the others.
+
+Methods, each a function of what a flight controller can read (the thermometer and time):
+
+- ``raw``: no correction (the output minus the true input).
+- ``poly3``: the cubic offset in the temperature as PX4 ships it (:mod:`tcbench.compensation.px4`:
+  held at the edges of the fitted range).
+- ``poly3_rate``: the cubic plus a term in the temperature rate (``dT/dt`` over a trailing
+  window, :func:`tcbench.compensation.features.temperature_rate_c_per_s`): the first-order
+  expansion of an offset seen through a thermal lag, which the heating and cooling branches
+  of a cycle tell apart.
+
+The scores of a branch: the RMS of the residual (output minus true input minus the model's
+offset), and the RMS of its running mean over ``drift_window_s`` (the drift, with the white
+noise mostly averaged out), in the recording's unit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from tcbench.compensation.features import temperature_rate_c_per_s
+from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
+
+METHODS = ("raw", "poly3", "poly3_rate")
+RATE_WINDOW_S = 120.0
+
+
+@dataclass(frozen=True)
+class Record:
+    """The part of a static record a calibration reads: time (s), thermometer (°C), the
+    output and the true input (same unit)."""
+
+    t_s: np.ndarray
+    temp_c: np.ndarray
+    output: np.ndarray
+    truth: np.ndarray
+
+    def part(self, start: int, stop: int) -> Record:
+        return Record(self.t_s[start:stop], self.temp_c[start:stop], self.output[start:stop], self.truth[start:stop])
+
+
+@dataclass(frozen=True)
+class OffsetModel:
+    """A fitted offset: the cubic in the temperature and, for ``poly3_rate``, a rate coefficient
+    (unit per °C/s) on the rate the trailing window reads."""
+
+    method: str
+    cubic: OffsetPolynomial | None = None
+    rate_coef: float = 0.0
+
+    def offset(self, rec: Record, rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+        if self.cubic is None:
+            return np.zeros_like(rec.output)
+        out = self.cubic.offset(rec.temp_c)
+        if self.rate_coef:
+            rate = temperature_rate_c_per_s(rec.t_s, rec.temp_c, RATE_WINDOW_S) if rate_c_per_s is None \
+                else rate_c_per_s
+            out = out + self.rate_coef * rate
+        return out
+
+
+def fit(method: str, train: Sequence[Record]) -> OffsetModel:
+    """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``."""
+    if method not in METHODS:
+        raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
+    if method == "raw":
+        return OffsetModel("raw")
+    temp = np.concatenate([r.temp_c for r in train])
+    target = np.concatenate([r.output - r.truth for r in train])
+    cubic = fit_offset(temp, target)
+    if method == "poly3":
+        return OffsetModel("poly3", cubic)
+    rate = np.concatenate([temperature_rate_c_per_s(r.t_s, r.temp_c, RATE_WINDOW_S) for r in train])
+    dt = np.clip(temp, cubic.tmin_c, cubic.tmax_c) - cubic.tref_c
+    design = np.column_stack([dt ** n for n in range(4)] + [rate])
+    coef, *_ = np.linalg.lstsq(design, target, rcond=None)
+    both = OffsetPolynomial(tuple(float(c) for c in coef[:4]), cubic.tref_c, cubic.tmin_c, cubic.tmax_c)  # type: ignore[arg-type]
+    return OffsetModel("poly3_rate", both, float(coef[4]))
+
+
+def residual(model: OffsetModel, rec: Record) -> np.ndarray:
+    """Output minus true input minus the model's offset."""
+    return rec.output - rec.truth - model.offset(rec)
+
+
+def scores(res: np.ndarray, t_s: np.ndarray, drift_window_s: float = 60.0) -> dict[str, float]:
+    """RMS of a residual, and of its centred running mean over ``drift_window_s``."""
+    dt = float(np.median(np.diff(t_s))) if t_s.size > 1 else 1.0
+    width = max(1, int(round(drift_window_s / dt)))
+    kernel = np.ones(width) / width
+    smooth = np.convolve(res, kernel, mode="valid") if res.size >= width else np.array([res.mean()])
+    return {"rms": float(np.sqrt(np.mean(res ** 2))), "drift_rms": float(np.sqrt(np.mean(smooth ** 2)))}

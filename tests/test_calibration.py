@@ -1,0 +1,48 @@
+"""Calibration on the user's own record: offset models fitted on the first cooling branch of the
+real tofupilot chamber cycle and scored on its heating and second cooling branches."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tcbench.compensation.calibration import METHODS, Record, fit, residual, scores
+from tcbench.diagnose.real_records import tofupilot_gyro
+from tcbench.signal.branches import temperature_branches
+
+
+@pytest.fixture(scope="module")
+def axes() -> dict[str, tuple[Record, list[slice]]]:
+    out = {}
+    for a in "xyz":
+        r = tofupilot_gyro(a)
+        rec = Record(r.time_s, r.temperature_c, r.output, r.input)
+        out[a] = (rec, [slice(b.start, b.stop) for b in temperature_branches(r.time_s, r.temperature_c)])
+    return out
+
+
+def test_the_cubic_from_one_branch_cuts_the_drift_of_the_others(axes: dict[str, tuple[Record, list[slice]]]) -> None:
+    for a, (rec, branches) in axes.items():
+        train = [rec.part(branches[0].start, branches[0].stop)]
+        models = {m: fit(m, train) for m in METHODS}
+        res = {m: residual(model, rec) for m, model in models.items()}
+        np.testing.assert_array_equal(res["raw"], rec.output - rec.truth)
+        for held_out in branches[1:]:
+            raw = scores(res["raw"][held_out], rec.t_s[held_out])["drift_rms"]
+            cubic = scores(res["poly3"][held_out], rec.t_s[held_out])["drift_rms"]
+            assert cubic < 0.8 * raw, (a, held_out)
+        fitted = branches[0]
+        # nested least squares: the rate term cannot fit the training branch worse
+        assert scores(res["poly3_rate"][fitted], rec.t_s[fitted])["rms"] <= \
+            scores(res["poly3"][fitted], rec.t_s[fitted])["rms"] + 1e-12
+
+
+def test_scores_and_bad_methods() -> None:
+    t = np.arange(600.0)
+    noise = np.random.default_rng(0).normal(0.0, 1.0, t.size)
+    s = scores(noise + 0.5, t, drift_window_s=60.0)
+    assert s["rms"] == pytest.approx(np.sqrt(1.0 + 0.25), rel=0.1)
+    assert s["drift_rms"] == pytest.approx(0.5, abs=0.15)  # the noise averaged out, the offset kept
+    rec = Record(t, 20.0 + 0.01 * t, noise, np.zeros_like(t))
+    with pytest.raises(ValueError, match="unknown calibration method 'elm'"):
+        fit("elm", [rec])
