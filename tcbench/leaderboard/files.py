@@ -1,6 +1,6 @@
 """What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard.optimisation`) and compensation
-(:mod:`tcbench.leaderboard.compensation`): the MLflow runs of a kind, one run per job, markdown tables
-and the board files. A leaf module (numpy and pandas only)."""
+(:mod:`tcbench.leaderboard.compensation`): the MLflow runs of a kind, one run per job and the board
+files (markdown tables: :mod:`tcbench.tables`). A leaf module (pandas only)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 
@@ -42,24 +41,6 @@ def one_run_per_job(runs: pd.DataFrame, keys: tuple[str, ...] = ("task", "method
     order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
     keys = list(keys)
     return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
-
-
-def _fmt(value: object) -> str:
-    if isinstance(value, (float, np.floating)):
-        if np.isinf(value):
-            return "∞"
-        if np.isnan(value):
-            return "–"
-        return f"{value:.3g}"
-    return str(value)
-
-
-def markdown_table(table: pd.DataFrame) -> str:
-    """A pandas table as a GitHub markdown table."""
-    head = "| " + " | ".join(table.columns) + " |"
-    rule = "|" + "|".join("---" for _ in table.columns) + "|"
-    body = ["| " + " | ".join(_fmt(v) for v in row) + " |" for row in table.itertuples(index=False)]
-    return "\n".join([head, rule, *body])
 
 
 def failed_lines(failed: pd.DataFrame) -> list[str]:

@@ -25,11 +25,11 @@ import pandas as pd
 
 from tcbench.leaderboard.files import (
     failed_lines,
-    markdown_table,
     one_run_per_job,
     search_runs,
     write_board_files,
 )
+from tcbench.tables import markdown_table
 from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
 COLUMNS = [
