@@ -151,6 +151,32 @@ SPECS: dict[str, CommandHelp] = {
                "(effects found, held-out RMSEs, the report) when tracking is on",
         required=("recording",),
     ),
+    "calibrate": CommandHelp(
+        name="calibrate",
+        summary="Calibrate a static recording on its own temperature branches: each offset model (raw, PX4's "
+                "cubic in the thermometer, the cubic with a temperature-rate term) fitted on some branches and "
+                "scored on every branch, with plots and, for a gyro, PX4's TC_G* parameters.",
+        schema=_schema("calibrate"),
+        params={
+            "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
+            "out": "output folder",
+            "train_branches": "the temperature branches to fit on, numbered from 0 in time order",
+            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate)",
+            "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
+            "drift_window_s": "the drift score's running mean (s)",
+            "px4_instance": "the gyro instance the TC_G parameters are for (0..3)",
+            **TRACKING,
+        },
+        examples=(
+            "tcbench calibrate recording=recordings/tofupilot/imu-imu.gyro.y.csv out=cal/gyro-y",
+            "tcbench calibrate recording=run.csv 'train_branches=[0,1]' 'methods=[poly3]'",
+            "tcbench calibrate -m recording=a.csv,b.csv 'out=cal/${stem:recording}'",
+        ),
+        output="OUT/calibration.md and .csv (one row per method and branch: drift and RMS), OUT/residuals.png, "
+               "OUT/px4_tc_params.txt for a gyro; MLflow experiment 'calibrations' when tracking is on",
+        positional="recording",
+        required=("recording",),
+    ),
     "leaderboard": CommandHelp(
         name="leaderboard",
         summary="Aggregate the finished runs of MLflow experiments into leaderboards (optimisation and "

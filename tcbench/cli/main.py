@@ -25,6 +25,7 @@ commands:
   import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL[:unit] ... out=DIR)
   metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
   diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
+  calibrate    fit offset models on some temperature branches of a static recording, score them on the others
 
 Every command is a Hydra app: `tcbench <command> --help` (or -h) shows its parameters, their
 defaults, examples and where its output goes; `--cfg job` prints the config a command would run
@@ -472,9 +473,14 @@ def cmd_diagnose(argv: list[str]) -> int:
     return _app_command("diagnose", argv)
 
 
+def cmd_calibrate(argv: list[str]) -> int:
+    return _app_command("calibrate", argv)
+
+
 COMMANDS = {
     "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
     "simulate": cmd_simulate, "import": cmd_import, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
+    "calibrate": cmd_calibrate,
 }
 
 

@@ -82,6 +82,23 @@ class DiagnoseConfig:
 
 
 @dataclass
+class CalibrateConfig:
+    """``tcbench calibrate``: offset models of a static recording fitted on some of its
+    temperature branches (``train_branches``, numbered from 0 in time order) and scored on the
+    others."""
+
+    kind: str = "calibrate"
+    recording: str = ""
+    out: str = "calibration"
+    train_branches: list[int] = field(default_factory=lambda: [0])
+    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate"])
+    min_swing_c: float = 5.0
+    drift_window_s: float = 60.0
+    px4_instance: int = 0
+    tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
+
+
+@dataclass
 class LeaderboardConfig:
     """``tcbench leaderboard``: the boards of the runs in ``experiments`` (a name, or a list
     ``[a,b]``), optionally of one ``sweep``, written into ``out``. It reads the store
@@ -130,7 +147,7 @@ class QuickstartConfig:
 
 
 SCHEMAS: dict[str, type] = {"simulate": SimulateConfig, "metrics": MetricsConfig, "import": ImportConfig,
-                            "diagnose": DiagnoseConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
+                            "diagnose": DiagnoseConfig, "calibrate": CalibrateConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
                             "quickstart": QuickstartConfig}
 
 

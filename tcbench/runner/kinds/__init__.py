@@ -27,6 +27,7 @@ KIND_MODULES = {
     "import": "tcbench.runner.kinds.recordings",
     "diagnose": "tcbench.runner.kinds.diagnosis",
     "leaderboard": "tcbench.runner.kinds.leaderboards",
+    "calibrate": "tcbench.runner.kinds.calibration",
 }
 
 
