@@ -28,8 +28,10 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import json
 import logging
 import os
+import re
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -101,19 +103,19 @@ class GroupedLauncher(Launcher):
         sweep_dir.mkdir(parents=True, exist_ok=True)
         sweep_id = hashlib.sha256(str(sweep_dir.resolve()).encode()).hexdigest()[:12]
         jobs: list[tuple[int, list[str], dict[str, Any], str]] = []
+        loader = self.hydra_context.config_loader
         for indices in groups(job_overrides).values():
-            composed = self.hydra_context.config_loader.load_sweep_config(self.config, list(job_overrides[indices[0]]))
+            composed = loader.load_sweep_config(self.config, list(job_overrides[indices[0]]))
+            per_job = interpolates_seed(composed)  # e.g. out=cal/${seed}: each seed its own resolution
             hydra_cfg = composed.hydra
-            task = {key: _resolved(composed, key) for key in composed if key != "hydra"}
-            track = task.setdefault("tracking", {})
-            if not track.get("sweep_id"):
-                track["sweep_id"] = sweep_id
-            if track.get("plots") is None:  # one convergence PNG per run of an optimisation sweep is
-                track["plots"] = plots_default(task)  # per kind: a PNG per optimisation run is noise
+            task = _task_config(composed, sweep_id)
             for i in indices:
                 num = initial_job_idx + i
                 overrides = list(job_overrides[i])
                 seed = split_seed(overrides)[1]
+                if per_job and i != indices[0]:
+                    composed = loader.load_sweep_config(self.config, overrides)
+                    hydra_cfg, task = composed.hydra, _task_config(composed, sweep_id)
                 cfg = copy.deepcopy(task)
                 if seed is not None:
                     cfg["seed"] = int(seed)
@@ -160,6 +162,28 @@ class Progress:
         left = elapsed / self.done * (self.total - self.done)
         log.info("sweep: %d/%d jobs done (%d failed), %.0f s so far, about %.0f s left",
                  self.done, self.total, self.failed, elapsed, left)
+
+
+def interpolates_seed(cfg: DictConfig) -> bool:
+    """True when a value of the job's config (``hydra`` aside) interpolates ``seed``: such a
+    config is resolved per job, not once for all the seeds of a group."""
+    plain = OmegaConf.to_container(cfg, resolve=False)
+    plain.pop("hydra", None)  # type: ignore[union-attr]
+    return bool(_SEED_INTERPOLATION.search(json.dumps(plain, default=str)))
+
+
+_SEED_INTERPOLATION = re.compile(r"\$\{[^}]*\bseed\b")
+
+
+def _task_config(composed: DictConfig, sweep_id: str) -> dict[str, Any]:
+    """The job's plain, resolved config (``hydra`` aside) with the sweep's tracking defaults."""
+    task = {key: _resolved(composed, key) for key in composed if key != "hydra"}
+    track = task.setdefault("tracking", {})
+    if not track.get("sweep_id"):
+        track["sweep_id"] = sweep_id
+    if track.get("plots") is None:  # per kind: a convergence PNG per optimisation run is noise
+        track["plots"] = plots_default(task)
+    return task
 
 
 def _resolved(cfg: DictConfig, key: str) -> Any:

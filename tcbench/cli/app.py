@@ -186,8 +186,15 @@ def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
         last: dict[str, Any] = {}
         written: dict[Path, int] = {}
         for combo in combos:
-            cfg = compose_job(fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)], config_name)
-            last = check_job(cfg, written)
+            chosen = fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)]
+            cfg = compose_job(chosen, config_name)
+            if not seeds:
+                last = check_job(cfg, written)
+                continue
+            last = check_job(cfg)
+            if kind_of(last).outputs(last):  # a kind that writes files: each seed's own (out=x/${seed})
+                for s in seeds:
+                    check_job(compose_job([*chosen, f"seed={s}"], config_name), written)
         for s in seeds or []:
             if not s.lstrip("-").isdigit() or int(s) < 0:
                 raise ConfigError(f"seed must be a non-negative integer, got {s!r}")

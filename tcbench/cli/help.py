@@ -154,14 +154,16 @@ SPECS: dict[str, CommandHelp] = {
     "calibrate": CommandHelp(
         name="calibrate",
         summary="Calibrate a static recording on its own temperature branches: each offset model (raw, PX4's "
-                "cubic in the thermometer, the cubic with a temperature-rate term) fitted on some branches and "
+                "cubic in the thermometer, the cubic with a temperature-rate term, BP and Elman networks) fitted on some branches and "
                 "scored on every branch, with plots and, for a gyro, PX4's TC_G* parameters.",
         schema=_schema("calibrate"),
         params={
             "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
             "out": "output folder",
             "train_branches": "the temperature branches to fit on, numbered from 0 in time order",
-            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate)",
+            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp, elman "
+                       "(the seed papers' networks on [T, dT/dt])",
+            "seed": "the networks' initial weights",
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
             "px4_instance": "the gyro instance the TC_G parameters are for (0..3)",

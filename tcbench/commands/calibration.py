@@ -43,6 +43,8 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
         raise CommandError("methods: give at least one (known: " + ", ".join(METHODS) + ")")
     if not (cfg.min_swing_c > 0 and cfg.drift_window_s > 0):
         raise CommandError("min_swing_c and drift_window_s must be > 0")
+    if cfg.seed < 0:
+        raise CommandError(f"seed must be a non-negative integer, got {cfg.seed}")
     if not 0 <= cfg.px4_instance <= 3:
         raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
     writable_folder(cfg.out)
@@ -73,7 +75,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     whole = Record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(branches[k].start, branches[k].stop) for k in cfg.train_branches]
-    models = {m: fit(m, train) for m in dict.fromkeys(cfg.methods)}
+    models = {m: fit(m, train, cfg.seed) for m in dict.fromkeys(cfg.methods)}
     residuals = {m: residual(model, whole) for m, model in models.items()}
     rows = []
     for m in models:

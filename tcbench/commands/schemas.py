@@ -91,7 +91,8 @@ class CalibrateConfig:
     recording: str = ""
     out: str = "calibration"
     train_branches: list[int] = field(default_factory=lambda: [0])
-    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate"])
+    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman"])
+    seed: int = 0
     min_swing_c: float = 5.0
     drift_window_s: float = 60.0
     px4_instance: int = 0

@@ -11,6 +11,8 @@ Methods, each a function of what a flight controller can read (the thermometer a
   window, :func:`tcbench.compensation.features.temperature_rate_c_per_s`): the first-order
   expansion of an offset seen through a thermal lag, which the heating and cooling branches
   of a cycle tell apart.
+- ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`, their defaults) on
+  ``[T, dT/dt]``, trained from the run's seed.
 
 The scores of a branch: the RMS of the residual (output minus true input minus the model's
 offset), and the RMS of its running mean over ``drift_window_s`` (the drift, with the white
@@ -21,13 +23,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 
-METHODS = ("raw", "poly3", "poly3_rate")
+METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman")
+LEARNERS = ("bp", "elman")
 RATE_WINDOW_S = 120.0
 
 
@@ -53,8 +57,13 @@ class OffsetModel:
     method: str
     cubic: OffsetPolynomial | None = None
     rate_coef: float = 0.0
+    learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
 
     def offset(self, rec: Record, rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+        if self.learner is not None:
+            rate = temperature_rate_c_per_s(rec.t_s, rec.temp_c, RATE_WINDOW_S) if rate_c_per_s is None \
+                else rate_c_per_s
+            return np.asarray(self.learner.predict(np.column_stack([rec.temp_c, rate])), dtype=np.float64).reshape(-1)
         if self.cubic is None:
             return np.zeros_like(rec.output)
         out = self.cubic.offset(rec.temp_c)
@@ -65,14 +74,22 @@ class OffsetModel:
         return out
 
 
-def fit(method: str, train: Sequence[Record]) -> OffsetModel:
-    """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``."""
+def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
+    """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``; a
+    network's initial weights drawn from ``seed``."""
     if method not in METHODS:
         raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
     if method == "raw":
         return OffsetModel("raw")
     temp = np.concatenate([r.temp_c for r in train])
     target = np.concatenate([r.output - r.truth for r in train])
+    if method in LEARNERS:
+        from tcbench.learners import registry
+
+        rate = np.concatenate([temperature_rate_c_per_s(r.t_s, r.temp_c, RATE_WINDOW_S) for r in train])
+        learner = registry.create(method, 2, None, np.random.default_rng(seed))
+        learner.fit(np.column_stack([temp, rate]), target)
+        return OffsetModel(method, learner=learner)
     cubic = fit_offset(temp, target)
     if method == "poly3":
         return OffsetModel("poly3", cubic)
