@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tcbench.compensation.calibration import METHODS, Record, fit, residual, scores
+from tcbench.compensation.calibration import METHODS, Record, fit, record, residual, scores
 from tcbench.diagnose.real_records import tofupilot_gyro
 from tcbench.signal.branches import temperature_branches
 
@@ -16,7 +16,7 @@ def axes() -> dict[str, tuple[Record, list[slice]]]:
     out = {}
     for a in "xyz":
         r = tofupilot_gyro(a)
-        rec = Record(r.time_s, r.temperature_c, r.output, r.input)
+        rec = record(r.time_s, r.temperature_c, r.output, r.input)
         out[a] = (rec, [slice(b.start, b.stop) for b in temperature_branches(r.time_s, r.temperature_c)])
     return out
 
@@ -43,6 +43,6 @@ def test_scores_and_bad_methods() -> None:
     s = scores(noise + 0.5, t, drift_window_s=60.0)
     assert s["rms"] == pytest.approx(np.sqrt(1.0 + 0.25), rel=0.1)
     assert s["drift_rms"] == pytest.approx(0.5, abs=0.15)  # the noise averaged out, the offset kept
-    rec = Record(t, 20.0 + 0.01 * t, noise, np.zeros_like(t))
+    rec = record(t, 20.0 + 0.01 * t, noise, np.zeros_like(t))
     with pytest.raises(ValueError, match="unknown calibration method 'elm'"):
         fit("elm", [rec])

@@ -7,6 +7,7 @@ from __future__ import annotations
 import itertools
 import logging
 import os
+import re
 from pathlib import Path
 from dataclasses import dataclass
 from typing import Any
@@ -57,6 +58,24 @@ class Plan:
     tracking_uri: str | None
     experiment: str
     sweep_id: str
+
+
+def hydra_string(value: str) -> str:
+    """``value`` as one quoted string of Hydra's override grammar (backslashes are doubled only
+    where they precede a quote or the closing quote, as the grammar reads them)."""
+    return "'" + re.sub(r"(\\*)('|$)", lambda m: m.group(1) * 2 + ("\\'" if m.group(2) else ""), value) + "'"
+
+
+def claim_outputs(paths: list[Path], written: dict[Path, int], job: int) -> None:
+    """Record that job ``job`` (0-based) writes ``paths``; ConfigError when an earlier job of the
+    sweep writes one of them."""
+    for path in paths:
+        key = Path(os.path.abspath(path))
+        if key in written:
+            raise ConfigError(f"jobs {written[key] + 1} and {job + 1} of the sweep would both write "
+                              f"{path}; give each its own out=, named after what the sweep varies (e.g. "
+                              "'out=results/${stem:recording}', 'out=lb/${experiments}', 'out=cal/${seed}')")
+        written[key] = job
 
 
 def _known_options(group: str) -> list[str]:
@@ -124,13 +143,7 @@ def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None 
     kind = kind_of(c)
     kind.plan_check(kind.prepare(c))
     if written is not None:
-        for path in kind.outputs(c):
-            key = Path(os.path.abspath(path))
-            if key in written:
-                raise ConfigError(f"jobs {written[key] + 1} and {len(written) + 1} of the sweep would both write "
-                                  f"{path}; give each its own out=, named after what the sweep varies (e.g. "
-                                  "'out=results/${stem:recording}', 'out=lb/${experiments}')")
-            written[key] = len(written)
+        claim_outputs(kind.outputs(c), written, len(set(written.values())))
     return c
 
 

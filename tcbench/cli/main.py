@@ -5,10 +5,10 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import re
 import sys
 import uuid
 from collections.abc import Iterator
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -73,8 +73,9 @@ def _hydra_value(arg: str) -> str:
             return arg
     except HydraException:
         pass
-    quoted = re.sub(r"(\\*)('|$)", lambda m: m.group(1) * 2 + ("\\'" if m.group(2) else ""), value)
-    return f"{key}='{quoted}'"
+    from tcbench.cli.app import hydra_string
+
+    return f"{key}={hydra_string(value)}"
 
 
 def _open_key(arg: str, command: str) -> str:
@@ -316,21 +317,16 @@ def cmd_run(args: list[str]) -> int:
 def _in_turn(command: str, args: list[str]) -> int:
     """A ``-m`` sweep of a command of :data:`IN_TURN`: every job checked, then each run here in
     turn; the worst exit code."""
-    from tcbench.cli.app import expand
+    from tcbench.cli.app import claim_outputs, expand
     from tcbench.runner.config import ConfigError
 
     check, work = IN_TURN[command]
     try:
         jobs = expand(["-m", *args], command)
-        outs: dict[str, int] = {}
+        written: dict[Path, int] = {}
         for i, (_, c) in enumerate(jobs):
             check(c)
-            if "out" in c:
-                key = os.path.abspath(str(c["out"]))
-                if key in outs:
-                    raise ConfigError(f"jobs {outs[key] + 1} and {i + 1} of the sweep would both write {c['out']}; "
-                                      "give each its own out= (e.g. 'out=qs/${diagnose_effect}')")
-                outs[key] = i
+            claim_outputs([Path(str(c["out"]))] if "out" in c else [], written, i)
     except ConfigError as exc:
         raise UserError(str(exc)) from None
     status = 0
@@ -410,11 +406,6 @@ IN_TURN = {"list": (_check_list, _list), "quickstart": (_check_quickstart, _quic
 LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--out": "out", "--tracking-uri": "tracking.uri"}
 
 
-def _hydra_string(value: str) -> str:
-    """``value`` as one quoted string of Hydra's override grammar."""
-    return "'" + value.replace("\\", "\\\\").replace("'", "\\'") + "'"
-
-
 def cmd_leaderboard(argv: list[str]) -> int:
     """``tcbench leaderboard``: its key=value (``conf/leaderboard.yaml``), or the flags
     ``--experiment`` (repeatable), ``--sweep``, ``--out``, ``--tracking-uri`` and ``--ecdf``."""
@@ -445,7 +436,9 @@ def cmd_leaderboard(argv: list[str]) -> int:
     if len(experiments) == 1:
         args.append(f"experiments={experiments[0]}")
     elif experiments:
-        args.append(f"experiments=[{','.join(_hydra_string(e) for e in experiments)}]")
+        from tcbench.cli.app import hydra_string
+
+        args.append(f"experiments=[{','.join(hydra_string(e) for e in experiments)}]")
     return _app_command("leaderboard", args)
 
 

@@ -21,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from tcbench.cli.app import hydra_string
 from tcbench.commands.schemas import QuickstartConfig
 from tcbench.errors import ConfigError
 
@@ -40,11 +41,6 @@ from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
   python experiments/diagnose-concealed/run.py --workers 2   every hidden effect and controls, 80 recordings
   tcbench run -m experiment=paper_fa_ifa   FA against IFA on the paper's benchmark functions
   tcbench --help                           every command; tcbench <command> --help for its parameters"""
-
-
-def _quoted(value: str) -> str:
-    """``value`` as one literal string of Hydra's override grammar."""
-    return "'" + str(value).replace("\\", "\\\\").replace("'", "\\'") + "'"
 
 
 def _rule(title: str) -> str:
@@ -100,8 +96,8 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     started = time.monotonic()
     sweep = cfg.tracking.sweep_id or uuid.uuid4().hex[:12]
     out = Path(cfg.out)
-    tracked = [f"tracking.sweep_id={sweep}", f"tracking.experiment={_quoted(cfg.tracking.experiment)}",
-               *([f"tracking.uri={_quoted(cfg.tracking.uri)}"] if cfg.tracking.uri else [])]
+    tracked = [f"tracking.sweep_id={sweep}", f"tracking.experiment={hydra_string(cfg.tracking.experiment)}",
+               *([f"tracking.uri={hydra_string(cfg.tracking.uri)}"] if cfg.tracking.uri else [])]
     print(HEADER)
 
     print(_rule("1. Compensating a sensor: MSRA zero-bias stability (seed 000 §3, Table 1)"))

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.commands.errors import CommandError, cannot_write, checked_store, writable_folder
+from tcbench.commands.errors import CommandError, cannot_write, checked_store, read_recording_arg, writable_folder
 from tcbench.commands.schemas import CalibrateConfig
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
@@ -31,8 +31,6 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
     """Every argument before any work: the recording (read and validated), its branches and the
     training ones among them, the methods."""
     from tcbench.compensation.calibration import METHODS
-    from tcbench.sensors.recording import read_recording
-    from tcbench.sensors.recording_schema import RecordingError
     from tcbench.signal.branches import temperature_branches
 
     if not cfg.recording:
@@ -49,12 +47,7 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
         raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    try:
-        rec = read_recording(cfg.recording)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except OSError as exc:
-        raise CommandError(f"{cfg.recording}: cannot read the file ({exc.strerror or exc})") from None
+    rec = read_recording_arg(cfg.recording)
     branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
     bad = [k for k in cfg.train_branches if not 0 <= k < len(branches)]
     if bad or not cfg.train_branches:
@@ -68,12 +61,12 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     """Fit, score and write; print the board."""
     import pandas as pd
 
-    from tcbench.compensation.calibration import Record, fit, residual, scores
+    from tcbench.compensation.calibration import fit, record, residual, scores
     from tcbench.tables import markdown_table
 
     rec, branches = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
-    whole = Record(rec.time_s, rec.temperature_c, rec.output, rec.input)
+    whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(branches[k].start, branches[k].stop) for k in cfg.train_branches]
     models = {m: fit(m, train, cfg.seed) for m in dict.fromkeys(cfg.methods)}
     residuals = {m: residual(model, whole) for m, model in models.items()}

@@ -10,7 +10,14 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.commands.schemas import DiagnoseConfig
-from tcbench.commands.errors import CommandError, cannot_write, checked_store, overwrite_error, writable_folder
+from tcbench.commands.errors import (
+    CommandError,
+    cannot_write,
+    checked_store,
+    overwrite_error,
+    read_recording_arg,
+    writable_folder,
+)
 
 log = logging.getLogger(__name__)
 
@@ -27,8 +34,6 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     """Every argument before any work: the recording (read and validated), its sensor and the
     effects the model file declares already modelled."""
     from tcbench.diagnose.model_file import ModelFileError, read_model
-    from tcbench.sensors.recording import read_recording
-    from tcbench.sensors.recording_schema import RecordingError
 
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
@@ -36,12 +41,7 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
         raise CommandError(f"sensor must be msra or gyro, got {cfg.sensor!r}")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    try:
-        rec = read_recording(cfg.recording)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except OSError as exc:
-        raise CommandError(f"{cfg.recording}: cannot read the file ({exc.strerror or exc})") from None
+    rec = read_recording_arg(cfg.recording)
     sensor = cfg.sensor or rec.meta.sensor
     if sensor is None:
         raise CommandError(f"{cfg.recording}: no sidecar says which sensor this is; give sensor=msra or sensor=gyro")

@@ -1,5 +1,5 @@
-"""What the recording commands share: their one-line user error and the checks of their
-output folder, file names and tracking store, made before any work."""
+"""What the commands share: their one-line user error, reading a recording argument, and the
+checks of their output folder, file names and tracking store, made before any work."""
 
 from __future__ import annotations
 
@@ -45,6 +45,19 @@ def overwrite_error(exc: Any) -> CommandError:
     """The one-line error for output that would replace one of the command's inputs."""
     return CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out= "
                         "or name=")
+
+
+def read_recording_arg(path: str | Path) -> Any:
+    """The recording at ``path`` (a command's ``recording=``), read and validated; a
+    :class:`CommandError` naming the file when it is malformed or cannot be read."""
+    from tcbench.sensors.recording import RecordingError, read_recording
+
+    try:
+        return read_recording(path)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    except OSError as exc:
+        raise CommandError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
 
 
 def checked_store(track: TrackingConfig) -> None:

@@ -11,7 +11,15 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.commands.schemas import ImportConfig, MetricsConfig, SimulateConfig
-from tcbench.commands.errors import CommandError, cannot_write, checked_store, file_stem, overwrite_error, writable_folder
+from tcbench.commands.errors import (
+    CommandError,
+    cannot_write,
+    checked_store,
+    file_stem,
+    overwrite_error,
+    read_recording_arg,
+    writable_folder,
+)
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
@@ -120,17 +128,6 @@ def metrics_folder(cfg: MetricsConfig) -> Path:
     return Path(cfg.out) if cfg.out else path.with_name(f"{path.stem}_metrics")
 
 
-def _read(path: str | Path) -> Any:
-    from tcbench.sensors.recording import RecordingError, read_recording
-
-    try:
-        return read_recording(path)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except OSError as exc:
-        raise CommandError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
-
-
 def check_metrics(cfg: MetricsConfig) -> Any:
     """Every argument of ``tcbench metrics`` before any work; the recording, read and validated."""
     if not cfg.recording:
@@ -138,7 +135,7 @@ def check_metrics(cfg: MetricsConfig) -> Any:
     scale = cfg.scale_factor_hz_per_g
     if scale is not None and not (math.isfinite(scale) and scale > 0):
         raise CommandError(f"scale_factor_hz_per_g: must be a finite number > 0, got {scale:g}")
-    rec = _read(cfg.recording)
+    rec = read_recording_arg(cfg.recording)
     writable_folder(metrics_folder(cfg))
     checked_store(cfg.tracking)
     return rec
@@ -218,24 +215,13 @@ def check_import(cfg: ImportConfig) -> None:
 def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     """Import a table as validated recordings with their sidecars, one per ``output=`` axis
     (sharing the clock and temperature columns), all written or none; print what was written."""
-    from tcbench.sensors.importer import import_csv, save_all
+    from tcbench.sensors.importer import save_all
     from tcbench.sensors.recording import RecordingError
 
     check_import(cfg)
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
-    recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else {}
-    for stem, axis in zip([] if is_ulog(cfg) else import_stems(cfg), import_axes(cfg), strict=False):
-        columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, "output": axis}
-        if cfg.input:
-            columns["input"] = cfg.input
-        try:
-            recs[stem] = import_csv(csv, cfg.sensor, columns, drop=drop, device_id=cfg.device_id,
-                                    sample_rate_hz=cfg.sample_rate_hz)
-        except RecordingError as exc:
-            raise CommandError(str(exc)) from None
-        except OSError as exc:
-            raise CommandError(f"{csv}: cannot read the file ({exc.strerror or exc})") from None
+    recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else _table_recordings(cfg, drop)
     try:
         paths = save_all(recs, cfg.out, inputs=[csv])
     except RecordingError as exc:
@@ -257,6 +243,22 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     return first
 
 
+def _table_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
+    """One recording per ``output=`` axis of a table, read once, named by :func:`import_stems`."""
+    from tcbench.sensors.importer import import_csv_axes
+    from tcbench.sensors.recording import RecordingError
+
+    columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, **({"input": cfg.input} if cfg.input else {})}
+    try:
+        recs = import_csv_axes(cfg.csv, cfg.sensor, columns, import_axes(cfg), drop=drop, device_id=cfg.device_id,
+                               sample_rate_hz=cfg.sample_rate_hz)
+    except RecordingError as exc:
+        raise CommandError(str(exc)) from None
+    except OSError as exc:
+        raise CommandError(f"{cfg.csv}: cannot read the file ({exc.strerror or exc})") from None
+    return dict(zip(import_stems(cfg), recs, strict=True))
+
+
 def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
     """One recording per instance and axis of the sensor's topic in a PX4 log, named
     ``NAME-<topic>-<instance>-<axis>``; ``time=``, ``temperature=``, ``output=`` name other fields."""
@@ -272,7 +274,7 @@ def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
     axes = import_axes(cfg) or default_axes(cfg.sensor)
     recs = {}
     for inst in instances:
-        columns = default_columns(cfg.sensor, list(inst.fields))
+        columns = default_columns(list(inst.fields))
         columns |= {k: v for k, v in (("time_s", cfg.time), ("temperature_c", cfg.temperature),
                                       ("input", cfg.input)) if v}
         about = {"file": path.name, "format": "PX4 ULog", "topic": inst.topic, "instance": inst.instance,

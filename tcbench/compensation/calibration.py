@@ -38,15 +38,23 @@ RATE_WINDOW_S = 120.0
 @dataclass(frozen=True)
 class Record:
     """The part of a static record a calibration reads: time (s), thermometer (°C), the
-    output and the true input (same unit)."""
+    output and the true input (same unit), and the temperature rate (°C/s) the trailing window
+    reads there (:func:`record` computes it once, on the whole record, so a part keeps the rate
+    its past gives it)."""
 
     t_s: np.ndarray
     temp_c: np.ndarray
     output: np.ndarray
     truth: np.ndarray
+    rate_c_per_s: np.ndarray
 
     def part(self, start: int, stop: int) -> Record:
-        return Record(self.t_s[start:stop], self.temp_c[start:stop], self.output[start:stop], self.truth[start:stop])
+        return Record(*(getattr(self, f)[start:stop] for f in ("t_s", "temp_c", "output", "truth", "rate_c_per_s")))
+
+
+def record(t_s: np.ndarray, temp_c: np.ndarray, output: np.ndarray, truth: np.ndarray) -> Record:
+    """A :class:`Record` of a whole recording, its temperature rate computed once."""
+    return Record(t_s, temp_c, output, truth, temperature_rate_c_per_s(t_s, temp_c, RATE_WINDOW_S))
 
 
 @dataclass(frozen=True)
@@ -59,19 +67,13 @@ class OffsetModel:
     rate_coef: float = 0.0
     learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
 
-    def offset(self, rec: Record, rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+    def offset(self, rec: Record) -> np.ndarray:
         if self.learner is not None:
-            rate = temperature_rate_c_per_s(rec.t_s, rec.temp_c, RATE_WINDOW_S) if rate_c_per_s is None \
-                else rate_c_per_s
-            return np.asarray(self.learner.predict(np.column_stack([rec.temp_c, rate])), dtype=np.float64).reshape(-1)
+            inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
+            return np.asarray(self.learner.predict(inputs), dtype=np.float64).reshape(-1)
         if self.cubic is None:
             return np.zeros_like(rec.output)
-        out = self.cubic.offset(rec.temp_c)
-        if self.rate_coef:
-            rate = temperature_rate_c_per_s(rec.t_s, rec.temp_c, RATE_WINDOW_S) if rate_c_per_s is None \
-                else rate_c_per_s
-            out = out + self.rate_coef * rate
-        return out
+        return self.cubic.offset(rec.temp_c) + self.rate_coef * rec.rate_c_per_s
 
 
 def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
@@ -83,17 +85,16 @@ def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
         return OffsetModel("raw")
     temp = np.concatenate([r.temp_c for r in train])
     target = np.concatenate([r.output - r.truth for r in train])
+    rate = np.concatenate([r.rate_c_per_s for r in train])
     if method in LEARNERS:
         from tcbench.learners import registry
 
-        rate = np.concatenate([temperature_rate_c_per_s(r.t_s, r.temp_c, RATE_WINDOW_S) for r in train])
         learner = registry.create(method, 2, None, np.random.default_rng(seed))
         learner.fit(np.column_stack([temp, rate]), target)
         return OffsetModel(method, learner=learner)
     cubic = fit_offset(temp, target)
     if method == "poly3":
         return OffsetModel("poly3", cubic)
-    rate = np.concatenate([temperature_rate_c_per_s(r.t_s, r.temp_c, RATE_WINDOW_S) for r in train])
     dt = np.clip(temp, cubic.tmin_c, cubic.tmax_c) - cubic.tref_c
     design = np.column_stack([dt ** n for n in range(4)] + [rate])
     coef, *_ = np.linalg.lstsq(design, target, rcond=None)

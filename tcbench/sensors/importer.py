@@ -163,9 +163,21 @@ def import_csv(
     file's stem, ``sample_rate_hz`` to the rate inside the segments (one over the median
     interval). Raises :class:`RecordingError` naming the file, row and column.
     """
+    shared = {k: v for k, v in columns.items() if k != "output"}
+    return import_csv_axes(path, sensor, shared, [columns.get("output", "")], drop=drop, device_id=device_id,
+                           sample_rate_hz=sample_rate_hz)[0]
+
+
+def import_csv_axes(path: str | Path, sensor: str, columns: Mapping[str, str], outputs: Sequence[str], *,
+                    drop: Sequence[str] = (), device_id: str | None = None,
+                    sample_rate_hz: float | None = None) -> list[Recording]:
+    """One recording per ``outputs`` column (``name`` or ``name:unit``) of the table at ``path``,
+    sharing the other ``columns`` (clock, temperature, input): the file is read once. As
+    :func:`import_csv` otherwise."""
     path = Path(path)
     name = str(path)
-    _check_request(sensor, columns)
+    for output in outputs:
+        _check_request(sensor, {**columns, "output": output})
     try:
         if path.is_dir():
             raise RecordingError("is a directory, not a CSV file")
@@ -174,15 +186,18 @@ def import_csv(
         delimiter = sniff_delimiter(path)
         header = _header_names(path, delimiter)
         _scan_text(path, header, delimiter)
-        spec, used = _spec(columns, drop, sensor, header)
+        axes = [_spec({**columns, "output": output}, drop, sensor, header) for output in outputs]
+        used = list(dict.fromkeys(c for _, axis_used in axes for c in axis_used))
         twice = [c for c in used if header.count(c) > 1]
         if twice:
             raise RecordingError(f"the header names column {twice[0]!r} more than once")
         raw, empty = _read(path, used, header, delimiter)
     except RecordingError as err:
         raise err.located(name) from None
-    return _recording(raw, empty, spec, drop, sensor, name, {"file": path.name, "delimiter": delimiter},
-                      device_id or path.stem, sample_rate_hz)
+    return [_recording({c: raw[c] for c in axis_used}, empty[:, [used.index(c) for c in axis_used]], spec, drop,
+                       sensor, name, {"file": path.name, "delimiter": delimiter}, device_id or path.stem,
+                       sample_rate_hz)
+            for spec, axis_used in axes]
 
 
 def import_table(table: Mapping[str, np.ndarray], sensor: str, columns: Mapping[str, str], *, source: str,

@@ -33,7 +33,7 @@ class TopicInstance:
     device_id: int | None
 
 
-def default_columns(sensor: str, fields: list[str]) -> dict[str, str]:
+def default_columns(fields: list[str]) -> dict[str, str]:
     """The column map of a topic in PX4's units: the sample clock (else the publication clock),
     the temperature; the axes are :func:`default_axes`."""
     clock = "timestamp_sample" if "timestamp_sample" in fields else "timestamp"
