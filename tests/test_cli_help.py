@@ -206,3 +206,9 @@ def test_a_sweep_with_a_bad_value_is_one_line_before_any_job(command: str, capsy
 def test_help_command_shows_a_command_s_usage(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["help", "diagnose"]) == 0
     assert capsys.readouterr().out.startswith("usage: tcbench diagnose")
+
+
+def test_leaderboard_flag_values_keep_backslashes_and_quotes(capsys: pytest.CaptureFixture[str]) -> None:
+    """Hydra's grammar escapes a backslash only before a quote: ``a\\b`` stays one backslash."""
+    assert main(["leaderboard", "--cfg", "job", "--experiment", "a\\b", "--experiment", "c'd\\"]) == 0
+    assert yaml.safe_load(capsys.readouterr().out)["experiments"] == ["a\\b", "c'd\\"]
