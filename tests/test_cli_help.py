@@ -150,7 +150,7 @@ def test_an_unknown_option_is_one_line_exit_2(command: str, flag: str, capsys: p
 
 @pytest.mark.parametrize(("command", "arg", "words"), [
     ("list", "seed=3", ["seed"]),
-    ("list", "what=tools", ["what=tools", "tasks, optimisers, learners"]),
+    ("list", "what=tools", ["what=tools", "tasks, optimisers, learners, sensors"]),
     ("quickstart", "seeds=0", ["seeds=0", "at least 1"]),
     ("quickstart", "diagnose_effect=glitch", ["diagnose_effect=glitch", "thermal_lag"]),
     ("leaderboard", "--ecdf=yes", ["--ecdf takes no value"]),

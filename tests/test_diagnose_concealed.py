@@ -16,7 +16,7 @@ from tcbench.diagnose.concealed import (
     concealed_recording,
 )
 from tcbench.sensors.devices import unit
-from tcbench.sensors.recording import STANDARD_UNITS
+from tcbench.sensors.recording import standard_units
 from tcbench.sensors.thermal import Segment, segment_index
 
 CASES = [(s, e) for s, effects in EFFECTS_BY_SENSOR.items() for e in effects]
@@ -126,7 +126,7 @@ def test_control_has_no_effect(sensor: str) -> None:
     accel = parts.profile.accel_g if sensor == "msra" else None
     assert _left_rms(parts.base, parts.profile.temp_c, accel) < 1e-3 * truth.white_sigma
     assert _left_rms(rec.output - parts.base, parts.profile.temp_c, accel) == pytest.approx(truth.white_sigma, rel=0.03)
-    assert rec.meta.sensor == sensor and rec.meta.units == STANDARD_UNITS[sensor]
+    assert rec.meta.sensor == sensor and rec.meta.units == standard_units(sensor)
     assert rec.meta.sample_rate_hz == 1.0 and rec.meta.device_id == f"concealed-{sensor}-9"
     assert np.array_equal(rec.input, parts.profile.input)
 

@@ -37,7 +37,7 @@ def test_exported_parameters_reproduce_the_fitted_correction(cooling: tuple[np.n
         assert px4_dps[probe > temp.max() + 1].std() < 1e-6  # held at TMAX, no cubic extrapolation
         corrected = rates["xyz"[axis]] - np.degrees(px4_offset(params, temp, "gyro", 1, axis).astype(np.float64))
         assert corrected.std() < 0.3 * rates["xyz"[axis]].std()  # the correction takes out most of the drift
-    script = write_parameters(params, tmp_path / "tc.txt").read_text().splitlines()
+    script = write_parameters(params, tmp_path / "tc.txt", "gyro").read_text().splitlines()
     assert script[0] == "param set TC_G1_ID 2424842" and script[-1] == "param set TC_G_ENABLE 1"
     assert {ln.split()[2] for ln in script[:-1]} == set(params)
     read_back = {ln.split()[2]: float(ln.split()[3]) for ln in script[:-1]}

@@ -121,7 +121,7 @@ def test_round_trip_is_exact(tmp_path, suffix, sensor):
     back = read_recording(path)
     _assert_same(rec, back)
     assert back.meta.extra == {"protocol": "ramp", "device_seed": 3, "sim": {"k": [1.0, 2.5]}}
-    assert back.meta.units == recording.STANDARD_UNITS[sensor]
+    assert back.meta.units == recording.standard_units(sensor)
 
 
 @settings(max_examples=30, deadline=None)
@@ -266,7 +266,7 @@ def test_million_rows_read_fast(tmp_path):
 def test_data_frame_is_canonical():
     data = pd.DataFrame({"position": ["+0g", ""], "output": [1, 2], "input": [0, 0], "temperature_c": [20, 21],
                          "time_s": [0, 1]})
-    rec = Recording(data, RecordingMeta("msra", dict(recording.STANDARD_UNITS["msra"]), 1.0, "m"))
+    rec = Recording(data, RecordingMeta("msra", recording.standard_units("msra"), 1.0, "m"))
     rec.validate()
     assert rec.time_s.dtype == np.float64 and rec.position.tolist() == ["+0g", None]
 

@@ -83,7 +83,7 @@ def test_cli_simulate_then_metrics(workdir: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["sensor=imu"], "unknown sensor 'imu'; known: msra, gyro"),
+        (["sensor=imu"], "unknown sensor 'imu' (known: msra, gyro, accel)"),
         (["sensor=msra", "protocol=oven"], "unknown protocol 'oven' for msra"),
         (["device_seed=-1"], "non-negative"),
         (["device_seed=abc"], "device_seed: Value 'abc'"),

@@ -61,8 +61,9 @@ SPECS: dict[str, CommandHelp] = {
         summary="Simulate a recording of one device under a test protocol, then compute its metrics.",
         schema=_schema("simulate"),
         params={
-            "sensor": "msra (accelerometer) or gyro (null: msra, or the model file's)",
-            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static",
+            "sensor": "msra (resonant accelerometer), gyro or accel (capacitive accelerometer); `tcbench list what=sensors` "
+                      "(null: msra, or the model file's)",
+            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static, accel chamber|multipos|static",
             "device_seed": "which unit of the device population (integer >= 0)",
             "seed": "the run's noise draw (integer >= 0)",
             "out": "output folder",
@@ -108,11 +109,12 @@ SPECS: dict[str, CommandHelp] = {
         schema=_schema("import"),
         params={
             "csv": "the table to import (fields separated by commas, tabs or semicolons), or a PX4 log (.ulg: "
-                   "every instance and axis of the sensor's topic, sensor_gyro for a gyro); also the first argument",
-            "sensor": "msra or gyro",
+                   "every instance and axis of the sensor's topic, sensor_gyro for a gyro, sensor_accel for accel); also the first argument",
+            "sensor": "msra, gyro or accel (any kind `tcbench list what=sensors` shows)",
             "time": "time column, COL[:unit] (any time unit pint knows: s, ms, us, ns, min, h)",
             "temperature": "temperature column, COL[:unit] (degC, K, degF)",
-            "output": "sensor output column, COL[:unit] (gyro: deg/s, rad/s, mrad/s, mdps ...; msra: Hz, kHz ...); "
+            "output": "sensor output column, COL[:unit] (gyro: deg/s, rad/s, mrad/s, mdps ...; accel: g, mg, m/s^2 ...; "
+                      "msra: Hz, kHz ...); "
                       "several axes: COL[:unit],COL[:unit],... (one recording each, NAME-COL)",
             "input": "optional true-input column, COL[:unit]",
             "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
@@ -126,6 +128,8 @@ SPECS: dict[str, CommandHelp] = {
             "tcbench import csv=log.csv sensor=gyro time=time_s temperature=temp_c:degC "
             "output=gyro_x_dps:deg/s out=recordings",
             "tcbench import csv=flight.ulg sensor=gyro out=recordings   (NAME-sensor_gyro-<instance>-<axis>.csv)",
+            "tcbench import csv=imu.tsv sensor=accel time=t:us temperature=temp output=ax:m/s^2,ay:m/s^2,az:m/s^2 "
+            "out=recordings",
         ),
         output="OUT/NAME.csv and its sidecar OUT/NAME.json; MLflow experiment 'recordings' when tracking is on",
         positional="csv",
@@ -138,7 +142,7 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "recording": "the recording to diagnose",
             "out": "output folder",
-            "sensor": "msra or gyro, for a recording without a sidecar (null: from the sidecar)",
+            "sensor": "the sensor kind (msra, gyro, accel), for a recording without a sidecar (null: from the sidecar)",
             "model": "model file of the effects already modelled (null: none)",
             **TRACKING,
         },
@@ -155,27 +159,34 @@ SPECS: dict[str, CommandHelp] = {
         name="calibrate",
         summary="Calibrate a static recording on its own temperature branches: each offset model (raw, PX4's "
                 "cubic in the thermometer, the cubic with a temperature-rate term, BP and Elman networks) fitted on some branches and "
-                "scored on every branch, with plots and, for a gyro, PX4's TC_G* parameters.",
+                "scored on every branch, with plots and, for a gyro or accelerometer, PX4's TC_G* / TC_A* parameters.",
         schema=_schema("calibrate"),
         params={
             "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
             "out": "output folder",
-            "train_branches": "the temperature branches to fit on, numbered from 0 in time order",
+            "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order",
+            "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
+                      "(a record that only cools: train_branches=[0,2,4] blocks=5)",
             "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp, elman "
                        "(the seed papers' networks on [T, dT/dt])",
             "seed": "the networks' initial weights",
+            "restarts": "networks per learner method, seeds seed, seed+1, ...: the board gives the median of their "
+                        "scores (the plot shows the first)",
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
-            "px4_instance": "the gyro instance the TC_G parameters are for (0..3)",
+            "px4_instance": "the sensor instance the TC_G / TC_A parameters are for (0..3)",
+            "true_input": "the static record's true input, VALUE[:unit] (an accelerometer axis along gravity: "
+                          "-1:g); null: the recording's input column",
             **TRACKING,
         },
         examples=(
             "tcbench calibrate recording=recordings/tofupilot/imu-imu.gyro.y.csv out=cal/gyro-y",
             "tcbench calibrate recording=run.csv 'train_branches=[0,1]' 'methods=[poly3]'",
             "tcbench calibrate -m recording=a.csv,b.csv 'out=cal/${stem:recording}'",
+            "tcbench calibrate recording=recordings/tofupilot/imu-imu.acc.z.csv true_input=-1:g out=cal/acc-z",
         ),
         output="OUT/calibration.md and .csv (one row per method and branch: drift and RMS), OUT/residuals.png, "
-               "OUT/px4_tc_params.txt for a gyro; MLflow experiment 'calibrations' when tracking is on",
+               "OUT/px4_tc_params.txt for a gyro or accelerometer; MLflow experiment 'calibrations' when tracking is on",
         positional="recording",
         required=("recording",),
     ),
@@ -215,7 +226,7 @@ SPECS: dict[str, CommandHelp] = {
         summary="Print the registered tasks (their gymnasium env id and task= name), optimisers (with the "
                 "package that provides them: tcbench or a plugin), learners and broken plugins.",
         schema=_schema("list"),
-        params={"what": "which list: all, tasks, optimisers or learners"},
+        params={"what": "which list: all, tasks, optimisers, learners or sensors"},
         examples=("tcbench list", "tcbench list what=optimisers", "tcbench list -m what=tasks,learners"),
         output="stdout only",
         sweep=f"{IN_TURN}, each list printed in turn",

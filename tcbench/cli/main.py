@@ -348,7 +348,7 @@ def _check_list(c: dict[str, object]) -> None:
 
 
 def _list(c: dict[str, object]) -> int:
-    """Print the registered tasks, optimisers and learners (``what``: one of them, or all)."""
+    """Print the registered tasks, optimisers, learners and sensor kinds (``what``: one of them, or all)."""
     what = c.get("what", "all")
     if what in {"all", "tasks"}:
         from tcbench.tasks import TASKS
@@ -377,6 +377,14 @@ def _list(c: dict[str, object]) -> int:
         for name, err in learners.broken().items():
             print(f"  {name:10s} BROKEN: {err}")
         print("  raw, oracle  baselines: no compensation; the simulator's truth (physical limit)")
+    if what in {"all", "sensors"}:
+        from tcbench.sensors import kinds as sensor_kinds
+
+        print("sensors:")
+        for kind in sensor_kinds.registry().values():
+            units = f"{kind.input_unit} in, {kind.output_unit} out"
+            print(f"  {kind.name:10s} {kind.title}; {units}; protocols: {', '.join(kind.protocols)}"
+                  + (f"; PX4 {kind.ulog_topic}" if kind.ulog_topic else ""))
     return 0
 
 

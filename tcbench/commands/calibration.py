@@ -1,7 +1,9 @@
-"""What ``tcbench calibrate`` does: split a static recording into its temperature branches
+"""What ``tcbench calibrate`` does: split a static recording into its temperature branches (or,
+with ``blocks=N``, into time blocks)
 (:mod:`tcbench.signal.branches`), fit each offset model (:mod:`tcbench.compensation.calibration`)
 on the training branches, score it on every branch, and write the board (``calibration.md`` and
-``.csv``), the residual plots and, for a gyro, PX4's ``TC_G*`` parameters of the cubic."""
+``.csv``), the residual plots and, for a kind PX4 calibrates (gyro, accel), PX4's ``TC_G*`` or
+``TC_A*`` parameters of the cubic."""
 
 from __future__ import annotations
 
@@ -15,7 +17,6 @@ from tcbench.commands.errors import CommandError, cannot_write, checked_store, r
 from tcbench.commands.schemas import CalibrateConfig
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
-UNITS_TO_PX4 = {"deg/s": np.pi / 180.0}  # the recording's unit -> PX4's (rad/s for sensor_gyro)
 
 
 @dataclass
@@ -31,7 +32,7 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
     """Every argument before any work: the recording (read and validated), its branches and the
     training ones among them, the methods."""
     from tcbench.compensation.calibration import METHODS
-    from tcbench.signal.branches import temperature_branches
+    from tcbench.signal.branches import temperature_branches, time_blocks
 
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
@@ -43,45 +44,89 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
         raise CommandError("min_swing_c and drift_window_s must be > 0")
     if cfg.seed < 0:
         raise CommandError(f"seed must be a non-negative integer, got {cfg.seed}")
+    if not 1 <= cfg.restarts <= 1000:
+        raise CommandError(f"restarts must be 1..1000, got {cfg.restarts}")
     if not 0 <= cfg.px4_instance <= 3:
         raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
     rec = read_recording_arg(cfg.recording)
-    branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
+    if cfg.true_input is not None:
+        rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
+    if cfg.blocks is None:
+        branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
+        parts = f"temperature branch{'es' * (len(branches) != 1)}"
+        how = f"min_swing_c={cfg.min_swing_c:g} degC"
+    else:
+        try:
+            branches = time_blocks(rec.time_s, rec.temperature_c, cfg.blocks)
+        except ValueError as exc:
+            raise CommandError(f"blocks={cfg.blocks}: {exc}") from None
+        parts, how = f"time block{'s' * (len(branches) != 1)}", f"blocks={cfg.blocks}"
     bad = [k for k in cfg.train_branches if not 0 <= k < len(branches)]
     if bad or not cfg.train_branches:
         raise CommandError(f"train_branches={list(cfg.train_branches)}: the recording has {len(branches)} "
-                           f"temperature branch{'es' * (len(branches) != 1)} (0..{len(branches) - 1}; "
-                           f"min_swing_c={cfg.min_swing_c:g} degC)")
+                           f"{parts} (0..{len(branches) - 1}; {how})")
     return rec, branches
+
+
+def true_input(spec: object, input_unit: str) -> float:
+    """``VALUE[:unit]`` (``-1:g``, ``-9.81:m/s^2``, ``0.5``) in the recording's input unit."""
+    from tcbench.sensors.units import UnitError, conversion
+
+    text = str(spec)
+    value, _, unit = text.partition(":")
+    unit = unit.strip() or input_unit
+    try:
+        number = float(value)
+    except ValueError:
+        raise CommandError(f"true_input={text}: expected VALUE[:unit], e.g. -1:g") from None
+    try:
+        converted = conversion(unit, input_unit).to_schema(np.float64(number))
+    except UnitError as exc:
+        raise CommandError(f"true_input={text}: {exc}") from None
+    if not np.isfinite(converted):
+        raise CommandError(f"true_input={text}: must be a finite number")
+    return float(converted)
 
 
 def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     """Fit, score and write; print the board."""
     import pandas as pd
 
-    from tcbench.compensation.calibration import fit, record, residual, scores
+    from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
     from tcbench.tables import markdown_table
 
     rec, branches = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
     whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(branches[k].start, branches[k].stop) for k in cfg.train_branches]
-    models = {m: fit(m, train, cfg.seed) for m in dict.fromkeys(cfg.methods)}
-    residuals = {m: residual(model, whole) for m, model in models.items()}
+    diagnosis = _diagnosed(rec, branches, cfg) if "model" in cfg.methods else None
+    fitted = {m: [from_model(diagnosis[1])] if m == "model" else  # type: ignore[index]
+              [fit(m, train, cfg.seed + r) for r in range(cfg.restarts if m in LEARNERS else 1)]
+              for m in dict.fromkeys(cfg.methods)}
+    every = {m: [residual(model, whole) for model in runs] for m, runs in fitted.items()}
     rows = []
-    for m in models:
+    for m, runs in every.items():
         for k, b in enumerate(branches):
-            s = scores(residuals[m][b.start:b.stop], rec.time_s[b.start:b.stop], cfg.drift_window_s)
+            s = [scores(res[b.start:b.stop], rec.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
             rows.append({"method": m, "branch": k, "direction": b.direction, "from_c": b.from_c, "to_c": b.to_c,
                          "role": "train" if k in cfg.train_branches else "test",
-                         f"drift_rms_{_slug(unit)}": s["drift_rms"], f"rms_{_slug(unit)}": s["rms"]})
+                         f"drift_rms_{_slug(unit)}": float(np.median([x["drift_rms"] for x in s])),
+                         f"rms_{_slug(unit)}": float(np.median([x["rms"] for x in s])),
+                         "restarts": len(runs)})
+    models = {m: runs[0] for m, runs in fitted.items()}
+    residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
     out = Path(cfg.out)
     try:
         with staged_dir(out, [Path(cfg.recording)]) as tmp:
             written = _write(tmp, cfg, rec, branches, models, residuals, table, unit)
+            if diagnosis is not None:
+                from tcbench.diagnose.report import write_report
+
+                written |= {f"diagnosis {k}": v for k, v in write_report(diagnosis[0], tmp / "diagnosis").items()
+                            if k in ("model.yaml", "report.md")}
     except InputOverwriteError as exc:
         raise CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out=") \
             from None
@@ -96,13 +141,38 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     return CalibrationOutcome(table, written, str(rec.meta.sensor))
 
 
+def _diagnosed(rec: Any, branches: list[Any], cfg: CalibrateConfig) -> tuple[Any, Any]:
+    """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
+    kept as gaps) and the model it fitted, for the ``model`` method. The parts may be shorter
+    than a diagnosis of its own asks (30 min): down to five cross-validation folds of two
+    thermometer-smoothing windows each (20 min)."""
+    from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.model_file import to_sensor_model
+    from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
+    from tcbench.diagnose.plan import FOLDS
+    from tcbench.diagnose.report import model_spec
+    from tcbench.diagnose.signals import DiagnosisDataError
+    from tcbench.sensors.recording import make_recording
+
+    rows = np.concatenate([np.arange(branches[k].start, branches[k].stop) for k in sorted(set(cfg.train_branches))])
+    part = make_recording(rec.time_s[rows], rec.temperature_c[rows], rec.input[rows], rec.output[rows],
+                          sensor=rec.meta.sensor, sample_rate_hz=rec.meta.sample_rate_hz, device_id=rec.meta.device_id)
+    try:
+        diag = diagnose(part, name=f"{Path(cfg.recording).name} (training parts)",
+                        min_duration_s=FOLDS * 2 * DEFAULT_SMOOTH_S)
+    except DiagnosisDataError as exc:
+        raise CommandError(f"methods: model: the training parts cannot be diagnosed ({exc}); fit on more parts, "
+                           "or leave model out of methods") from None
+    return diag, to_sensor_model(model_spec(diag))
+
+
 def _slug(unit: str) -> str:
     return unit.replace("/", "_per_").replace(" ", "") or "unit"
 
 
 def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, branches: list[Any], models: dict[str, Any],
            residuals: dict[str, np.ndarray], table: Any, unit: str) -> dict[str, Path]:
-    from tcbench.compensation.px4 import px4_parameters, write_parameters
+    from tcbench.compensation.px4 import px4_covers, px4_factor, px4_parameters, write_parameters
     from tcbench.tables import markdown_table
 
     written = {"csv": tmp / "calibration.csv", "md": tmp / "calibration.md"}
@@ -111,16 +181,22 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, branches: list[Any], model
     note = ("" if len(test) else "\nEvery branch was used to fit: the scores are in-sample only.\n")
     written["md"].write_text(
         f"# Calibration of {Path(cfg.recording).name}\n\n"
-        f"{rec.meta.sensor} recording, output in {unit}; {len(branches)} temperature branches "
-        f"(turning points standing out by {cfg.min_swing_c:g} degC); fitted on branch(es) "
-        f"{', '.join(map(str, cfg.train_branches))}, scored on every branch. drift = RMS of the residual's "
+        f"{rec.meta.sensor} recording, output in {unit}; " + (
+            f"{len(branches)} temperature branches (turning points standing out by {cfg.min_swing_c:g} degC)"
+            if cfg.blocks is None else f"{len(branches)} time blocks of equal duration") +
+        "; fitted on part(s) "
+        f"{', '.join(map(str, cfg.train_branches))}, scored on every part. drift = RMS of the residual's "
         f"{cfg.drift_window_s:g}-s running mean (output minus true input minus the model's offset); rms = RMS of "
-        f"the residual.\n{note}\n{markdown_table(table)}\n\n![residuals](residuals.png)\n")
+        f"the residual." + (f" The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+                            f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}."
+                            if cfg.restarts > 1 else "") +
+        f"\n{note}\n{markdown_table(table)}\n\n![residuals](residuals.png)\n")
     written["png"] = _plot(tmp / "residuals.png", rec, branches, residuals, unit, cfg)
     cubic = models.get("poly3")
-    if rec.meta.sensor == "gyro" and cubic is not None and unit in UNITS_TO_PX4:
-        params = px4_parameters([cubic.cubic], "gyro", cfg.px4_instance, to_px4_unit=UNITS_TO_PX4[unit])
-        written["px4"] = write_parameters(params, tmp / "px4_tc_params.txt")
+    if cubic is not None and px4_covers(rec.meta.sensor):
+        sensor = rec.meta.sensor
+        params = px4_parameters([cubic.cubic], sensor, cfg.px4_instance, to_px4_unit=px4_factor(sensor, unit))
+        written["px4"] = write_parameters(params, tmp / "px4_tc_params.txt", sensor)
     return written
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.commands.schemas import DiagnoseConfig
+from tcbench.sensors import kinds
 from tcbench.commands.errors import (
     CommandError,
     cannot_write,
@@ -37,14 +38,14 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
 
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
-    if cfg.sensor not in (None, "msra", "gyro"):
-        raise CommandError(f"sensor must be msra or gyro, got {cfg.sensor!r}")
+    if cfg.sensor is not None and not kinds.known(cfg.sensor):
+        raise CommandError(f"sensor must be one of {', '.join(kinds.names())}, got {cfg.sensor!r}")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
     rec = read_recording_arg(cfg.recording)
     sensor = cfg.sensor or rec.meta.sensor
     if sensor is None:
-        raise CommandError(f"{cfg.recording}: no sidecar says which sensor this is; give sensor=msra or sensor=gyro")
+        raise CommandError(f"{cfg.recording}: no sidecar says which sensor this is; give sensor=" + "|".join(kinds.names()))
     if cfg.sensor and rec.meta.sensor and cfg.sensor != rec.meta.sensor:
         raise CommandError(f"sensor={cfg.sensor} but the sidecar of {cfg.recording} says {rec.meta.sensor}")
     declared: dict[str, dict[str, float]] = {}

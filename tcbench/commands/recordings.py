@@ -161,8 +161,8 @@ def metrics(cfg: MetricsConfig) -> RecordingOutcome:
 
 # -- import --------------------------------------------------------------------------------------
 
-IMPORT_USAGE = ("usage: tcbench import csv=PATH sensor=msra|gyro time=COL[:unit] temperature=COL[:unit] "
-                "output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR, or csv=LOG.ulg sensor=gyro out=DIR")
+IMPORT_USAGE = ("usage: tcbench import csv=PATH sensor=msra|gyro|accel time=COL[:unit] temperature=COL[:unit] "
+                "output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR, or csv=LOG.ulg sensor=gyro|accel out=DIR")
 
 
 def import_stem(cfg: ImportConfig) -> str:

@@ -91,11 +91,14 @@ class CalibrateConfig:
     recording: str = ""
     out: str = "calibration"
     train_branches: list[int] = field(default_factory=lambda: [0])
-    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman"])
+    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman", "model"])
     seed: int = 0
+    restarts: int = 1  # networks per learner method (seeds seed, seed+1, ...): the board gives their median
     min_swing_c: float = 5.0
     drift_window_s: float = 60.0
     px4_instance: int = 0
+    blocks: int | None = None  # cut into this many time blocks instead of temperature branches
+    true_input: str | None = None  # VALUE[:unit]: the static record's true input (an axis along gravity: -1:g)
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
 
 
@@ -113,7 +116,7 @@ class LeaderboardConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(enabled=False, experiment="leaderboards"))
 
 
-LISTS = ("all", "tasks", "optimisers", "learners")
+LISTS = ("all", "tasks", "optimisers", "learners", "sensors")
 
 
 @dataclass

@@ -13,6 +13,11 @@ Methods, each a function of what a flight controller can read (the thermometer a
   of a cycle tell apart.
 - ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`, their defaults) on
   ``[T, dT/dt]``, trained from the run's seed.
+- ``model``: the diagnosed physics. ``tcbench diagnose`` on the training parts fits a model
+  (polynomial core, thermal lag, hysteresis, warm-up, steps ...; :mod:`tcbench.diagnose`), and its
+  deterministic output is the offset (:mod:`tcbench.compensation.fitted_model`); the command
+  (:mod:`tcbench.commands.calibration`) runs the diagnosis and hands the model in with
+  :func:`from_model`.
 
 The scores of a branch: the RMS of the residual (output minus true input minus the model's
 offset), and the RMS of its running mean over ``drift_window_s`` (the drift, with the white
@@ -30,7 +35,7 @@ import numpy as np
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 
-METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman")
+METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman", "model")
 LEARNERS = ("bp", "elman")
 RATE_WINDOW_S = 120.0
 
@@ -66,8 +71,13 @@ class OffsetModel:
     cubic: OffsetPolynomial | None = None
     rate_coef: float = 0.0
     learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
+    sensor_model: Any = None  # a diagnosed PolynomialModel
 
     def offset(self, rec: Record) -> np.ndarray:
+        if self.sensor_model is not None:
+            from tcbench.compensation.fitted_model import deterministic_output
+
+            return deterministic_output(self.sensor_model, rec.t_s, rec.temp_c, rec.truth) - rec.truth
         if self.learner is not None:
             inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
             return np.asarray(self.learner.predict(inputs), dtype=np.float64).reshape(-1)
@@ -83,6 +93,8 @@ def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
         raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
     if method == "raw":
         return OffsetModel("raw")
+    if method == "model":
+        raise ValueError("the diagnosed model is fitted by tcbench diagnose: pass it to from_model()")
     temp = np.concatenate([r.temp_c for r in train])
     target = np.concatenate([r.output - r.truth for r in train])
     rate = np.concatenate([r.rate_c_per_s for r in train])
@@ -100,6 +112,11 @@ def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
     coef, *_ = np.linalg.lstsq(design, target, rcond=None)
     both = OffsetPolynomial(tuple(float(c) for c in coef[:4]), cubic.tref_c, cubic.tmin_c, cubic.tmax_c)  # type: ignore[arg-type]
     return OffsetModel("poly3_rate", both, float(coef[4]))
+
+
+def from_model(sensor_model: Any) -> OffsetModel:
+    """The ``model`` method: a diagnosed :class:`~tcbench.sensors.fitted.PolynomialModel` as the offset."""
+    return OffsetModel("model", sensor_model=sensor_model)
 
 
 def residual(model: OffsetModel, rec: Record) -> np.ndarray:

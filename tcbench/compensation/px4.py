@@ -18,8 +18,30 @@ from pathlib import Path
 
 import numpy as np
 
+from tcbench.sensors import kinds
+
 ORDER = 3
-TYPES = {"gyro": ("G", "rad/s"), "accel": ("A", "m/s^2")}
+
+
+def px4_type(sensor: str) -> tuple[str, str]:
+    """PX4's parameter letter and unit of a sensor kind (``G``, rad/s for a gyro)."""
+    covered = {k.name: (k.px4_letter, k.ulog_unit or k.output_unit) for k in kinds.registry().values() if k.px4_letter}
+    if sensor not in covered:
+        raise ValueError(f"PX4 thermal calibration covers {', '.join(covered)}, not {sensor!r}")
+    return covered[sensor]  # type: ignore[return-value]
+
+
+def px4_covers(sensor: str | None) -> bool:
+    """Whether PX4 has thermal-calibration parameters for this kind."""
+    return sensor is not None and kinds.known(sensor) and kinds.get(sensor).px4_letter is not None
+
+
+def px4_factor(sensor: str, unit: str) -> float:
+    """The multiplier from ``unit`` (a recording's output unit) to PX4's unit of ``sensor``
+    (pi/180 from deg/s to rad/s; 9.80665 from g to m/s^2)."""
+    from tcbench.sensors.units import conversion
+
+    return 1.0 / conversion(px4_type(sensor)[1], unit).mul
 
 
 @dataclass(frozen=True)
@@ -62,13 +84,11 @@ def px4_parameters(axes: Sequence[OffsetPolynomial], sensor: str = "gyro", insta
     coefficients multiplied by ``to_px4_unit`` (e.g. pi/180 from deg/s to PX4's rad/s) and
     rounded to 32-bit floats as PX4 stores them. The axes share one reference and range: the
     first axis's (fit them on the same record)."""
-    if sensor not in TYPES:
-        raise ValueError(f"PX4 thermal calibration covers {', '.join(TYPES)}, not {sensor!r}")
     if not 1 <= len(axes) <= 3 or not 0 <= instance <= 3:
         raise ValueError("one to three axes, instance 0..3")
     if any((a.tref_c, a.tmin_c, a.tmax_c) != (axes[0].tref_c, axes[0].tmin_c, axes[0].tmax_c) for a in axes):
         raise ValueError("the axes of one instance share TREF, TMIN and TMAX: fit them on the same record")
-    t = TYPES[sensor][0]
+    t = px4_type(sensor)[0]
     head = f"TC_{t}{instance}"
     params: dict[str, float | int] = {f"{head}_ID": int(device_id)}
     for a, poly in enumerate(axes):
@@ -83,7 +103,7 @@ def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: st
                axis: int = 0) -> np.ndarray:
     """The offset PX4 subtracts, in PX4's unit, evaluated from the parameters alone (32-bit, as
     on the flight controller)."""
-    head = f"TC_{TYPES[sensor][0]}{instance}"
+    head = f"TC_{px4_type(sensor)[0]}{instance}"
     f32 = np.float32
     tmin, tmax, tref = (f32(params[f"{head}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
     x = [f32(params[f"{head}_X{n}_{axis}"]) for n in range(ORDER + 1)]
@@ -91,11 +111,11 @@ def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: st
     return x[0] + x[1] * dt + x[2] * dt ** 2 + x[3] * dt ** 3
 
 
-def write_parameters(params: Mapping[str, float | int], path: str | Path, sensor: str = "gyro") -> Path:
+def write_parameters(params: Mapping[str, float | int], path: str | Path, sensor: str) -> Path:
     """``params`` as a PX4 console script (``param set NAME VALUE`` per line, then the enable
     switch), to paste into the NuttX shell or run from the SD card."""
     lines = [f"param set {k} {v:d}" if isinstance(v, int) else f"param set {k} {v:.9g}" for k, v in params.items()]
-    lines.append(f"param set TC_{TYPES[sensor][0]}_ENABLE 1")
+    lines.append(f"param set TC_{px4_type(sensor)[0]}_ENABLE 1")
     path = Path(path)
     path.write_text("\n".join(lines) + "\n")
     return path

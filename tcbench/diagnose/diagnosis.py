@@ -30,7 +30,7 @@ from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.plan import SURROGATE
 from tcbench.diagnose.reference import Reference, reference_fit
 from tcbench.diagnose.surrogate import LEVEL
-from tcbench.diagnose.signals import DiagnosisData, prepare
+from tcbench.diagnose.signals import MIN_DURATION_S, DiagnosisData, prepare
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
@@ -182,8 +182,10 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
     d: Designer = att.designer
     beta = att.final_fit.beta
     n_core = len(d.core_names())
-    core = {"kind": "polynomial", "centre_c": d.centre_c, "half_range_c": d.half_range_c,
-            "bias": [float(b) for b in beta[:3]],
+    bias = [float(b) for b in beta[:3]]
+    if n_core < 6:  # one input level a: the fit is output = bias(T), written as bias(T) - a plus a unit scale factor
+        bias[0] -= float(np.median(d.data.input)) if d.data.input.size else 0.0
+    core = {"kind": "polynomial", "centre_c": d.centre_c, "half_range_c": d.half_range_c, "bias": bias,
             "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
     effects: dict[str, dict[str, float]] = {}
     if att.final.lag_tau_s:
@@ -238,10 +240,11 @@ def diagnose(
     declared: dict[str, dict[str, float]] | None = None,
     name: str = "",
     threshold: float = DETECTION_THRESHOLD,
+    min_duration_s: float = MIN_DURATION_S,
 ) -> Diagnosis:
     """Diagnose ``rec`` against the minimal model plus the effects ``declared`` already modelled
     (``{effect_id: params}``). Raises :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a
-    recording that cannot show anything.
+    recording that cannot show anything, or that is shorter than ``min_duration_s``.
 
     Where the thermometer smoothing fitted to the profile (:func:`~tcbench.diagnose.signals.fitted_window_s`)
     is shorter than the default, the record is diagnosed at both windows, and the default is kept
@@ -253,9 +256,9 @@ def diagnose(
     paid for like a term, is the judge the diagnosis uses for everything else."""
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     if nonmean.default_smooth_s >= DEFAULT_SMOOTH_S:
-        return _diagnose(rec, nonmean, sensor, declared or {}, name, threshold)
+        return _diagnose(rec, nonmean, sensor, declared or {}, name, threshold, min_duration_s)
     # the two diagnoses are independent: one per core (same results as in turn, in about half the time)
-    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, nm, sensor, declared or {}, name, threshold)
+    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, nm, sensor, declared or {}, name, threshold, min_duration_s)
                                for nm in (nonmean, NonMean.before(rec, window_s=DEFAULT_SMOOTH_S)))
     fitted, default = tried
     # the default window is a model choice like a term: it must pay the open-world gain threshold
@@ -269,9 +272,9 @@ def diagnose(
 
 
 def _diagnose(rec: Recording, nonmean: NonMean, sensor: str | None, declared: dict[str, dict[str, float]],
-              name: str, threshold: float) -> Diagnosis:
+              name: str, threshold: float, min_duration_s: float = MIN_DURATION_S) -> Diagnosis:
     """:func:`diagnose` with the non-mean detectors' thermometer reading ``nonmean``."""
-    data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s))  # output lattice; clipping
+    data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s, min_duration_s=min_duration_s))  # output lattice; clipping
     base = base_model(declared)
     relative_sigma = nonmean.relative_sigma(data)
     outliers = _outliers(data, base, relative_sigma)  # judged at the local noise level

@@ -3,8 +3,8 @@
 A model file is YAML::
 
     tcbench_model: 1            # format version
-    sensor: msra                # or gyro
-    output_unit: Hz             # informative: Hz for msra, deg/s for gyro
+    sensor: msra                # or gyro, accel (any kind of tcbench.sensors.kinds)
+    output_unit: Hz             # informative: Hz for msra, deg/s for gyro, g for accel
     core:
       kind: polynomial
       centre_c: 10.0            # degC
@@ -25,7 +25,7 @@ A model file is YAML::
 
 with ``u = (T_die - centre_c) / half_range_c`` and the model output
 ``sum_j bias[j] u^j + input * sum_j scale_factor[j] u^j``; ``input`` is the acceleration in g
-(msra) or the rate in deg/s (gyro). Effects take their defaults for parameters not given; an
+(msra, accel) or the rate in deg/s (gyro). Effects take their defaults for parameters not given; an
 effect with no parameters may be written ``warmup: {}``. ``final``-stage effects (``quantisation``,
 ``saturation``) act on the finished output in file order, after every additive term; the
 ``thermometer``-stage effect (``thermometer_quantisation``) changes only the thermometer reading a
@@ -47,7 +47,8 @@ from typing import Any
 import yaml
 
 from tcbench.sensors import effects as fx
-from tcbench.sensors.fitted import OUTPUT_UNITS, SENSORS, PolynomialModel
+from tcbench.sensors import kinds
+from tcbench.sensors.fitted import PolynomialModel
 
 VERSION = 1
 TOP_KEYS = ("tcbench_model", "sensor", "output_unit", "core", "effects", "outliers")
@@ -159,9 +160,9 @@ def parse_model(data: Any, where: str) -> ModelSpec:
     _unknown_keys(data, TOP_KEYS, "key", where)
     sensor = data.get("sensor")
     if sensor is None:
-        raise ModelFileError(f"{where}: sensor is missing; known: {', '.join(SENSORS)}")
-    if sensor not in SENSORS:
-        raise ModelFileError(f"{where}: unknown sensor {sensor!r}; known: {', '.join(SENSORS)}")
+        raise ModelFileError(f"{where}: sensor is missing; known: {', '.join(kinds.names())}")
+    if not kinds.known(sensor):
+        raise ModelFileError(f"{where}: unknown sensor {sensor!r}; known: {', '.join(kinds.names())}")
     core = data.get("core")
     if not isinstance(core, dict):
         raise ModelFileError(f"{where}: core is missing or not a mapping")
@@ -214,7 +215,7 @@ def to_data(spec: ModelSpec) -> dict[str, Any]:
     out: dict[str, Any] = {
         "tcbench_model": VERSION,
         "sensor": spec.sensor,
-        "output_unit": OUTPUT_UNITS[spec.sensor],
+        "output_unit": kinds.get(spec.sensor).output_unit,
         "core": {
             "kind": "polynomial",
             "centre_c": float(spec.centre_c),

@@ -14,7 +14,7 @@ from typing import Any
 
 from tcbench.diagnose.diagnosis import Diagnosis
 from tcbench.diagnose.markdown import render_markdown
-from tcbench.diagnose.model_file import parse_model, write_model
+from tcbench.diagnose.model_file import ModelSpec, parse_model, write_model
 from tcbench.diagnose.plots import write_plots
 from tcbench.staging import staged_dir
 
@@ -32,13 +32,18 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def model_spec(diag: Diagnosis) -> ModelSpec:
+    """The fitted model of a diagnosis, as ``model.yaml`` holds it."""
+    return parse_model(_plain(diag.model), "model.yaml")
+
+
 def write_report(diag: Diagnosis, out: str | Path, inputs: Sequence[str | Path] = ()) -> dict[str, Path]:
     """Write the report files into ``out`` (created if needed), none of them over one of
     ``inputs``; returns name -> path."""
     out = Path(out)
     with staged_dir(out, inputs) as tmp:
         (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
-        write_model(parse_model(_plain(diag.model), "model.yaml"), tmp / "model.yaml")
+        write_model(model_spec(diag), tmp / "model.yaml")
         plots = write_plots(diag, tmp)
         (tmp / "report.md").write_text(render_markdown(diag, plots))
         names = sorted(item.name for item in tmp.iterdir())

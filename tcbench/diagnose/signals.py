@@ -16,6 +16,7 @@ from itertools import pairwise
 import numpy as np
 from scipy.signal import lfilter, oaconvolve, savgol_coeffs, savgol_filter
 
+from tcbench.sensors import kinds
 from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
@@ -50,6 +51,7 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.nd
     return value, slope
 
 
+MIN_DURATION_S = 1800.0  # a recording shorter than this is refused unless a caller asks for less
 MIN_WINDOW_SAMPLES = 10  # a fitted smoothing window never holds fewer samples than this
 FFT_WINDOW = 255  # longer Savitzky-Golay windows convolve by FFT (a 120 s window at 100 Hz holds 12001 samples)
 
@@ -214,7 +216,7 @@ def prepare(
     sensor: str | None = None,
     *,
     smooth_s: float = 120.0,
-    min_duration_s: float = 1800.0,
+    min_duration_s: float = MIN_DURATION_S,
     min_span_c: float = 2.0,
     min_samples: int = 200,
 ) -> DiagnosisData:
@@ -225,8 +227,8 @@ def prepare(
     its output has no noise to measure.
     """
     kind = sensor or rec.meta.sensor
-    if kind not in ("msra", "gyro"):
-        raise DiagnosisDataError(f"unknown sensor {kind!r}; give sensor=msra or sensor=gyro")
+    if not kinds.known(kind):
+        raise DiagnosisDataError(f"unknown sensor {kind!r}; give sensor=" + "|".join(kinds.names()))
     t, temp, u, y = rec.time_s, rec.temperature_c, rec.input, rec.output
     if t.size < min_samples or t[-1] - t[0] < min_duration_s:
         raise DiagnosisDataError(
@@ -253,7 +255,7 @@ def prepare(
     smooth, rate = smooth_temperature(t, temp, smooth_s)
     units = rec.meta.units or {}
     return DiagnosisData(
-        sensor=kind, unit=str(units.get("output", "Hz" if kind == "msra" else "deg/s")), t_s=t,
+        sensor=kind, unit=str(units.get("output", kinds.get(str(kind)).output_unit)), t_s=t,
         temp_raw_c=temp, temp_c=smooth, rate_c_per_s=rate, input=u, output=y, run_id=run_id,
         white_sigma=sigma,
         sample_rate_hz=float(rec.meta.sample_rate_hz or 1.0 / np.median(np.diff(t))), smooth_s=smooth_s,

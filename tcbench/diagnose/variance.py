@@ -32,7 +32,7 @@ Test (:func:`find_variance`), on the final model's in-sample residual ``r``:
    noisiest and the quietest bin.
 5. **Model**: ``log sigma`` linear in temperature (time), its slope from the blocks' linear
    regression and its level from the pairs; ``model.yaml`` gets ``noise_temperature: {density,
-   growth_per_c, ref_c}`` (or ``noise_time: {density, growth_per_h}``) in place of
+   growth_per_c, ref_c}`` (or ``noise_time: {density, growth_per_h, ref_s}``) in place of
    ``white_noise``, so ``tcbench simulate model=`` draws noise of the same changing level.
 """
 
@@ -102,8 +102,7 @@ class Variance:
         density = self.sigma_ref / np.sqrt(self.sample_rate_hz)
         if self.found.against == "temperature":
             return "noise_temperature", {"density": float(density), "growth_per_c": self.found.slope, "ref_c": self.ref}
-        at_zero = density * np.exp(-self.found.slope * self.ref)  # the effect's clock starts at t = 0
-        return "noise_time", {"density": float(at_zero), "growth_per_h": 3600.0 * self.found.slope}
+        return "noise_time", {"density": float(density), "growth_per_h": 3600.0 * self.found.slope, "ref_s": self.ref}
 
     def finding(self, unit: str) -> dict[str, Any]:
         """The report.json ``effects`` entry (shape ``variance``)."""

@@ -4,6 +4,10 @@
   variation over temperature (seed 000 Table 2).
 - MSRA otherwise (a 0 g run): zero-bias stability after 30 min, 20 min and from zero start
   (seed 000 Table 1), and its Allan read-offs.
+- Any accelerometer kind with complete four-position groups (an ``accel`` multi-position
+  test): the same per-node table.
+- Any other kind (an ``accel`` chamber or static run): bias stability, noise density (VRW), bias
+  instability, bias against temperature and hysteresis (:mod:`tcbench.metrics.inertial`).
 - Gyroscope: Allan read-offs (seed 001), when the run reaches 60 and -40 degC the drift
   between those soaks, and the output against temperature with a fitted line (slope, its
   standard error and r), plotted as ``rate_vs_temperature.png``.
@@ -27,6 +31,8 @@ import pandas as pd
 from tcbench import plots
 from tcbench.metrics import accelerometer as acc
 from tcbench.metrics import gyro
+from tcbench.metrics.inertial import kind_metrics, token
+from tcbench.sensors import kinds
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 from tcbench.signal.allan import (
@@ -81,27 +87,35 @@ def _floor_read(p: NoiseParameters, unit: str, scale: float) -> tuple[dict[str, 
                      "record would show the floor"]
 
 
-def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: dict[str, Path]) -> Report:
+def _positions(rec: Recording) -> np.ndarray | None:
+    """The position labels as strings (empty where none), or None without the column."""
     labels = rec.position
-    pos = None if labels is None else np.where(labels == None, "", labels).astype(str)  # noqa: E711
-    if pos is not None and np.isin(pos, ["+1g", "-1g"]).any():  # a four-position test
-        nodes = acc.four_position(rec.temperature_c, rec.output, pos)
-        var = acc.temperature_variation(nodes)
-        metrics = {
-            "sf_variation_ppm": var.scale_factor_ppm,
-            "bias_variation_ug": var.bias_ug,
-            "nodes": float(var.nodes),
-            "sf_mean_hz_per_g": float(nodes["scale_factor_hz_per_g"].mean()),
-        }
-        conventions = [
-            "scale factor K1 = (U(+1g) - U(-1g))/2; bias B0 = (U(+0g) + U(-0g))/(U(+1g) - U(-1g)) g "
-            "(eq. 12 with the plus sign; the printed minus measures misalignment)",
-            "variation: std/mean of K1 (ppm), std of B0 (micro-g); sample std (ddof=1) over nodes",
-        ]
-        if out is not None:
-            files["nodes"] = out / "nodes.csv"
-            nodes.to_csv(files["nodes"], index=False)
-        return Report(metrics, conventions, nodes, files)
+    return None if labels is None else np.where(labels == None, "", labels).astype(str)  # noqa: E711
+
+
+def _four_position(rec: Recording, pos: np.ndarray, out: Path | None, files: dict[str, Path]) -> Report:
+    """Scale factor and bias per temperature node from a four-position test (any accelerometer kind)."""
+    nodes = acc.four_position(rec.temperature_c, rec.output, pos)
+    var = acc.temperature_variation(nodes)
+    unit = token(kinds.get(str(rec.meta.sensor)).output_unit)
+    metrics = {
+        "sf_variation_ppm": var.scale_factor_ppm,
+        "bias_variation_ug": var.bias_ug,
+        "nodes": float(var.nodes),
+        f"sf_mean_{unit}_per_g": float(nodes["scale_factor_hz_per_g"].mean()),
+    }
+    conventions = [
+        "scale factor K1 = (U(+1g) - U(-1g))/2; bias B0 = (U(+0g) + U(-0g))/(U(+1g) - U(-1g)) g "
+        "(eq. 12 with the plus sign; the printed minus measures misalignment)",
+        "variation: std/mean of K1 (ppm), std of B0 (micro-g); sample std (ddof=1) over nodes",
+    ]
+    if out is not None:
+        files["nodes"] = out / "nodes.csv"
+        nodes.to_csv(files["nodes"], index=False)
+    return Report(metrics, conventions, nodes, files)
+
+
+def _msra(rec: Recording, scale_factor: float | None, out: Path | None, files: dict[str, Path]) -> Report:
     sf = _scale_factor(rec, scale_factor)
     metrics, unstable = {}, []
     for row, start_s in acc.ZERO_BIAS_STARTS_S.items():
@@ -171,21 +185,68 @@ def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     return Report(metrics, conventions, None, files, details)
 
 
+def _kind(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
+    """Any other kind: bias stability, noise density, bias instability, bias against temperature
+    and hysteresis in the kind's noise unit (:mod:`tcbench.metrics.inertial`)."""
+    kind = kinds.get(str(rec.meta.sensor))
+    fs = rec.meta.sample_rate_hz or 1.0 / float(np.median(np.diff(rec.time_s)))
+    seg = segments(rec.time_s)
+    n_seg = int(seg[-1]) + 1
+    km = kind_metrics(kind, rec.time_s, rec.temperature_c, rec.input, rec.output, fs, seg if n_seg > 1 else None)
+    unit = kind.noise_unit
+    floor, floor_note = _floor_read(km.params, unit, 1.0)
+    conventions = [
+        f"bias = output - applied input, in {unit}; bias stability = 1 sigma (ddof=1) of non-overlapping 10 s means "
+        "over the whole record (at constant temperature the (1 sigma, 10 s) figure; over a chamber cycle mostly drift)",
+        f"noise density = Allan -1/2 line at tau = 1 s ({unit}/sqrt(Hz)); bias instability = Allan minimum / 0.664 "
+        f"({unit}); read-offs over tau <= T/10", *floor_note]
+    if "bias_temp_r" in km.metrics:
+        conventions.append(f"bias vs temperature: least-squares line through {km.fit.temperature_c.size} "  # type: ignore[union-attr]
+                           f"{km.fit.method} (mean bias at mean temperature); slope in {unit} per degC")  # type: ignore[union-attr]
+    if km.loop is not None:
+        conventions.append(f"hysteresis: cooling minus heating bias in {km.loop.temperature_c.size} common 1 degC bins; "
+                           "width = the largest |difference|, mean = its signed mean (a die lag opens the same loop)")
+    details: dict[str, Any] = {"hysteresis": km.loop.as_dict()} if km.loop is not None else {}
+    if km.fit is not None:
+        details["bias_vs_temperature"] = km.fit.as_dict()
+    if n_seg > 1:
+        km.metrics["segments"] = float(n_seg)
+    if out is not None:
+        files["allan"] = plots.allan_plot(out / "allan.png", km.ad.tau_s, km.ad.adev, _allan_lines(km.params), unit,
+                                          f"{kind.name} Allan deviation of the bias")
+        if km.fit is not None:
+            loop = f", hysteresis {km.loop.width:.4g} {unit}" if km.loop is not None else ""
+            files["bias_vs_temperature"] = plots.rate_temperature_plot(
+                out / "bias_vs_temperature.png", rec.temperature_c, km.bias, (km.fit.temperature_c, km.fit.output_dps),
+                (km.fit.slope_dps_per_c, km.fit.intercept_dps), f"{km.fit.method} ({km.fit.temperature_c.size})",
+                f"bias ({unit})", f"{rec.meta.device_id}: {km.fit.slope_dps_per_c:+.4g} ± "
+                f"{km.fit.slope_stderr_dps_per_c:.2g} {unit} per °C{loop}")
+    return Report(km.metrics | floor, conventions, None, files, details)
+
+
 def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None = None) -> Report:
     """Metrics (and, with ``out``, plots, ``metrics.json`` and ``nodes.csv``) of a recording."""
     sensor = rec.meta.sensor
-    if sensor not in {"msra", "gyro"}:
+    if not kinds.known(sensor):
         raise ValueError("the recording has no sidecar saying which sensor it is; add one")
     files: dict[str, Path] = {}
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
-        unit = "Hz" if sensor == "msra" else "°/s"
+        unit = {"deg/s": "°/s"}.get(rec.meta.units.get("output", ""), rec.meta.units.get("output", ""))
         files["overview"] = plots.recording_overview(
             out / "overview.png", rec.time_s, rec.temperature_c, rec.output, f"output ({unit})",
             f"{rec.meta.device_id}: {rec.meta.extra.get('protocol', '') if rec.meta.extra else ''}",
             segment=segments(rec.time_s),
         )
-    report = _msra(rec, scale_factor, out, files) if sensor == "msra" else _gyro(rec, out, files)
+    pos = _positions(rec) if kinds.get(str(sensor)).positions else None
+    if pos is not None and np.isin(pos, ["+1g", "-1g"]).any():  # a four-position test
+        report = _four_position(rec, pos, out, files)
+    elif sensor == "msra":
+        report = _msra(rec, scale_factor, out, files)
+    elif sensor == "gyro":
+        report = _gyro(rec, out, files)
+    else:
+        report = _kind(rec, out, files)
     if out is not None:
         payload: dict[str, Any] = {"device_id": rec.meta.device_id, "sensor": sensor,
                                    "metrics": report.metrics, "conventions": report.conventions, **report.details}

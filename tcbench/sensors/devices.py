@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tcbench.sensors import kinds
 from tcbench.sensors.models import MSRA, Gyro, Unit, gyro_effects, msra_effects
 
 
@@ -73,11 +74,7 @@ def gyro_unit(device_seed: int) -> Unit:
     return Unit(f"gyro-{device_seed:04d}", model, draws)
 
 
-UNITS = {"msra": msra_unit, "gyro": gyro_unit}
-
-
 def unit(sensor: str, device_seed: int) -> Unit:
-    """The unit ``device_seed`` of sensor kind ``sensor`` (``msra`` or ``gyro``)."""
-    if sensor not in UNITS:
-        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(UNITS)}")
-    return UNITS[sensor](device_seed)
+    """The unit ``device_seed`` of sensor kind ``sensor`` (:mod:`tcbench.sensors.kinds`)."""
+    device: Unit = kinds.get(sensor).device(device_seed)
+    return device

@@ -402,13 +402,15 @@ class NoiseTemperature(Effect):
 
 @dataclass(frozen=True)
 class NoiseTime(Effect):
-    """White noise whose level changes with time since power-on: per-sample standard deviation
-    ``density * sqrt(fs) * exp(growth_per_h * t / 3600)`` (``density`` in output unit per
-    sqrt(Hz) at t = 0; ``growth_per_h`` the relative growth of sigma per hour)."""
+    """White noise whose level changes with time: per-sample standard deviation
+    ``density * sqrt(fs) * exp(growth_per_h * (t - ref_s) / 3600)`` (``density`` in output unit
+    per sqrt(Hz) at ``t = ref_s`` on the record's clock; ``growth_per_h`` the relative growth of
+    sigma per hour). A reference inside the record keeps the level finite on an epoch clock."""
 
     id: ClassVar[str] = "noise_time"
     density: float = 0.0
     growth_per_h: float = 0.0
+    ref_s: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.density >= 0:
@@ -416,7 +418,7 @@ class NoiseTime(Effect):
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
         x = noise.white(s.t_s.size, self.density / np.sqrt(s.dt_s), rng)
-        x *= np.exp(self.growth_per_h * s.t_s / 3600.0)
+        x *= np.exp(self.growth_per_h * (s.t_s - self.ref_s) / 3600.0)
         return x
 
 

@@ -1,11 +1,11 @@
 """A fitted sensor model: polynomial bias and scale factor in the die temperature, plus effects.
 
-The core of :class:`PolynomialModel` serves either sensor kind::
+The core of :class:`PolynomialModel` serves every sensor kind (:mod:`tcbench.sensors.kinds`)::
 
     output = sum_j bias[j] u^j + input * sum_j scale_factor[j] u^j,   u = (T_die - centre_c) / half_range_c
 
-with ``input`` the acceleration along the sensitive axis in g (MSRA, output in Hz) or the
-applied rate in deg/s (gyroscope, output in deg/s). This is what ``tcbench diagnose`` fits to
+with ``input`` the kind's applied input: the acceleration along the sensitive axis in g (MSRA,
+output in Hz; accelerometer, output in g) or the applied rate in deg/s (gyroscope, output in deg/s). This is what ``tcbench diagnose`` fits to
 a recording and writes as a model file (:mod:`tcbench.diagnose.model_file`); the effects
 (lag, warm-up, noise, ...) are the same objects as in the physical models.
 """
@@ -20,11 +20,8 @@ import numpy as np
 from numpy.polynomial import polynomial as npoly
 
 from tcbench.sensors import effects as fx
+from tcbench.sensors import kinds
 from tcbench.sensors.models import SensorModel
-
-SENSORS = ("msra", "gyro")
-OUTPUT_UNITS = {"msra": "Hz", "gyro": "deg/s"}
-INPUT_UNITS = {"msra": "g", "gyro": "deg/s"}
 
 
 @dataclass(frozen=True)
@@ -48,8 +45,7 @@ class PolynomialModel(SensorModel):
     spike_size: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
-        if self.sensor not in SENSORS:
-            raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join(SENSORS)}")
+        kinds.get(self.sensor)  # a known kind, or one line naming them
         if not np.isfinite(self.centre_c):
             raise ValueError(f"centre_c must be finite, got {self.centre_c!r}")
         if not (np.isfinite(self.half_range_c) and self.half_range_c > 0):
@@ -71,12 +67,12 @@ class PolynomialModel(SensorModel):
 
     @property
     def kind(self) -> str:  # type: ignore[override]
-        """The sensor kind, ``msra`` or ``gyro`` (checked against a protocol's)."""
+        """The sensor kind (checked against a protocol's)."""
         return self.sensor
 
     @property
     def scale_factor_hz_per_g(self) -> float | None:
-        """Nominal MSRA scale factor at ``centre_c`` (Hz/g); None for a gyroscope."""
+        """Nominal MSRA scale factor at ``centre_c`` (Hz/g); None for other kinds."""
         return self.scale_factor[0] if self.sensor == "msra" else None
 
     def normalised(self, temp_c: np.ndarray) -> np.ndarray:
@@ -93,7 +89,7 @@ class PolynomialModel(SensorModel):
 
     def core(self, s: fx.Signals) -> np.ndarray:
         u = self.normalised(s.temp_die_c)
-        applied = s.accel_g if self.sensor == "msra" else s.rate_dps
+        applied = getattr(s, kinds.get(self.sensor).input_field)
         return npoly.polyval(u, self.bias) + applied * npoly.polyval(u, self.scale_factor) + self.spikes(s.t_s)
 
     def spikes(self, t_s: np.ndarray) -> np.ndarray:

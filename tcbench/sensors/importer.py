@@ -30,11 +30,11 @@ import pyarrow.csv as pcsv
 
 from tcbench.sensors.recording import (
     NUMERIC_COLUMNS,
-    SENSORS,
-    STANDARD_UNITS,
     Recording,
     RecordingError,
+    check_sensor,
     make_recording,
+    standard_units,
     write_recording,
 )
 from tcbench.sensors.recording_files import (
@@ -70,7 +70,7 @@ class Column:
 def parse_column(target: str, spec: str, sensor: str, available: Sequence[str]) -> Column:
     """The file column and unit of ``spec`` (``name`` or ``name:unit``) for schema column
     ``target``; a name that exists in the file as written wins over splitting at its last colon."""
-    schema_unit = STANDARD_UNITS[sensor][target]
+    schema_unit = standard_units(sensor)[target]
     name, unit = spec, schema_unit
     if spec not in available and ":" in spec:
         name, unit = spec.rsplit(":", 1)
@@ -139,7 +139,7 @@ def _in_csv(err: RecordingError, file: str, rows: np.ndarray, columns: Mapping[s
 
     col = columns.get(err.column or "")
     problem = re.sub(r"\brow (\d+)", lambda m: f"row {row(int(m.group(1)))}", err.problem)
-    unit = STANDARD_UNITS[sensor][col.target] if col is not None else None
+    unit = standard_units(sensor)[col.target] if col is not None else None
     if col is not None and err.row and col.unit != unit and np.isfinite(table[col.target][err.row - 1]):
         problem += f" (after converting {col.unit} to {unit})"
     return RecordingError(problem, file=file, row=row(err.row) if err.row else None,
@@ -217,8 +217,7 @@ def import_table(table: Mapping[str, np.ndarray], sensor: str, columns: Mapping[
 
 
 def _check_request(sensor: str, columns: Mapping[str, str]) -> None:
-    if sensor not in SENSORS:
-        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    check_sensor(sensor)
     unknown = [k for k in columns if k not in NUMERIC_COLUMNS]
     if unknown:
         raise RecordingError(f"unknown schema column {unknown[0]!r} (expected {', '.join(NUMERIC_COLUMNS)})")

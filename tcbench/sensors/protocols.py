@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tcbench.sensors import kinds
 from tcbench.sensors.thermal import Segment, first_order_lag, gauss_markov, segment_index, setpoint
 
 MAX_LEVELS = 1000  # temperature levels of an oven run
@@ -55,8 +56,9 @@ class Profile:
 
     @property
     def input(self) -> np.ndarray:
-        """The recorded ``input`` column: acceleration (g) for the MSRA, rate (deg/s) for a gyro."""
-        return self.accel_g if self.sensor == "msra" else self.rate_dps
+        """The recorded ``input`` column: the applied input its sensor kind measures
+        (acceleration in g, or rate in deg/s)."""
+        return getattr(self, kinds.get(self.sensor).input_field)
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,28 @@ def _from_segments(
     )
 
 
+def four_position_nodes(
+    name: str,
+    sensor: str,
+    nodes_c: tuple[float, ...],
+    soak_s: float,
+    position_s: float,
+    move_s: float,
+    start_c: float,
+    sample_rate_hz: float,
+    chamber: Chamber,
+) -> Profile:
+    """An accelerometer's multi-position test: at each temperature node a soak at +0g, then
+    +0g, +1g, -0g, -1g for ``position_s`` each with ``move_s`` turntable moves between."""
+    segments: list[Segment] = []
+    for node in nodes_c:
+        segments.append(Segment(node, soak_s, "", *POSITIONS["+0g"]))
+        for label, (accel, cross) in POSITIONS.items():
+            segments.append(Segment(node, move_s, "", accel, cross))
+            segments.append(Segment(node, position_s, label, accel, cross))
+    return _from_segments(name, sensor, segments, start_c, sample_rate_hz, chamber)
+
+
 def msra_fulltemp(
     nodes_c: tuple[float, ...] = (-40.0, -20.0, 0.0, 20.0, 40.0, 60.0),
     soak_s: float = 3600.0,
@@ -133,13 +157,8 @@ def msra_fulltemp(
     chamber: Chamber = Chamber(),
 ) -> Profile:
     """Seed 000 full-temperature test: soak at each node, then the four positions."""
-    segments: list[Segment] = []
-    for node in nodes_c:
-        segments.append(Segment(node, soak_s, "", *POSITIONS["+0g"]))
-        for label, (accel, cross) in POSITIONS.items():
-            segments.append(Segment(node, move_s, "", accel, cross))
-            segments.append(Segment(node, position_s, label, accel, cross))
-    return _from_segments("fulltemp", "msra", segments, start_c, sample_rate_hz, chamber)
+    return four_position_nodes("fulltemp", "msra", nodes_c, soak_s, position_s, move_s, start_c, sample_rate_hz,
+                               chamber)
 
 
 def msra_roomtemp(

@@ -1,9 +1,10 @@
 """Sensor recordings, schema v1: a CSV or Parquet table plus a JSON sidecar, validated on I/O.
 
 Table columns: ``time_s`` (strictly increasing), ``temperature_c`` (the sensor's thermometer),
-``input`` (applied acceleration in g, or applied rate in deg/s), ``output`` (MSRA frequency
-difference in Hz, or gyro rate in deg/s) and, for MSRA only, an optional ``position`` (``+0g``,
-``+1g``, ``-0g``, ``-1g``, or empty outside the four-position test). Other columns are rejected.
+``input`` (applied acceleration in g, or applied rate in deg/s), ``output`` (in the kind's unit:
+an MSRA's frequency difference in Hz, a gyro's rate in deg/s, an accelerometer's g) and, for
+accelerometer kinds, an optional ``position`` (``+0g``, ``+1g``, ``-0g``, ``-1g``, or empty outside
+a four-position test). Other columns are rejected. The kinds are :mod:`tcbench.sensors.kinds`.
 The sidecar ``<stem>.json`` holds the sensor kind, units, sample rate, device id and a free-form
 ``extra`` object; it is optional when reading and always written.
 
@@ -40,13 +41,10 @@ from tcbench.sensors.recording_files import (
 from tcbench.sensors.recording_schema import (
     COLUMNS,
     FORMATS,
-    KNOWN_UNITS,
     NUMERIC_COLUMNS,
     POSITIONS,
     RATE_TOLERANCE,
     SCHEMA_VERSION,
-    SENSORS,
-    STANDARD_UNITS,
     RecordingError,
     RecordingMeta,
     _check_consistency,
@@ -55,24 +53,27 @@ from tcbench.sensors.recording_schema import (
     _meta_from_dict,
     _normalise,
     _positions,
+    check_sensor,
+    known_units,
+    standard_units,
 )
 
 __all__ = [
     "COLUMNS",
     "FORMATS",
-    "KNOWN_UNITS",
     "NUMERIC_COLUMNS",
     "POSITIONS",
     "RATE_TOLERANCE",
     "SCHEMA_VERSION",
-    "SENSORS",
-    "STANDARD_UNITS",
     "Recording",
     "RecordingError",
     "RecordingMeta",
+    "check_sensor",
+    "known_units",
     "make_recording",
     "read_recording",
     "sidecar_path",
+    "standard_units",
     "write_recording",
 ]
 
@@ -96,12 +97,12 @@ class Recording:
 
     @property
     def input(self) -> np.ndarray:
-        """Applied stimulus: acceleration in g (MSRA) or rate in deg/s (gyro)."""
+        """Applied stimulus in the kind's input unit: acceleration in g, or rate in deg/s."""
         return self.data["input"].to_numpy(dtype=np.float64)
 
     @property
     def output(self) -> np.ndarray:
-        """Sensor output: frequency difference in Hz (MSRA) or rate in deg/s (gyro)."""
+        """Sensor output in the kind's output unit: Hz (MSRA), deg/s (gyro), g (accel)."""
         return self.data["output"].to_numpy(dtype=np.float64)
 
     @property
@@ -132,13 +133,12 @@ def make_recording(
 
     Contiguous float64 arrays become the table's columns without a copy (the recording then
     shares them with the caller); anything else, broadcast views included, is copied once."""
-    if sensor not in SENSORS:
-        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    check_sensor(sensor)
     columns: dict[str, Any] = {"time_s": time_s, "temperature_c": temperature_c, "input": input, "output": output}
     columns = {k: np.ascontiguousarray(v, dtype=np.float64).reshape(-1) for k, v in columns.items()}
     if position is not None:
         columns["position"] = pd.Series(np.asarray(position, dtype=object).reshape(-1), dtype=object)
-    meta = RecordingMeta(sensor, dict(STANDARD_UNITS[sensor]), float(sample_rate_hz), device_id,
+    meta = RecordingMeta(sensor, standard_units(sensor), float(sample_rate_hz), device_id,
                          extra=dict(extra or {}))
     rec = Recording(pd.DataFrame(columns, copy=False), meta)
     rec.data = _checked(rec, None, None)[0]

@@ -16,16 +16,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from tcbench.sensors import kinds
+
 SCHEMA_VERSION = 1
-SENSORS = ("msra", "gyro")
 POSITIONS = ("+0g", "+1g", "-0g", "-1g")
 NUMERIC_COLUMNS = ("time_s", "temperature_c", "input", "output")
 COLUMNS = (*NUMERIC_COLUMNS, "position")
-STANDARD_UNITS = {
-    "msra": {"time_s": "s", "temperature_c": "degC", "input": "g", "output": "Hz"},
-    "gyro": {"time_s": "s", "temperature_c": "degC", "input": "deg/s", "output": "deg/s"},
-}
-KNOWN_UNITS = {c: tuple(dict.fromkeys(u[c] for u in STANDARD_UNITS.values())) for c in NUMERIC_COLUMNS}
 FORMATS = (".csv", ".parquet")
 RATE_TOLERANCE = 0.01
 TIME_LIMIT_S = 1.0e10  # |time_s| beyond this (317 years) is a unit mistake or a glitch, not a clock
@@ -180,8 +176,7 @@ def _meta_from_dict(doc: Any) -> RecordingMeta:
     if unknown:
         raise RecordingError(f"unknown key {unknown[0]!r} (free-form data goes under 'extra')")
     sensor = doc["sensor"]
-    if sensor not in SENSORS:
-        raise RecordingError(f"unknown sensor {sensor!r} (expected 'msra' or 'gyro')")
+    check_sensor(sensor)
     units = _check_units(doc["units"], sensor)
     rate = doc["sample_rate_hz"]
     if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not math.isfinite(rate) or rate <= 0:
@@ -195,6 +190,23 @@ def _meta_from_dict(doc: Any) -> RecordingMeta:
     return RecordingMeta(sensor, units, float(rate), device, SCHEMA_VERSION, extra)
 
 
+def check_sensor(sensor: Any) -> None:
+    """A known sensor kind, or one line naming the known ones."""
+    if not kinds.known(sensor):
+        raise RecordingError(f"unknown sensor {sensor!r} (expected one of {', '.join(map(repr, kinds.names()))})")
+
+
+def standard_units(sensor: str) -> dict[str, str]:
+    """The schema units of a ``sensor`` recording's numeric columns."""
+    check_sensor(sensor)
+    return kinds.get(sensor).units
+
+
+def known_units(column: str) -> tuple[str, ...]:
+    """Every schema unit ``column`` has in some kind."""
+    return tuple(dict.fromkeys(kind.units[column] for kind in kinds.registry().values()))
+
+
 def _check_units(units: Any, sensor: str) -> dict[str, str]:
     """Every column's unit known to the schema and the one of ``sensor``."""
     if not isinstance(units, dict):
@@ -205,29 +217,33 @@ def _check_units(units: Any, sensor: str) -> dict[str, str]:
     for c in NUMERIC_COLUMNS:
         if c not in units:
             raise RecordingError("no unit given", column=c)
-        unit, expected = units[c], STANDARD_UNITS[sensor][c]
-        if unit not in KNOWN_UNITS[c]:
-            raise RecordingError(f"unknown unit {unit!r}; accepted: {', '.join(KNOWN_UNITS[c])}", column=c)
+        unit, expected = units[c], standard_units(sensor)[c]
+        if unit not in known_units(c):
+            raise RecordingError(f"unknown unit {unit!r}; accepted: {', '.join(known_units(c))}", column=c)
         if unit != expected:
             raise RecordingError(f"unit {unit!r} does not fit a {sensor} recording (expected {expected!r})", column=c)
     return {c: units[c] for c in NUMERIC_COLUMNS}
 
 
-# Plausible ranges of each column in its schema unit, beyond which a value is a unit mistake
-# (kelvin labelled degC, mdps labelled deg/s, ...) rather than a measurement: test chambers run
-# -70..+180 degC; MEMS gyros measure up to a few thousand deg/s; accelerometers up to a few
-# hundred g; an MSRA's output is a frequency difference well below its ~30 kHz resonance.
-PLAUSIBLE = {
-    "temperature_c": (-100.0, 200.0, "degC"),
-    "gyro": {"input": (-20000.0, 20000.0, "deg/s"), "output": (-20000.0, 20000.0, "deg/s")},
-    "msra": {"input": (-1000.0, 1000.0, "g"), "output": (-1.0e6, 1.0e6, "Hz")},
-}
+# Plausible temperatures (test chambers run -70..+180 degC); beyond them a value is a unit mistake
+# (kelvin labelled degC) rather than a measurement. Each kind states its input's and output's.
+PLAUSIBLE_TEMPERATURE_C = (-100.0, 200.0)
+
+
+def plausible_ranges(sensor: str | None) -> dict[str, tuple[float, float, str]]:
+    """Column -> (low, high, unit) beyond which a value is a unit mistake (mdps labelled deg/s,
+    mg labelled g, ...), not a measurement."""
+    ranges = {"temperature_c": (*PLAUSIBLE_TEMPERATURE_C, "degC")}
+    if kinds.known(sensor):
+        kind = kinds.get(str(sensor))
+        ranges |= {"input": (*kind.input_range, kind.input_unit), "output": (*kind.output_range, kind.output_unit)}
+    return ranges
 
 
 def _check_plausible(data: pd.DataFrame, sensor: str | None, table: str | None) -> None:
-    """Every value within :data:`PLAUSIBLE` for its column's unit; the first outside names file,
-    row and column."""
-    ranges = {"temperature_c": PLAUSIBLE["temperature_c"], **(PLAUSIBLE.get(sensor or "", {}))}
+    """Every value within :func:`plausible_ranges` for its column's unit; the first outside
+    names file, row and column."""
+    ranges = plausible_ranges(sensor)
     for column, (low, high, unit) in ranges.items():
         x = data[column].to_numpy(dtype=np.float64)
         bad = (x < low) | (x > high)
@@ -240,13 +256,13 @@ def _check_plausible(data: pd.DataFrame, sensor: str | None, table: str | None) 
 
 def _check_consistency(data: pd.DataFrame, meta: RecordingMeta, table: str | None, side: str | None) -> None:
     """Sidecar against table: plausible values for the units, sample rate vs the median time
-    step, positions only for MSRA."""
+    step, positions only for kinds that have them."""
     _check_plausible(data, meta.sensor, table)
-    if meta.sensor == "gyro" and "position" in data:
+    if meta.sensor is not None and not kinds.get(meta.sensor).positions and "position" in data:
         given = data["position"].notna().to_numpy()
         if given.any():
-            raise RecordingError("gyro recordings have no positions", file=table, row=int(np.argmax(given)) + 1,
-                                 column="position")
+            raise RecordingError(f"{meta.sensor} recordings have no positions", file=table,
+                                 row=int(np.argmax(given)) + 1, column="position")
     t = data["time_s"].to_numpy()
     if meta.sample_rate_hz is None or t.size < 2:
         return

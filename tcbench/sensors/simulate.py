@@ -11,26 +11,20 @@ from typing import Any
 import numpy as np
 
 from tcbench.sensors import effects as fx
-from tcbench.sensors import protocols
+from tcbench.sensors import kinds
 from tcbench.sensors.devices import unit
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.noise import quantise
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording, make_recording
 
-PROTOCOLS: dict[str, dict[str, Callable[..., Profile]]] = {
-    "msra": {"roomtemp": protocols.msra_roomtemp, "fulltemp": protocols.msra_fulltemp},
-    "gyro": {"oven": protocols.gyro_oven, "static": protocols.gyro_static},
-}
 THERMOMETER_NOISE_C = 0.005  # std of the sensor's thermometer reading
 THERMOMETER_STEP_C = 0.01  # its resolution
 
 
 def protocol_names(sensor: str) -> list[str]:
     """Protocols available for a sensor kind."""
-    if sensor not in PROTOCOLS:
-        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(PROTOCOLS)}")
-    return list(PROTOCOLS[sensor])
+    return list(kinds.get(sensor).protocols)
 
 
 def build_profile(
@@ -40,7 +34,7 @@ def build_profile(
     names = protocol_names(sensor)
     if protocol not in names:
         raise ValueError(f"unknown protocol {protocol!r} for {sensor}; known: {', '.join(names)}")
-    fn = PROTOCOLS[sensor][protocol]
+    fn: Callable[..., Profile] = kinds.get(sensor).protocols[protocol]
     accepted = inspect.signature(fn).parameters
     given = {k: v for k, v in params.items() if v is not None}
     unknown = sorted(set(given) - set(accepted) - {"rng"})
@@ -64,7 +58,7 @@ def _checked_param(key: str, value: Any, default: Any) -> Any:
     if not isinstance(default, Real):
         raise ValueError(f"{where}: cannot be set from outside (it is a {type(default).__name__})")
     x = _number(where, value)
-    if key.endswith("_hz") or key in {"duration_s", "step_c"}:
+    if key.endswith(("_hz", "_per_min")) or key in {"duration_s", "step_c"}:
         if x <= 0:
             raise ValueError(f"{where}: must be a finite number > 0, got {x:g}")
     elif key.endswith("_s") and x < 0:

@@ -19,16 +19,13 @@ from typing import Any
 import numpy as np
 
 from tcbench.sensors import effects as fx
+from tcbench.sensors import kinds
 from tcbench.sensors.devices import unit
 from tcbench.sensors.models import SensorModel, _signals
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.simulate import build_profile
 
 STOCHASTIC_EFFECTS = ("white_noise", "bias_instability", "random_walk", "quantisation", "noise_temperature", "noise_time")
-# Input step of the sensitivity's central difference, in the input unit (g or deg/s). The MSRA
-# output is quadratic and the gyro output linear in the input, so the central difference is
-# exact up to rounding for both.
-INPUT_STEP = {"msra": 1e-3, "gyro": 1e-3}
 
 
 @dataclass(frozen=True)
@@ -40,7 +37,7 @@ class Truth:
     output_det: noise-free output (Hz for the MSRA, deg/s for the gyro): the model without
         white noise, bias instability, random walk and quantisation.
     sensitivity_per_input: d output_det / d input (Hz/g for the MSRA, output per deg/s for
-        the gyro), by a central difference with the input shifted by +-``INPUT_STEP``.
+        the gyro), by a central difference with the input shifted by +-the kind's ``input_step``.
     input: the applied input (g or deg/s), the recording's ``input``.
     """
 
@@ -53,9 +50,8 @@ class Truth:
 
 def _shifted(profile: Profile, delta: float) -> Profile:
     """The profile with its recorded input (acceleration or rate) shifted by ``delta``."""
-    if profile.sensor == "msra":
-        return dataclasses.replace(profile, accel_g=profile.accel_g + delta)
-    return dataclasses.replace(profile, rate_dps=profile.rate_dps + delta)
+    name = kinds.get(profile.sensor).input_field
+    return dataclasses.replace(profile, **{name: getattr(profile, name) + delta})
 
 
 def _deterministic(model: SensorModel, profile: Profile) -> np.ndarray:
@@ -80,7 +76,7 @@ def simulate_truth(
     profile = build_profile(sensor, protocol, profile_rng, **protocol_params)
     det = model.without(*STOCHASTIC_EFFECTS)
     temp_die_c = fx.die_temperature(list(det.effects), _signals(profile, det.ref_c))
-    step = INPUT_STEP[sensor]
+    step = kinds.get(sensor).input_step  # outputs are at most quadratic in the input: the difference is exact
     plus = _deterministic(det, _shifted(profile, step))
     minus = _deterministic(det, _shifted(profile, -step))
     return Truth(

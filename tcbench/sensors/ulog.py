@@ -1,10 +1,10 @@
 """PX4 ULog files (``.ulg``, read with pyulog) as recordings: the sensor topic of a kind
-(``sensor_gyro`` for a gyro), every instance (one per physical sensor), each axis a recording
+(``sensor_gyro`` for a gyro, ``sensor_accel`` for an accelerometer), every instance (one per physical sensor), each axis a recording
 with the topic's own clock and temperature.
 
 A topic instance is a table of fields (``timestamp``, ``timestamp_sample`` in µs since boot,
 ``x``, ``y``, ``z``, ``temperature`` in °C, ...); the default column map reads the sample clock,
-the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``), and any field can
+the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``, m/s^2 for ``sensor_accel``), and any field can
 be named instead, with a unit, as for a CSV file (:func:`tcbench.sensors.importer.import_table`).
 """
 
@@ -15,11 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
+from tcbench.sensors import kinds
 from tcbench.sensors.recording import RecordingError
 
-# sensor kind -> its PX4 topic and the unit PX4 logs its axes in (an accelerometer kind's
-# sensor_accel, in m/s^2, joins when tcbench has one)
-TOPICS = {"gyro": ("sensor_gyro", "rad/s")}
 AXES = ("x", "y", "z")
 
 
@@ -40,9 +38,14 @@ def default_columns(fields: list[str]) -> dict[str, str]:
     return {"time_s": f"{clock}:us", "temperature_c": "temperature:degC"}
 
 
+def topics() -> dict[str, tuple[str, str]]:
+    """Sensor kind -> its PX4 topic and the unit PX4 logs the axes in (kinds that have one)."""
+    return {k.name: (k.ulog_topic, k.ulog_unit or k.output_unit) for k in kinds.registry().values() if k.ulog_topic}
+
+
 def default_axes(sensor: str) -> list[str]:
     """``x:UNIT``, ``y:UNIT``, ``z:UNIT`` in the unit PX4 logs the sensor's topic in."""
-    unit = TOPICS[sensor][1]
+    unit = topics()[sensor][1]
     return [f"{a}:{unit}" for a in AXES]
 
 
@@ -50,10 +53,11 @@ def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
     """Every instance of ``sensor``'s topic in the ULog file ``path``, in instance order;
     :class:`RecordingError` (one line, the file named) when the file cannot be read or holds none."""
     path = Path(path)
-    if sensor not in TOPICS:
+    known = topics()
+    if sensor not in known:
         raise RecordingError(f"a PX4 log has no topic tcbench reads for sensor {sensor!r} "
-                             f"(it reads: {', '.join(f'{k} from {v[0]}' for k, v in TOPICS.items())})", file=str(path))
-    topic = TOPICS[sensor][0]
+                             f"(it reads: {', '.join(f'{k} from {v[0]}' for k, v in known.items())})", file=str(path))
+    topic = known[sensor][0]
     if not path.is_file():
         raise RecordingError("no such file" if not path.exists() else "is a directory, not a ULog file", file=str(path))
     from pyulog import ULog

@@ -74,3 +74,18 @@ def temperature_branches(t_s: np.ndarray, temp_c: np.ndarray, min_swing_c: float
         stop = int(b) + 1 if k == len(edges) - 2 else int(b)
         out.append(Branch(int(a), stop, float(smooth[a]), float(smooth[b])))
     return out
+
+
+def time_blocks(t_s: np.ndarray, temp_c: np.ndarray, blocks: int) -> list[Branch]:
+    """The record cut into ``blocks`` parts of equal duration, in time order (a record with one
+    temperature branch, such as a single cooling, is then fitted on some blocks and scored on
+    the others); each part's ``from_c``/``to_c`` are its first and last temperatures."""
+    t = np.asarray(t_s, dtype=np.float64)
+    if not 1 <= blocks <= t.size:
+        raise ValueError(f"blocks must be 1..{t.size} (the samples), got {blocks}")
+    cuts = np.searchsorted(t, np.linspace(t[0], t[-1], blocks + 1)[1:-1])
+    edges = np.concatenate([[0], cuts, [t.size]]).astype(int)
+    if np.any(np.diff(edges) == 0):
+        raise ValueError(f"{blocks} blocks of equal duration leave one without samples; use fewer")
+    return [Branch(int(a), int(b), float(temp_c[a]), float(temp_c[b - 1])) for a, b in zip(edges[:-1], edges[1:],
+                                                                                           strict=True)]

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Real IMU records end to end: the six axes of the tofupilot chamber cycle (gyro and accelerometer)
+# and the three PAN LSM6DSM gyro axes, imported as a user would, then their metrics, a diagnosis
+# of each whole record and the calibration board (every offset model fitted on one part, scored on
+# the others). Results under leaderboards/real-imu/.
+# Usage (from the repository root, with tcbench installed): bash experiments/real-imu/run.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+here=experiments/real-imu
+data=${TCBENCH_REAL_DATA:-../shared/data/real}
+work=${WORK:-$here/runs}        # the imported recordings and the MLflow store (generated, git-ignored)
+out=${OUT:-leaderboards/real-imu}
+restarts=${RESTARTS:-5}
+rm -rf "$work" "$out"
+mkdir -p "$work"
+export MLFLOW_TRACKING_URI="sqlite:///$PWD/$work/mlflow.db"
+tofu="$data/tofupilot_imu_chamber/imu_raw_data.csv"
+pan="$data/pan_lsm6dsm_tvac_cooling/pan_lsm6dsm_tvac_cooling.csv"
+
+echo "== import"
+tcbench import "csv=$tofu" sensor=gyro time=timestamp:us temperature=imu.temperature \
+    output=imu.gyro.x:rad/s,imu.gyro.y:rad/s,imu.gyro.z:rad/s "out=$work/rec" name=tofupilot device_id=tofupilot-imu
+tcbench import "csv=$tofu" sensor=accel time=timestamp:us temperature=imu.temperature \
+    output=imu.acc.x:m/s^2,imu.acc.y:m/s^2,imu.acc.z:m/s^2 "out=$work/rec" name=tofupilot device_id=tofupilot-imu
+tcbench import "csv=$pan" sensor=gyro time=time_s temperature=temp_c:degC \
+    output=gyro_x_dps:deg/s,gyro_y_dps:deg/s,gyro_z_dps:deg/s drop=spike_flag "out=$work/rec" name=pan \
+    device_id=pan-etu-lsm6dsm
+
+tofu_axes=$(printf "$work/rec/tofupilot-imu.%s.csv," gyro.x gyro.y gyro.z acc.x acc.y)
+pan_axes=$(printf "$work/rec/pan-gyro_%s_dps.csv," x y z)
+all="${tofu_axes}$work/rec/tofupilot-imu.acc.z.csv,${pan_axes%,}"
+
+echo "== metrics"
+tcbench metrics -m "recording=$all" "out=$out/metrics/\${stem:recording}" hydra.launcher.n_jobs=2
+echo "== diagnosis of each whole record"
+tcbench diagnose -m "recording=$all" "out=$out/diagnosis/\${stem:recording}"
+echo "== calibration: tofupilot fitted on its first cooling branch, PAN on every other time block"
+tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration/\${stem:recording}" "restarts=$restarts"
+tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g \
+    "out=$out/calibration/tofupilot-imu.acc.z" "restarts=$restarts"
+tcbench calibrate -m "recording=${pan_axes%,}" "out=$out/calibration/\${stem:recording}" blocks=5 \
+    'train_branches=[0,2,4]' drift_window_s=5 "restarts=$restarts"
+echo "== calibration: tofupilot fitted on its cooling and heating branches, scored on the second cooling"
+tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration-both/\${stem:recording}" 'train_branches=[0,1]' \
+    "restarts=$restarts"
+tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g 'train_branches=[0,1]' \
+    "out=$out/calibration-both/tofupilot-imu.acc.z" "restarts=$restarts"
+echo "== board"
+python "$here/summarise.py" --calibrations "$out/calibration" "$out/calibration-both" --recordings "$work/rec" \
+    --diagnoses "$out/diagnosis" --out "$out"
