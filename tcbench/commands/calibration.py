@@ -125,8 +125,8 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
             if diagnosis is not None:
                 from tcbench.diagnose.report import write_report
 
-                written |= {f"diagnosis {k}": v for k, v in write_report(diagnosis[0], tmp / "diagnosis").items()
-                            if k in ("model.yaml", "report.md")}
+                report = write_report(diagnosis[0], tmp / "diagnosis", with_plots=False)
+                written |= {f"diagnosis {k}": v for k, v in report.items()}
     except InputOverwriteError as exc:
         raise CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out=") \
             from None

@@ -37,14 +37,15 @@ def model_spec(diag: Diagnosis) -> ModelSpec:
     return parse_model(_plain(diag.model), "model.yaml")
 
 
-def write_report(diag: Diagnosis, out: str | Path, inputs: Sequence[str | Path] = ()) -> dict[str, Path]:
+def write_report(diag: Diagnosis, out: str | Path, inputs: Sequence[str | Path] = (),
+                 with_plots: bool = True) -> dict[str, Path]:
     """Write the report files into ``out`` (created if needed), none of them over one of
-    ``inputs``; returns name -> path."""
+    ``inputs``; returns name -> path. ``with_plots=False`` leaves out the figures."""
     out = Path(out)
     with staged_dir(out, inputs) as tmp:
         (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
         write_model(model_spec(diag), tmp / "model.yaml")
-        plots = write_plots(diag, tmp)
+        plots = write_plots(diag, tmp) if with_plots else {}
         (tmp / "report.md").write_text(render_markdown(diag, plots))
         names = sorted(item.name for item in tmp.iterdir())
     return {name: out / name for name in names}
