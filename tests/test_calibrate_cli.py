@@ -127,3 +127,46 @@ def test_network_restarts_are_summarised_by_their_median(gyro_y: Path, workdir: 
     pd.testing.assert_series_equal(board.loc["bp", "drift_rms_deg_per_s"].reset_index(drop=True),
                                    pd.Series(np.median(single, axis=0), name="drift_rms_deg_per_s"))
     assert "3 restarts each (seeds 0..2)" in (workdir / "cal3" / "calibration.md").read_text()
+
+
+def test_fitted_on_one_recording_scored_on_another(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The tofupilot gyro y cut in two recordings: fitted on the first (its cooling), scored on every
+    part of the second; the cubic's scores there are those of the cubic fitted by hand."""
+    from tcbench.compensation.calibration import fit, record, residual, scores
+    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.sensors.recording import make_recording, write_recording
+    from tcbench.signal.branches import temperature_branches
+
+    full = tofupilot_gyro("y")
+    cut = int(np.searchsorted(full.time_s, 40 * 60.0))
+    for name, rows, sensor, scale in (("first", slice(0, cut), "gyro", 1.0), ("second", slice(cut, None), "gyro", 1.0),
+                                      ("accel", slice(cut, None), "accel", 1e-3)):
+        write_recording(make_recording(full.time_s[rows], full.temperature_c[rows], full.input[rows],
+                                       full.output[rows] * scale, sensor=sensor,
+                                       sample_rate_hz=full.meta.sample_rate_hz, device_id="tofu"),
+                        workdir / f"{name}.csv")
+    code, _, err = run(capsys, "calibrate", "recording=first.csv", "test_recordings=[second.csv]", "out=cal",
+                       "methods=[raw,poly3]")
+    assert code == 0, err
+    table = pd.read_csv(workdir / "cal" / "calibration.csv")
+    second = table[table["recording"] == "second"]
+    assert (second["role"] == "test").all() and set(table["recording"]) == {"first", "second"}
+    whole = record(full.time_s, full.temperature_c, full.output, full.input)
+    first_branch = temperature_branches(full.time_s[:cut], full.temperature_c[:cut])[0]
+    res = residual(fit("poly3", [whole.part(first_branch.start, first_branch.stop)]), whole.part(cut, full.time_s.size))
+    parts = temperature_branches(full.time_s[cut:], full.temperature_c[cut:])
+    assert len(second) == 2 * len(parts)
+    for k, part in enumerate(parts):
+        expected = scores(res[part.start:part.stop], full.time_s[cut:][part.start:part.stop])["drift_rms"]
+        got = second.loc[(second["method"] == "poly3") & (second["branch"] == k), "drift_rms_deg_per_s"]
+        assert float(got.iloc[0]) == pytest.approx(expected, rel=1e-9)
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    (r,) = client.search_runs([client.get_experiment_by_name("calibrations").experiment_id])
+    assert "poly3.second.b0.drift_rms" in r.data.metrics and "poly3.b0.drift_rms" in r.data.metrics
+
+    for others, words in (("[first.csv]", "two recordings named 'first'"),
+                          ("[accel.csv]", "accel.csv records accel output in g, not gyro output in deg/s")):
+        code, _, err = run(capsys, "calibrate", "recording=first.csv", f"test_recordings={others}", "out=bad",
+                           "tracking.enabled=false")
+        assert code == 2 and len(err) == 1 and words in err[0], err
+    assert not (workdir / "bad").exists()

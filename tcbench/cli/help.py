@@ -175,6 +175,8 @@ SPECS: dict[str, CommandHelp] = {
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
             "px4_instance": "the sensor instance the TC_G / TC_A parameters are for (0..3)",
+            "test_recordings": "other recordings of the same kind and unit to score the fitted models on, every "
+                               "part of them held out: train on one record, test on others",
             "true_input": "the static record's true input, VALUE[:unit] (an accelerometer axis along gravity: "
                           "-1:g); null: the recording's input column",
             **TRACKING,

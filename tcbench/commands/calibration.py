@@ -28,11 +28,11 @@ class CalibrationOutcome:
     sensor: str
 
 
-def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
+def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any], list[tuple[str, Any, list[Any]]]]:
     """Every argument before any work: the recording (read and validated), its branches and the
-    training ones among them, the methods."""
+    training ones among them, the methods, and each of ``test_recordings`` with its parts (same
+    kind and unit as the recording)."""
     from tcbench.compensation.calibration import METHODS
-    from tcbench.signal.branches import temperature_branches, time_blocks
 
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
@@ -50,24 +50,40 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any]]:
         raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    rec = read_recording_arg(cfg.recording)
-    if cfg.true_input is not None:
-        rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
-    if cfg.blocks is None:
-        branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
-        parts = f"temperature branch{'es' * (len(branches) != 1)}"
-        how = f"min_swing_c={cfg.min_swing_c:g} degC"
-    else:
-        try:
-            branches = time_blocks(rec.time_s, rec.temperature_c, cfg.blocks)
-        except ValueError as exc:
-            raise CommandError(f"blocks={cfg.blocks}: {exc}") from None
-        parts, how = f"time block{'s' * (len(branches) != 1)}", f"blocks={cfg.blocks}"
+    rec, branches, (parts, how) = _prepared(cfg.recording, cfg)
     bad = [k for k in cfg.train_branches if not 0 <= k < len(branches)]
     if bad or not cfg.train_branches:
         raise CommandError(f"train_branches={list(cfg.train_branches)}: the recording has {len(branches)} "
                            f"{parts} (0..{len(branches) - 1}; {how})")
-    return rec, branches
+    others = []
+    for path in cfg.test_recordings:
+        other, other_parts, _ = _prepared(path, cfg)
+        if (other.meta.sensor, other.meta.units.get("output")) != (rec.meta.sensor, rec.meta.units.get("output")):
+            raise CommandError(f"test_recordings: {path} records {other.meta.sensor} output in "
+                               f"{other.meta.units.get('output')}, not {rec.meta.sensor} output in "
+                               f"{rec.meta.units.get('output')} like {cfg.recording}")
+        if Path(path).stem == Path(cfg.recording).stem or Path(path).stem in {Path(p).stem for p, *_ in others}:
+            raise CommandError(f"test_recordings: two recordings named {Path(path).stem!r}; rename one")
+        others.append((str(path), other, other_parts))
+    return rec, branches, others
+
+
+def _prepared(path: str, cfg: CalibrateConfig) -> tuple[Any, list[Any], tuple[str, str]]:
+    """A recording read (``true_input`` applied) and cut into its parts: temperature branches, or
+    ``blocks`` time blocks; with the parts' name and how they were cut, for messages."""
+    from tcbench.signal.branches import temperature_branches, time_blocks
+
+    rec = read_recording_arg(path)
+    if cfg.true_input is not None:
+        rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
+    if cfg.blocks is None:
+        branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
+        return rec, branches, (f"temperature branch{'es' * (len(branches) != 1)}", f"min_swing_c={cfg.min_swing_c:g} degC")
+    try:
+        branches = time_blocks(rec.time_s, rec.temperature_c, cfg.blocks)
+    except ValueError as exc:
+        raise CommandError(f"blocks={cfg.blocks}: {exc}") from None
+    return rec, branches, (f"time block{'s' * (len(branches) != 1)}", f"blocks={cfg.blocks}")
 
 
 def true_input(spec: object, input_unit: str) -> float:
@@ -97,7 +113,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
     from tcbench.tables import markdown_table
 
-    rec, branches = check_calibrate(cfg)
+    rec, branches, others = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
     whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(branches[k].start, branches[k].stop) for k in cfg.train_branches]
@@ -105,22 +121,28 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     fitted = {m: [from_model(diagnosis[1])] if m == "model" else  # type: ignore[index]
               [fit(m, train, cfg.seed + r) for r in range(cfg.restarts if m in LEARNERS else 1)]
               for m in dict.fromkeys(cfg.methods)}
-    every = {m: [residual(model, whole) for model in runs] for m, runs in fitted.items()}
-    rows = []
-    for m, runs in every.items():
-        for k, b in enumerate(branches):
-            s = [scores(res[b.start:b.stop], rec.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
-            rows.append({"method": m, "branch": k, "direction": b.direction, "from_c": b.from_c, "to_c": b.to_c,
-                         "role": "train" if k in cfg.train_branches else "test",
-                         f"drift_rms_{_slug(unit)}": float(np.median([x["drift_rms"] for x in s])),
-                         f"rms_{_slug(unit)}": float(np.median([x["rms"] for x in s])),
-                         "restarts": len(runs)})
+    rows: list[dict[str, Any]] = []
+    residuals = {}
+    for path, r, parts in [(cfg.recording, rec, branches), *others]:
+        own = r is rec
+        target = whole if own else record(r.time_s, r.temperature_c, r.output, r.input)
+        every = {m: [residual(model, target) for model in runs] for m, runs in fitted.items()}
+        for m, runs in every.items():
+            for k, b in enumerate(parts):
+                s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
+                rows.append({"recording": Path(path).stem, "method": m, "branch": k, "direction": b.direction,
+                             "from_c": b.from_c, "to_c": b.to_c,
+                             "role": "train" if own and k in cfg.train_branches else "test",
+                             f"drift_rms_{_slug(unit)}": float(np.median([x["drift_rms"] for x in s])),
+                             f"rms_{_slug(unit)}": float(np.median([x["rms"] for x in s])),
+                             "restarts": len(runs)})
+        if own:
+            residuals = {m: runs[0] for m, runs in every.items()}
     models = {m: runs[0] for m, runs in fitted.items()}
-    residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
     out = Path(cfg.out)
     try:
-        with staged_dir(out, [Path(cfg.recording)]) as tmp:
+        with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)]) as tmp:
             written = _write(tmp, cfg, rec, branches, models, residuals, table, unit)
             if diagnosis is not None:
                 from tcbench.diagnose.report import write_report
@@ -187,7 +209,8 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, branches: list[Any], model
         "; fitted on part(s) "
         f"{', '.join(map(str, cfg.train_branches))}, scored on every part. drift = RMS of the residual's "
         f"{cfg.drift_window_s:g}-s running mean (output minus true input minus the model's offset); rms = RMS of "
-        f"the residual." + (f" The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+        f"the residual." + (f" Also scored on every part of {', '.join(map(str, cfg.test_recordings))}."
+                            if cfg.test_recordings else "") + (f" The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
                             f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}."
                             if cfg.restarts > 1 else "") +
         f"\n{note}\n{markdown_table(table)}\n\n![residuals](residuals.png)\n")

@@ -98,6 +98,7 @@ class CalibrateConfig:
     drift_window_s: float = 60.0
     px4_instance: int = 0
     blocks: int | None = None  # cut into this many time blocks instead of temperature branches
+    test_recordings: list[str] = field(default_factory=list)  # more records to score on, every part held out
     true_input: str | None = None  # VALUE[:unit]: the static record's true input (an axis along gravity: -1:g)
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
 

@@ -1,10 +1,11 @@
 """The calibration job kind: ``tcbench calibrate`` on one static recording
 (:mod:`tcbench.commands.calibration`). Its MLflow run carries each method's drift and RMS on
-every branch (``<method>.b<k>.drift_rms`` ...), the sensor, and the board, plot and PX4
+every branch (``<method>.b<k>.drift_rms`` ...; ``<method>.<stem>.b<k>.drift_rms`` on a test recording), the sensor, and the board, plot and PX4
 parameters as artifacts."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -36,11 +37,13 @@ class CalibrateKind(JobKind):
     def record(self, run: Any, outcome: CalibrationOutcome, c: dict[str, Any], where: Path) -> list[Path]:
         run.set_tag("tcbench.sensor", outcome.sensor)
         metrics = {}
+        own = Path(str(c.get("recording"))).stem
         for row in outcome.table.to_dict("records"):
+            where = "" if row["recording"] == own else re.sub(r"[^\w\-. /]", "_", str(row["recording"])) + "."
             for key, value in row.items():
                 if key.startswith(("drift_rms_", "rms_")):
                     stat = "drift_rms" if key.startswith("drift_rms_") else "rms"
-                    metrics[f"{row['method']}.b{row['branch']}.{stat}"] = float(value)
+                    metrics[f"{row['method']}.{where}b{row['branch']}.{stat}"] = float(value)
         run.log_metrics(metrics)
         announce(run, c)
         return [p for p in outcome.written.values() if Path(p).is_file()]
