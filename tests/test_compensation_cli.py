@@ -73,7 +73,7 @@ def foreign_files(workdir: Path) -> tuple[str, str]:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, oracle, poly, raw"),
+        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, lagpoly, oracle, oracle_thermometer, poly, raw"),
         (["learner.hidden=0"], "learner bp: hidden"),
         (["learner.training=sgd"], "learner bp: training"),
         (["task.n_train=0"], "n_train and n_test must be integers >= 1"),
@@ -82,6 +82,8 @@ def foreign_files(workdir: Path) -> tuple[str, str]:
         (["optimiser=mopso"], "multi-objective only"),
         (["budget=5"], "smaller than one generation"),
         (["task=rastrigin"], "learners apply to compensation tasks"),
+        (["task=gyro_driftnoise", "learner=lagpoly", "optimiser=none"],
+         "learner lagpoly is not a baseline of task gyro_driftnoise"),
     ],
 )
 def test_bad_input_one_line_exit_2(workdir: Path, args: list[str], message: str) -> None:

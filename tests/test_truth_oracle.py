@@ -121,3 +121,28 @@ def test_oracle_rejects_mismatched_lengths(roomtemp: Run) -> None:
         oracle_bias(rec.output[:-1], truth)
     with pytest.raises(ValueError, match="samples"):
         oracle_inverse(rec.output[:-1], truth)
+
+
+def test_the_thermometer_limited_oracle_reads_the_recorded_thermometer(roomtemp: Run) -> None:
+    """``output_det_thermometer`` is the noise-free model fed the recording's own thermometer
+    column, smoothed over 61 samples; with a thermometer far coarser than the sensor's (1 degC
+    steps, as a Bosch part reads) the two oracles part, the thermometer-limited one the worse."""
+    from scipy.ndimage import uniform_filter1d
+
+    from tcbench.sensors.simulate import build_profile
+    from tcbench.sensors.truth import STOCHASTIC_EFFECTS
+
+    rec, truth = roomtemp
+    det = unit("msra", 0).model.without(*STOCHASTIC_EFFECTS)
+    profile = build_profile("msra", "roomtemp", np.random.default_rng(np.random.SeedSequence(0).spawn(3)[0]))
+    profile.temp_c = uniform_filter1d(rec.temperature_c, 61, mode="nearest")
+    np.testing.assert_allclose(truth.output_det_thermometer, det.simulate(profile, np.random.default_rng(0)),
+                               rtol=0, atol=1e-9)
+    assert 0 < np.std(truth.output_det_thermometer - truth.output_det) < 0.1 * np.std(rec.output - truth.output_det)
+
+    coarse = {"thermometer_quantisation": {"step_c": 1.0}}
+    rough, rough_truth = simulate_recording("msra", "roomtemp", 0, 0, coarse), simulate_truth("msra", "roomtemp", 0, 0, coarse)
+    sf = float(rough.meta.extra["scale_factor_hz_per_g"])
+    true_limit = acc.zero_bias_stability_ug(rough.time_s, oracle_bias(rough.output, rough_truth), sf)
+    read_limit = acc.zero_bias_stability_ug(rough.time_s, oracle_bias(rough.output, rough_truth, thermometer=True), sf)
+    assert read_limit > 1.5 * true_limit, (true_limit, read_limit)

@@ -13,7 +13,7 @@ rm -f "$here/mlflow.db"
 sweep=paper-ifa-bp-$(date -u +%Y%m%dT%H%M%S)
 common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra/launcher=joblib hydra.launcher.n_jobs=2)
 tcbench run -m experiment=paper_ifa_bp "${common[@]}"
-tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,oracle,poly optimiser=none \
+tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,oracle,oracle_thermometer,lagpoly,poly optimiser=none \
   tracking.experiment=paper-ifa-bp "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment paper-ifa-bp --sweep "$sweep" --out "$out"

@@ -1,4 +1,5 @@
-"""Compensation methods on an MSRA task: a learner, no compensation (raw), and the oracle.
+"""Compensation methods on an MSRA task: a learner, no compensation (raw), the lag-aware
+polynomial (lagpoly), and the two oracles.
 
 Each method is a *compensator*: a function of a test recording and an output array (the
 recorded one, or a probe of it) returning the compensated output (g for fulltemp, Hz for
@@ -12,10 +13,11 @@ from collections.abc import Callable
 import numpy as np
 
 from tcbench.compensation.data import MSRAData, TaskDataError, TaskRecording
+from tcbench.compensation.lagpoly import fit_lag_poly
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.learners.base import Learner
 
-BASELINES = ("raw", "oracle")
+BASELINES = ("raw", "oracle", "oracle_thermometer", "lagpoly")
 Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
 
 
@@ -40,10 +42,21 @@ def raw_compensator(data: MSRAData) -> Compensator:
     return lambda tr, output: np.asarray(output, dtype=np.float64)
 
 
-def oracle_compensator(data: MSRAData) -> Compensator:
+def lagpoly_compensator(data: MSRAData) -> Compensator:
+    """The lag-aware polynomial (:mod:`tcbench.compensation.lagpoly`) fitted on the training
+    recordings: the input solved from the output (``inverse``) or the modelled bias removed."""
+    model = fit_lag_poly([tr.recording for tr in data.train])
+    if data.form == "inverse":
+        return lambda tr, output: model.inverse(tr.recording, output)
+    return lambda tr, output: np.asarray(output, dtype=np.float64) - model.bias_of(tr.recording)
+
+
+def oracle_compensator(data: MSRAData, thermometer: bool = False) -> Compensator:
     """The physical limit: the simulator's deterministic model inverted at the true die
-    temperature, so what is left is noise alone (simulated recordings only)."""
+    temperature, so what is left is noise alone (simulated recordings only); with
+    ``thermometer``, the same model fed the thermometer reading instead (the limit of a
+    compensator that knows the physics and reads what a real one reads)."""
     if any(tr.truth is None for tr in data.test):
         raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
     fn = oracle_inverse if data.form == "inverse" else oracle_bias
-    return lambda tr, output: fn(output, tr.truth)  # type: ignore[arg-type]
+    return lambda tr, output: fn(output, tr.truth, thermometer)  # type: ignore[arg-type]

@@ -7,6 +7,12 @@ sensor's noise (white, flicker, random walk, quantisation) alone. That noise is 
 independently of temperature and of everything a method can observe, so no method, however it
 models temperature, can remove it without knowing the noise itself: the oracle's metrics are the
 floor every method's metrics are compared with.
+
+With ``thermometer=True`` each oracle knows the same model but reads only the thermometer
+(``Truth.output_det_thermometer``: the model fed the recorded, smoothed thermometer reading): the
+limit of a compensator that knows the physics exactly and reads what a real one reads. The gap
+between the two oracles is what the thermometer's noise and resolution cost; a method's gap to the
+thermometer-limited one is what better modelling could still win.
 """
 
 from __future__ import annotations
@@ -23,7 +29,11 @@ def _checked(output: np.ndarray, truth: Truth) -> np.ndarray:
     return y
 
 
-def oracle_inverse(output: np.ndarray, truth: Truth) -> np.ndarray:
+def _det(truth: Truth, thermometer: bool) -> np.ndarray:
+    return truth.output_det_thermometer if thermometer else truth.output_det
+
+
+def oracle_inverse(output: np.ndarray, truth: Truth, thermometer: bool = False) -> np.ndarray:
     """Applied input estimated from ``output`` (g for the MSRA): ``input + (output -
     output_det) / sensitivity``.
 
@@ -33,10 +43,10 @@ def oracle_inverse(output: np.ndarray, truth: Truth) -> np.ndarray:
     local scale factor, which no compensation of temperature can beat.
     """
     y = _checked(output, truth)
-    return truth.input + (y - truth.output_det) / truth.sensitivity_per_input
+    return truth.input + (y - _det(truth, thermometer)) / truth.sensitivity_per_input
 
 
-def oracle_bias(output: np.ndarray, truth: Truth) -> np.ndarray:
+def oracle_bias(output: np.ndarray, truth: Truth, thermometer: bool = False) -> np.ndarray:
     """Compensated output (output unit, Hz for the MSRA): ``output - output_det +
     mean(output_det)``.
 
@@ -45,4 +55,5 @@ def oracle_bias(output: np.ndarray, truth: Truth) -> np.ndarray:
     can beat.
     """
     y = _checked(output, truth)
-    return y - truth.output_det + float(np.mean(truth.output_det))
+    det = _det(truth, thermometer)
+    return y - det + float(np.mean(det))

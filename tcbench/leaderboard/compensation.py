@@ -94,8 +94,20 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     names = table["method"].tolist()
     table["p_vs_next"] = [paired_p_value(values[a], values[b]) for a, b in zip(names, names[1:], strict=False)] + [np.nan]
+    for column, limit in LIMITS.items():
+        table[column] = _ratio_to(table, protocol, limit)
     table["note"] = _notes(table, protocol)
     return table
+
+
+LIMITS = {"x_oracle": "oracle", "x_thermo": "oracle_thermometer"}  # ratio column -> the limit row it divides by
+
+
+def _ratio_to(table: pd.DataFrame, protocol: str, limit: str) -> np.ndarray:
+    """Each method's median primary metric over that of the ``limit`` row (NaN without one)."""
+    primary = table[f"median_{SHORT[PRIMARY[protocol]]}"].to_numpy(float)
+    row = table.loc[table["method"] == limit, f"median_{SHORT[PRIMARY[protocol]]}"]
+    return primary / float(row.iloc[0]) if not row.empty and float(row.iloc[0]) > 0 else np.full(len(table), np.nan)
 
 
 def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
@@ -110,7 +122,7 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
     limit = float(oracle.iloc[0])
     notes = []
     for row in table.itertuples(index=False):
-        below = row.method != "oracle" and getattr(row, primary) < limit
+        below = row.method not in LIMITS.values() and getattr(row, primary) < limit
         probe = getattr(row, "median_halfg_ug", np.nan)
         notes.append(f"below the physical limit: fits the trained levels, ±0.5 g error {probe:.3g} µg"
                      if below and np.isfinite(probe) else "below the physical limit" if below else "")
@@ -119,7 +131,11 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
 
 MSRA_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
-    "physical limit); poly3 = bias and scale factor cubic in temperature (least squares). p_vs_next = Wilcoxon "
+    "physical limit); oracle_thermometer = the same model fed the thermometer reading (smoothed over 60 s) instead: "
+    "the limit of a compensator that knows the physics and reads what a real one reads; poly3 = bias and scale "
+    "factor cubic in temperature (least squares); lagpoly = the same in the thermometer passed through a "
+    "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
+    "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by seed. note: a median below the "
     "oracle's is not physics — such a method has learned the trained acceleration levels, which its ±0.5 g "
     "probe error (halfg) shows.")
@@ -128,7 +144,9 @@ GYRO_KEY = (
     "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition), then "
     "the drift learner (BAS-elman = BAS-initialised Elman on [T, dT/dt]; (T) = temperature input only); "
     "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
-    "limit). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by "
+    "limit); oracle_thermometer = the simulator's drift model fed the thermometer reading (smoothed over 60 s) "
+    "instead of the true temperature; x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
+    "signed-rank p-value of the primary metric against the next row, paired by "
     "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
 
@@ -140,9 +158,12 @@ def _gyro_notes(table: pd.DataFrame) -> list[str]:
     notes = []
     for row in table.itertuples(index=False):
         parts = []
-        if row.method != "oracle" and row.median_arw < 0.9 * oracle["median_arw"]:
+        if row.method in LIMITS.values():
+            notes.append("")
+            continue
+        if row.median_arw < 0.9 * oracle["median_arw"]:
             parts.append(f"ARW below the physical limit by filtering: bandwidth {row.median_bw_hz:.3g} Hz")
-        if row.method != "oracle" and row.median_drift_dph < 0.9 * oracle["median_drift_dph"]:
+        if row.median_drift_dph < 0.9 * oracle["median_drift_dph"]:
             parts.append("drift below the oracle's: the flicker of the soak means is smoothed too")
         notes.append("; ".join(parts))
     return notes

@@ -56,6 +56,9 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
         env.check_files()
     except TaskDataError as exc:
         raise _error(str(exc)) from None
+    known = getattr(env, "baselines", BASELINES)
+    if name in BASELINES and name not in known:
+        raise _error(f"learner {name} is not a baseline of task {task['name']} (its baselines: {', '.join(known)})")
     if getattr(env, "needs_tuning", False):
         _check_tuner(task)
     opt = dict(c["optimiser"])

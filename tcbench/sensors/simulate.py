@@ -106,9 +106,6 @@ def simulate_recording(
     )
     profile = build_profile(sensor, protocol, profile_rng, **protocol_params)
     output = model.simulate(profile, sensor_rng)
-    reading = thermometer_rng.standard_normal(profile.t_s.size)
-    reading *= THERMOMETER_NOISE_C
-    reading += profile.temp_c
     extra = {
         "protocol": protocol,
         "device_seed": int(device_seed),
@@ -122,11 +119,19 @@ def simulate_recording(
         **profile.info,
     }
     return make_recording(
-        profile.t_s, fx.thermometer_reading(list(model.effects), quantise(reading, THERMOMETER_STEP_C, in_place=True)),
-        profile.input, output,
+        profile.t_s, thermometer_reading(profile, model, thermometer_rng), profile.input, output,
         sensor=sensor, sample_rate_hz=profile.sample_rate_hz, device_id=device.device_id,
         position=profile.position, extra=_plain(extra),
     )
+
+
+def thermometer_reading(profile: Profile, model: SensorModel, rng: np.random.Generator) -> np.ndarray:
+    """What the sensor's thermometer reads of the profile's package temperature: its noise drawn
+    from ``rng``, its resolution, then the model's thermometer-stage effects."""
+    reading = rng.standard_normal(profile.t_s.size)
+    reading *= THERMOMETER_NOISE_C
+    reading += profile.temp_c
+    return fx.thermometer_reading(list(model.effects), quantise(reading, THERMOMETER_STEP_C, in_place=True))
 
 
 def _plain(value: Any) -> Any:

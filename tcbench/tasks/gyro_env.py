@@ -42,7 +42,7 @@ from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
-BASELINES = ("raw", "oracle")
+BASELINES = ("raw", "oracle", "oracle_thermometer")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
@@ -78,6 +78,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     """
 
     metadata = {"render_modes": []}
+    baselines = BASELINES  # no lagpoly: the drift pipeline has its own learners
 
     def __init__(self, learner: str | None = "elman", learner_params: dict[str, Any] | None = None,
                  budget: int = 1000, device_seed: int = 0, recordings_seed: int = 0, n_train: int = 1,
@@ -214,16 +215,18 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
 
     def score_baseline(self, which: str, bandwidth: bool = True) -> Score:
         """``raw`` (the pipeline without drift compensation: the recorded output itself for the
-        serial pipeline without a denoiser) or ``oracle`` (the simulator's truth)."""
+        serial pipeline without a denoiser), ``oracle`` (the simulator's truth) or
+        ``oracle_thermometer`` (the simulator's model fed the thermometer reading)."""
         if self.data is None or self.pipeline is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which == "raw":
             self.pipeline.learner = None
             return self._score_pipeline(float("nan"), bandwidth)
-        if which != "oracle":
+        if which not in ("oracle", "oracle_thermometer"):
             raise ValueError(f"unknown baseline {which!r}; known: {', '.join(BASELINES)}")
         if not self.data.has_truth:
             raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
-        recs = [score_record(tr, lambda y, tr=tr: oracle_inverse(y, tr.truth), self.amplitude_dps,
+        thermometer = which == "oracle_thermometer"
+        recs = [score_record(tr, lambda y, tr=tr: oracle_inverse(y, tr.truth, thermometer), self.amplitude_dps,
                              None, bandwidth) for tr in self.data.test]
         return Score("gyro", recs)

@@ -172,11 +172,15 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         return score_outputs(self.data, fn, self.bias_form, rmse), history
 
     def score_baseline(self, which: str) -> Score:
-        """``raw`` (no compensation) or ``oracle`` (the simulator's truth: noise alone)."""
+        """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone) or
+        ``oracle_thermometer`` (the simulator's model fed the thermometer reading)."""
         if self.data is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which == "raw":
             return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
-        if which == "oracle":
-            return score_outputs(self.data, methods.oracle_compensator(self.data), self.bias_form)
+        if which == "lagpoly":
+            return score_outputs(self.data, methods.lagpoly_compensator(self.data), self.bias_form)
+        if which in ("oracle", "oracle_thermometer"):
+            fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
+            return score_outputs(self.data, fn, self.bias_form)
         raise ValueError(f"unknown baseline {which!r}; known: {', '.join(methods.BASELINES)}")

@@ -32,7 +32,7 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
         label = f"{prefix}-{name.upper() if name == 'bp' else name}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
     pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
-    if pipeline is None or name == "oracle":
+    if pipeline is None or name.startswith("oracle"):
         return label
     front = pipeline(task)  # type: ignore[arg-type]
     back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
