@@ -99,6 +99,12 @@ def test_accelerometer_tables_in_mg_and_m_s2(tmp_path: Path, capsys: pytest.Capt
                            "tracking.enabled=false")
         assert code == 2 and len(err) == 1 and words in err[0], err
     assert not (tmp_path / "bad").exists()
+    # axes of different lengths (one column ends early): one line naming the cell, nothing written
+    (tmp_path / "short.csv").write_text("t,temp,ax,ay\n0,25,1,1\n1,25.1,1,1\n2,25.2,1,\n3,25.3,1,\n")
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'short.csv'}", "sensor=accel", "time=t", "temperature=temp",
+                       "output=ax,ay", f"out={tmp_path / 'bad'}", "tracking.enabled=false")
+    assert code == 2 and err == [f"tcbench: error: {tmp_path / 'short.csv'}: row 3, column 'ay': empty cell"], err
+    assert not (tmp_path / "bad").exists()
 
 
 def test_a_px4_log_imports_every_accelerometer(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,9 +1,9 @@
-"""What ``tcbench calibrate`` does: split a static recording into its temperature branches (or,
-with ``blocks=N``, into time blocks)
-(:mod:`tcbench.signal.branches`), fit each offset model (:mod:`tcbench.compensation.calibration`)
-on the training branches, score it on every branch, and write the board (``calibration.md`` and
-``.csv``), the residual plots and, for a kind PX4 calibrates (gyro, accel), PX4's ``TC_G*`` or
-``TC_A*`` parameters of the cubic."""
+"""What ``tcbench calibrate`` does: cut a static recording into parts — its temperature branches,
+or with ``blocks=N`` time blocks (:mod:`tcbench.signal.branches`) —, fit each offset model
+(:mod:`tcbench.compensation.calibration`) on the training parts, score it on every part (and on
+every part of ``test_recordings``), and write the board (``calibration.md`` and ``.csv``), the
+residual plots and, for a kind PX4 calibrates (gyro, accel), PX4's ``TC_G*`` or ``TC_A*``
+parameters of the cubic."""
 
 from __future__ import annotations
 
@@ -16,7 +16,6 @@ import numpy as np
 from tcbench.commands.errors import CommandError, cannot_write, checked_store, read_recording_arg, writable_folder
 from tcbench.commands.schemas import CalibrateConfig
 from tcbench.staging import InputOverwriteError, moved, staged_dir
-
 
 
 @dataclass
@@ -201,19 +200,19 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, branches: list[Any], model
     table.to_csv(written["csv"], index=False)
     test = table[table["role"] == "test"]
     note = ("" if len(test) else "\nEvery branch was used to fit: the scores are in-sample only.\n")
-    written["md"].write_text(
-        f"# Calibration of {Path(cfg.recording).name}\n\n"
-        f"{rec.meta.sensor} recording, output in {unit}; " + (
-            f"{len(branches)} temperature branches (turning points standing out by {cfg.min_swing_c:g} degC)"
-            if cfg.blocks is None else f"{len(branches)} time blocks of equal duration") +
-        "; fitted on part(s) "
-        f"{', '.join(map(str, cfg.train_branches))}, scored on every part. drift = RMS of the residual's "
-        f"{cfg.drift_window_s:g}-s running mean (output minus true input minus the model's offset); rms = RMS of "
-        f"the residual." + (f" Also scored on every part of {', '.join(map(str, cfg.test_recordings))}."
-                            if cfg.test_recordings else "") + (f" The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
-                            f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}."
-                            if cfg.restarts > 1 else "") +
-        f"\n{note}\n{markdown_table(table)}\n\n![residuals](residuals.png)\n")
+    parts = (f"{len(branches)} temperature branches (turning points standing out by {cfg.min_swing_c:g} degC)"
+             if cfg.blocks is None else f"{len(branches)} time blocks of equal duration")
+    about = [f"{rec.meta.sensor} recording, output in {unit}; {parts}; fitted on part(s) "
+             f"{', '.join(map(str, cfg.train_branches))}, scored on every part.",
+             f"drift = RMS of the residual's {cfg.drift_window_s:g}-s running mean (output minus true input minus "
+             "the model's offset); rms = RMS of the residual."]
+    if cfg.test_recordings:
+        about.append(f"Also scored on every part of {', '.join(map(str, cfg.test_recordings))}.")
+    if cfg.restarts > 1:
+        about.append(f"The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+                     f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}.")
+    written["md"].write_text(f"# Calibration of {Path(cfg.recording).name}\n\n{' '.join(about)}\n{note}\n"
+                             f"{markdown_table(table)}\n\n![residuals](residuals.png)\n")
     written["png"] = _plot(tmp / "residuals.png", rec, branches, residuals, unit, cfg)
     cubic = models.get("poly3")
     if cubic is not None and px4_covers(rec.meta.sensor):

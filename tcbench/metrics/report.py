@@ -200,9 +200,9 @@ def _kind(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
         "over the whole record (at constant temperature the (1 sigma, 10 s) figure; over a chamber cycle mostly drift)",
         f"noise density = Allan -1/2 line at tau = 1 s ({unit}/sqrt(Hz)); bias instability = Allan minimum / 0.664 "
         f"({unit}); read-offs over tau <= T/10", *floor_note]
-    if "bias_temp_r" in km.metrics:
-        conventions.append(f"bias vs temperature: least-squares line through {km.fit.temperature_c.size} "  # type: ignore[union-attr]
-                           f"{km.fit.method} (mean bias at mean temperature); slope in {unit} per degC")  # type: ignore[union-attr]
+    if km.fit is not None:
+        conventions.append(f"bias vs temperature: least-squares line through {km.fit.temperature_c.size} "
+                           f"{km.fit.method} (mean bias at mean temperature); slope in {unit} per degC")
     if km.loop is not None:
         conventions.append(f"hysteresis: cooling minus heating bias in {km.loop.temperature_c.size} common 1 degC bins; "
                            "width = the largest |difference|, mean = its signed mean (a die lag opens the same loop)")
