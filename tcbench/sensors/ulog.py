@@ -1,11 +1,12 @@
 """PX4 ULog files (``.ulg``, read with pyulog) as recordings: the sensor topic of a kind
-(``sensor_gyro`` for a gyro, ``sensor_accel`` for an accelerometer), every instance (one per physical sensor), each axis a recording
-with the topic's own clock and temperature.
+(``sensor_gyro`` for a gyro, ``sensor_accel`` for an accelerometer), every instance (one per
+physical sensor), each axis a recording with the topic's own clock and temperature.
 
 A topic instance is a table of fields (``timestamp``, ``timestamp_sample`` in µs since boot,
 ``x``, ``y``, ``z``, ``temperature`` in °C, ...); the default column map reads the sample clock,
-the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``, m/s^2 for ``sensor_accel``), and any field can
-be named instead, with a unit, as for a CSV file (:func:`tcbench.sensors.importer.import_table`).
+the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``, m/s^2 for
+``sensor_accel``), and any field can be named instead, with a unit, as for a CSV file
+(:func:`tcbench.sensors.importer.import_table`).
 """
 
 from __future__ import annotations

@@ -119,6 +119,7 @@ def names() -> list[str]:
 
 
 def known(name: object) -> bool:
+    """Whether ``name`` is a known kind's name."""
     return isinstance(name, str) and name in registry()
 
 
