@@ -14,7 +14,8 @@ from tcbench.sensors import kinds
 from tcbench.sensors.models import MSRA, Gyro, Unit, gyro_effects, msra_effects
 
 
-def _rng(kind: str, device_seed: int) -> np.random.Generator:
+def device_rng(kind: str, device_seed: int) -> np.random.Generator:
+    """The random stream of unit ``device_seed`` of ``kind`` (a non-negative integer seed)."""
     if int(device_seed) != device_seed or device_seed < 0:
         raise ValueError(f"device_seed must be a non-negative integer, got {device_seed!r}")
     return np.random.default_rng([int(device_seed), sum(map(ord, kind))])
@@ -25,7 +26,7 @@ def msra_unit(device_seed: int) -> Unit:
     (11-15 %, giving dU/dT of about -0.16 Hz/K, ~800 micro-g/K of bias) and a log-uniform
     scale-factor coefficient gK in 60-600 ppm/K (scale-factor variation 2 000-20 000 ppm over
     -40..60 degC) are the draws that set the full-temperature figures."""
-    rng = _rng("msra", device_seed)
+    rng = device_rng("msra", device_seed)
     f0_1 = 30000.0 + rng.normal(0.0, 30.0)
     f0 = (f0_1, f0_1 - rng.normal(150.0, 20.0))
     k = tuple(100.0 * (1.0 + rng.normal(0.0, 0.02, 2)))
@@ -56,7 +57,7 @@ def msra_unit(device_seed: int) -> Unit:
 def gyro_unit(device_seed: int) -> Unit:
     """One dual-mass gyroscope around PHYSICS.md §6's defaults (bias 1.10 u + 4.0e-3 u^2 +
     1.5e-4 u^3 deg/h, ARW 0.52 deg/sqrt(h), bias instability 33 deg/h, lag 8 min)."""
-    rng = _rng("gyro", device_seed)
+    rng = device_rng("gyro", device_seed)
     draws = {
         "lag_tau_s": rng.uniform(390.0, 570.0),
         "c3_dph_per_k3": 1.5e-4 * (1.0 + rng.normal(0.0, 0.1)),

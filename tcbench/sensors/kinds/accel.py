@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors import effects as fx
+from tcbench.sensors.devices import device_rng
 from tcbench.sensors.kinds import SensorKind
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.protocols import Chamber, Profile, _from_segments, check_length, four_position_nodes
@@ -78,9 +79,7 @@ def accel_unit(device_seed: int) -> Unit:
     """One consumer accelerometer axis: zero-g offset ~15 mg, bias coefficient 0.05-0.5 mg/K
     of either sign (log-uniform), scale-factor coefficient 50-300 ppm/K, hysteresis 5-15 % of
     the bias span over 80 K, noise 70-150 µg/√Hz, flicker 20-60 µg (PHYSICS.md §7)."""
-    if int(device_seed) != device_seed or device_seed < 0:
-        raise ValueError(f"device_seed must be a non-negative integer, got {device_seed!r}")
-    rng = np.random.default_rng([int(device_seed), sum(map(ord, "accel"))])
+    rng = device_rng("accel", device_seed)
     sign = rng.choice([-1.0, 1.0], size=2)
     b1 = float(sign[0] * np.exp(rng.uniform(np.log(0.05), np.log(0.5))))
     draws = {
