@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sqlite3
 import subprocess
 import sys
 import time
@@ -116,6 +117,24 @@ def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, 
     assert "MemoryError" in run.stdout and "TCBENCH_JOB_MEMORY_MB" in run.stdout
 
 
+def running_now(cwd: Path) -> dict[str, int]:
+    """RUNNING runs by task key, read from the store without touching it: an ``MlflowClient``
+    polled while the sweep is still creating the store would create (and migrate) it too."""
+    db = cwd / "mlflow.db"
+    if not db.exists():
+        return {}
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=1) as con:
+            rows = con.execute("SELECT t.value FROM runs r JOIN tags t ON t.run_uuid = r.run_uuid "
+                               "WHERE t.key = 'tcbench.task' AND r.status = 'RUNNING'").fetchall()
+    except sqlite3.Error:  # the store's tables are not made yet, or it is locked for a moment
+        return {}
+    out: dict[str, int] = {}
+    for (task,) in rows:
+        out[task] = out.get(task, 0) + 1
+    return out
+
+
 def _wait_for(predicate, timeout_s: float) -> bool:  # type: ignore[no-untyped-def]
     end = time.monotonic() + timeout_s
     while time.monotonic() < end:
@@ -139,16 +158,16 @@ def test_killed_sweep_workers_exit_and_resume_marks_dead_runs(site: Path, tmp_pa
     args = [sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "task.dim=6", "optimiser=fa",
             "optimiser.name=crashy", "seed=range(4)", "budget=60", "hydra.launcher.n_jobs=2",
             "tracking.sweep_id=killme"]
-    proc = subprocess.Popen(args, cwd=tmp_path, env=env | {"CRASHY_SLEEP": "1"},
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    log = tmp_path / "sweep.log"
+    with log.open("w") as sink:
+        proc = subprocess.Popen(args, cwd=tmp_path, env=env | {"CRASHY_SLEEP": "1"},
+                                stdout=sink, stderr=subprocess.STDOUT)
     try:
         def two_running() -> bool:
-            try:
-                return statuses(tmp_path).get("sphere-6d", []).count("RUNNING") == 2
-            except Exception:  # noqa: BLE001 - the store is still being created
-                return False
+            return proc.poll() is not None or running_now(tmp_path).get("sphere-6d", 0) == 2
 
-        assert _wait_for(two_running, 120), "the sweep never had two jobs running"
+        assert _wait_for(two_running, 300) and proc.poll() is None, \
+            f"the sweep never had two jobs running (exit {proc.poll()}):\n{log.read_text()[-3000:]}"
         workers = _children(proc.pid)
         assert len(workers) >= 2
         proc.send_signal(signal.SIGKILL)
