@@ -81,7 +81,7 @@ def test_sweep_then_leaderboard(workdir: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["task=nope"], "unknown task 'nope'; known: ackley, "),
+        (["task=nope"], "unknown task 'nope'; known: accel_chamber, ackley, "),
         (["optimiser=nope"], "unknown optimiser 'nope'; known: bas, "),
         (["seed=abc"], "seed: Value 'abc'"),
         (["seed=-1"], "seed must be >= 0"),

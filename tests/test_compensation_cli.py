@@ -73,7 +73,7 @@ def foreign_files(workdir: Path) -> tuple[str, str]:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, lagpoly, oracle, oracle_thermometer, poly, raw"),
+        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, lagpoly, model, oracle, oracle_thermometer, poly, raw"),
         (["learner.hidden=0"], "learner bp: hidden"),
         (["learner.training=sgd"], "learner bp: training"),
         (["task.n_train=0"], "n_train and n_test must be integers >= 1"),

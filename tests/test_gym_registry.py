@@ -28,6 +28,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import tcbench  # noqa: F401  (registers the envs)
+from tcbench.tasks.ids import ACCEL_CHAMBER_ID
 from tcbench.tasks import BBOB_ID, FUNCTIONS, GYRO_ENV_IDS, MSRA_ENV_IDS, PROBLEMS, env_id, mo_env_id
 
 IDS = sorted(i for i in gym.registry if i.startswith("tcbench/"))
@@ -82,7 +83,7 @@ def _assert_deterministic(make: Any) -> None:
 
 def test_registry_holds_every_task_and_nothing_else() -> None:
     expected = ({env_id(f) for f in FUNCTIONS} | {mo_env_id(p) for p in PROBLEMS} | set(MSRA_ENV_IDS.values())
-                | set(GYRO_ENV_IDS.values()) | {BBOB_ID})
+                | set(GYRO_ENV_IDS.values()) | {BBOB_ID, ACCEL_CHAMBER_ID})
     assert set(IDS) == expected
 
 

@@ -28,7 +28,7 @@ def test_every_task_config_has_a_spec_and_every_spec_a_registered_env() -> None:
         assert spec.gym_id in gym.registry and spec.job_kind in kinds.KIND_MODULES
         assert "name" in spec.schema.__dataclass_fields__
         assert spec.is_compensation == (spec.protocol is not None)
-    with pytest.raises(KeyError, match="unknown task 'nope'; known: ackley"):
+    with pytest.raises(KeyError, match="unknown task 'nope'; known: accel_chamber, ackley"):
         task_spec("nope")
 
 

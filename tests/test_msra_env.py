@@ -132,7 +132,7 @@ def test_file_recordings_are_checked(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"task": "msra_nope"}, "unknown MSRA task"),
+        ({"task": "msra_nope"}, "unknown static-input task"),
         ({"n_train": 0}, "n_train and n_test must be integers >= 1"),
         ({"train_on": "some"}, "train_on must be one of positions, all"),
         ({"bias_form": "minus"}, "bias_form must be one of plus, printed"),

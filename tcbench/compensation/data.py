@@ -1,6 +1,6 @@
-"""The recordings of an MSRA compensation task and the learner's view of them.
+"""The recordings of a static-input compensation task and the learner's view of them.
 
-Two tasks of seed 000 §3:
+Two tasks of seed 000 §3 on the MSRA, and one on an ordinary accelerometer:
 
 - ``fulltemp`` (Table 2): four-position runs over -40..60 degC. A learner maps
   ``[U (Hz), temperature (degC)]`` to the applied acceleration (g) — form ``inverse``; the
@@ -9,6 +9,11 @@ Two tasks of seed 000 §3:
   is degenerate (a constant 0 fits every training sample), so tcbench models the bias instead:
   ``[temperature (degC), temperature rate (degC/s)] -> U (Hz)`` — form ``bias``; the
   compensated output is ``U - prediction`` (Hz), a 2-input network as in the paper.
+- ``chamber``: a static capacitive accelerometer (``accel``, output in g) through a chamber cycle
+  (60 -> -20 -> 60 -> 25 degC), the most common real calibration record. Form ``bias`` as
+  ``roomtemp``: ``[temperature, temperature rate] -> output (g)``; the compensated output is
+  ``output - prediction`` (g). The rate input lets a learner tell heating from cooling (the
+  lag and the package's hysteresis open a loop between them).
 
 Recordings are simulated from the sensors package (one device, several runs that differ by
 their run seed) or read from schema-v1 files (for example real ones); simulated ones keep the
@@ -30,8 +35,10 @@ from tcbench.sensors.recording import Recording, RecordingError, read_recording
 from tcbench.sensors.simulate import simulate_recording
 from tcbench.sensors.truth import Truth, simulate_truth
 
-PROTOCOLS = {"fulltemp": "inverse", "roomtemp": "bias"}
-DEFAULT_SPLIT = {"fulltemp": (3, 2), "roomtemp": (4, 2)}  # (train, test) recordings, seed 000 §3.2
+PROTOCOLS = {"fulltemp": "inverse", "roomtemp": "bias", "chamber": "bias"}
+SENSORS = {"fulltemp": "msra", "roomtemp": "msra", "chamber": "accel"}  # the kind each protocol records
+# (train, test) recordings: seed 000 §3.2's for the MSRA; three and two chamber cycles otherwise
+DEFAULT_SPLIT = {"fulltemp": (3, 2), "roomtemp": (4, 2), "chamber": (3, 2)}
 TRAIN_ON = ("positions", "all")
 
 
@@ -50,7 +57,8 @@ class TaskRecording:
 
 @dataclass
 class MSRAData:
-    """Training and test recordings of one MSRA task and how a learner sees them."""
+    """Training and test recordings of one task and how a learner sees them;
+    ``scale_factor_hz_per_g`` is the output per g (1 for an accelerometer reading in g)."""
 
     protocol: str
     train: list[TaskRecording]
@@ -63,7 +71,7 @@ class MSRAData:
 
     @property
     def form(self) -> str:
-        """``inverse`` (fulltemp) or ``bias`` (roomtemp)."""
+        """``inverse`` (fulltemp) or ``bias`` (roomtemp, chamber)."""
         return PROTOCOLS[self.protocol]
 
     def features(self, rec: Recording, output: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +104,7 @@ class MSRAData:
 
     def compensate(self, output: np.ndarray, prediction: np.ndarray) -> np.ndarray:
         """Compensated output from a learner's prediction over every row: the prediction in g
-        (fulltemp), or ``output - prediction`` in Hz (roomtemp)."""
+        (fulltemp), or ``output - prediction`` in the output unit (roomtemp: Hz, chamber: g)."""
         return prediction if self.form == "inverse" else output - prediction
 
 
@@ -107,8 +115,8 @@ def recording_seed(recordings_seed: int, index: int) -> int:
 
 @functools.lru_cache(maxsize=8)
 def _simulated(protocol: str, device_seed: int, seed: int) -> TaskRecording:
-    rec = simulate_recording("msra", protocol, device_seed, seed)
-    truth = simulate_truth("msra", protocol, device_seed, seed)
+    rec = simulate_recording(SENSORS[protocol], protocol, device_seed, seed)
+    truth = simulate_truth(SENSORS[protocol], protocol, device_seed, seed)
     return TaskRecording(f"dev{device_seed}-seed{seed}", rec, truth)
 
 
@@ -118,7 +126,7 @@ def simulated_data(protocol: str, device_seed: int, recordings_seed: int, n_trai
     check_split(protocol, n_train, n_test, train_on, rate_window_s)
     recs = [_simulated(protocol, int(device_seed), recording_seed(recordings_seed, i))
             for i in range(n_train + n_test)]
-    sf = float(recs[0].recording.meta.extra["scale_factor_hz_per_g"])
+    sf = float(recs[0].recording.meta.extra.get("scale_factor_hz_per_g") or 1.0)
     return MSRAData(protocol, recs[:n_train], recs[n_train:], sf, train_on, rate_window_s,
                     "simulated", {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed)})
 
@@ -126,7 +134,7 @@ def simulated_data(protocol: str, device_seed: int, recordings_seed: int, n_trai
 def check_split(protocol: str, n_train: int, n_test: int, train_on: str, rate_window_s: float) -> None:
     """Raise :class:`TaskDataError` for an impossible split or setting."""
     if protocol not in PROTOCOLS:
-        raise TaskDataError(f"unknown MSRA protocol {protocol!r}; known: {', '.join(PROTOCOLS)}")
+        raise TaskDataError(f"unknown compensation protocol {protocol!r}; known: {', '.join(PROTOCOLS)}")
     if int(n_train) != n_train or n_train < 1 or int(n_test) != n_test or n_test < 1:
         raise TaskDataError(f"n_train and n_test must be integers >= 1, got {n_train} and {n_test}")
     if n_train + n_test > 100:
@@ -142,9 +150,13 @@ def _load(path: str, protocol: str, role: str) -> TaskRecording:
         rec = read_recording(path)
     except RecordingError as exc:
         raise TaskDataError(str(exc)) from None
-    if rec.meta.sensor != "msra":
+    sensor = SENSORS[protocol]
+    if rec.meta.sensor != sensor:
         kind = rec.meta.sensor or "unknown (no sidecar)"
-        raise TaskDataError(f"{path}: {role} recording is from a {kind} sensor; MSRA tasks need msra recordings")
+        raise TaskDataError(f"{path}: {role} recording is from a {kind} sensor; this task needs {sensor} recordings")
+    if protocol == "chamber" and np.ptp(rec.input) > 1e-9:
+        raise TaskDataError(f"{path}: {role} recording's applied input varies "
+                            f"({rec.input.min():g}..{rec.input.max():g} g); the chamber task needs a static unit")
     if protocol == "fulltemp":
         labels = rec.position
         if labels is None or not np.isin(labels.astype(str), ["+1g", "-1g"]).any():
@@ -167,6 +179,7 @@ def file_data(protocol: str, train_files: list[str], test_files: list[str], trai
     train = [_load(p, protocol, "training") for p in train_files]
     test = [_load(p, protocol, "test") for p in test_files]
     sfs = [r.recording.meta.extra.get("scale_factor_hz_per_g") for r in train + test if r.recording.meta.extra]
-    sf = float(next((s for s in sfs if s), DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G))
+    default = DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G if SENSORS[protocol] == "msra" else 1.0
+    sf = float(next((s for s in sfs if s), default))
     return MSRAData(protocol, train, test, sf, train_on, rate_window_s, "files",
                     {"train_files": list(train_files), "test_files": list(test_files)})

@@ -1,9 +1,10 @@
-"""Compensation methods on an MSRA task: a learner, no compensation (raw), the lag-aware
-polynomial (lagpoly), and the two oracles.
+"""Compensation methods on a static-input task (MSRA, accelerometer chamber): a learner, no
+compensation (raw), the lag-aware polynomial (lagpoly), and the two oracles (the diagnosed
+model, ``model``, is fitted by the diagnosis: :mod:`tcbench.tasks.diagnosed`).
 
 Each method is a *compensator*: a function of a test recording and an output array (the
 recorded one, or a probe of it) returning the compensated output (g for fulltemp, Hz for
-roomtemp), so the scorer can also ask how a method answers at accelerations it never saw.
+roomtemp, g for chamber), so the scorer can also ask how a method answers at accelerations it never saw.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from tcbench.compensation.lagpoly import fit_lag_poly
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.learners.base import Learner
 
-BASELINES = ("raw", "oracle", "oracle_thermometer", "lagpoly")
+BASELINES = ("raw", "oracle", "oracle_thermometer", "lagpoly", "model")
 Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
 
 
@@ -38,7 +39,7 @@ def learner_compensator(data: MSRAData, learner: Learner) -> Compensator:
 
 
 def raw_compensator(data: MSRAData) -> Compensator:
-    """No compensation: the output itself (Hz)."""
+    """No compensation: the output itself (its unit)."""
     return lambda tr, output: np.asarray(output, dtype=np.float64)
 
 

@@ -14,6 +14,13 @@ Conventions (stated in every report):
   the noise around -1, 0 and +1 g) can even beat the oracle on Table 2 and fails here.
 - roomtemp (Table 1): zero-bias stability = 1 sigma (ddof=1) of non-overlapping 10 s means of
   output / scale factor, from 30 min, 20 min and 0 min after power-on, in micro-g.
+- chamber (a static accelerometer through a chamber cycle): ``drift_ug``, 1 sigma (ddof=1) of
+  non-overlapping 10 s means of the output over the whole cycle (the residual bias over
+  temperature and time, with the noise left in 10 s means); ``hysteresis_ug``, the largest
+  cooling-minus-heating difference of the output in common 1 degC bins
+  (:func:`tcbench.metrics.inertial.hysteresis`); ``temp_slope_ug_per_c``, the absolute slope of
+  the least-squares line of the output against the thermometer. All in micro-g, before on the
+  raw output, after on the compensated one (a constant offset changes none of them).
 """
 
 from __future__ import annotations
@@ -27,14 +34,20 @@ import pandas as pd
 from tcbench.compensation.data import MSRAData, TaskRecording
 from tcbench.compensation.methods import Compensator
 from tcbench.metrics import accelerometer as acc
+from tcbench.metrics.gyro import rate_vs_temperature
+from tcbench.metrics.inertial import hysteresis
 
 FULLTEMP_METRICS = ("sf_variation_ppm", "bias_variation_ug", "halfg_error_ug")
 PROBE_G = 0.5
 ROOMTEMP_METRICS = ("zb_after_30min_ug", "zb_after_20min_ug", "zb_zero_start_ug")
+CHAMBER_METRICS = ("drift_ug", "hysteresis_ug", "temp_slope_ug_per_c")
 GYRO_METRICS = ("drift_dph", "arw_deg_per_sqrt_h", "bias_instability_dph", "rms_error_dph", "bandwidth_hz")
-METRIC_NAMES = {"fulltemp": FULLTEMP_METRICS, "roomtemp": ROOMTEMP_METRICS, "gyro": GYRO_METRICS}
-PRIMARY = {"fulltemp": "bias_variation_ug", "roomtemp": "zb_zero_start_ug", "gyro": "drift_dph"}
-TRAIN_RMSE = {"fulltemp": "train_rmse_ug", "roomtemp": "train_rmse_ug", "gyro": "train_rmse_dph"}
+METRIC_NAMES = {"fulltemp": FULLTEMP_METRICS, "roomtemp": ROOMTEMP_METRICS, "chamber": CHAMBER_METRICS,
+                "gyro": GYRO_METRICS}
+PRIMARY = {"fulltemp": "bias_variation_ug", "roomtemp": "zb_zero_start_ug", "chamber": "drift_ug",
+           "gyro": "drift_dph"}
+TRAIN_RMSE = {"fulltemp": "train_rmse_ug", "roomtemp": "train_rmse_ug", "chamber": "train_rmse_ug",
+              "gyro": "train_rmse_dph"}
 CONVENTIONS = {
     "fulltemp": [
         "scale factor K1 = (U(+1g) - U(-1g))/2; bias B0 = (U(+0g) + U(-0g))/(U(+1g) - U(-1g)) g "
@@ -45,6 +58,12 @@ CONVENTIONS = {
     "roomtemp": [
         "zero-bias stability: 1 sigma (ddof=1) of non-overlapping 10 s means of output / scale factor "
         "from 30 min, 20 min and 0 min after power-on (micro-g)",
+    ],
+    "chamber": [
+        "drift_ug: 1 sigma (ddof=1) of non-overlapping 10 s means of the output over the whole chamber cycle (micro-g)",
+        "hysteresis_ug: largest |cooling - heating| difference of the output in common 1 degC bins of the "
+        "thermometer (micro-g); temp_slope_ug_per_c: |slope| of the output's least-squares line against the "
+        "thermometer (micro-g/degC); before = raw output, after = compensated output (g), a constant offset aside",
     ],
     "gyro": [
         "drift_dph: residual drift over temperature, std (ddof=1) over the oven's soaks of the output's "
@@ -159,6 +178,25 @@ def _roomtemp(rec: TaskRecording, fn: Compensator, sf: float) -> RecordingScore:
                           before_ug=r.output / sf * 1e6, after_ug=compensated_hz / sf * 1e6)
 
 
+def _chamber_metrics(t_s: np.ndarray, temp_c: np.ndarray, output_g: np.ndarray) -> dict[str, float]:
+    ug = np.asarray(output_g, dtype=np.float64) * 1e6
+    loop = hysteresis(t_s, temp_c, ug)
+    line = rate_vs_temperature(temp_c, ug)
+    return {"drift_ug": acc.zero_bias_stability_ug(t_s, ug * 1e-6, 1.0, 0.0, 10.0),
+            "hysteresis_ug": loop.width if loop is not None else float("nan"),
+            "temp_slope_ug_per_c": abs(line.slope_dps_per_c) if line is not None else float("nan")}
+
+
+def _chamber(rec: TaskRecording, fn: Compensator) -> RecordingScore:
+    r = rec.recording
+    compensated_g = fn(rec, r.output)
+    before = _chamber_metrics(r.time_s, r.temperature_c, r.output)
+    after = _chamber_metrics(r.time_s, r.temperature_c, compensated_g)
+    centre = float(np.mean(r.output))  # the plot shows both about zero
+    return RecordingScore(rec.name, before, after, t_s=r.time_s, before_ug=(r.output - centre) * 1e6,
+                          after_ug=(compensated_g - float(np.mean(compensated_g))) * 1e6)
+
+
 def score_outputs(data: MSRAData, fn: Compensator, bias_form: str = "plus",
                   train_rmse_ug: float = float("nan"), probe: bool = True) -> Score:
     """Metrics before and after for each test recording compensated by ``fn``; ``probe``
@@ -167,6 +205,8 @@ def score_outputs(data: MSRAData, fn: Compensator, bias_form: str = "plus",
     for rec in data.test:
         if data.protocol == "fulltemp":
             recs.append(_fulltemp(rec, fn, bias_form, probe))
+        elif data.protocol == "chamber":
+            recs.append(_chamber(rec, fn))
         else:
             recs.append(_roomtemp(rec, fn, data.scale_factor_hz_per_g))
     return Score(data.protocol, recs, train_rmse_ug)

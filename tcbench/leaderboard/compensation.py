@@ -33,7 +33,8 @@ METRICS = METRIC_NAMES
 SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
          "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug", "drift_dph": "drift_dph",
          "arw_deg_per_sqrt_h": "arw", "bias_instability_dph": "bi_dph", "rms_error_dph": "rms_dph",
-         "bandwidth_hz": "bw_hz"}
+         "bandwidth_hz": "bw_hz", "drift_ug": "drift_ug", "hysteresis_ug": "hyst_ug",
+         "temp_slope_ug_per_c": "slope_ug_per_c"}
 NO_GAIN = ("halfg_error_ug", "bandwidth_hz")  # no raw value (probe), or not a figure to improve
 
 
@@ -139,6 +140,16 @@ MSRA_KEY = (
     "signed-rank p-value of the primary metric against the next row, paired by seed. note: a median below the "
     "oracle's is not physics — such a method has learned the trained acceleration levels, which its ±0.5 g "
     "probe error (halfg) shows.")
+CHAMBER_KEY = (
+    "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
+    "physical limit); oracle_thermometer = the same model fed the thermometer reading (smoothed over 60 s); "
+    "poly3 = bias cubic in the thermometer, as flight stacks ship it (least squares); poly3_rate = the same plus "
+    "a cubic times the temperature rate (the inputs the networks get); lagpoly = cubic in the thermometer passed "
+    "through a first-order lag, lag and degree by leave-one-recording-out error; model = the physics tcbench "
+    "diagnose fitted on the first training cycle (lag, hysteresis, warm-up ...), run noise-free on the test "
+    "thermometer. Networks get [T, dT/dt]. x_oracle, x_thermo = the median drift over the oracle's and over "
+    "oracle_thermometer's. p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, "
+    "paired by seed.")
 GYRO_KEY = (
     "Methods are named by their pipeline: MOVMD = MOPSO-tuned VMD with sample-entropy classes (noise modes "
     "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition), then "
@@ -149,6 +160,9 @@ GYRO_KEY = (
     "signed-rank p-value of the primary metric against the next row, paired by "
     "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
+
+
+KEYS = {"gyro": GYRO_KEY, "chamber": CHAMBER_KEY}
 
 
 def _gyro_notes(table: pd.DataFrame) -> list[str]:
@@ -219,6 +233,9 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
                     "variation std over the nodes (µg), eq. 12 plus form",
         "roomtemp": "zb30/zb20/zb0 = zero-bias stability (1σ of 10 s means) from 30 min, 20 min and 0 min "
                     "after power-on (µg)",
+        "chamber": "drift_ug = 1σ of the 10 s means of the output over the whole chamber cycle (µg); hyst_ug = "
+                   "largest cooling − heating difference in common 1 °C bins (µg); slope_ug_per_c = |slope| of "
+                   "the output against the thermometer (µg/°C)",
         "gyro": "drift_dph = residual drift over temperature, std of the 5-min soak means (°/h); arw = σ(1 s)/60 "
                 "(°/√h); bi_dph = Allan minimum / 0.664 (°/h); rms_dph = RMS error against the true rate "
                 "(°/h); bw_hz = bandwidth kept, the −3 dB frequency of the whole method measured by "
@@ -229,7 +246,7 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
         f"Source: {source}. Metrics are means over the test recordings; {conv}.",
         f"Rows are ordered by the median of {primary} over restarts (seeds); ci95 = bootstrap 95 % "
         "interval of that median; best_by_train = the run with the smallest training RMSE (the paper's "
-        "\"best of 30\" selection); gain = raw / median. " + (GYRO_KEY if board.protocol == "gyro" else MSRA_KEY), "",
+        "\"best of 30\" selection); gain = raw / median. " + KEYS.get(board.protocol, MSRA_KEY), "",
         markdown_table(board.table), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
     write_board_files(lines + failed_lines(failed), board.table, paths)

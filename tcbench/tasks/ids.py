@@ -8,6 +8,7 @@ BBOB_ID = "tcbench/BBOB-v0"
 GYRO_DRIFTNOISE_ID = "tcbench/Gyro-DriftNoise-v0"
 GYRO_VMDTUNING_ID = "tcbench/Gyro-VMDTuning-v0"
 GYRO_ENV_IDS = {"gyro_driftnoise": GYRO_DRIFTNOISE_ID, "gyro_vmdtuning": GYRO_VMDTUNING_ID}
+ACCEL_CHAMBER_ID = "tcbench/Accel-Chamber-v0"
 MSRA_ENV_IDS = {"msra_zerobias": "tcbench/MSRA-ZeroBias-v0", "msra_fulltemp": "tcbench/MSRA-FullTemp-v0"}
 
 

@@ -1,4 +1,5 @@
-"""MSRA temperature compensation as gymnasium environments (seed 000 §2.3 and §3).
+"""Static-input temperature compensation as gymnasium environments: the MSRA tasks of seed 000
+§2.3 and §3, and ``accel_chamber``, a capacitive accelerometer at rest through a chamber cycle.
 
 The action is a candidate vector of a learner's initial weights and thresholds (or a batch of
 them, ``(n, d)``); the observation is its training error — seed 000 eq. 3 in normalised units,
@@ -25,6 +26,7 @@ import numpy as np
 from tcbench.compensation import methods
 from tcbench.compensation.data import (
     DEFAULT_SPLIT,
+    PROTOCOLS,
     MSRAData,
     TaskDataError,
     check_split,
@@ -38,9 +40,11 @@ from tcbench.tasks.checks import is_integer
 from tcbench.tasks.weight_search import WeightSearch
 from tcbench.tasks.ids import MSRA_ENV_IDS
 
-TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp"}
+TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp", "accel_chamber": "chamber"}
 ENV_IDS = MSRA_ENV_IDS
 BIAS_FORMS = ("plus", "printed")
+# the diagnosed model needs a record with a temperature span to diagnose: the chamber cycle's
+MODEL_PROTOCOLS = ("chamber",)
 
 
 def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.random.Generator,
@@ -55,19 +59,20 @@ def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.ra
 
 
 class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
-    """Search a learner's initial parameters on an MSRA compensation task.
+    """Search a learner's initial parameters on a static-input compensation task.
 
     Parameters
     ----------
-    task: ``msra_fulltemp`` or ``msra_zerobias``.
+    task: ``msra_fulltemp``, ``msra_zerobias`` or ``accel_chamber``.
     learner, learner_params: the registered learner and its parameters (default: BP 2-10-1);
         ``None`` for an env that only scores the baselines (raw, oracle).
     budget: candidate evaluations per episode.
     device_seed: the simulated device; recordings_seed: fixes the recordings (None: from reset).
-    n_train, n_test: recordings to train on and to test on (default 3/2 fulltemp, 4/2 roomtemp).
+    n_train, n_test: recordings to train on and to test on (default 3/2 fulltemp and chamber,
+        4/2 roomtemp).
     train_files, test_files: schema-v1 recordings instead of simulated ones.
     train_on: ``positions`` (fulltemp: the labelled four-position samples) or ``all`` rows.
-    rate_window_s: trailing window of the temperature-rate input (roomtemp), in s.
+    rate_window_s: trailing window of the temperature-rate input (roomtemp, chamber), in s.
     bias_form: eq. 12 ``plus`` (default) or ``printed``.
     """
 
@@ -90,8 +95,9 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         bias_form: str = "plus",
     ) -> None:
         if task not in TASKS:
-            raise ValueError(f"unknown MSRA task {task!r}; known: {', '.join(TASKS)}")
+            raise ValueError(f"unknown static-input task {task!r}; known: {', '.join(TASKS)}")
         self.task, self.protocol = task, TASKS[task]
+        self.baselines = tuple(b for b in methods.BASELINES if b != "model" or self.protocol in MODEL_PROTOCOLS)
         if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         if not is_integer(device_seed) or device_seed < 0:
@@ -113,7 +119,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self.train_files, self.test_files = train_files, test_files
         self.train_on, self.rate_window_s, self.bias_form = train_on, float(rate_window_s), bias_form
         self.learner_name, self.learner_params = learner, dict(learner_params or {})
-        form = "inverse" if self.protocol == "fulltemp" else "bias"
+        form = PROTOCOLS[self.protocol]
         self.learner: Learner | None = None
         if learner is not None:
             self.learner = make_learner(learner, self.learner_params, form, np.random.default_rng(0))
@@ -172,14 +178,24 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         return score_outputs(self.data, fn, self.bias_form, rmse), history
 
     def score_baseline(self, which: str) -> Score:
-        """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone) or
-        ``oracle_thermometer`` (the simulator's model fed the thermometer reading)."""
+        """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone),
+        ``oracle_thermometer`` (the simulator's model fed the thermometer reading), ``lagpoly``
+        or (chamber) ``model``, the model diagnosed on the first training recording."""
         if self.data is None:
             raise RuntimeError("call reset() before score_baseline()")
+        if which not in self.baselines:
+            raise ValueError(f"unknown baseline {which!r} of task {self.task}; known: {', '.join(self.baselines)}")
         if which == "raw":
             return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
         if which == "lagpoly":
             return score_outputs(self.data, methods.lagpoly_compensator(self.data), self.bias_form)
+        if which == "model":
+            from tcbench.tasks.diagnosed import diagnosed_compensator
+
+            fn, diag = diagnosed_compensator(self.data)
+            score = score_outputs(self.data, fn, self.bias_form)
+            score.extra["diagnosis"] = diag
+            return score
         if which in ("oracle", "oracle_thermometer"):
             fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
             return score_outputs(self.data, fn, self.bias_form)

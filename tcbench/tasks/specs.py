@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tcbench.tasks.functions import FUNCTIONS
-from tcbench.tasks.ids import BBOB_ID, GYRO_DRIFTNOISE_ID, GYRO_VMDTUNING_ID, MSRA_ENV_IDS, env_id
+from tcbench.tasks.ids import ACCEL_CHAMBER_ID, BBOB_ID, GYRO_DRIFTNOISE_ID, GYRO_VMDTUNING_ID, MSRA_ENV_IDS, env_id
 from tcbench.tasks.multiobjective import PROBLEMS
 from tcbench.tasks.schemas import BBOBTaskConfig, GyroTaskConfig, GyroTuningTaskConfig, MSRATaskConfig, TaskConfig
 
@@ -115,6 +115,10 @@ def _specs() -> dict[str, TaskSpec]:
             key, eid, "tcbench.tasks.msra_env:MSRACompensationEnv", MSRATaskConfig, "compensation",
             f"MSRA {'four-position runs -40..60 °C' if full else 'zero-bias runs at room temperature'}",
             device_key, key_arg="task", protocol="fulltemp" if full else "roomtemp", family="compensation")
+    out["accel_chamber"] = TaskSpec(
+        "accel_chamber", ACCEL_CHAMBER_ID, "tcbench.tasks.msra_env:MSRACompensationEnv", MSRATaskConfig,
+        "compensation", "accelerometer (g) at rest through chamber cycles 60 → −20 → 60 → 25 °C", device_key,
+        key_arg="task", protocol="chamber", family="compensation")
     out["gyro_driftnoise"] = TaskSpec(
         "gyro_driftnoise", GYRO_DRIFTNOISE_ID, "tcbench.tasks.gyro_env:GyroDriftNoiseEnv", GyroTaskConfig,
         "compensation", "seed 001 parallel model on gyro oven runs (decomposition, denoiser, drift learner; "

@@ -19,13 +19,14 @@ from tcbench.tasks import task_spec
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``poly3``, ``IFA-BP-gd``, ``random-BP-lm`` ...; for
+    """Leaderboard name: ``raw``, ``oracle``, ``poly3`` (``poly3_rate`` with the temperature rate), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
     the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``."""
     if learner.get("label"):
         return str(learner["label"])
     name = str(learner["name"])
     if name in BASELINES or name == "poly":
         label = f"poly{learner.get('degree', 3)}" if name == "poly" else name
+        label += "_rate" if name == "poly" and learner.get("form") == "bias_rate" else ""
     else:
         opt = str(optimiser.get("label") or optimiser["name"])
         prefix = "random" if opt == "none" else opt.upper()

@@ -1,0 +1,120 @@
+"""The accelerometer chamber task: an ordinary IMU's accelerometer at rest through chamber cycles,
+compensated by the baselines, the learners and the diagnosed model, on simulated and on files."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pandas as pd
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import tcbench  # noqa: F401 - registers the envs
+from tcbench.compensation.data import TaskDataError, file_data
+from tcbench.sensors.recording import write_recording
+from tcbench.sensors.simulate import simulate_recording
+
+ENV = "tcbench/Accel-Chamber-v0"
+
+
+@pytest.fixture(scope="module")
+def baselines() -> dict[str, dict[str, float]]:
+    env = gym.make(ENV, learner=None).unwrapped
+    env.reset(seed=0)
+    out = {name: env.score_baseline(name).summary() for name in env.baselines}
+    poly = gym.make(ENV, learner="poly").unwrapped
+    poly.reset(seed=0)
+    out["poly3"] = poly.score(None)[0].summary()
+    return out
+
+
+def test_the_env_checks_and_splits_three_cycles_to_two() -> None:
+    env = gym.make(ENV, learner="bp", learner_params={"training": "gd", "epochs": 20}, budget=20).unwrapped
+    check_env(env, skip_render_check=True)
+    env.reset(seed=0)
+    assert (len(env.data.train), len(env.data.test)) == (3, 2) and env.data.form == "bias"
+    x, y = env.data.training_set()
+    assert x.shape == (y.size, 2) and y.size == sum(len(t.recording.data) for t in env.data.train)
+    assert env.data.train[0].recording.meta.sensor == "accel" and env.data.scale_factor_hz_per_g == 1.0
+
+
+def test_the_limits_bound_every_baseline(baselines) -> None:
+    oracle, thermo, raw = baselines["oracle"]["drift_ug"], baselines["oracle_thermometer"]["drift_ug"], \
+        baselines["raw"]["drift_ug"]
+    assert thermo == pytest.approx(oracle, rel=0.05)  # a 0.01 degC thermometer costs almost nothing here
+    for name in ("model", "lagpoly", "poly3"):
+        assert oracle * 0.98 < baselines[name]["drift_ug"] < raw / 10, name
+    assert baselines["raw"]["gain_drift_ug"] == 1.0 and raw > 1000.0
+
+
+def test_a_temperature_polynomial_cannot_close_the_loop_and_the_diagnosed_model_can(baselines) -> None:
+    """The cooling-minus-heating difference at one thermometer reading is untouched by any function of
+    that reading (poly3 leaves the raw loop but for the spread of readings inside a 1 degC bin); the
+    diagnosed lag and hysteresis close most of it."""
+    raw, poly, model, oracle = (baselines[k]["hysteresis_ug"] for k in ("raw", "poly3", "model", "oracle"))
+    assert poly == pytest.approx(raw, rel=0.01)
+    assert oracle < model < 0.6 * raw
+    assert baselines["model"]["drift_ug"] < baselines["poly3"]["drift_ug"]
+
+
+def test_the_model_baseline_is_the_chamber_tasks_only() -> None:
+    env = gym.make("tcbench/MSRA-FullTemp-v0", learner=None).unwrapped
+    assert "model" not in env.baselines and "model" in gym.make(ENV, learner=None).unwrapped.baselines
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="unknown baseline 'model' of task msra_fulltemp"):
+        env.score_baseline("model")
+
+
+def _write(tmp: Path, name: str, rec) -> str:  # type: ignore[no-untyped-def]
+    path = tmp / f"{name}.csv"
+    write_recording(rec, path)
+    return str(path)
+
+
+def test_recordings_from_files_are_compensated_and_checked(tmp_path: Path) -> None:
+    cycles = [_write(tmp_path, f"c{i}", simulate_recording("accel", "chamber", 1, i)) for i in range(3)]
+    env = gym.make(ENV, learner="poly", train_files=cycles[:2], test_files=cycles[2:]).unwrapped
+    env.reset(seed=0)
+    s = env.score(None)[0].summary()
+    assert env.data.source == "files" and s["drift_ug"] < s["raw_drift_ug"] / 2
+    model = env.score_baseline("model").summary()  # the diagnosis needs no truth
+    assert model["drift_ug"] < s["drift_ug"] / 3  # device 1's 7 mg loop: the hysteresis is the drift
+    with pytest.raises(TaskDataError, match="oracle needs the simulator's truth"):
+        env.score_baseline("oracle")
+    msra = _write(tmp_path, "msra", simulate_recording("msra", "roomtemp", 0, 0))
+    with pytest.raises(TaskDataError, match=r"msra.csv: test recording is from a msra sensor; this task needs accel"):
+        file_data("chamber", cycles[:1], [msra])
+    moving = _write(tmp_path, "moving", simulate_recording("accel", "multipos", 0, 0))
+    with pytest.raises(TaskDataError, match=r"moving.csv: training recording's applied input varies"):
+        file_data("chamber", [moving], cycles[:1])
+
+
+def test_a_sweep_and_its_board_from_the_command_line(tmp_path: Path) -> None:
+    """Baselines and the two polynomials (named apart) in one sweep, then the board with both limits."""
+    run = subprocess.run([sys.executable, "-m", "tcbench", "run", "-m", "task=accel_chamber",
+                          "learner=raw,oracle,oracle_thermometer,poly", "seed=0"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stdout + run.stderr
+    rate = subprocess.run([sys.executable, "-m", "tcbench", "run", "task=accel_chamber", "learner=poly",
+                           "learner.form=bias_rate"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert rate.returncode == 0 and "poly3_rate-accel_chamber-dev0-s0" in rate.stdout + rate.stderr
+    board = subprocess.run([sys.executable, "-m", "tcbench", "leaderboard"], cwd=tmp_path,
+                           capture_output=True, text=True, timeout=600)
+    assert board.returncode == 0, board.stdout + board.stderr
+    table = pd.read_csv(tmp_path / "leaderboards" / "accel_chamber-dev0.csv").set_index("method")
+    assert list(table.index[:2]) == ["oracle", "oracle_thermometer"] and table.index[-1] == "raw"
+    assert set(table.index) == {"oracle", "oracle_thermometer", "poly3", "poly3_rate", "raw"}
+    np.testing.assert_allclose(table["x_oracle"], table["median_drift_ug"] / table.loc["oracle", "median_drift_ug"])
+    assert "hyst_ug" in (tmp_path / "leaderboards" / "accel_chamber-dev0.md").read_text()
+
+
+def test_the_model_baseline_on_another_task_is_one_line(tmp_path: Path) -> None:
+    run = subprocess.run([sys.executable, "-m", "tcbench", "run", "task=msra_zerobias", "learner=model"],
+                         cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "learner model is not a baseline of task msra_zerobias" in run.stderr
+    assert not (tmp_path / "mlflow.db").exists()
