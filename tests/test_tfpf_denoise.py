@@ -155,3 +155,25 @@ def test_denoise_bad_input(func, args, kwargs):
     with pytest.raises(ValueError) as info:
         func(*args, **kwargs)
     assert "\n" not in str(info.value)
+
+
+def test_read_only_input_as_pandas_gives_it() -> None:
+    """A read-only array (pandas 3's ``.values``) failed in PyWavelets with "buffer source array
+    is read-only"; every signal function now takes one and leaves it untouched."""
+    from tcbench.signal.denoise import emd_wavelet_denoise, universal_threshold, wavelet_denoise
+    from tcbench.signal.entropy import fuzzy_entropy, permutation_entropy, sample_entropy
+    from tcbench.signal.tfpf import tfpf
+    from tcbench.signal.vmd import vmd
+
+    rng = np.random.default_rng(4)
+    x = np.sin(np.linspace(0.0, 20.0, 1024)) + 0.3 * rng.normal(size=1024)
+    frozen = x.copy()
+    frozen.flags.writeable = False
+    np.testing.assert_array_equal(wavelet_denoise(frozen), wavelet_denoise(x))
+    assert universal_threshold(frozen) == universal_threshold(x)
+    np.testing.assert_array_equal(emd_wavelet_denoise(frozen), emd_wavelet_denoise(x))
+    np.testing.assert_array_equal(tfpf(frozen), tfpf(x))
+    np.testing.assert_array_equal(vmd(frozen, 3, 2000.0).modes, vmd(x, 3, 2000.0).modes)
+    for fn in (sample_entropy, permutation_entropy, fuzzy_entropy):
+        assert fn(frozen[:300]) == fn(x[:300])
+    np.testing.assert_array_equal(frozen, x)

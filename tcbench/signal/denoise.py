@@ -26,8 +26,12 @@ MAD_TO_SIGMA = 0.6745  # median(|N(0, 1)|)
 
 
 def _check(x: np.ndarray, min_size: int = 2) -> np.ndarray:
-    """Validated float64 view of ``x``; raises ValueError with a one-line message."""
+    """Validated float64 array of ``x`` (a copy when ``x`` is read-only, as pandas' ``.values``
+    may be: PyWavelets' compiled transforms refuse a read-only buffer); raises ValueError with
+    a one-line message."""
     a = np.asarray(x, dtype=np.float64)
+    if not a.flags.writeable:
+        a = a.copy()
     if a.ndim != 1:
         raise ValueError(f"x must be a 1-D array, got shape {a.shape}")
     if a.size < min_size:
