@@ -25,7 +25,7 @@ def test_tuned_bas_elman_job_is_tracked_with_the_seed_figures(workdir: Path) -> 
     m, t = run.data.metrics, run.data.tags
     assert t["tcbench.method"] == "MOVMD-TFPF+BAS-elman-adam" and t["tcbench.task"] == "gyro_driftnoise-dev0"
     assert 4 <= m["vmd_k"] <= 12 and 1000 <= m["vmd_alpha"] <= 10000 and m["search_evaluations"] == 40
-    assert {"drift_dph", "raw_arw_deg_per_sqrt_h", "bandwidth_hz", "train_rmse_dph"} <= set(m)
+    assert {"drift_dph", "raw_arw_1s_deg_per_sqrt_h", "bandwidth_hz", "train_rmse_dph"} <= set(m)
     assert m["bandwidth_hz"] < m["raw_bandwidth_hz"] == 0.5
     names = {a.path for a in client.list_artifacts(run.info.run_id)}
     assert {"fig11_pareto.png", "fig12_modes_test1.png", "fig13_entropy_test1.png", "fig17_drift_test1.png",

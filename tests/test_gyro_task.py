@@ -126,16 +126,19 @@ def test_compensation_removes_the_drift_and_keeps_the_bandwidth(scores: dict[str
     assert serial["drift_dph"] < 1.15 * oracle["drift_dph"]
     assert serial["bandwidth_hz"] == pytest.approx(0.5)  # no filter: the whole band (Nyquist) kept
     assert oracle["bandwidth_hz"] == pytest.approx(0.5)
-    assert serial["arw_deg_per_sqrt_h"] == pytest.approx(raw["arw_deg_per_sqrt_h"], rel=0.05)
+    assert serial["arw_1s_deg_per_sqrt_h"] == pytest.approx(raw["arw_1s_deg_per_sqrt_h"], rel=0.05)
     # the parallel pipeline lowers the ARW far below the oracle's by dropping bandwidth
-    assert poly["arw_deg_per_sqrt_h"] < 0.5 * oracle["arw_deg_per_sqrt_h"]
+    assert poly["arw_1s_deg_per_sqrt_h"] < 0.5 * oracle["arw_1s_deg_per_sqrt_h"]
     assert poly["bandwidth_hz"] < 0.1 and poly["drift_dph"] < 1.15 * oracle["drift_dph"]
     assert poly["bias_instability_dph"] < 0.2 * oracle["bias_instability_dph"]
+    # ... and that "bias instability" is no floor: the filtered output's Allan minimum is an end of
+    # its curve, where the raw record has its flicker floor inside it
+    assert poly["allan_min_interior"] == 0.0 and poly["raw_allan_min_interior"] == 1.0
 
 
 def test_denoising_alone_smooths_but_does_not_compensate(scores: dict[str, dict[str, float]]) -> None:
     raw, wtd = scores["plain"], scores["wtd"]
-    assert wtd["arw_deg_per_sqrt_h"] < 0.5 * raw["arw_deg_per_sqrt_h"]
+    assert wtd["arw_1s_deg_per_sqrt_h"] < 0.5 * raw["arw_1s_deg_per_sqrt_h"]
     assert wtd["bandwidth_hz"] < 0.5
     assert wtd["drift_dph"] == pytest.approx(raw["drift_dph"], rel=0.05)
     assert scores["raw"]["drift_dph"] == pytest.approx(raw["drift_dph"], rel=0.3)  # VMD-TFPF alone

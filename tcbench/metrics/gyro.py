@@ -58,6 +58,7 @@ def allan_summary(output_dps: np.ndarray, fs_hz: float, segment: np.ndarray | No
         "bias_instability_dph": p.bias_instability * 3600.0,
         "allan_min_dph": p.adev_min * 3600.0,
         "allan_min_tau_s": p.tau_min_s,
+        "allan_min_is_interior": float(p.min_is_interior),
         "rrw_dph_per_sqrt_h": p.rate_random_walk * 3600.0 * 60.0,
     })
 
