@@ -79,6 +79,8 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             s = SHORT[m]
             row[f"median_{s}"] = float(np.median(x)) if x.size else np.nan
             row[f"ci95_{s}"] = f"{low:.3g}–{high:.3g}" if np.isfinite(low) else "–"
+            if m == primary:
+                row["ci_high_primary"] = high
             row[f"best_by_train_{s}"] = float(best[m]) if best is not None else np.nan
             raw = ok[f"raw_{m}"].to_numpy(float) if f"raw_{m}" in ok else np.array([])
             if m not in NO_GAIN:
@@ -101,7 +103,7 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     for column, limit in LIMITS.items():
         table[column] = _ratio_to(table, protocol, limit)
     table["note"] = _notes(table, protocol)
-    return table
+    return table.drop(columns="ci_high_primary")
 
 
 LIMITS = {"x_oracle": "oracle", "x_thermo": "oracle_thermometer"}  # ratio column -> the limit row it divides by
@@ -114,22 +116,38 @@ def _ratio_to(table: pd.DataFrame, protocol: str, limit: str) -> np.ndarray:
     return primary / float(row.iloc[0]) if not row.empty and float(row.iloc[0]) > 0 else np.full(len(table), np.nan)
 
 
+PROBE_FAILS = 10.0  # a ±0.5 g error this many times the oracle's: the method learned the trained levels
+
+
 def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
-    """Flag a method whose median beats the oracle: that is not physics but a model of the
-    trained acceleration levels (its +-0.5 g probe error tells how far off it is elsewhere)."""
+    """Flag what a median alone hides. Below the physical limit: the upper end of the median's
+    95 % interval is under the oracle's value (one draw of the noise, no interval of its own).
+    Fails the ±0.5 g probe (fulltemp): its error is over :data:`PROBE_FAILS` times the oracle's —
+    a model of the trained acceleration levels, not of the sensor, whatever its Table 2 figure.
+    And (fulltemp) when the paper's pick, the best of the restarts by training RMSE, fails the
+    probe worse than the median restart."""
     primary = f"median_{SHORT[PRIMARY[protocol]]}"
-    oracle = table.loc[table["method"] == "oracle", primary]
+    oracle = table.loc[table["method"] == "oracle"]
     if oracle.empty:
         return [""] * len(table)
     if protocol == "gyro":
         return _gyro_notes(table)
-    limit = float(oracle.iloc[0])
+    limit = float(oracle[primary].iloc[0])
+    probe_limit = float(oracle["median_halfg_ug"].iloc[0]) if "median_halfg_ug" in oracle else np.nan
     notes = []
     for row in table.itertuples(index=False):
-        below = row.method not in LIMITS.values() and getattr(row, primary) < limit
-        probe = getattr(row, "median_halfg_ug", np.nan)
-        notes.append(f"below the physical limit: fits the trained levels, ±0.5 g error {probe:.3g} µg"
-                     if below and np.isfinite(probe) else "below the physical limit" if below else "")
+        if row.method in LIMITS.values():
+            notes.append("")
+            continue
+        parts = []
+        if row.ci_high_primary < limit:  # NaN (a single run) compares False
+            parts.append(f"below the physical limit (ci95 up to {row.ci_high_primary:.3g} < {limit:.3g})")
+        probe, picked = getattr(row, "median_halfg_ug", np.nan), getattr(row, "best_by_train_halfg_ug", np.nan)
+        if probe > PROBE_FAILS * probe_limit:
+            parts.append(f"fails the ±0.5 g probe ({probe:.2g} µg, oracle {probe_limit:.2g}): fits the trained levels")
+        if picked > probe > PROBE_FAILS * probe_limit:
+            parts.append(f"the best-by-train pick fails it worse ({picked:.2g} µg)")
+        notes.append("; ".join(parts))
     return notes
 
 
@@ -140,9 +158,14 @@ MSRA_KEY = (
     "factor cubic in temperature (least squares); lagpoly = the same in the thermometer passed through a "
     "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
     "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
-    "signed-rank p-value of the primary metric against the next row, paired by seed. note: a median below the "
-    "oracle's is not physics — such a method has learned the trained acceleration levels, which its ±0.5 g "
-    "probe error (halfg) shows.")
+    "signed-rank p-value of the primary metric against the next row, paired by seed.")
+FULLTEMP_NOTE = (
+    " note: \"below the physical limit\" when even the upper end of the median's 95 % interval is under the "
+    "oracle's; a method below it is not better physics but has learned the trained acceleration levels (−1, 0, "
+    "+1 g), which the ±0.5 g probe (halfg: the 0 g samples moved to ±0.5 g) shows; \"fails the ±0.5 g probe\" "
+    "when its error is over ten times the oracle's, whatever its bias figure. The paper's selection rule (best of "
+    "the restarts by training RMSE) favours such networks: the note says where its pick fails the probe worse "
+    "than the median restart.")
 CHAMBER_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
     "physical limit); oracle_thermometer = the same model fed the thermometer reading (smoothed over 60 s); "
@@ -165,7 +188,7 @@ GYRO_KEY = (
     "says how much of a real rate input the method throws away with the noise.")
 
 
-KEYS = {"gyro": GYRO_KEY, "chamber": CHAMBER_KEY}
+KEYS = {"gyro": GYRO_KEY, "chamber": CHAMBER_KEY, "fulltemp": MSRA_KEY + FULLTEMP_NOTE, "roomtemp": MSRA_KEY}
 
 
 def _gyro_notes(table: pd.DataFrame) -> list[str]:

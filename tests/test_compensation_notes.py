@@ -1,0 +1,39 @@
+"""The notes of a compensation board: below the limit only with the interval, the ±0.5 g probe
+whatever the bias figure, and where the paper's best-by-training-RMSE pick fails it worse."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from tcbench.leaderboard.compensation import summarise
+
+
+def _runs(method: str, bias_ug: np.ndarray, halfg_ug: np.ndarray, train_rmse: np.ndarray | None = None) -> pd.DataFrame:
+    n = bias_ug.size
+    return pd.DataFrame({
+        "method": method, "status": "FINISHED", "seed": np.arange(n), "bias_variation_ug": bias_ug,
+        "raw_bias_variation_ug": 4e4, "sf_variation_ppm": 100.0, "raw_sf_variation_ppm": 2e4,
+        "halfg_error_ug": halfg_ug, "train_rmse_ug": np.arange(n, dtype=float) if train_rmse is None else train_rmse,
+    })
+
+
+def test_notes_use_the_interval_and_the_probe() -> None:
+    rng = np.random.default_rng(0)
+    runs = pd.concat([
+        _runs("oracle", np.array([8.95]), np.array([3.0])),
+        _runs("wide", np.linspace(5.0, 12.5, 30), np.full(30, 4.0)),          # median below, interval across
+        _runs("memoriser", rng.uniform(5.0, 6.0, 30), np.full(30, 5e4)),        # below, and fails the probe
+        _runs("honest_fit", rng.uniform(20.0, 22.0, 30), np.full(30, 12.0)),   # above, passes the probe
+        # above the limit and failing the probe; its lowest training RMSE (seed 0) fails it worst
+        _runs("picked_worse", rng.uniform(30.0, 31.0, 30), np.r_[3e5, np.full(29, 6e4)]),
+    ], ignore_index=True)
+    table = summarise(runs, "fulltemp").set_index("method")
+    wide = float(np.median(runs.loc[runs["method"] == "wide", "bias_variation_ug"]))
+    assert wide < 8.95 and table.loc["wide", "note"] == ""
+    assert table.loc["memoriser", "note"].startswith("below the physical limit (ci95 up to 5.")
+    assert "fails the ±0.5 g probe (5e+04 µg, oracle 3)" in table.loc["memoriser", "note"]
+    assert table.loc["honest_fit", "note"] == "" and table.loc["oracle", "note"] == ""
+    note = table.loc["picked_worse", "note"]
+    assert "below" not in note and "fails the ±0.5 g probe" in note and "best-by-train pick fails it worse (3e+05 µg)" in note
+    assert "ci_high_primary" not in table.columns
