@@ -187,3 +187,30 @@ def test_diverging_gd_keeps_finite_parameters() -> None:
     assert history.stopped == "diverged"
     assert np.isfinite(history.loss).all() and np.isfinite(net.get_params()).all()
     assert np.isfinite(net.predict(x)).all()
+
+
+def test_checkpoints_are_the_shorter_trainings_of_the_same_trajectory() -> None:
+    """A GD training with checkpoints keeps the weights after those epochs; each equals a training
+    stopped there, and the task scores them beside the final weights."""
+    import gymnasium as gym
+
+    import tcbench  # noqa: F401 - registers the envs
+
+    def env(**params):  # type: ignore[no-untyped-def]
+        e = gym.make("tcbench/MSRA-FullTemp-v0", learner="bp", learner_params={"training": "gd", **params}).unwrapped
+        e.reset(seed=2)
+        return e
+
+    init = env(epochs=60).learner.initial_params(np.random.default_rng(5))
+    long_score, history = env(epochs=60, checkpoints=[10, 30]).score(init)
+    assert sorted(history.snapshots) == [10, 30] and len(history.loss) == 61
+    short = env(epochs=30)
+    short_score, _ = short.score(init)
+    np.testing.assert_array_equal(history.snapshots[30], short.learner.get_params())
+    at30 = long_score.extra["checkpoints"][30]
+    assert at30 == short_score.summary()
+    assert long_score.summary() != at30
+    with pytest.raises(ValueError, match="checkpoints must be null or, with training gd"):
+        env(training="lm", checkpoints=[10])
+    with pytest.raises(ValueError, match="checkpoints must be null or, with training gd"):
+        env(epochs=20, checkpoints=[30])

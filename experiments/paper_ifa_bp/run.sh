@@ -15,6 +15,14 @@ common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra/launc
 tcbench run -m experiment=paper_ifa_bp "${common[@]}"
 tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,oracle,oracle_thermometer,lagpoly,poly optimiser=none \
   tracking.experiment=paper-ifa-bp "${common[@]}"
+# the cubic with the networks' inputs on zero bias: [T, dT/dt] (poly3_rate)
+tcbench run task=msra_zerobias learner=poly learner.form=bias_rate optimiser=none tracking.experiment=paper-ifa-bp \
+  "${common[@]}"
+# Table 2 against the gradient-descent budget: one 300 000-epoch training per seed, scored after
+# 1e3, 3e3, 1e4, 3e4, 1e5 epochs on the way (learner.checkpoints)
+tcbench run -m task=msra_fulltemp learner=bp learner.training=gd learner.epochs=300000 \
+  'learner.checkpoints=[1000,3000,10000,30000,100000]' optimiser=ifa 'seed=range(30)' \
+  '+learner.label=IFA-BP-gd-300000ep' tracking.experiment=paper-ifa-bp "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment paper-ifa-bp --sweep "$sweep" --out "$out"
 python "$here/tables.py" --experiment paper-ifa-bp --sweep "$sweep" --out "$out"

@@ -36,6 +36,7 @@ class FitHistory:
     iterations: int = 0
     stopped: str = ""  # why training ended: "max_epochs", "goal", "converged", "closed_form", ...
     seconds: float = 0.0
+    snapshots: dict[int, np.ndarray] = field(default_factory=dict)  # parameters after N epochs (checkpoints)
 
 
 @dataclass(frozen=True)

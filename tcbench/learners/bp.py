@@ -45,6 +45,9 @@ class BPParams(LearnerParams):
     momentum: gradient-descent momentum mu in [0, 1): ``v <- mu v - eta grad C``.
     goal: stop once the eq. 3 error (normalised units) is <= goal, >= 0.
     lm_tolerance: LM ``ftol``, ``xtol`` and ``gtol``, > machine epsilon.
+    checkpoints: gradient-descent epochs (each <= ``epochs``) after which the weights are kept in
+        :attr:`FitHistory.snapshots`, so that one long training scores every shorter budget on the
+        same trajectory (a task scores them beside the final weights); None: none.
     """
 
     hidden: int = 10
@@ -56,6 +59,7 @@ class BPParams(LearnerParams):
     momentum: float = 0.9
     goal: float = 0.0
     lm_tolerance: float = 1e-12
+    checkpoints: list | None = None
 
     @property
     def max_epochs(self) -> int:
@@ -77,6 +81,9 @@ class BPParams(LearnerParams):
             ("momentum", 0 <= self.momentum < 1, "in [0, 1)"),
             ("goal", self.goal >= 0, "a number >= 0"),
             ("lm_tolerance", np.finfo(float).eps < self.lm_tolerance < 1, "in (machine epsilon, 1)"),
+            ("checkpoints", self.checkpoints is None or (
+                self.training == "gd" and all(isinstance(c, int) and 1 <= c <= self.max_epochs for c in self.checkpoints)),
+             "null or, with training gd, a list of epochs within 1..epochs"),
         ]
         for name, ok, allowed in checks:
             if not ok:
@@ -251,6 +258,7 @@ class BPNetwork(Learner):
         history = FitHistory()
         v = np.zeros_like(p)
         best, best_loss = p.copy(), np.inf
+        marks = set(cfg.checkpoints or ())
         with np.errstate(all="ignore"):
             while True:
                 loss, grad = self.loss_and_grad(p, x, t)
@@ -258,6 +266,8 @@ class BPNetwork(Learner):
                     history.stopped = "diverged"
                     return best, history
                 history.loss.append(loss)
+                if history.iterations in marks:
+                    history.snapshots[history.iterations] = p.copy()
                 if loss < best_loss:
                     best, best_loss = p.copy(), loss
                 if loss <= cfg.goal or history.iterations == cfg.max_epochs:

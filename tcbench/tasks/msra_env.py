@@ -173,9 +173,19 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if self.data is None or self.learner is None:
             raise RuntimeError("call reset() on an env with a learner before score()")
         history = self.learner.fit(self._x, self._y, init=init)  # the training set built by reset()
+        final = self.learner.get_params()
+        checkpoints = {}
+        for epochs, params in sorted(history.snapshots.items()):  # shorter budgets of the same training
+            self.learner.set_params(params)
+            rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
+            fn = methods.learner_compensator(self.data, self.learner)
+            checkpoints[epochs] = score_outputs(self.data, fn, self.bias_form, rmse).summary()
+        self.learner.set_params(final)
         rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
         fn = methods.learner_compensator(self.data, self.learner)
-        return score_outputs(self.data, fn, self.bias_form, rmse), history
+        score = score_outputs(self.data, fn, self.bias_form, rmse)
+        score.extra["checkpoints"] = checkpoints
+        return score, history
 
     def score_baseline(self, which: str) -> Score:
         """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone),

@@ -138,6 +138,8 @@ class CompensationKind(JobKind):
             "init_loss": result.init_loss, "seconds_search": result.seconds_search,
             "seconds_train": result.seconds_train,
         }
+        for epochs, at in result.score.extra.get("checkpoints", {}).items():  # e.g. at1000.bias_variation_ug
+            values |= {f"at{epochs}.{k}": v for k, v in at.items()}
         run.log_metrics({k: v for k, v in values.items() if not np.isnan(v)})
         if result.trace.evaluations:
             run.log_series("init_best_f", result.trace.best_f, result.trace.evaluations)
