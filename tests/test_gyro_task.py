@@ -227,3 +227,19 @@ def test_device_effects_change_the_simulated_gyro() -> None:
         GyroDriftNoiseEnv("poly", effects={"nosuch": {"b": 1.0}})
     with pytest.raises(ValueError, match="has no parameter q"):
         GyroVMDTuningEnv(effects={"bias_instability": {"q": 1.0}})
+
+
+def test_the_wavelet_level_sets_what_the_threshold_removes(scores: dict[str, dict[str, float]]) -> None:
+    """WTD's ARW and bandwidth are functions of its level (the boards' WTD is the deepest): a
+    shallow threshold keeps more band and more noise; the level is named in the method."""
+    from tcbench.runner.kinds.compensation import compensation_label
+
+    shallow = _env(None, decomposition="none", denoise="wavelet", wavelet_level=2).score_baseline("raw").summary()
+    deepest = scores["wtd"]
+    assert shallow["bandwidth_hz"] > 4 * deepest["bandwidth_hz"]
+    assert shallow["arw_1s_deg_per_sqrt_h"] > 2 * deepest["arw_1s_deg_per_sqrt_h"]
+    task = {"name": "gyro_driftnoise", "decomposition": "none", "denoise": "wavelet", "wavelet_level": 2}
+    assert compensation_label({"name": "raw"}, {"name": "none"}, task) == "WTD-L2"
+    assert compensation_label({"name": "raw"}, {"name": "none"}, task | {"wavelet_level": None}) == "WTD"
+    with pytest.raises(ValueError, match="wavelet_level must be an integer >= 1"):
+        _env(None, decomposition="none", denoise="wavelet", wavelet_level=0)

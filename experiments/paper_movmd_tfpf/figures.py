@@ -62,10 +62,15 @@ def _verdict(runs: pd.DataFrame, oracle: pd.Series) -> list[str]:
     n = len(mine)
     lines = [
         f"**Claim (Fig. 19): ARW 0.531 → 5.2e-3 (×{paper_arw:.0f}) and bias stability 32.7 → 0.14 °/h "
-        f"(×{paper_bi:.0f}).** Over {n} restarts of the same pipeline here: ARW ×{arw_gain.median():.1f} "
+        f"(×{paper_bi:.0f}).** Here, with one VMD tuning and one decomposition shared by the {n} restarts "
+        f"(they differ only in the BAS-Elman drift learner's start, so the ARW and bias instability are "
+        f"in effect one observation): ARW ×{arw_gain.median():.1f} "
         f"(range {arw_gain.min():.1f}–{arw_gain.max():.1f}), bias instability ×{bi_gain.median():.1f} "
-        f"(range {bi_gain.min():.1f}–{bi_gain.max():.1f}); {int((arw_gain >= paper_arw).sum())} of {n} reach the "
-        f"paper's ARW factor and {int((bi_gain >= paper_bi).sum())} of {n} its bias-stability factor: "
+        f"(range {bi_gain.min():.1f}–{bi_gain.max():.1f}); the paper's ARW factor is "
+        + ("reached" if (arw_gain >= paper_arw).all() else "not reached")
+        + " and its bias-stability factor "
+        + ("reached" if (bi_gain >= paper_bi).all() else "not reached")
+        + " by that one decomposition: "
         + ("**reproduced**." if (arw_gain >= paper_arw).all() and (bi_gain >= paper_bi).all() else
            "**not reproduced** at the paper's size."),
         f"**What the gains are made of.** The oracle — the simulator's true drift removed, the noise "

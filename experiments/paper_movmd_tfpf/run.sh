@@ -6,7 +6,7 @@
 # and the Allan curves of every method.
 # Usage (from the repository root, with tcbench and plugins/tcbench-peers installed):
 #   bash experiments/paper_movmd_tfpf/run.sh
-# About 32 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
+# About 35 min on 2 cores (the VMD tuning and the decompositions are computed once per process).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 here=experiments/paper_movmd_tfpf
@@ -49,3 +49,4 @@ run 13 "${low[@]}" task.decomposition=emd task.denoise=wavelet learner=bp optimi
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment paper-movmd-tfpf --out "$out"
 python "$here/figures.py" --experiment paper-movmd-tfpf --out "$out"
+python "$here/wtd_levels.py" --out "$out"

@@ -178,7 +178,8 @@ CHAMBER_KEY = (
     "paired by seed.")
 GYRO_KEY = (
     "Methods are named by their pipeline: MOVMD = MOPSO-tuned VMD with sample-entropy classes (noise modes "
-    "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition), then "
+    "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition; WTD = "
+    "universal soft threshold at the deepest level the record allows unless named -L<level>), then "
     "the drift learner (BAS-elman = BAS-initialised Elman on [T, dT/dt]; (T) = temperature input only); "
     "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
     "limit); oracle_thermometer = the simulator's drift model fed the thermometer reading (smoothed over 60 s) "
@@ -268,7 +269,9 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
                 "inside the curve (0: the minimum is the curve's end, for a filtered output σ at the first τ, and "
                 "bi_dph is no floor); rms_dph = RMS error against the true rate (°/h); bw_hz = bandwidth kept, the "
                 "−3 dB frequency of the whole method measured by injecting a multi-sine rate (Nyquist when "
-                "nothing is lost)",
+                "nothing is lost); for a nonlinear method (a wavelet threshold, TFPF) it depends on the test "
+                "signal, and single sines can give another value (experiments/paper_movmd_tfpf/wtd_levels.py "
+                "measures both)",
     }[board.protocol]
     lines = [
         f"# Compensation leaderboard: {board.task}", "",

@@ -65,7 +65,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s: the simulated oven
         runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks).
     train_files, test_files: schema-v1 gyro recordings instead.
-    decomposition, k, alpha, denoise, tfpf_window, noise_above, drift_below, inputs,
+    decomposition, k, alpha, denoise, tfpf_window, wavelet_level, noise_above, drift_below, inputs,
         rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.compensation.gyro.pipeline.PipelineConfig`);
         ``k``/``alpha`` default to seed 001's tuned ``[8, 9755]``; None: to be tuned, then set by
         ``reset(options=...)``.
@@ -85,7 +85,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  n_test: int = 1, train_files: list[str] | None = None, test_files: list[str] | None = None,
                  sample_rate_hz: float = 10.0, hold_s: float = 3600.0, decomposition: str = "vmd",
                  k: int | None = PAPER_BEST[0], alpha: float | None = PAPER_BEST[1], denoise: str = "tfpf",
-                 tfpf_window: int = 31,
+                 tfpf_window: int = 31, wavelet_level: int | None = None,
                  noise_above: float = 0.5, drift_below: float = 0.15, inputs: str = "t_rate",
                  rate_window_s: float = 120.0, learner_block_s: float = 10.0,
                  bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
@@ -112,6 +112,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         except TaskDataError as exc:
             raise ValueError(str(exc)) from None
         pipeline = {"decomposition": decomposition, "denoise": denoise, "tfpf_window": tfpf_window,
+                    "wavelet_level": wavelet_level,
                     "noise_above": noise_above, "drift_below": drift_below, "inputs": inputs,
                     "rate_window_s": rate_window_s, "learner_block_s": learner_block_s}
         self.config = PipelineConfig(**pipeline, **({"k": k} if k is not None else {}),

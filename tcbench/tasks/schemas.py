@@ -79,6 +79,7 @@ class GyroTaskConfig(GyroTuningTaskConfig):
     tuning_budget: int = 440
     denoise: str = "tfpf"
     tfpf_window: int = 31
+    wavelet_level: int | None = None
     noise_above: float = 0.5
     drift_below: float = 0.15
     inputs: str = "t_rate"

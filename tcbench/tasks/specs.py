@@ -61,6 +61,8 @@ def gyro_pipeline(task: dict[str, Any]) -> str:
     tuned = task.get("k") is None or task.get("alpha") is None
     front = {"vmd": "MOVMD" if tuned else "VMD", "emd": "EMD", "none": ""}[decomposition]
     denoise = {"tfpf": "TFPF", "wavelet": "WTD", "none": ""}[task.get("denoise", "tfpf")]
+    if denoise == "WTD" and task.get("wavelet_level") is not None:
+        denoise += f"-L{task['wavelet_level']}"
     return "-".join(p for p in (front, denoise) if p)
 
 

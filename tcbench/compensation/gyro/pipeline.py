@@ -127,6 +127,9 @@ class PipelineConfig:
     k, alpha: VMD modes and bandwidth penalty (vmdpy's alpha convention, see signal.vmd).
     denoise: "tfpf" (seed 001), "wavelet" (universal soft threshold) or "none".
     tfpf_window: TFPF lag window (odd, samples).
+    wavelet_level: the wavelet threshold's decomposition depth; None: the deepest the record allows
+        (``pywt.dwt_max_level``, 16 for a 14 h record at 10 Hz). What the threshold removes, and so
+        its ARW and the bandwidth it keeps, is a function of it (``experiments/paper_movmd_tfpf``).
     noise_above / drift_below: sample-entropy thresholds (:func:`classify_modes`).
     inputs: learner inputs, "t_rate" ([T, dT/dt], seed 001 eq. 28) or "t" ([T]).
     rate_window_s: trailing window of the dT/dt input (s).
@@ -138,6 +141,7 @@ class PipelineConfig:
     alpha: float = 2000.0
     denoise: str = "tfpf"
     tfpf_window: int = 31
+    wavelet_level: int | None = None
     noise_above: float = DEFAULT_NOISE_ABOVE
     drift_below: float = DEFAULT_DRIFT_BELOW
     inputs: str = "t_rate"
@@ -155,6 +159,8 @@ class PipelineConfig:
         _int_at_least(self.tfpf_window, "tfpf_window", 3)
         if self.tfpf_window % 2 == 0:
             raise ValueError(f"tfpf_window must be an odd integer >= 3 samples, got {self.tfpf_window!r}")
+        if self.wavelet_level is not None:
+            _int_at_least(self.wavelet_level, "wavelet_level", 1)
         _check_thresholds(self.noise_above, self.drift_below)
         for name, value in (("rate_window_s", self.rate_window_s), ("learner_block_s", self.learner_block_s)):
             if not (np.isfinite(value) and value > 0):
@@ -236,12 +242,12 @@ def block_means(block: np.ndarray, values: np.ndarray) -> np.ndarray:
     return means.reshape(-1) if values.ndim == 1 else means
 
 
-def denoise(x: np.ndarray, how: str, window: int, fs_hz: float) -> np.ndarray:
-    """``x`` through the denoiser ``how`` ("tfpf", "wavelet" or "none")."""
+def denoise(x: np.ndarray, how: str, window: int, fs_hz: float, level: int | None = None) -> np.ndarray:
+    """``x`` through the denoiser ``how`` ("tfpf", "wavelet" at ``level``, or "none")."""
     if how == "tfpf":
         return tfpf(x, window, fs_hz=fs_hz)
     if how == "wavelet":
-        return wavelet_denoise(x)
+        return wavelet_denoise(x, level=level)
     return x.copy()
 
 
@@ -262,7 +268,8 @@ def front_end(y: np.ndarray, fs_hz: float, config: PipelineConfig) -> FrontEnd:
     classes = classify_modes(modes, noise_above=config.noise_above, drift_below=config.drift_below)
     mixed = modes[classes.mask("mixed")].sum(axis=0)
     return FrontEnd(modes, classes, modes[classes.mask("noise")].sum(axis=0), mixed,
-                    modes[classes.mask("drift")].sum(axis=0), denoise(mixed, config.denoise, config.tfpf_window, fs_hz))
+                    modes[classes.mask("drift")].sum(axis=0), denoise(mixed, config.denoise, config.tfpf_window, fs_hz,
+                                                                        config.wavelet_level))
 
 
 class ParallelPipeline:
@@ -333,7 +340,7 @@ class ParallelPipeline:
         predicted = self.predict_drift(t, temp)
         compensated = f.drift_part - predicted
         if self.config.decomposition == "none":
-            out = denoise(compensated, self.config.denoise, self.config.tfpf_window, fs_hz)
+            out = denoise(compensated, self.config.denoise, self.config.tfpf_window, fs_hz, self.config.wavelet_level)
         else:
             out = f.denoised_mixed + compensated
         return PipelineOutput(modes=f.modes, classes=f.classes, noise_part=f.noise_part, mixed_part=f.mixed_part,
