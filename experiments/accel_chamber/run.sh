@@ -2,7 +2,7 @@
 # The accelerometer chamber task's board: BP (IFA and random initial weights; GD and LM) over 30
 # seeds, BAS-Elman over 10, and the baselines (raw, poly3, poly3_rate, lagpoly, the diagnosed model,
 # both oracles) on device 0; the baselines on devices 1-9; then leaderboards/accel-chamber/ (one board
-# per device, and devices.md across them). About 30 min on 2 cores.
+# per device, and devices.md across them). About 40 min on 2 cores.
 # Usage (from the repository root, tcbench installed): bash experiments/accel_chamber/run.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
