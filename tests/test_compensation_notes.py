@@ -33,6 +33,7 @@ def test_notes_use_the_interval_and_the_probe() -> None:
     assert wide < 8.95 and table.loc["wide", "note"] == ""
     assert table.loc["memoriser", "note"].startswith("below the physical limit (ci95 up to 5.")
     assert "fails the ±0.5 g probe (5e+04 µg, oracle 3)" in table.loc["memoriser", "note"]
+    assert "fails" not in table.loc["wide", "note"] + table.loc["honest_fit", "note"]
     assert table.loc["honest_fit", "note"] == "" and table.loc["oracle", "note"] == ""
     note = table.loc["picked_worse", "note"]
     assert "below" not in note and "fails the ±0.5 g probe" in note and "best-by-train pick fails it worse (3e+05 µg)" in note
