@@ -177,15 +177,17 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         checkpoints = {}
         for epochs, params in sorted(history.snapshots.items()):  # shorter budgets of the same training
             self.learner.set_params(params)
-            rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
-            fn = methods.learner_compensator(self.data, self.learner)
-            checkpoints[epochs] = score_outputs(self.data, fn, self.bias_form, rmse).summary()
+            checkpoints[epochs] = self._score_learner().summary()
         self.learner.set_params(final)
-        rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
-        fn = methods.learner_compensator(self.data, self.learner)
-        score = score_outputs(self.data, fn, self.bias_form, rmse)
+        score = self._score_learner()
         score.extra["checkpoints"] = checkpoints
         return score, history
+
+    def _score_learner(self) -> Score:
+        """The test recordings compensated by the learner with its current parameters."""
+        assert self.data is not None and self.learner is not None
+        rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
+        return score_outputs(self.data, methods.learner_compensator(self.data, self.learner), self.bias_form, rmse)
 
     def score_baseline(self, which: str) -> Score:
         """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone),
@@ -206,7 +208,5 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             score = score_outputs(self.data, fn, self.bias_form)
             score.extra["diagnosis"] = diag
             return score
-        if which in ("oracle", "oracle_thermometer"):
-            fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
-            return score_outputs(self.data, fn, self.bias_form)
-        raise ValueError(f"unknown baseline {which!r}; known: {', '.join(methods.BASELINES)}")
+        fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
+        return score_outputs(self.data, fn, self.bias_form)
