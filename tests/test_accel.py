@@ -212,8 +212,8 @@ def test_a_fourth_kind_is_one_module(tmp_path: Path) -> None:
 
 def test_the_accelerometer_is_diagnosed_and_calibrated(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A simulated chamber cycle: ``tcbench diagnose`` finds its lag and hysteresis, and ``tcbench
-    calibrate`` fitted on the full cooling branch beats the raw output on the other branches and
-    exports PX4's accelerometer parameters (TC_A*, in m/s^2)."""
+    calibrate`` fitted on the full cooling branch beats the raw output on the other branches, and
+    ``tcbench export`` writes PX4's accelerometer parameters (TC_A*, in m/s^2)."""
     code, _, err = run(capsys, "simulate", "sensor=accel", "protocol=chamber", "device_seed=0", "out=rec",
                        "tracking.enabled=false")
     assert code == 0, err
@@ -222,14 +222,16 @@ def test_the_accelerometer_is_diagnosed_and_calibrated(workdir: Path, capsys: py
     assert code == 0, err
     assert "thermal_lag" in out and "hysteresis" in out and (workdir / "diag" / "model.yaml").is_file()
     code, out, err = run(capsys, "calibrate", f"recording={path}", "out=cal", "train_branches=[1]",
-                         "methods=[raw,poly3]", "tracking.enabled=false")
+                         "methods=[raw,poly3]", "axis=z", "tracking.enabled=false")
     assert code == 0, err
     table = pd.read_csv(workdir / "cal" / "calibration.csv")
     test = table[table["role"] == "test"].pivot(index="branch", columns="method", values="drift_rms_g")
     assert (test["poly3"] < 0.5 * test["raw"]).all(), test
-    script = (workdir / "cal" / "px4_tc_params.txt").read_text().splitlines()
-    assert script[-1] == "param set TC_A_ENABLE 1" and script[0] == "param set TC_A0_ID 0"
-    x0 = float(next(ln.split()[3] for ln in script if ln.split()[2] == "TC_A0_X0_0"))
+    code, out, err = run(capsys, "export", "calibrations=[cal]", "device_id=4", "out=params")
+    assert code == 0, err
+    script = (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()
+    assert script[-1] == "param set TC_A_ENABLE 1" and script[0] == "param set TC_A0_ID 4"
+    x0 = float(next(ln.split()[3] for ln in script if ln.split()[2] == "TC_A0_X0_2"))
     assert abs(x0) < 0.5 * G0 and abs(x0) > 0  # m/s^2: the offset near TREF, in PX4's unit
 
 

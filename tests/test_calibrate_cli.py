@@ -3,6 +3,7 @@ first cooling branch, scored on the heating and the second cooling branch, track
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import mlflow
@@ -47,16 +48,29 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
     # PX4's cubic is held at its edge) leaves less than half the cubic's held-out drift (0.31x and 0.20x)
     assert (drift.loc[[1, 2], "model"] < 0.5 * drift.loc[[1, 2], "poly3"]).all(), drift
     assert "sensor: gyro" in (workdir / "cal" / "diagnosis" / "model.yaml").read_text()
-    params = (workdir / "cal" / "px4_tc_params.txt").read_text().splitlines()
-    assert params[0] == "param set TC_G0_ID 0" and "param set TC_G0_X3_0" in " ".join(params)
+    assert not (workdir / "cal" / "px4_tc_params.txt").exists()  # one axis alone: tcbench export writes them
     assert (workdir / "cal" / "residuals.png").stat().st_size > 10_000
-    assert "| poly3 | 1 | heating |" in out
+    lines = out.strip().splitlines()
+    assert lines[0].startswith("calibrate gyro-y.csv (gyro, output in deg/s): fitting raw, poly3, poly3_rate, bp, "
+                               "elman, model on temperature branch 0 (cooling 51.6 -> -17.5 degC); scoring on "
+                               "temperature branches 1, 2 (held out)"), lines[0]
+    summary = json.loads((workdir / "cal" / "calibration.json").read_text())
+    best = next(ln for ln in lines if ln.startswith("best held out"))  # the last line but MLflow's
+    assert best.startswith(f"best held out: {summary['best']}, drift ") and "95% block bootstrap" in best, best
+    assert summary["best"] == "model" and summary["next"] in {"bp", "elman", "poly3", "poly3_rate"}
+    assert summary["ratio_lo"] <= summary["ratio_to_next"] <= summary["ratio_hi"]
+    held = table[table["role"] == "test"]
+    pooled = {m: np.sqrt(np.average(g["drift_rms_deg_per_s"] ** 2)) for m, g in held.groupby("method")}
+    assert min(pooled, key=pooled.get) == summary["best"]  # the ranking agrees with the long table
+    assert len(lines) < 20 and "| raw | 1 | heating |" not in out  # the long table goes to the file
 
     client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     (r,) = client.search_runs([client.get_experiment_by_name("calibrations").experiment_id])
     assert r.data.tags["tcbench.kind"] == "calibration" and r.data.tags["tcbench.sensor"] == "gyro"
     assert r.data.metrics["poly3.b1.drift_rms"] == pytest.approx(drift.loc[1, "poly3"])
-    assert {"calibration.md", "residuals.png", "px4_tc_params.txt", "model.yaml", "report.md"} <= \
+    assert r.data.metrics["model.held_out.drift"] == pytest.approx(summary["best_drift"])
+    assert r.data.tags["tcbench.data_hash"] == summary["content_hash"]
+    assert {"calibration.md", "calibration.json", "residuals.png", "model.yaml", "report.md"} <= \
         {a.path for a in client.list_artifacts(r.info.run_id)}
 
 
@@ -92,20 +106,31 @@ def test_a_seed_sweep_resolves_each_seed_and_never_shares_an_output(gyro_y: Path
 
 
 def test_a_record_that_only_cools_is_cut_into_time_blocks(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """The PAN gyro cools once (one branch): ``blocks=5 train_branches=[0,2,4]`` fits on every
-    other block and scores the cubic on the two between, far below the raw bias."""
+    """The PAN gyro cools once (one branch): with nothing said, it is cut into five time blocks,
+    fitted on 0, 2, 4 and scored on the two between — held out, and the first line says so —, the
+    cubic far below the raw bias there; ``blocks=``/``train_branches=`` choose otherwise."""
     code, _, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s", "temperature=temp_c:degC",
                        "output=gyro_x_dps:deg/s", "drop=spike_flag", "out=rec", "name=pan-x",
                        "tracking.enabled=false")
     assert code == 0, err
-    code, _, err = run(capsys, "calibrate", "recording=rec/pan-x.csv", "out=cal", "blocks=5", "train_branches=[0,2,4]",
-                       "methods=[raw,poly3]", "drift_window_s=5", "tracking.enabled=false")
+    code, out, err = run(capsys, "calibrate", "recording=rec/pan-x.csv", "out=cal", "methods=[raw,poly3]",
+                         "drift_window_s=5", "tracking.enabled=false")
     assert code == 0, err
+    assert out.splitlines()[0] == ("calibrate pan-x.csv (gyro, output in deg/s): fitting raw, poly3 on time blocks "
+                                   "0, 2, 4; scoring on time blocks 1, 3 (held out)"), out
     table = pd.read_csv(workdir / "cal" / "calibration.csv")
     assert list(table.loc[table["method"] == "raw", "role"]) == ["train", "test", "train", "test", "train"]
     drift = table.pivot(index="branch", columns="method", values="drift_rms_deg_per_s")
     assert (drift.loc[[1, 3], "poly3"] < 0.01 * drift.loc[[1, 3], "raw"]).all()
-    assert "5 time blocks of equal duration" in (workdir / "cal" / "calibration.md").read_text()
+    assert "5 time blocks (blocks=5, as the record has one temperature branch)" in \
+        (workdir / "cal" / "calibration.md").read_text()
+    summary = json.loads((workdir / "cal" / "calibration.json").read_text())
+    assert summary["best"] == "poly3" and summary["ratio_hi"] < 0.01  # far below raw, and the interval says so
+    code, out, err = run(capsys, "calibrate", "recording=rec/pan-x.csv", "out=cal2", "blocks=4", "train_branches=[0,1,2,3]",
+                         "methods=[raw,poly3]", "tracking.enabled=false")
+    assert code == 0 and err == ["tcbench: warning: every part is fitted and no test_recordings= is given: the "
+                                 "scores are in-sample and no method is ranked"], err
+    assert "nothing held out: no method is ranked" in out
     code, _, err = run(capsys, "calibrate", "recording=rec/pan-x.csv", "out=bad", "blocks=0", "tracking.enabled=false")
     assert code == 2 and len(err) == 1 and "blocks=0" in err[0], err
 

@@ -12,7 +12,7 @@ import yaml
 from tcbench.cli import help as cli_help
 from tcbench.cli import COMMANDS, main
 
-KEYVALUE = ["simulate", "metrics", "import", "diagnose", "calibrate", "leaderboard", "list", "quickstart"]
+KEYVALUE = ["simulate", "metrics", "import", "diagnose", "calibrate", "export", "leaderboard", "list", "quickstart"]
 # what the help of the other commands must name: their parameters or settings
 NAMED = {
     "run": ["usage: tcbench run", "seed", "budget", "tracking", "optimiser", "examples:", "output:"],

@@ -25,7 +25,8 @@ def test_exported_parameters_reproduce_the_fitted_correction(cooling: tuple[np.n
                                                              tmp_path: Path) -> None:
     temp, rates = cooling
     polys = [fit_offset(temp, rates[a]) for a in "xyz"]
-    params = px4_parameters(polys, "gyro", instance=1, device_id=2424842, to_px4_unit=np.pi / 180)
+    params = px4_parameters(dict(zip("xyz", polys, strict=True)), "gyro", instance=1, device_id=2424842,
+                            to_px4_unit=np.pi / 180)
     assert params["TC_G1_ID"] == 2424842 and len(params) == 1 + 12 + 3
     assert params["TC_G1_TMIN"] == pytest.approx(temp.min(), abs=1e-5)
     assert params["TC_G1_TMAX"] == pytest.approx(temp.max(), abs=1e-5)
@@ -53,7 +54,9 @@ def test_bad_fits_and_parameters_are_refused() -> None:
         fit_offset(t, np.where(t > 5, np.nan, t))
     a = fit_offset(t, t ** 2)
     b = OffsetPolynomial(a.x, a.tref_c + 1.0, a.tmin_c, a.tmax_c)
-    with pytest.raises(ValueError, match="share TREF"):
-        px4_parameters([a, b])
+    shared = px4_parameters({"x": a, "y": b})  # two references: both written about one, values kept
+    assert shared["TC_G0_TREF"] == pytest.approx(0.5 * (a.tmin_c + a.tmax_c))
+    with pytest.raises(TypeError, match="mapping of axis name"):
+        px4_parameters([a])  # type: ignore[arg-type]  # a list would put the first axis in x's slot
     with pytest.raises(ValueError, match="not 'baro'"):
-        px4_parameters([a], sensor="baro")
+        px4_parameters({"x": a}, sensor="baro")

@@ -158,13 +158,14 @@ SPECS: dict[str, CommandHelp] = {
     "calibrate": CommandHelp(
         name="calibrate",
         summary="Calibrate a static recording on its own temperature branches: each offset model (raw, PX4's "
-                "cubic in the thermometer, the cubic with a temperature-rate term, BP and Elman networks) fitted on some branches and "
-                "scored on every branch, with plots and, for a gyro or accelerometer, PX4's TC_G* / TC_A* parameters.",
+                "cubic in the thermometer, the cubic with a temperature-rate term, BP and Elman networks, the diagnosed "
+                "model) fitted on some parts and ranked on the others, held out, with a block-bootstrap interval.",
         schema=_schema("calibrate"),
         params={
             "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
             "out": "output folder",
-            "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order",
+            "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
+                              "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
             "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
                       "(a record that only cools: train_branches=[0,2,4] blocks=5)",
             "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp, elman "
@@ -174,7 +175,7 @@ SPECS: dict[str, CommandHelp] = {
                         "scores (the plot shows the first)",
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
-            "px4_instance": "the sensor instance the TC_G / TC_A parameters are for (0..3)",
+            "axis": "x, y or z: the recording's axis when its sidecar does not say (tcbench import axes= records it)",
             "test_recordings": "other recordings of the same kind and unit to score the fitted models on, every "
                                "part of them held out: train on one record, test on others",
             "true_input": "the static record's true input, VALUE[:unit] (an accelerometer axis along gravity: "
@@ -187,8 +188,9 @@ SPECS: dict[str, CommandHelp] = {
             "tcbench calibrate -m recording=a.csv,b.csv 'out=cal/${stem:recording}'",
             "tcbench calibrate recording=recordings/tofupilot/imu-imu.acc.z.csv true_input=-1:g out=cal/acc-z",
         ),
-        output="OUT/calibration.md and .csv (one row per method and branch: drift and RMS), OUT/residuals.png, "
-               "OUT/px4_tc_params.txt for a gyro or accelerometer; MLflow experiment 'calibrations' when tracking is on",
+        output="the held-out ranking (printed); OUT/calibration.md and .csv (one row per method and part: drift and "
+               "RMS), OUT/residuals.png, OUT/calibration.json (the ranking and the cubic for tcbench export); MLflow "
+               "experiment 'calibrations' when tracking is on",
         positional="recording",
         required=("recording",),
     ),
@@ -222,6 +224,29 @@ SPECS: dict[str, CommandHelp] = {
                  "  --out DIR           out=DIR",
                  "  --tracking-uri URI  tracking.uri=URI",
                  "  --ecdf              ecdf=true"),
+    ),
+    "export": CommandHelp(
+        name="export",
+        summary="Write the thermal-calibration parameters of one IMU for PX4 (TC_G*/TC_A*, a param-set "
+                "script) and ArduPilot (INS_TCALn_*, a .parm file) from tcbench calibrate's outputs, one per axis "
+                "and sensor kind, every axis in its slot (the axis from the recording's sidecar or calibrate axis=).",
+        schema=_schema("export"),
+        params={
+            "calibrations": "the out= folders of tcbench calibrate (their calibration.json): one per axis and kind",
+            "out": "output folder",
+            "formats": "px4, ardupilot, or both",
+            "device_id": "PX4's TC_*_ID: the sensor's device id (CAL_GYROn_ID / CAL_ACCn_ID), one number or "
+                         "{gyro: N, accel: M}; null: the id the PX4 log gave (required for px4 otherwise)",
+            "px4_instance": "the TC_G<i> / TC_A<i> instance (0..3)",
+            "ardupilot_imu": "the INS_TCAL<n> IMU (1..3)",
+        },
+        examples=(
+            "tcbench export 'calibrations=[cal/x,cal/y,cal/z]' device_id=2293768 out=params",
+            "tcbench export 'calibrations=[cal/gx,cal/gy,cal/gz,cal/ax,cal/ay,cal/az]' formats=[ardupilot] out=params",
+        ),
+        output="OUT/px4_tc_params.txt and OUT/ardupilot_tcal.parm",
+        required=("calibrations",),
+        sweep=f"{IN_TURN}",
     ),
     "list": CommandHelp(
         name="list",

@@ -26,6 +26,7 @@ commands:
   metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
   diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
   calibrate    fit offset models on some temperature branches of a static recording, score them on the others
+  export       PX4 and ArduPilot thermal-calibration parameters of calibrations (calibrations=[DIR,...])
 
 Every command is a Hydra app: `tcbench <command> --help` (or -h) shows its parameters, their
 defaults, examples and where its output goes; `--cfg job` prints the config a command would run
@@ -408,9 +409,30 @@ def _quickstart(c: dict[str, object]) -> int:
     return quickstart.run(_run_sweep, _sweep_report, _quickstart_config(c))  # type: ignore[arg-type]
 
 
-# commands whose jobs run here, not on the launcher: a listing is instant, and each quickstart
-# runs sweeps of its own on the launcher; name -> (check before any job, the job)
-IN_TURN = {"list": (_check_list, _list), "quickstart": (_check_quickstart, _quickstart)}
+def _export_config(c: dict[str, object]) -> object:
+    from tcbench.commands.schemas import ExportConfig, as_schema
+
+    return as_schema(c, ExportConfig)
+
+
+def _check_export(c: dict[str, object]) -> None:
+    from tcbench.commands.export import check_export
+
+    check_export(_export_config(c))  # type: ignore[arg-type]
+
+
+def _export(c: dict[str, object]) -> int:
+    from tcbench.commands.export import export
+
+    export(_export_config(c))  # type: ignore[arg-type]
+    return 0
+
+
+# commands whose jobs run here, not on the launcher: a listing is instant, an export writes two
+# small files, and each quickstart runs sweeps of its own on the launcher; name -> (check before
+# any job, the job)
+IN_TURN = {"list": (_check_list, _list), "quickstart": (_check_quickstart, _quickstart),
+           "export": (_check_export, _export)}
 
 # ``tcbench leaderboard``'s flags, kept as aliases of its keys
 LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--out": "out", "--tracking-uri": "tracking.uri"}
@@ -480,10 +502,14 @@ def cmd_calibrate(argv: list[str]) -> int:
     return _app_command("calibrate", argv)
 
 
+def cmd_export(argv: list[str]) -> int:
+    return _app_command("export", argv)
+
+
 COMMANDS = {
     "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
     "simulate": cmd_simulate, "import": cmd_import, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
-    "calibrate": cmd_calibrate,
+    "calibrate": cmd_calibrate, "export": cmd_export,
 }
 
 

@@ -1,13 +1,21 @@
 """What ``tcbench calibrate`` does: cut a static recording into parts — its temperature branches,
 or with ``blocks=N`` time blocks (:mod:`tcbench.signal.branches`) —, fit each offset model
 (:mod:`tcbench.compensation.calibration`) on the training parts, score it on every part (and on
-every part of ``test_recordings``), and write the board (``calibration.md`` and ``.csv``), the
-residual plots and, for a kind PX4 calibrates (gyro, accel), PX4's ``TC_G*`` or ``TC_A*``
-parameters of the cubic."""
+every part of ``test_recordings``), rank the methods on the held-out parts with a block-bootstrap
+interval (:mod:`tcbench.compensation.holdout`), and write the long table (``calibration.md`` and
+``.csv``), the residual plots and ``calibration.json`` (the ranking, and the cubic refitted on the
+whole record with the recording's sensor, unit, axis and device id, which ``tcbench export``
+turns into PX4 and ArduPilot parameters).
+
+Something is always held out: with no ``train_branches=``, a record of several temperature
+branches is fitted on its first and scored on the others; a record of one branch (a single
+cooling) is cut into five time blocks, fitted on blocks 0, 2, 4 and scored on 1 and 3."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import json
+import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -18,19 +26,49 @@ from tcbench.commands.schemas import CalibrateConfig
 from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
+AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
+
+
 @dataclass
 class CalibrationOutcome:
-    """The board (one row per method and branch), the files written, the recording's sensor."""
+    """The long table (one row per method and part), the held-out summary (one row per method),
+    the files written, the recording's sensor and the summary as ``calibration.json`` holds it."""
 
     table: Any
     written: dict[str, Path]
     sensor: str
+    summary: Any = None
+    about: dict[str, Any] = field(default_factory=dict)
 
 
-def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any], list[tuple[str, Any, list[Any]]]]:
-    """Every argument before any work: the recording (read and validated), its branches and the
-    training ones among them, the methods, and each of ``test_recordings`` with its parts (same
-    kind and unit as the recording)."""
+@dataclass(frozen=True)
+class Split:
+    """How a recording is cut and which parts are fitted: ``parts`` in time order, the indices of
+    the ``train`` ones, the parts' name (``temperature branch``, ``time block``) and how they were
+    cut (for messages)."""
+
+    parts: list[Any]
+    train: list[int]
+    noun: str
+    how: str
+
+    @property
+    def held_out(self) -> list[int]:
+        return [k for k in range(len(self.parts)) if k not in self.train]
+
+    def describe(self, ks: list[int]) -> str:
+        """``temperature branch 0 (cooling 51.6 -> -17.5 degC)`` or ``time blocks 1, 3``."""
+        plural = self.noun.replace("branch", "branches") if self.noun.endswith("branch") else self.noun + "s"
+        if len(ks) == 1:
+            b = self.parts[ks[0]]
+            return f"{self.noun} {ks[0]} ({b.direction} {b.from_c:.1f} -> {b.to_c:.1f} degC)"
+        return f"{plural} {', '.join(map(str, ks))}"
+
+
+def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, Any, list[Any]]]]:
+    """Every argument before any work: the recording (read and validated), how it is split and
+    fitted, the methods, and each of ``test_recordings`` with its parts (same kind and unit as the
+    recording)."""
     from tcbench.compensation.calibration import METHODS
 
     if not cfg.recording:
@@ -45,18 +83,15 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any], list[tuple[st
         raise CommandError(f"seed must be a non-negative integer, got {cfg.seed}")
     if not 1 <= cfg.restarts <= 1000:
         raise CommandError(f"restarts must be 1..1000, got {cfg.restarts}")
-    if not 0 <= cfg.px4_instance <= 3:
-        raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
+    if cfg.axis is not None and cfg.axis not in ("x", "y", "z"):
+        raise CommandError(f"axis={cfg.axis}: the axes are x, y and z")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    rec, branches, (parts, how) = _prepared(cfg.recording, cfg)
-    bad = [k for k in cfg.train_branches if not 0 <= k < len(branches)]
-    if bad or not cfg.train_branches:
-        raise CommandError(f"train_branches={list(cfg.train_branches)}: the recording has {len(branches)} "
-                           f"{parts} (0..{len(branches) - 1}; {how})")
+    rec, split = _split(cfg.recording, cfg)
     others = []
     for path in cfg.test_recordings:
-        other, other_parts, _ = _prepared(path, cfg)
+        other, other_split = _split(path, cfg, own=False)
+        other_parts = other_split.parts
         if (other.meta.sensor, other.meta.units.get("output")) != (rec.meta.sensor, rec.meta.units.get("output")):
             raise CommandError(f"test_recordings: {path} records {other.meta.sensor} output in "
                                f"{other.meta.units.get('output')}, not {rec.meta.sensor} output in "
@@ -64,25 +99,43 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, list[Any], list[tuple[st
         if Path(path).stem == Path(cfg.recording).stem or Path(path).stem in {Path(p).stem for p, *_ in others}:
             raise CommandError(f"test_recordings: two recordings named {Path(path).stem!r}; rename one")
         others.append((str(path), other, other_parts))
-    return rec, branches, others
+    return rec, split, others
 
 
-def _prepared(path: str, cfg: CalibrateConfig) -> tuple[Any, list[Any], tuple[str, str]]:
-    """A recording read (``true_input`` applied) and cut into its parts: temperature branches, or
-    ``blocks`` time blocks; with the parts' name and how they were cut, for messages."""
+def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Split]:
+    """A recording read (``true_input`` applied) and cut into its parts — temperature branches, or
+    ``blocks`` time blocks, or five time blocks when it has one branch and nothing says which parts
+    to fit — with the fitted ones (``own``: the recording calibrated; a test recording's are all
+    held out)."""
     from tcbench.signal.branches import temperature_branches, time_blocks
 
     rec = read_recording_arg(path)
     if cfg.true_input is not None:
         rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
-    if cfg.blocks is None:
-        branches = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
-        return rec, branches, (f"temperature branch{'es' * (len(branches) != 1)}", f"min_swing_c={cfg.min_swing_c:g} degC")
-    try:
-        branches = time_blocks(rec.time_s, rec.temperature_c, cfg.blocks)
-    except ValueError as exc:
-        raise CommandError(f"blocks={cfg.blocks}: {exc}") from None
-    return rec, branches, (f"time block{'s' * (len(branches) != 1)}", f"blocks={cfg.blocks}")
+    blocks = cfg.blocks
+    if blocks is None:
+        parts = temperature_branches(rec.time_s, rec.temperature_c, cfg.min_swing_c)
+        noun, how = "temperature branch", f"min_swing_c={cfg.min_swing_c:g} degC"
+        if len(parts) == 1 and cfg.train_branches is None and own:
+            blocks = min(AUTO_BLOCKS, rec.time_s.size)
+    if blocks is not None:
+        try:
+            parts = time_blocks(rec.time_s, rec.temperature_c, blocks)
+        except ValueError as exc:
+            raise CommandError(f"blocks={blocks}: {exc}") from None
+        noun, how = "time block", f"blocks={blocks}" + ("" if cfg.blocks else ", as the record has one temperature branch")
+    if not own:
+        return rec, Split(parts, [], noun, how)
+    if cfg.train_branches is not None:
+        train = sorted(set(cfg.train_branches))
+    else:
+        train = list(range(0, len(parts), 2)) if noun == "time block" and len(parts) > 1 else [0]
+    bad = [k for k in train if not 0 <= k < len(parts)]
+    if bad or not train:
+        raise CommandError(f"train_branches={list(cfg.train_branches or [])}: the recording has {len(parts)} "
+                           f"{noun}{'es' * (noun.endswith('branch') and len(parts) != 1)}"
+                           f"{'s' * (noun.endswith('block') and len(parts) != 1)} (0..{len(parts) - 1}; {how})")
+    return rec, Split(parts, train, noun, how)
 
 
 def true_input(spec: object, input_unit: str) -> float:
@@ -106,43 +159,71 @@ def true_input(spec: object, input_unit: str) -> float:
 
 
 def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
-    """Fit, score and write; print the board."""
+    """Fit, score, rank and write; print what is fitted and scored first, the held-out ranking last."""
     import pandas as pd
+    from tqdm import tqdm
 
     from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
-    from tcbench.tables import markdown_table
 
-    rec, branches, others = check_calibrate(cfg)
+    rec, split, others = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
+    name = Path(cfg.recording).name
+    methods = list(dict.fromkeys(cfg.methods))
+    scored = split.describe(split.held_out) + (" (held out)" if split.held_out else "")
+    if cfg.test_recordings:
+        scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
+    print(f"calibrate {name} ({rec.meta.sensor}, output in {unit}): fitting {', '.join(methods)} on "
+          f"{split.describe(split.train)}; scoring on {scored or 'the fitted parts only'}", flush=True)
+    if not split.held_out and not others:
+        print("tcbench: warning: every part is fitted and no test_recordings= is given: the scores are "
+              "in-sample and no method is ranked", file=sys.stderr)
     whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
-    train = [whole.part(branches[k].start, branches[k].stop) for k in cfg.train_branches]
-    diagnosis = _diagnosed(rec, branches, cfg) if "model" in cfg.methods else None
-    fitted = {m: [from_model(diagnosis[1])] if m == "model" else  # type: ignore[index]
-              [fit(m, train, cfg.seed + r) for r in range(cfg.restarts if m in LEARNERS else 1)]
-              for m in dict.fromkeys(cfg.methods)}
+    train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
+    jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
+    fitted: dict[str, list[Any]] = {m: [] for m in methods}
+    diagnosis = None
+    with tqdm(jobs, desc="fitting", unit="fit", leave=False, disable=None) as bar:
+        for m, r in bar:
+            bar.set_postfix_str(m)
+            if m == "model":
+                diagnosis = _diagnosed(rec, split, cfg)
+                fitted[m].append(from_model(diagnosis[1]))
+            else:
+                fitted[m].append(fit(m, train, cfg.seed + r))
     rows: list[dict[str, Any]] = []
-    residuals = {}
-    for path, r, parts in [(cfg.recording, rec, branches), *others]:
+    residuals: dict[str, np.ndarray] = {}
+    held: dict[str, list[list[np.ndarray]]] = {m: [[] for _ in runs] for m, runs in fitted.items()}
+    steps: list[float] = []
+    drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
+    for path, r, parts, fitted_parts in [(cfg.recording, rec, split.parts, split.train),
+                                         *[(p, o, ps, []) for p, o, ps in others]]:
         own = r is rec
         target = whole if own else record(r.time_s, r.temperature_c, r.output, r.input)
         every = {m: [residual(model, target) for model in runs] for m, runs in fitted.items()}
-        for m, runs in every.items():
-            for k, b in enumerate(parts):
+        dt_s = float(np.median(np.diff(r.time_s))) if r.time_s.size > 1 else 1.0
+        for k, b in enumerate(parts):
+            role = "train" if k in fitted_parts else "test"
+            if role == "test":
+                steps.append(dt_s)
+            for m, runs in every.items():
                 s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
+                if role == "test":
+                    for i, res in enumerate(runs):
+                        held[m][i].append(res[b.start:b.stop])
                 rows.append({"recording": Path(path).stem, "method": m, "branch": k, "direction": b.direction,
-                             "from_c": b.from_c, "to_c": b.to_c,
-                             "role": "train" if own and k in cfg.train_branches else "test",
-                             f"drift_rms_{_slug(unit)}": float(np.median([x["drift_rms"] for x in s])),
-                             f"rms_{_slug(unit)}": float(np.median([x["rms"] for x in s])),
-                             "restarts": len(runs)})
+                             "from_c": b.from_c, "to_c": b.to_c, "role": role,
+                             drift_key: float(np.median([x["drift_rms"] for x in s])),
+                             rms_key: float(np.median([x["rms"] for x in s])), "restarts": len(runs)})
         if own:
             residuals = {m: runs[0] for m, runs in every.items()}
-    models = {m: runs[0] for m, runs in fitted.items()}
     table = pd.DataFrame(rows)
+    summary, about = _ranked(table, held, steps, cfg, unit, drift_key, rms_key)
+    about |= _about(cfg, rec, split, unit)
+    about["export"] = _export_fit(rec, whole, cfg)
     out = Path(cfg.out)
     try:
         with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)]) as tmp:
-            written = _write(tmp, cfg, rec, branches, models, residuals, table, unit)
+            written = _write(tmp, cfg, rec, split, residuals, table, summary, about, unit)
             if diagnosis is not None:
                 from tcbench.diagnose.report import write_report
 
@@ -154,15 +235,106 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     except OSError as exc:
         raise cannot_write(out, exc, "the calibration") from None
     written = moved(written, tmp, out)
-    print(f"\ncalibration of {Path(cfg.recording).name} ({rec.meta.sensor}, {unit}): fitted on branch"
-          f"{'es' * (len(cfg.train_branches) > 1)} {', '.join(map(str, cfg.train_branches))}, "
-          f"drift = RMS of the residual's {cfg.drift_window_s:g}-s running mean\n")
-    print(markdown_table(table))
-    print(f"\nwritten: {', '.join(str(p) for p in written.values())}")
-    return CalibrationOutcome(table, written, str(rec.meta.sensor))
+    _print_summary(summary, about, unit, written)
+    return CalibrationOutcome(table, written, str(rec.meta.sensor), summary, about)
 
 
-def _diagnosed(rec: Any, branches: list[Any], cfg: CalibrateConfig) -> tuple[Any, Any]:
+def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[float], cfg: CalibrateConfig,
+            unit: str, drift_key: str, rms_key: str) -> tuple[Any, dict[str, Any]]:
+    """One row per method: its held-out drift and RMS (every held-out sample pooled; the networks'
+    restarts averaged in the squares), its drift on the fitted parts and its ratio to the best;
+    and the ranking with the best method's margin over the next and its block-bootstrap interval."""
+    import pandas as pd
+
+    from tcbench.compensation.holdout import LEVEL, block_sums, ratio_interval
+
+    fit_rows = table[(table["role"] == "train")]
+    fit_drift = fit_rows.groupby("method", sort=False)[drift_key].apply(lambda x: float(np.sqrt(np.mean(x ** 2))))
+    if not steps:
+        summary = pd.DataFrame({"method": list(held), f"fit_drift_{_slug(unit)}": [fit_drift.get(m) for m in held]})
+        return summary, {"held_out": False}
+    runs = {f"{m}#{i}": parts for m, per in held.items() for i, parts in enumerate(per)}
+    sums = block_sums(runs, steps, cfg.drift_window_s)
+    squares = {m: np.mean([sums.squares[f"{m}#{i}"] for i in range(len(per))], axis=0) for m, per in held.items()}
+    pooled = type(sums)(squares, sums.counts, sums.block_s)
+    rms = {m: float(np.sqrt(np.mean([np.mean(np.concatenate(parts) ** 2) for parts in per]))) for m, per in held.items()}
+    order = sorted(held, key=lambda m: (np.isnan(pooled.drift(m)), pooled.drift(m)))
+    best = order[0]
+    summary = pd.DataFrame({
+        "method": order,
+        f"held_out_drift_{_slug(unit)}": [pooled.drift(m) for m in order],
+        f"held_out_rms_{_slug(unit)}": [rms[m] for m in order],
+        f"fit_drift_{_slug(unit)}": [float(fit_drift.get(m, np.nan)) for m in order],
+        "x_best": [pooled.drift(m) / pooled.drift(best) if pooled.drift(best) > 0 else np.nan for m in order],
+    })
+    ranking: dict[str, Any] = {"held_out": True, "best": best, "best_drift": pooled.drift(best),
+                               "block_s": pooled.block_s, "blocks": int(pooled.counts.size), "level": LEVEL,
+                               "drift": {m: pooled.drift(m) for m in order}}
+    if len(order) > 1:
+        point, lo, hi = ratio_interval(pooled, best, order[1], seed=cfg.seed)
+        ranking |= {"next": order[1], "ratio_to_next": point, "ratio_lo": lo, "ratio_hi": hi}
+        if "raw" in order and best != "raw":
+            ranking["ratio_to_raw"] = list(ratio_interval(pooled, best, "raw", seed=cfg.seed))
+    return summary, ranking
+
+
+def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str) -> dict[str, Any]:
+    """What ``calibration.json`` says of the recording and the split."""
+    source = rec.meta.extra.get("source", {}) if isinstance(rec.meta.extra, dict) else {}
+    return {"recording": Path(cfg.recording).name, "content_hash": _content_hash(cfg.recording),
+            "sensor": rec.meta.sensor, "unit": unit, "axis": cfg.axis or _axis(rec.meta),
+            "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
+            "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train,
+            "held_out_parts": split.held_out, "test_recordings": [Path(p).name for p in cfg.test_recordings],
+            "drift_window_s": cfg.drift_window_s}
+
+
+def _axis(meta: Any) -> str | None:
+    axis = meta.extra.get("axis") if isinstance(meta.extra, dict) else None
+    return axis if axis in ("x", "y", "z") else None
+
+
+def _content_hash(path: str) -> str:
+    from tcbench.data_hash import content_hash
+    from tcbench.sensors.recording import sidecar_path
+
+    return content_hash([Path(path), sidecar_path(Path(path))])
+
+
+def _export_fit(rec: Any, whole: Any, cfg: CalibrateConfig) -> dict[str, Any] | None:
+    """The cubic an autopilot is given: ``poly3`` refitted on the whole record (the held-out scores
+    judged the method; the parameters use every sample), in the recording's output unit."""
+    from tcbench.compensation.px4 import fit_offset
+
+    try:
+        cubic = fit_offset(whole.temp_c, whole.output - whole.truth)
+    except ValueError:
+        return None
+    return {"method": "poly3", "fitted_on": "the whole record", "x": list(cubic.x), "tref_c": cubic.tref_c,
+            "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c}
+
+
+def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict[str, Path]) -> None:
+    """The short table and the verdict, as the last lines a user reads."""
+    from tcbench.tables import markdown_table
+
+    print("\n" + markdown_table(summary.round(6)))
+    print(f"\nlong table (every part): {written['md']}; residual plots: {written['png']}; "
+          f"for PX4/ArduPilot: tcbench export calibrations=[{Path(written['json']).parent}]")
+    if not about.get("held_out"):
+        print("nothing held out: no method is ranked")
+        return
+    line = f"best held out: {about['best']}, drift {about['best_drift']:.4g} {unit}"
+    if "next" in about:
+        line += (f"; {about['ratio_to_next']:.2f}x {about['next']}'s [{about['ratio_lo']:.2f}, "
+                 f"{about['ratio_hi']:.2f}] ({about['level']:.0%} block bootstrap over {about['blocks']} "
+                 f"blocks of {about['block_s']:g} s)")
+        if about["ratio_hi"] >= 1.0:
+            line += f": not told apart from {about['next']}"
+    print(line)
+
+
+def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig) -> tuple[Any, Any]:
     """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
     kept as gaps) and the model it fitted, for the ``model`` method. The parts may be shorter
     than a diagnosis of its own asks (30 min): down to five cross-validation folds of two
@@ -175,7 +347,7 @@ def _diagnosed(rec: Any, branches: list[Any], cfg: CalibrateConfig) -> tuple[Any
     from tcbench.diagnose.signals import DiagnosisDataError
     from tcbench.sensors.recording import make_recording
 
-    rows = np.concatenate([np.arange(branches[k].start, branches[k].stop) for k in sorted(set(cfg.train_branches))])
+    rows = np.concatenate([np.arange(split.parts[k].start, split.parts[k].stop) for k in split.train])
     part = make_recording(rec.time_s[rows], rec.temperature_c[rows], rec.input[rows], rec.output[rows],
                           sensor=rec.meta.sensor, sample_rate_hz=rec.meta.sample_rate_hz, device_id=rec.meta.device_id)
     try:
@@ -191,38 +363,44 @@ def _slug(unit: str) -> str:
     return unit.replace("/", "_per_").replace(" ", "") or "unit"
 
 
-def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, branches: list[Any], models: dict[str, Any],
-           residuals: dict[str, np.ndarray], table: Any, unit: str) -> dict[str, Path]:
-    from tcbench.compensation.px4 import px4_covers, px4_factor, px4_parameters, write_parameters
+def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: dict[str, np.ndarray], table: Any,
+           summary: Any, about: dict[str, Any], unit: str) -> dict[str, Path]:
     from tcbench.tables import markdown_table
 
-    written = {"csv": tmp / "calibration.csv", "md": tmp / "calibration.md"}
+    written = {"csv": tmp / "calibration.csv", "md": tmp / "calibration.md", "json": tmp / "calibration.json"}
     table.to_csv(written["csv"], index=False)
-    test = table[table["role"] == "test"]
-    note = ("" if len(test) else "\nEvery branch was used to fit: the scores are in-sample only.\n")
-    parts = (f"{len(branches)} temperature branches (turning points standing out by {cfg.min_swing_c:g} degC)"
-             if cfg.blocks is None else f"{len(branches)} time blocks of equal duration")
-    about = [f"{rec.meta.sensor} recording, output in {unit}; {parts}; fitted on part(s) "
-             f"{', '.join(map(str, cfg.train_branches))}, scored on every part.",
+    note = "" if about.get("held_out") else "\nNothing was held out: the scores are in-sample only.\n"
+    lines = [f"{rec.meta.sensor} recording, output in {unit}; {len(split.parts)} {split.noun}s ({split.how}); "
+             f"fitted on {split.describe(split.train)}, scored on every part.",
              f"drift = RMS of the residual's {cfg.drift_window_s:g}-s running mean (output minus true input minus "
              "the model's offset); rms = RMS of the residual."]
     if cfg.test_recordings:
-        about.append(f"Also scored on every part of {', '.join(map(str, cfg.test_recordings))}.")
+        lines.append(f"Also scored on every part of {', '.join(map(str, cfg.test_recordings))}.")
     if cfg.restarts > 1:
-        about.append(f"The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+        lines.append(f"The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
                      f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}.")
-    written["md"].write_text(f"# Calibration of {Path(cfg.recording).name}\n\n{' '.join(about)}\n{note}\n"
-                             f"{markdown_table(table)}\n\n![residuals](residuals.png)\n")
-    written["png"] = _plot(tmp / "residuals.png", rec, branches, residuals, unit, cfg)
-    cubic = models.get("poly3")
-    if cubic is not None and px4_covers(rec.meta.sensor):
-        sensor = rec.meta.sensor
-        params = px4_parameters([cubic.cubic], sensor, cfg.px4_instance, to_px4_unit=px4_factor(sensor, unit))
-        written["px4"] = write_parameters(params, tmp / "px4_tc_params.txt", sensor)
+    ranking = ""
+    if about.get("held_out"):
+        ranking = (f"\n## Held out\n\nEvery held-out sample pooled; x_best = held-out drift over the best's. "
+                   f"Best: **{about['best']}**"
+                   + (f", {about['ratio_to_next']:.2f}x {about['next']}'s drift [{about['ratio_lo']:.2f}, "
+                      f"{about['ratio_hi']:.2f}] ({about['level']:.0%} block bootstrap, {about['blocks']} blocks of "
+                      f"{about['block_s']:g} s)" if "next" in about else "")
+                   + f".\n\n{markdown_table(summary.round(6))}\n")
+    written["md"].write_text(f"# Calibration of {Path(cfg.recording).name}\n\n{' '.join(lines)}\n{note}{ranking}\n"
+                             f"## Every part\n\n{markdown_table(table.drop(columns=['recording']) if not cfg.test_recordings else table)}"
+                             "\n\n![residuals](residuals.png)\n")
+    written["json"].write_text(json.dumps(about, indent=2, default=_plain) + "\n")
+    written["png"] = _plot(tmp / "residuals.png", rec, split, residuals, unit, cfg)
     return written
 
 
-def _plot(path: Path, rec: Any, branches: list[Any], residuals: dict[str, np.ndarray], unit: str,
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as JSON numbers and lists."""
+    return value.tolist() if hasattr(value, "tolist") else str(value)
+
+
+def _plot(path: Path, rec: Any, split: Split, residuals: dict[str, np.ndarray], unit: str,
           cfg: CalibrateConfig) -> Path:
     """Residual against time and against temperature, per method, training branches shaded."""
     import matplotlib
@@ -232,8 +410,8 @@ def _plot(path: Path, rec: Any, branches: list[Any], residuals: dict[str, np.nda
 
     fig, (ax_t, ax_c) = plt.subplots(1, 2, figsize=(12, 4.5), constrained_layout=True)
     t_min = (rec.time_s - rec.time_s[0]) / 60.0
-    for k in cfg.train_branches:
-        b = branches[k]
+    for k in split.train:
+        b = split.parts[k]
         ax_t.axvspan(t_min[b.start], t_min[b.stop - 1], color="0.9", zorder=0)
     for m, res in residuals.items():
         ax_t.plot(t_min, res, lw=0.7, label=m)

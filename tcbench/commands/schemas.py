@@ -83,24 +83,38 @@ class DiagnoseConfig:
 
 @dataclass
 class CalibrateConfig:
-    """``tcbench calibrate``: offset models of a static recording fitted on some of its
-    temperature branches (``train_branches``, numbered from 0 in time order) and scored on the
-    others."""
+    """``tcbench calibrate``: offset models of a static recording fitted on some of its parts
+    (``train_branches``: temperature branches or time blocks, numbered from 0 in time order; null:
+    the first of several branches, or the even ones of five time blocks when there is one branch)
+    and scored on the others."""
 
     kind: str = "calibrate"
     recording: str = ""
     out: str = "calibration"
-    train_branches: list[int] = field(default_factory=lambda: [0])
+    train_branches: list[int] | None = None
     methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman", "model"])
     seed: int = 0
     restarts: int = 1  # networks per learner method (seeds seed, seed+1, ...): the board gives their median
     min_swing_c: float = 5.0
     drift_window_s: float = 60.0
-    px4_instance: int = 0
     blocks: int | None = None  # cut into this many time blocks instead of temperature branches
     test_recordings: list[str] = field(default_factory=list)  # more records to score on, every part held out
     true_input: str | None = None  # VALUE[:unit]: the static record's true input (an axis along gravity: -1:g)
+    axis: str | None = None  # x, y or z: the recording's axis when its sidecar does not say (for tcbench export)
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
+
+
+@dataclass
+class ExportConfig:
+    """``tcbench export``: the autopilots' parameter files of some ``tcbench calibrate`` outputs
+    (one per axis and sensor kind of one IMU)."""
+
+    calibrations: list[str] = field(default_factory=list)
+    out: str = "export"
+    formats: list[str] = field(default_factory=lambda: ["px4", "ardupilot"])
+    device_id: Any = None  # PX4's TC_*_ID: a number, or {gyro: N, accel: M}; null: the log's
+    px4_instance: int = 0
+    ardupilot_imu: int = 1
 
 
 @dataclass
@@ -152,7 +166,7 @@ class QuickstartConfig:
 
 
 SCHEMAS: dict[str, type] = {"simulate": SimulateConfig, "metrics": MetricsConfig, "import": ImportConfig,
-                            "diagnose": DiagnoseConfig, "calibrate": CalibrateConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
+                            "diagnose": DiagnoseConfig, "calibrate": CalibrateConfig, "export": ExportConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
                             "quickstart": QuickstartConfig}
 
 

@@ -78,32 +78,68 @@ def fit_offset(temp_c: np.ndarray, reading: np.ndarray, tref_c: float | None = N
     return OffsetPolynomial(tuple(float(c) for c in coef), tref, tmin, tmax)  # type: ignore[arg-type]
 
 
-def px4_parameters(axes: Sequence[OffsetPolynomial], sensor: str = "gyro", instance: int = 0,
+AXES = ("x", "y", "z")  # PX4's axis index 0, 1, 2; ArduPilot's _X, _Y, _Z
+
+
+def reexpanded(poly: OffsetPolynomial, tref_c: float, tmin_c: float, tmax_c: float) -> OffsetPolynomial:
+    """The same cubic written about another reference ``tref_c`` (exact: a binomial shift of
+    ``dT``), held to the range ``[tmin_c, tmax_c]`` instead of its own."""
+    shift = np.polynomial.Polynomial([tref_c - poly.tref_c, 1.0])  # T - tref_old as a polynomial in T - tref_new
+    coef = np.zeros(ORDER + 1)
+    expanded = np.polynomial.Polynomial(poly.x)(shift).coef
+    coef[:expanded.size] = expanded
+    return OffsetPolynomial(tuple(float(c) for c in coef), float(tref_c), float(tmin_c), float(tmax_c))  # type: ignore[arg-type]
+
+
+def common_range(axes: Mapping[str, OffsetPolynomial]) -> dict[str, OffsetPolynomial]:
+    """The axes of one sensor on one temperature range, as PX4 and ArduPilot keep it per sensor:
+    unchanged when they share one; otherwise each re-expanded about the middle of the range every
+    axis was fitted over (the intersection, so no axis extrapolates its cubic). ``ValueError`` when
+    the ranges do not overlap or an axis is not x, y or z."""
+    if not axes:
+        raise ValueError("no axis to export")
+    if bad := [a for a in axes if a not in AXES]:
+        raise ValueError(f"axis {bad[0]!r}: the axes are x, y and z")
+    polys = list(axes.values())
+    if all((p.tref_c, p.tmin_c, p.tmax_c) == (polys[0].tref_c, polys[0].tmin_c, polys[0].tmax_c) for p in polys):
+        return dict(axes)
+    lo, hi = max(p.tmin_c for p in polys), min(p.tmax_c for p in polys)
+    if not hi > lo:
+        raise ValueError("the axes' fitted temperature ranges do not overlap: calibrate them on one record")
+    return {a: reexpanded(p, 0.5 * (lo + hi), lo, hi) for a, p in axes.items()}
+
+
+def px4_parameters(axes: Mapping[str, OffsetPolynomial], sensor: str = "gyro", instance: int = 0,
                    device_id: int = 0, to_px4_unit: float = 1.0) -> dict[str, float | int]:
-    """The ``TC_*`` parameters of up to three axes (X, Y, Z) of one sensor instance, the
+    """The ``TC_*`` parameters of one sensor instance, each axis in its own slot (``x`` -> ``_0``,
+    ``y`` -> ``_1``, ``z`` -> ``_2``; an axis not given gets zero coefficients, no correction), the
     coefficients multiplied by ``to_px4_unit`` (e.g. pi/180 from deg/s to PX4's rad/s) and
-    rounded to 32-bit floats as PX4 stores them. The axes share one reference and range: the
-    first axis's (fit them on the same record)."""
-    if not 1 <= len(axes) <= 3 or not 0 <= instance <= 3:
-        raise ValueError("one to three axes, instance 0..3")
-    if any((a.tref_c, a.tmin_c, a.tmax_c) != (axes[0].tref_c, axes[0].tmin_c, axes[0].tmax_c) for a in axes):
-        raise ValueError("the axes of one instance share TREF, TMIN and TMAX: fit them on the same record")
+    rounded to 32-bit floats as PX4 stores them. The axes share one ``TREF``/``TMIN``/``TMAX``
+    (:func:`common_range`)."""
+    if not isinstance(axes, Mapping):
+        raise TypeError("axes: a mapping of axis name (x, y, z) to its OffsetPolynomial")
+    if not 0 <= instance <= 3:
+        raise ValueError("instance 0..3")
+    shared = common_range(axes)
+    first = next(iter(shared.values()))
     t = px4_type(sensor)[0]
     head = f"TC_{t}{instance}"
     params: dict[str, float | int] = {f"{head}_ID": int(device_id)}
-    for a, poly in enumerate(axes):
-        for n, c in enumerate(poly.x):
+    for n in range(ORDER + 1):
+        for a, name in enumerate(AXES):
+            c = shared[name].x[n] if name in shared else 0.0
             params[f"{head}_X{n}_{a}"] = float(np.float32(c * to_px4_unit))
-    params |= {f"{head}_TREF": float(np.float32(axes[0].tref_c)), f"{head}_TMIN": float(np.float32(axes[0].tmin_c)),
-               f"{head}_TMAX": float(np.float32(axes[0].tmax_c))}
+    params |= {f"{head}_TREF": float(np.float32(first.tref_c)), f"{head}_TMIN": float(np.float32(first.tmin_c)),
+               f"{head}_TMAX": float(np.float32(first.tmax_c))}
     return params
 
 
 def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: str = "gyro", instance: int = 0,
-               axis: int = 0) -> np.ndarray:
-    """The offset PX4 subtracts, in PX4's unit, evaluated from the parameters alone (32-bit, as
-    on the flight controller)."""
+               axis: int | str = 0) -> np.ndarray:
+    """The offset PX4 subtracts from ``axis`` (0, 1, 2 or x, y, z), in PX4's unit, evaluated from
+    the parameters alone (32-bit, as on the flight controller)."""
     head = f"TC_{px4_type(sensor)[0]}{instance}"
+    axis = AXES.index(axis) if isinstance(axis, str) else axis
     f32 = np.float32
     tmin, tmax, tref = (f32(params[f"{head}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
     x = [f32(params[f"{head}_X{n}_{axis}"]) for n in range(ORDER + 1)]
@@ -111,11 +147,12 @@ def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: st
     return x[0] + x[1] * dt + x[2] * dt ** 2 + x[3] * dt ** 3
 
 
-def write_parameters(params: Mapping[str, float | int], path: str | Path, sensor: str) -> Path:
+def write_parameters(params: Mapping[str, float | int], path: str | Path, sensors: Sequence[str] | str) -> Path:
     """``params`` as a PX4 console script (``param set NAME VALUE`` per line, then the enable
-    switch), to paste into the NuttX shell or run from the SD card."""
+    switch of each of ``sensors``), to paste into the NuttX shell or run from the SD card."""
     lines = [f"param set {k} {v:d}" if isinstance(v, int) else f"param set {k} {v:.9g}" for k, v in params.items()]
-    lines.append(f"param set TC_{px4_type(sensor)[0]}_ENABLE 1")
+    kinds_ = [sensors] if isinstance(sensors, str) else list(sensors)
+    lines += [f"param set TC_{px4_type(s)[0]}_ENABLE 1" for s in dict.fromkeys(kinds_)]
     path = Path(path)
     path.write_text("\n".join(lines) + "\n")
     return path

@@ -1,7 +1,11 @@
 """The calibration job kind: ``tcbench calibrate`` on one static recording
 (:mod:`tcbench.commands.calibration`). Its MLflow run carries each method's drift and RMS on
-every branch (``<method>.b<k>.drift_rms`` ...; ``<method>.<stem>.b<k>.drift_rms`` on a test recording), the sensor, and the board, plot and PX4
-parameters as artifacts."""
+every branch (``<method>.b<k>.drift_rms`` ...; ``<method>.<stem>.b<k>.drift_rms`` on a test
+recording), its held-out and fitted-part drift (``<method>.held_out.drift``,
+``<method>.held_out.rms``, ``<method>.fit.drift``), the tags the calibration board groups by
+(``tcbench.recording``, ``tcbench.data_hash``: the recording's content, so two files of one name
+never merge; ``tcbench.sensor``, ``tcbench.axis``, ``tcbench.best``), and the tables, plot and
+``calibration.json`` as artifacts."""
 
 from __future__ import annotations
 
@@ -35,8 +39,22 @@ class CalibrateKind(JobKind):
         return calibrate_recording(self.config(c))
 
     def record(self, run: Any, outcome: CalibrationOutcome, c: dict[str, Any], where: Path) -> list[Path]:
+        about = outcome.about
         run.set_tag("tcbench.sensor", outcome.sensor)
+        for key in ("recording", "axis", "best"):
+            if about.get(key) is not None:
+                run.set_tag(f"tcbench.{key}", str(about[key]))
+        run.set_tag("tcbench.data_hash", str(about.get("content_hash", "")))
+        run.set_tag("tcbench.held_out", str(bool(about.get("held_out"))).lower())
         metrics = {}
+        summary = outcome.summary
+        if summary is not None:
+            for row in summary.to_dict("records"):
+                for key, value in row.items():
+                    for prefix, name in (("held_out_drift_", "held_out.drift"), ("held_out_rms_", "held_out.rms"),
+                                         ("fit_drift_", "fit.drift")):
+                        if str(key).startswith(prefix) and value == value:
+                            metrics[f"{row['method']}.{name}"] = float(value)
         own = Path(str(c.get("recording"))).stem
         for row in outcome.table.to_dict("records"):
             where = "" if row["recording"] == own else re.sub(r"[^\w\-. /]", "_", str(row["recording"])) + "."

@@ -1,0 +1,156 @@
+"""What ``tcbench export`` does: gather the calibrations of one IMU (``tcbench calibrate``'s
+``calibration.json``, one per axis and sensor kind) and write the autopilots' parameter files,
+every axis in its slot: PX4's ``TC_G<i>_*``/``TC_A<i>_*`` (:mod:`tcbench.compensation.px4`) and
+ArduPilot's ``INS_TCAL<n>_*`` (:mod:`tcbench.compensation.ardupilot`).
+
+The axis of a calibration is the one its recording's sidecar names (``tcbench import axes=``, or
+a PX4 log's field) or ``calibrate axis=``; a calibration without one is refused, as are two of one
+axis. PX4 applies ``TC_<t><i>_*`` only to the sensor whose device id ``TC_<t><i>_ID`` names: it
+comes from ``device_id=`` (one number, or ``{gyro: N, accel: M}``) or the log the recording was
+imported from, and PX4's file is refused without one.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tcbench.commands.errors import CommandError, cannot_write, writable_folder
+from tcbench.commands.schemas import ExportConfig
+from tcbench.staging import moved, staged_dir
+
+FORMATS = ("px4", "ardupilot")
+
+
+@dataclass(frozen=True)
+class AxisCalibration:
+    """One calibration's cubic (in its recording's unit), for one axis of one sensor kind."""
+
+    folder: Path
+    sensor: str
+    unit: str
+    axis: str
+    poly: Any  # OffsetPolynomial
+    px4_device_id: int | None
+
+
+def read_calibration(folder: str | Path) -> AxisCalibration:
+    """The exportable cubic of a ``tcbench calibrate`` output folder; one line when it has none."""
+    from tcbench.compensation.px4 import OffsetPolynomial
+
+    path = Path(folder) / "calibration.json"
+    if not path.is_file():
+        raise CommandError(f"calibrations: {folder}: no calibration.json (a tcbench calibrate out= folder)")
+    try:
+        about = json.loads(path.read_text())
+        fit = about["export"]
+        poly = OffsetPolynomial(tuple(float(c) for c in fit["x"]), float(fit["tref_c"]),  # type: ignore[arg-type]
+                                float(fit["tmin_c"]), float(fit["tmax_c"]))
+        sensor, unit, axis = about["sensor"], about["unit"], about.get("axis")
+    except (ValueError, KeyError, TypeError) as exc:
+        raise CommandError(f"calibrations: {path}: not a calibration tcbench export reads ({exc})") from None
+    if axis not in ("x", "y", "z"):
+        raise CommandError(f"calibrations: {folder}: the recording's axis is unknown; import it with axes=x|y|z, "
+                           "or calibrate it again with axis=x|y|z")
+    device = about.get("px4_device_id")
+    return AxisCalibration(Path(folder), str(sensor), str(unit), str(axis), poly,
+                           int(device) if device is not None else None)
+
+
+def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
+    """Every argument before any work; the calibrations by sensor kind and axis."""
+    from tcbench.compensation.px4 import px4_covers
+
+    if not cfg.calibrations:
+        raise CommandError("calibrations=[DIR,...] is required: the out= folders of tcbench calibrate")
+    if bad := [f for f in cfg.formats if f not in FORMATS]:
+        raise CommandError(f"formats: unknown {bad[0]!r}; known: {', '.join(FORMATS)}")
+    if not cfg.formats:
+        raise CommandError(f"formats: give at least one of {', '.join(FORMATS)}")
+    if not 0 <= cfg.px4_instance <= 3:
+        raise CommandError(f"px4_instance must be 0..3, got {cfg.px4_instance}")
+    if not 1 <= cfg.ardupilot_imu <= 3:
+        raise CommandError(f"ardupilot_imu must be 1..3, got {cfg.ardupilot_imu}")
+    writable_folder(cfg.out)
+    by_sensor: dict[str, dict[str, AxisCalibration]] = {}
+    for folder in cfg.calibrations:
+        cal = read_calibration(folder)
+        if not px4_covers(cal.sensor):
+            raise CommandError(f"calibrations: {folder}: a {cal.sensor} recording; the autopilots calibrate gyro and accel")
+        axes = by_sensor.setdefault(cal.sensor, {})
+        if cal.axis in axes:
+            raise CommandError(f"calibrations: {axes[cal.axis].folder} and {folder} are both {cal.sensor} axis {cal.axis}")
+        axes[cal.axis] = cal
+    if "px4" in cfg.formats:
+        for sensor in by_sensor:
+            device_id(cfg, sensor, by_sensor[sensor])
+    return by_sensor
+
+
+def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) -> int:
+    """PX4's ``TC_*_ID`` of ``sensor``: ``device_id=`` (a number, or per kind), else the one id the
+    log gave every axis; one line when neither says."""
+    given = cfg.device_id.get(sensor) if isinstance(cfg.device_id, dict) else cfg.device_id
+    if given is not None:
+        try:
+            return int(given)
+        except (TypeError, ValueError):
+            raise CommandError(f"device_id: {given!r} is not an integer (PX4's device id, e.g. 2293768)") from None
+    logged = {c.px4_device_id for c in axes.values()}
+    if len(logged) == 1 and None not in logged:
+        return int(logged.pop())  # type: ignore[arg-type]
+    raise CommandError(f"device_id=: PX4 applies TC_{'G' if sensor == 'gyro' else 'A'}{cfg.px4_instance}_* only to "
+                       f"the {sensor} whose device id it names; give it (its CAL_{'GYRO' if sensor == 'gyro' else 'ACC'}n_ID "
+                       "parameter, or the log's), or formats=[ardupilot]")
+
+
+def export(cfg: ExportConfig) -> dict[str, Path]:
+    """Write the parameter files; print what each holds."""
+    from tcbench.compensation.ardupilot import ardupilot_parameters, write_parm
+    from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, write_parameters
+
+    by_sensor = check_export(cfg)
+    to_si = {s: px4_factor(s, next(iter(axes.values())).unit) for s, axes in by_sensor.items()}
+    polys = {s: {a: c.poly for a, c in axes.items()} for s, axes in by_sensor.items()}
+    for sensor, axes in polys.items():
+        missing = [a for a in ("x", "y", "z") if a not in axes]
+        if missing:
+            print(f"tcbench: {sensor} axis {', '.join(missing)}: no calibration given; its coefficients are 0 "
+                  "(no correction)")
+        try:
+            shared = common_range(axes)
+        except ValueError as exc:
+            raise CommandError(f"calibrations: {sensor}: {exc}") from None
+        if shared != axes:
+            first = next(iter(shared.values()))
+            print(f"tcbench: {sensor}: the axes were fitted over different temperatures; all held to "
+                  f"{first.tmin_c:.2f}..{first.tmax_c:.2f} degC, where every axis was fitted")
+    out = Path(cfg.out)
+    try:
+        with staged_dir(out, []) as tmp:
+            written: dict[str, Path] = {}
+            if "px4" in cfg.formats:
+                params: dict[str, float | int] = {}
+                for sensor, axes in polys.items():
+                    params |= px4_parameters(axes, sensor, cfg.px4_instance, device_id(cfg, sensor, by_sensor[sensor]),
+                                             to_px4_unit=to_si[sensor])
+                written["px4"] = write_parameters(params, tmp / "px4_tc_params.txt", list(polys))
+            if "ardupilot" in cfg.formats:
+                try:
+                    ap = ardupilot_parameters(polys, cfg.ardupilot_imu, to_si)
+                except ValueError as exc:
+                    raise CommandError(f"ardupilot: {exc}") from None
+                written["ardupilot"] = write_parm(ap, tmp / "ardupilot_tcal.parm")
+    except OSError as exc:
+        raise cannot_write(out, exc, "the parameter files") from None
+    written = moved(written, tmp, out)
+    every = ", ".join(f"{s} {''.join(sorted(a))}" for s, a in polys.items())
+    if "px4" in written:
+        print(f"tcbench: wrote {written['px4']} (PX4 TC_* of {every}, instance {cfg.px4_instance}; "
+              "paste into the NuttX console or run from the SD card)")
+    if "ardupilot" in written:
+        print(f"tcbench: wrote {written['ardupilot']} (ArduPilot INS_TCAL{cfg.ardupilot_imu}_* of {every}; "
+              "load it in the ground station)")
+    return written
