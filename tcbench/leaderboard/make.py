@@ -1,6 +1,6 @@
 """What ``tcbench leaderboard`` does: read the finished runs of some MLflow experiments, write
-every board (optimisation and compensation; ``OUT/<task>.md/.csv`` and plots) and print the
-tables. Reads the store, never writes to it."""
+every board (optimisation, compensation and calibration; ``OUT/<task>.md/.csv`` and plots) and
+print the tables. Reads the store, never writes to it."""
 
 from __future__ import annotations
 
@@ -38,6 +38,7 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
                       ecdf: bool = False) -> list[Path]:
     """Write and print the boards of the runs in ``experiment`` (optionally of one ``sweep``)
     into ``out``; the files written. ConfigError (one line) when there is nothing to rank."""
+    from tcbench.leaderboard import calibration as cal_board
     from tcbench.leaderboard import compensation as comp_board
     from tcbench.leaderboard import optimisation as leaderboard
     from tcbench.tasks.specs import protocols
@@ -49,9 +50,10 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
     try:
         runs = leaderboard.load_runs(client, experiments, sweep)
         comp = comp_board.load_runs(client, experiments, sweep)
+        cals = cal_board.load_runs(client, experiments, sweep)
     except LookupError as exc:
         raise ConfigError(f"{exc} in {resolved}") from None
-    if runs.empty and comp.empty:
+    if runs.empty and comp.empty and cals.empty:
         where = f", sweep {sweep}" if sweep else ""
         raise ConfigError(f"no tcbench runs in experiment {', '.join(experiments)}{where}")
     source = f"MLflow experiment {', '.join(experiments)}" + (f", sweep {sweep}" if sweep else "")
@@ -66,6 +68,12 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
         paths = comp_board.write(cboard, Path(out), source)
         print(f"\n## {cboard.task}  (compensation)\n")
         print(leaderboard.markdown_table(cboard.table))
+        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
+        written += list(paths.values())
+    for calboard in cal_board.boards(cals) if not cals.empty else []:
+        paths = cal_board.write(calboard, Path(out), source)
+        print(f"\n## {calboard.recording}  (calibration, content {calboard.data_hash})\n")
+        print(leaderboard.markdown_table(calboard.table) if not calboard.table.empty else "no finished calibration")
         print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
         written += list(paths.values())
     if ecdf and not runs.empty:

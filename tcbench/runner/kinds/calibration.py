@@ -46,6 +46,9 @@ class CalibrateKind(JobKind):
                 run.set_tag(f"tcbench.{key}", str(about[key]))
         run.set_tag("tcbench.data_hash", str(about.get("content_hash", "")))
         run.set_tag("tcbench.held_out", str(bool(about.get("held_out"))).lower())
+        run.set_tag("tcbench.split", f"fit {','.join(map(str, about.get('fitted', [])))} -> score "
+                                     f"{','.join(map(str, about.get('held_out_parts', []))) or '-'}"
+                                     + "".join(f" + {t}" for t in about.get("test_recordings", [])))
         metrics = {}
         summary = outcome.summary
         if summary is not None:
