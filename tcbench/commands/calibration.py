@@ -169,7 +169,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     name = Path(cfg.recording).name
     methods = list(dict.fromkeys(cfg.methods))
-    scored = split.describe(split.held_out) + (" (held out)" if split.held_out else "")
+    scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
     if cfg.test_recordings:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
     print(f"calibrate {name} ({rec.meta.sensor}, output in {unit}): fitting {', '.join(methods)} on "
@@ -217,7 +217,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         if own:
             residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
-    summary, about = _ranked(table, held, steps, cfg, unit, drift_key, rms_key)
+    summary, about = _ranked(table, held, steps, cfg, unit, drift_key)
     about |= _about(cfg, rec, split, unit)
     about["export"] = _export_fit(rec, whole, cfg)
     out = Path(cfg.out)
@@ -240,7 +240,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
 
 
 def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[float], cfg: CalibrateConfig,
-            unit: str, drift_key: str, rms_key: str) -> tuple[Any, dict[str, Any]]:
+            unit: str, drift_key: str) -> tuple[Any, dict[str, Any]]:
     """One row per method: its held-out drift and RMS (every held-out sample pooled; the networks'
     restarts averaged in the squares), its drift on the fitted parts and its ratio to the best;
     and the ranking with the best method's margin over the next and its block-bootstrap interval."""
@@ -328,7 +328,7 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     if "next" in about:
         line += (f"; {about['ratio_to_next']:.2f}x {about['next']}'s [{about['ratio_lo']:.2f}, "
                  f"{about['ratio_hi']:.2f}] ({about['level']:.0%} block bootstrap over {about['blocks']} "
-                 f"blocks of {about['block_s']:g} s)")
+                 f"blocks of {about['block_s']:.0f} s)")
         if about["ratio_hi"] >= 1.0:
             line += f": not told apart from {about['next']}"
     print(line)
