@@ -101,8 +101,8 @@ def test_accelerometer_tables_in_mg_and_m_s2(tmp_path: Path, capsys: pytest.Capt
     assert not (tmp_path / "bad").exists()
     # axes of different lengths (one column ends early): one line naming the cell, nothing written
     (tmp_path / "short.csv").write_text("t,temp,ax,ay\n0,25,1,1\n1,25.1,1,1\n2,25.2,1,\n3,25.3,1,\n")
-    code, _, err = run(capsys, "import", f"csv={tmp_path / 'short.csv'}", "sensor=accel", "time=t", "temperature=temp",
-                       "output=ax,ay", f"out={tmp_path / 'bad'}", "tracking.enabled=false")
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'short.csv'}", "sensor=accel", "time=t:s", "temperature=temp:degC",
+                       "output=ax:g,ay:g", f"out={tmp_path / 'bad'}", "tracking.enabled=false")
     assert code == 2 and err == [f"tcbench: error: {tmp_path / 'short.csv'}: row 3, column 'ay': empty cell"], err
     assert not (tmp_path / "bad").exists()
 
@@ -131,7 +131,7 @@ def test_the_tofupilot_accelerometer_imports(tmp_path: Path, capsys: pytest.Capt
 
     axes = ",".join(f"imu.acc.{a}:m/s^2" for a in "xyz")
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=accel", "time=timestamp:us",
-                       "temperature=imu.temperature", f"output={axes}", f"out={tmp_path / 'rec'}", "name=imu",
+                       "temperature=imu.temperature:degC", f"output={axes}", f"out={tmp_path / 'rec'}", "name=imu",
                        "tracking.enabled=false")
     assert code == 0, err
     table = pd.read_csv(TOFUPILOT_CSV, sep="\t")
@@ -241,7 +241,7 @@ def test_true_input_of_an_axis_along_gravity(tmp_path: Path, capsys: pytest.Capt
     from tcbench.diagnose.real_records import TOFUPILOT_CSV
 
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=accel", "time=timestamp:us",
-                       "temperature=imu.temperature", "output=imu.acc.z:m/s^2", f"out={tmp_path / 'rec'}",
+                       "temperature=imu.temperature:degC", "output=imu.acc.z:m/s^2", f"out={tmp_path / 'rec'}",
                        "name=z", "tracking.enabled=false")
     assert code == 0, err
     boards = {}

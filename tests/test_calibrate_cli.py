@@ -27,7 +27,7 @@ def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[
 @pytest.fixture()
 def gyro_y(workdir: Path, capsys: pytest.CaptureFixture[str]) -> Path:
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
-                       "temperature=imu.temperature", "output=imu.gyro.y:rad/s", "out=rec", "name=gyro-y",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.y:rad/s", "out=rec", "name=gyro-y",
                        "tracking.enabled=false")
     assert code == 0, err
     return workdir / "rec" / "gyro-y.csv"
@@ -109,7 +109,7 @@ def test_a_record_that_only_cools_is_cut_into_time_blocks(workdir: Path, capsys:
     """The PAN gyro cools once (one branch): with nothing said, it is cut into five time blocks,
     fitted on 0, 2, 4 and scored on the two between — held out, and the first line says so —, the
     cubic far below the raw bias there; ``blocks=``/``train_branches=`` choose otherwise."""
-    code, _, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s", "temperature=temp_c:degC",
+    code, _, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
                        "output=gyro_x_dps:deg/s", "drop=spike_flag", "out=rec", "name=pan-x",
                        "tracking.enabled=false")
     assert code == 0, err

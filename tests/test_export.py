@@ -32,13 +32,12 @@ def calibrated(workdir: Path, capsys: pytest.CaptureFixture[str]) -> dict[str, P
     for kind, col, unit in (("gyro", "gyro", "rad/s"), ("accel", "acc", "m/s^2")):
         outputs = ",".join(f"imu.{col}.{a}:{unit}" for a in AXES)
         code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", f"sensor={kind}", "time=timestamp:us",
-                           "temperature=imu.temperature:degC", f"output={outputs}", "out=rec", f"name={kind}",
-                           "tracking.enabled=false")
+                           "temperature=imu.temperature:degC", f"output={outputs}", "axes=x,y,z", "out=rec",
+                           f"name={kind}", "tracking.enabled=false")
         assert code == 0, err
-        for a in AXES:
-            # the axis from calibrate axis= (the sidecar's, when the import records it, is tested beside)
+        for a in AXES:  # each axis from its sidecar (import axes=)
             code, _, err = run(capsys, "calibrate", f"recording=rec/{kind}-imu.{col}.{a}.csv", f"out=cal/{kind}-{a}",
-                               "methods=[raw,poly3]", f"axis={a}", "tracking.enabled=false")
+                               "methods=[raw,poly3]", "tracking.enabled=false")
             assert code == 0, err
             folders[f"{kind}-{a}"] = workdir / "cal" / f"{kind}-{a}"
     return folders
@@ -99,12 +98,40 @@ def test_export_refusals_are_one_line(calibrated: dict[str, Path], workdir: Path
     assert code == 2 and len(err) == 1 and "both gyro axis x" in err[0], err
     code, _, err = run(capsys, "export", "calibrations=[cal/nowhere]", "out=p3", "device_id=1")
     assert code == 2 and len(err) == 1 and "no calibration.json" in err[0], err
-    code, _, err = run(capsys, "calibrate", "recording=rec/gyro-imu.gyro.z.csv", "out=cal/unknown",
-                       "methods=[poly3]", "tracking.enabled=false")
+    code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.z:rad/s", "out=rec2", "name=noaxis",
+                       "tracking.enabled=false")
+    assert code == 0, err
+    code, _, err = run(capsys, "calibrate", "recording=rec2/noaxis.csv", "out=cal/unknown", "methods=[poly3]",
+                       "tracking.enabled=false")
     assert code == 0, err
     code, _, err = run(capsys, "export", "calibrations=[cal/unknown]", "out=p4", "device_id=1")
     assert code == 2 and len(err) == 1 and "axis is unknown" in err[0], err
+    code, _, err = run(capsys, "calibrate", "recording=rec2/noaxis.csv", "out=cal/named", "methods=[poly3]",
+                       "axis=z", "tracking.enabled=false")  # calibrate axis= names it
+    assert code == 0, err
+    code, _, err = run(capsys, "export", "calibrations=[cal/named]", "out=p5", "device_id=1")
+    assert code == 0, err
     assert not any((workdir / p).exists() for p in ("p1", "p2", "p3", "p4"))
+
+
+def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Imported from a PX4 log, each recording knows its axis and the sensor's device id: the
+    export needs neither axis= nor device_id=, and the id is the log's."""
+    from tcbench.sensors.ulog import read_topic
+
+    log = Path(__file__).resolve().parents[1] / "data" / "real" / "px4_ulog_samples" / "sample_log_small.ulg"
+    code, _, err = run(capsys, "import", f"csv={log}", "sensor=gyro", "out=rec", "name=log", "tracking.enabled=false")
+    assert code == 0, err
+    for a in AXES:
+        code, _, err = run(capsys, "calibrate", f"recording=rec/log-sensor_gyro-0-{a}.csv", f"out=cal/{a}",
+                           "methods=[poly3]", "train_branches=[0]", "tracking.enabled=false")
+        assert code == 0, err
+    code, _, err = run(capsys, "export", "calibrations=[cal/x,cal/y,cal/z]", "out=params")
+    assert code == 0, err
+    script = (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()
+    logged = read_topic(log, "gyro")[0].device_id
+    assert script[0] == f"param set TC_G0_ID {logged}" and logged
 
 
 def test_a_partial_sensor_gets_zeros_and_says_so(calibrated: dict[str, Path], workdir: Path,

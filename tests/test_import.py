@@ -68,11 +68,11 @@ def test_round_trip_msra_units_and_defaults(tmp_path: Path, capsys: pytest.Captu
     temp_f = np.linspace(32.0, 50.0, 50)
     freq_khz = 1.2 + 1e-4 * np.arange(50)
     pd.DataFrame({"time_s": t, "temp_f": temp_f, "freq:khz": freq_khz}).to_csv(tmp_path / "m.csv", index=False)
-    code, _, err = run(capsys, "import", f"csv={tmp_path / 'm.csv'}", "sensor=msra", "time=time_s",
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'm.csv'}", "sensor=msra", "time=time_s:s",
                        "temperature=temp_f:degF", "output=freq:khz:kHz", f"out={tmp_path / 'o'}", "name=run1")
     assert code == 0, err
     rec = read_recording(tmp_path / "o" / "run1.csv")
-    np.testing.assert_array_equal(rec.time_s, t)  # no unit: already in the schema unit, kept bit for bit
+    np.testing.assert_array_equal(rec.time_s, t)  # in the schema unit: kept bit for bit
     np.testing.assert_allclose(rec.temperature_c, (temp_f - 32.0) * 5.0 / 9.0, atol=1e-12)
     np.testing.assert_allclose(rec.output, freq_khz * 1e3, rtol=1e-12)  # a column name with a colon in it
     np.testing.assert_array_equal(rec.input, np.zeros(50))  # no input column: 0 g
@@ -117,8 +117,8 @@ def test_any_unit_pint_knows(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     accel = pd.DataFrame({"t": np.arange(n) * 0.5, "T": np.full(n, 25.0), "f": np.full(n, 12_000.0),
                           "a": np.full(n, 9.80665)})
     accel.to_csv(tmp_path / "m.csv", sep=";", index=False)
-    code, _, err = run(capsys, "import", f"csv={tmp_path / 'm.csv'}", "sensor=msra", "time=t", "temperature=T",
-                       "output=f", "input=a:m/s2", f"out={tmp_path / 'o'}")
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'm.csv'}", "sensor=msra", "time=t:s", "temperature=T:degC",
+                       "output=f:Hz", "input=a:m/s2", f"out={tmp_path / 'o'}")
     assert code == 0, err
     np.testing.assert_allclose(read_recording(tmp_path / "o" / "m.csv").input, 1.0, rtol=1e-15)  # 1 g
 
@@ -129,7 +129,7 @@ def test_the_tofupilot_chamber_cycle_imports_as_written(tmp_path: Path, capsys: 
     from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
 
     code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
-                         "temperature=imu.temperature", "output=imu.gyro.y:rad/s", f"out={tmp_path / 'rec'}",
+                         "temperature=imu.temperature:degC", "output=imu.gyro.y:rad/s", f"out={tmp_path / 'rec'}",
                          "name=tofupilot-gyro-y", "tracking.enabled=false")
     assert code == 0, err
     rec = read_recording(tmp_path / "rec" / "tofupilot-gyro-y.csv")
@@ -150,7 +150,7 @@ def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixtur
 
     axes = ",".join(f"imu.gyro.{a}:rad/s" for a in "xyz")
     code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
-                         "temperature=imu.temperature", f"output={axes}", "out=rec", "name=imu")
+                         "temperature=imu.temperature:degC", f"output={axes}", "out=rec", "name=imu")
     assert code == 0, err
     recs = {a: read_recording(workdir / "rec" / f"imu-imu.gyro.{a}.csv") for a in "xyz"}
     table = pd.read_csv(TOFUPILOT_CSV, sep="\t")
@@ -166,7 +166,7 @@ def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixtur
 
     # an axis that fails leaves no recording of the others
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
-                       "temperature=imu.temperature", "output=imu.gyro.x:rad/s,imu.gyro.w:rad/s", "out=rec2",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.x:rad/s,imu.gyro.w:rad/s", "out=rec2",
                        "tracking.enabled=false")
     assert code == 2 and len(err) == 1 and "no column 'imu.gyro.w'" in err[0], err
     assert not (workdir / "rec2").exists()
@@ -211,7 +211,7 @@ def test_a_px4_log_imports_every_gyro_instance_and_axis(workdir: Path, capsys: p
 
 # -- bad input: one line, exit 2, nothing written --------------------------------------------------
 GOOD = "clock_ms,temp_c,rate_dps,flag\n0,25.0,0.1,0\n20,25.0,0.2,0\n40,25.1,0.3,0\n60,25.1,0.2,0\n"
-ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c", "output=rate_dps")
+ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c:degC", "output=rate_dps:deg/s")
 
 
 @pytest.mark.parametrize(
@@ -263,7 +263,7 @@ def test_failed_import_leaves_earlier_output(tmp_path: Path, capsys: pytest.Capt
 
 
 def test_missing_argument_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(capsys, "import", "csv=x.csv", "sensor=gyro", "time=t", "output=y", f"out={tmp_path}")
+    code, _, err = run(capsys, "import", "csv=x.csv", "sensor=gyro", "time=t:s", "output=y:deg/s", f"out={tmp_path}")
     assert code == 2 and len(err) == 1 and "missing temperature=" in err[0]
 
 
@@ -282,8 +282,8 @@ def _bursts(n_bursts: int = 25, per_burst: int = 250, spacing_s: float = 305.0, 
 
 def test_bursts_import_and_metrics(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _bursts().to_csv("bursts.csv", index=False)
-    code, _, err = run(capsys, "import", "csv=bursts.csv", "sensor=gyro", "time=t", "temperature=temp",
-                       "output=rate", "out=rec")
+    code, _, err = run(capsys, "import", "csv=bursts.csv", "sensor=gyro", "time=t:s", "temperature=temp:degC",
+                       "output=rate:deg/s", "out=rec")
     assert code == 0, err
     rec = read_recording("rec/bursts.csv")
     seg = rec.meta.extra["segments"]
@@ -345,7 +345,7 @@ def test_continuous_gyro_rate_vs_temperature_by_bins(tmp_path: Path) -> None:
 # -- the real PAN recording --------------------------------------------------------------------------
 @pytest.mark.skipif(not PAN.exists(), reason="real recordings not present")
 def test_pan_lsm6dsm_cooling(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s", "temperature=temp_c:degC",
+    code, out, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
                          "output=gyro_x_dps:deg/s", "drop=spike_flag", "device_id=pan-etu-lsm6dsm", "out=rec")
     assert code == 0, err
     assert "6247 samples in 25 segments at 50 Hz, 3 rows dropped where spike_flag is nonzero" in out
@@ -356,7 +356,7 @@ def test_pan_lsm6dsm_cooling(workdir: Path, capsys: pytest.CaptureFixture[str]) 
     assert m["rate_temp_slope_dps_per_c"] == pytest.approx(0.0298, abs=0.0005)  # PROVENANCE.md
     assert m["rate_temp_r"] > 0.998
     # the logged rad/s column lacks the x0.5 correction of gyro_x_dps: twice the rate after conversion
-    logged = import_csv(PAN, "gyro", {"time_s": "time_s", "temperature_c": "temp_c",
+    logged = import_csv(PAN, "gyro", {"time_s": "time_s:s", "temperature_c": "temp_c:degC",
                                       "output": "gyro_x_rads_logged:rad/s"}, drop=["spike_flag"])
     dps = read_recording("rec/pan_lsm6dsm_tvac_cooling.csv")
     np.testing.assert_allclose(logged.output, 2.0 * dps.output, rtol=1e-5)

@@ -24,7 +24,7 @@ from tcbench.sensors.recording import make_recording, write_recording
 
 SIM = ["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=100",
        "protocol_params.sample_rate_hz=1", "tracking.enabled=false"]
-IMPORT = ["import", "sensor=gyro", "time=t:ms", "temperature=temp", "output=rate:mdps"]
+IMPORT = ["import", "sensor=gyro", "time=t:ms", "temperature=temp:degC", "output=rate:mdps"]
 
 
 @pytest.fixture(autouse=True)
@@ -214,8 +214,8 @@ def test_a_clock_glitch_is_refused_by_every_reader(workdir: Path, capsys: pytest
     schema_csv(workdir / "glitch.csv", np.append(np.arange(100.0), last_s))
     for args in (["metrics", "glitch.csv", "tracking.enabled=false"],
                  ["diagnose", "recording=glitch.csv", "sensor=gyro", "out=d"],
-                 ["import", "csv=glitch.csv", "sensor=gyro", "time=time_s", "temperature=temperature_c",
-                  "output=output", "out=i"]):
+                 ["import", "csv=glitch.csv", "sensor=gyro", "time=time_s:s", "temperature=temperature_c:degC",
+                  "output=output:deg/s", "out=i"]):
         refused(capsys, workdir, args, "glitch.csv: row 101, column 'time_s'", words)
 
 
@@ -223,8 +223,8 @@ def test_a_logger_in_bursts_is_not_a_glitch(workdir: Path, capsys: pytest.Captur
     """Ten 30 s bursts at 1 Hz an hour apart (gaps 120 times the data), and one burst a day later."""
     bursts = [3600.0 * k + np.arange(30.0) for k in range(10)] + [86400.0 + np.arange(30.0)]
     schema_csv(workdir / "bursts.csv", np.concatenate(bursts))
-    code = main(["import", "csv=bursts.csv", "sensor=gyro", "time=time_s", "temperature=temperature_c",
-                 "output=output", "out=i"])
+    code = main(["import", "csv=bursts.csv", "sensor=gyro", "time=time_s:s", "temperature=temperature_c:degC",
+                 "output=output:deg/s", "out=i"])
     assert code == 0, capsys.readouterr().err
     assert "in 11 segments" in capsys.readouterr().out
 
@@ -266,7 +266,7 @@ def test_big_files_are_judged_from_a_bounded_read(workdir: Path, name: str) -> N
     make(workdir / name)
     before = snapshot_names(workdir)
     commands = [f"metrics {name} tracking.enabled=false", f"diagnose recording={name} sensor=gyro out=d",
-                f"import csv={name} sensor=gyro time=time_s temperature=temperature_c output=output out=i"]
+                f"import csv={name} sensor=gyro time=time_s:s temperature=temperature_c:degC output=output:deg/s out=i"]
     done = subprocess.run([sys.executable, "-c", RSS_PROBE, *commands], cwd=workdir, capture_output=True, text=True,
                           timeout=120, check=False, env={**os.environ, "MPLBACKEND": "Agg"})
     result = json.loads(done.stdout.strip().splitlines()[-1])

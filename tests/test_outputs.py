@@ -60,7 +60,7 @@ def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
          "tracking store blocker/mlflow.db: its folder blocker is not a folder"),
         (["simulate", "sensor=gyro", "protocol=static", "out=blocker/recs"],
          "out=blocker/recs: cannot be made: blocker is not a folder"),
-        (["import", "csv=in.csv", "sensor=gyro", "time=t", "temperature=T", "output=w", "out=blocker"],
+        (["import", "csv=in.csv", "sensor=gyro", "time=t:s", "temperature=T:degC", "output=w:deg/s", "out=blocker"],
          "out=blocker: is not a folder"),
         (["diagnose", "recording=in.csv", "out=blocker/d"], "out=blocker/d: cannot be made: blocker is not a folder"),
         (["leaderboard", "--out", "blocker"], "out=blocker: is not a folder"),

@@ -24,7 +24,7 @@ def _summarise():  # type: ignore[no-untyped-def]
 
 
 def test_the_board_of_two_splits(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us", "temperature=imu.temperature",
+    assert main(["import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us", "temperature=imu.temperature:degC",
                  "output=imu.gyro.y:rad/s", "out=rec", "name=tofu-y", "tracking.enabled=false"]) == 0
     for folder, train in (("one", "[0]"), ("both", "[0,1]")):
         assert main(["calibrate", "recording=rec/tofu-y.csv", f"out={folder}/tofu-y", f"train_branches={train}",

@@ -18,12 +18,14 @@ tofu="$data/tofupilot_imu_chamber/imu_raw_data.csv"
 pan="$data/pan_lsm6dsm_tvac_cooling/pan_lsm6dsm_tvac_cooling.csv"
 
 echo "== import"
-tcbench import "csv=$tofu" sensor=gyro time=timestamp:us temperature=imu.temperature \
-    output=imu.gyro.x:rad/s,imu.gyro.y:rad/s,imu.gyro.z:rad/s "out=$work/rec" name=tofupilot device_id=tofupilot-imu
-tcbench import "csv=$tofu" sensor=accel time=timestamp:us temperature=imu.temperature \
-    output=imu.acc.x:m/s^2,imu.acc.y:m/s^2,imu.acc.z:m/s^2 "out=$work/rec" name=tofupilot device_id=tofupilot-imu
-tcbench import "csv=$pan" sensor=gyro time=time_s temperature=temp_c:degC \
-    output=gyro_x_dps:deg/s,gyro_y_dps:deg/s,gyro_z_dps:deg/s drop=spike_flag "out=$work/rec" name=pan \
+tcbench import "csv=$tofu" sensor=gyro time=timestamp:us temperature=imu.temperature:degC \
+    output=imu.gyro.x:rad/s,imu.gyro.y:rad/s,imu.gyro.z:rad/s axes=x,y,z "out=$work/rec" name=tofupilot \
+    device_id=tofupilot-imu
+tcbench import "csv=$tofu" sensor=accel time=timestamp:us temperature=imu.temperature:degC \
+    output=imu.acc.x:m/s^2,imu.acc.y:m/s^2,imu.acc.z:m/s^2 axes=x,y,z "out=$work/rec" name=tofupilot \
+    device_id=tofupilot-imu
+tcbench import "csv=$pan" sensor=gyro time=time_s:s temperature=temp_c:degC \
+    output=gyro_x_dps:deg/s,gyro_y_dps:deg/s,gyro_z_dps:deg/s axes=x,y,z drop=spike_flag "out=$work/rec" name=pan \
     device_id=pan-etu-lsm6dsm
 
 tofu_axes=$(printf "$work/rec/tofupilot-imu.%s.csv," gyro.x gyro.y gyro.z acc.x acc.y)

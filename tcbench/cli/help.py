@@ -111,12 +111,21 @@ SPECS: dict[str, CommandHelp] = {
             "csv": "the table to import (fields separated by commas, tabs or semicolons), or a PX4 log (.ulg: "
                    "every instance and axis of the sensor's topic, sensor_gyro for a gyro, sensor_accel for accel); also the first argument",
             "sensor": "msra, gyro or accel (any kind `tcbench list what=sensors` shows)",
-            "time": "time column, COL[:unit] (any time unit pint knows: s, ms, us, ns, min, h)",
-            "temperature": "temperature column, COL[:unit] (degC, K, degF)",
-            "output": "sensor output column, COL[:unit] (gyro: deg/s, rad/s, mrad/s, mdps ...; accel: g, mg, m/s^2 ...; "
+            "time": "time column, COL:unit (any time unit pint knows: s, ms, us, ns, min, h)",
+            "temperature": "temperature column, COL:unit (degC, K, degF)",
+            "output": "sensor output column, COL:unit (gyro: deg/s, rad/s, mrad/s, mdps ...; accel: g, mg, m/s^2 ...; "
                       "msra: Hz, kHz ...); "
-                      "several axes: COL[:unit],COL[:unit],... (one recording each, NAME-COL)",
-            "input": "optional true-input column, COL[:unit]",
+                      "several axes: COL:unit,COL:unit,... (one recording each, NAME-COL)",
+            "input": "optional true-input column, COL:unit",
+            "units.time": "the unit of time= when it names its column without one (units={time:us,output:rad/s} "
+                          "sets several): a unit is never assumed; say it after the column's colon, here, or import "
+                          "a tcbench recording whose sidecar states it",
+            "units.temperature": "the unit of temperature= when it names its column without one",
+            "units.output": "the unit of every output= column named without one (units.output=m/s^2)",
+            "units.input": "the unit of input= when it names its column without one",
+            "axes": "the sensor axis of each output column, x, y or z (axes=y, or axes=x,y,z for three), written to "
+                    "the sidecar's extra.axis; null: not recorded (never guessed from a name; a PX4 log's x, y, z "
+                    "fields are their axes)",
             "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
             "out": "output folder",
             "name": "file stem (null: the CSV's)",
@@ -125,11 +134,11 @@ SPECS: dict[str, CommandHelp] = {
             **TRACKING,
         },
         examples=(
-            "tcbench import csv=log.csv sensor=gyro time=time_s temperature=temp_c:degC "
-            "output=gyro_x_dps:deg/s out=recordings",
+            "tcbench import csv=log.csv sensor=gyro time=time_s:s temperature=temp_c:degC "
+            "output=gyro_x_dps:deg/s axes=x out=recordings",
             "tcbench import csv=flight.ulg sensor=gyro out=recordings   (NAME-sensor_gyro-<instance>-<axis>.csv)",
-            "tcbench import csv=imu.tsv sensor=accel time=t:us temperature=temp output=ax:m/s^2,ay:m/s^2,az:m/s^2 "
-            "out=recordings",
+            "tcbench import csv=imu.tsv sensor=accel time=t temperature=temp output=ax,ay,az "
+            "units={time:us,temperature:degC} units.output=m/s^2 axes=x,y,z out=recordings",
         ),
         output="OUT/NAME.csv and its sidecar OUT/NAME.json; MLflow experiment 'recordings' when tracking is on",
         positional="csv",

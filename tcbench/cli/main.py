@@ -22,7 +22,7 @@ commands:
   quickstart   the main job in a minute: compensate a simulated MSRA, diagnose a recording
   list         registered tasks, optimisers and learners (what=all|tasks|optimisers|learners)
   simulate     simulate a recording (sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR) and its metrics
-  import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL[:unit] ... out=DIR)
+  import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL:unit ... out=DIR)
   metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
   diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
   calibrate    fit offset models on some temperature branches of a static recording, score them on the others

@@ -280,18 +280,19 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[flo
 
 def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str) -> dict[str, Any]:
     """What ``calibration.json`` says of the recording and the split."""
+    from tcbench.sensors.recording import RecordingError, recording_axis
+
     source = rec.meta.extra.get("source", {}) if isinstance(rec.meta.extra, dict) else {}
+    try:
+        axis = cfg.axis or recording_axis(rec.meta)
+    except RecordingError as exc:
+        raise CommandError(f"{cfg.recording}: {exc}") from None
     return {"recording": Path(cfg.recording).name, "content_hash": _content_hash(cfg.recording),
-            "sensor": rec.meta.sensor, "unit": unit, "axis": cfg.axis or _axis(rec.meta),
+            "sensor": rec.meta.sensor, "unit": unit, "axis": axis,
             "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
             "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train,
             "held_out_parts": split.held_out, "test_recordings": [Path(p).name for p in cfg.test_recordings],
             "drift_window_s": cfg.drift_window_s}
-
-
-def _axis(meta: Any) -> str | None:
-    axis = meta.extra.get("axis") if isinstance(meta.extra, dict) else None
-    return axis if axis in ("x", "y", "z") else None
 
 
 def _content_hash(path: str) -> str:

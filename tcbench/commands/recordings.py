@@ -161,8 +161,10 @@ def metrics(cfg: MetricsConfig) -> RecordingOutcome:
 
 # -- import --------------------------------------------------------------------------------------
 
-IMPORT_USAGE = ("usage: tcbench import csv=PATH sensor=msra|gyro|accel time=COL[:unit] temperature=COL[:unit] "
-                "output=COL[:unit] [input=COL[:unit]] [drop=COL] out=DIR, or csv=LOG.ulg sensor=gyro|accel out=DIR")
+IMPORT_USAGE = ("usage: tcbench import csv=PATH sensor=msra|gyro|accel time=COL:unit temperature=COL:unit "
+                "output=COL:unit [input=COL:unit] [units={output:UNIT,...}] [axes=x|y|z] [drop=COL] out=DIR, "
+                "or csv=LOG.ulg sensor=gyro|accel out=DIR")
+NO_AXIS = "axis unknown (axes=x|y|z to record it)"
 
 
 def import_stem(cfg: ImportConfig) -> str:
@@ -175,7 +177,8 @@ def is_ulog(cfg: ImportConfig) -> bool:
 
 
 def import_axes(cfg: ImportConfig) -> list[str]:
-    """The ``output=`` columns, ``COL[:unit]`` each: several axes are separated by commas."""
+    """The ``output=`` columns, ``COL:unit`` (or ``COL`` with its unit in ``units=``) each:
+    several axes are separated by commas."""
     return [a.strip() for a in str(cfg.output).split(",") if a.strip()]
 
 
@@ -191,6 +194,40 @@ def import_stems(cfg: ImportConfig) -> list[str]:
     return [f"{stem}-{c}" for c in columns]
 
 
+def import_units(cfg: ImportConfig) -> dict[str, str]:
+    """The ``units=`` map (keys time, temperature, output, input) by schema column."""
+    from tcbench.sensors.importer import KEYS
+
+    given = cfg.units if isinstance(cfg.units, dict) else vars(cfg.units)
+    units = {}
+    for target, key in KEYS.items():
+        unit = given.get(key)
+        if unit is None:
+            continue
+        if not str(unit).strip():
+            raise CommandError(f"units={{{key}:...}}: the unit is empty")
+        units[target] = str(unit).strip()
+    return units
+
+
+def import_axis_list(cfg: ImportConfig, outputs: list[str]) -> list[str | None]:
+    """The sensor axis of each ``outputs`` column from ``axes=`` (x, y or z, one per column), or
+    None each without ``axes=``: an axis is never guessed from a column's name."""
+    from tcbench.sensors.recording import AXES
+
+    if not cfg.axes:
+        return [None] * len(outputs)
+    axes = [a.strip() for a in str(cfg.axes).split(",")]
+    if bad := [a for a in axes if a not in AXES]:
+        raise CommandError(f"axes={cfg.axes}: {bad[0]!r} is not an axis (x, y or z)")
+    if len(axes) != len(outputs):
+        columns = ",".join(a.rsplit(":", 1)[0] for a in outputs)
+        raise CommandError(f"axes={cfg.axes} names {len(axes)} {'axis' if len(axes) == 1 else 'axes'} for "
+                           f"{len(outputs)} output column{'s' * (len(outputs) != 1)} ({columns}); "
+                           "give one axis per column")
+    return list(axes)
+
+
 def check_import(cfg: ImportConfig) -> None:
     """Every argument of ``tcbench import`` before any work."""
     from tcbench.outputs import overwritten_input
@@ -199,17 +236,33 @@ def check_import(cfg: ImportConfig) -> None:
     needed = [k for k in keys if not getattr(cfg, k)]
     if needed:
         raise CommandError(f"missing {needed[0]}=; {IMPORT_USAGE}")
+    import_units(cfg)
     if is_ulog(cfg):
+        _ulog_axes(cfg)
         file_stem(import_stem(cfg))
         writable_folder(cfg.out)
         checked_store(cfg.tracking)
         return
+    import_axis_list(cfg, import_axes(cfg))
     stems = [file_stem(import_stem(cfg))] + [file_stem(s, "output") for s in import_stems(cfg)]
     writable_folder(cfg.out)
     targets = [Path(cfg.out) / f"{stem}.{ext}" for stem in stems[1:] for ext in ("csv", "json")]
     if clash := overwritten_input(targets, [Path(cfg.csv)]):
         raise overwrite_error(InputOverwriteError(*clash))
     checked_store(cfg.tracking)
+
+
+def column_summary(rec: Any) -> str:
+    """What an imported recording was read from, each column with its unit, and its axis:
+    ``time=timestamp [us], temperature=imu.temperature [degC], output=imu.gyro.y [rad/s] -> deg/s; axis y``."""
+    from tcbench.sensors.importer import KEYS
+    from tcbench.sensors.recording import recording_axis
+
+    columns = rec.meta.extra["source"]["columns"]
+    stored = {"output": f" -> {rec.meta.units['output']}"}
+    text = ", ".join(f"{KEYS[target]}={columns[target]}{stored.get(target, '')}" for target in KEYS if target in columns)
+    axis = recording_axis(rec.meta)
+    return f"{text}; {f'axis {axis}' if axis else NO_AXIS}"
 
 
 def import_recording(cfg: ImportConfig) -> RecordingOutcome:
@@ -238,6 +291,7 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
         kind = f"in {seg['count']} segments " if seg["count"] > 1 else ""
         print(f"tcbench: wrote {o.path} ({len(o.rec.data)} samples {kind}at {o.rec.meta.sample_rate_hz:g} Hz{dropped}) "
               f"and its sidecar {o.path.with_suffix('.json')}")
+        print(f"  {column_summary(o.rec)}")
     first, *rest = outcomes
     first.also = rest
     return first
@@ -249,8 +303,10 @@ def _table_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
     from tcbench.sensors.recording import RecordingError
 
     columns = {"time_s": cfg.time, "temperature_c": cfg.temperature, **({"input": cfg.input} if cfg.input else {})}
+    outputs = import_axes(cfg)
     try:
-        recs = import_csv_axes(cfg.csv, cfg.sensor, columns, import_axes(cfg), drop=drop, device_id=cfg.device_id,
+        recs = import_csv_axes(cfg.csv, cfg.sensor, columns, outputs, units=import_units(cfg),
+                               axes=import_axis_list(cfg, outputs), drop=drop, device_id=cfg.device_id,
                                sample_rate_hz=cfg.sample_rate_hz)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
@@ -259,19 +315,39 @@ def _table_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
     return dict(zip(import_stems(cfg), recs, strict=True))
 
 
+def _ulog_axes(cfg: ImportConfig) -> list[tuple[str, str | None]]:
+    """The fields read from a PX4 log's sensor topic (``output=``, else x, y, z in PX4's unit),
+    each with its sensor axis: ``axes=`` where given, else the field's own (x, y, z); a field
+    that is an axis cannot be given another."""
+    from tcbench.sensors.ulog import AXES, default_axes, field_axis, topics
+
+    outputs = import_axes(cfg) or (default_axes(cfg.sensor) if cfg.sensor in topics() else list(AXES))
+    given = import_axis_list(cfg, outputs)
+    out = []
+    for output, axis in zip(outputs, given, strict=True):
+        field_name = output.rsplit(":", 1)[0] if ":" in output else output
+        own = field_axis(field_name)
+        if axis is not None and own is not None and axis != own:
+            raise CommandError(f"axes={cfg.axes}: the log's field {field_name} is the {own} axis, not {axis}")
+        out.append((output, axis or own))
+    return out
+
+
 def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
     """One recording per instance and axis of the sensor's topic in a PX4 log, named
-    ``NAME-<topic>-<instance>-<axis>``; ``time=``, ``temperature=``, ``output=`` name other fields."""
+    ``NAME-<topic>-<instance>-<field>``, its axis (the field x, y, z) in the sidecar;
+    ``time=``, ``temperature=``, ``output=`` name other fields."""
     from tcbench.sensors.importer import import_table
     from tcbench.sensors.recording import RecordingError
-    from tcbench.sensors.ulog import default_axes, default_columns, read_topic
+    from tcbench.sensors.ulog import default_columns, read_topic
 
     path = Path(cfg.csv)
     try:
         instances = read_topic(path, cfg.sensor)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
-    axes = import_axes(cfg) or default_axes(cfg.sensor)
+    outputs = _ulog_axes(cfg)
+    units = import_units(cfg)
     recs = {}
     for inst in instances:
         columns = default_columns(list(inst.fields))
@@ -279,12 +355,12 @@ def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
                                       ("input", cfg.input)) if v}
         about = {"file": path.name, "format": "PX4 ULog", "topic": inst.topic, "instance": inst.instance,
                  "px4_device_id": inst.device_id}
-        for axis in axes:
-            field_name = axis.rsplit(":", 1)[0] if ":" in axis else axis
+        for output, axis in outputs:
+            field_name = output.rsplit(":", 1)[0] if ":" in output else output
             stem = file_stem(f"{import_stem(cfg)}-{inst.topic}-{inst.instance}-{field_name}", "output")
             try:
                 recs[stem] = import_table(
-                    inst.fields, cfg.sensor, {**columns, "output": axis}, drop=drop,
+                    inst.fields, cfg.sensor, {**columns, "output": output}, units=units, axis=axis, drop=drop,
                     source=f"{path} ({inst.topic} instance {inst.instance})", about=about,
                     device_id=cfg.device_id or f"{path.stem}-{inst.topic}-{inst.instance}",
                     sample_rate_hz=cfg.sample_rate_hz)

@@ -48,10 +48,21 @@ class MetricsConfig:
 
 
 @dataclass
+class ImportUnits:
+    """``tcbench import``'s ``units=``: the unit of a column named without one (``units={output:rad/s}``)."""
+
+    time: str | None = None
+    temperature: str | None = None
+    output: str | None = None
+    input: str | None = None
+
+
+@dataclass
 class ImportConfig:
-    """``tcbench import``: the CSV, the sensor kind, the column map (``time=COL[:unit]`` ...), rows
-    to drop (``drop=flag`` or ``drop=a,b``: rows where a column is nonzero) and the output
-    directory; ``name`` is the recording's stem (default: the CSV's)."""
+    """``tcbench import``: the CSV, the sensor kind, the column map (``time=COL:unit`` ...), the
+    units of columns given without one (``units={output:rad/s,time:us}``), the sensor axis of each
+    output column (``axes=x,y,z``), rows to drop (``drop=flag`` or ``drop=a,b``: rows where a
+    column is nonzero) and the output directory; ``name`` is the recording's stem (default: the CSV's)."""
 
     kind: str = "import"
     csv: str = ""
@@ -60,6 +71,8 @@ class ImportConfig:
     temperature: str = ""
     output: str = ""
     input: str | None = None
+    units: ImportUnits = field(default_factory=lambda: ImportUnits())
+    axes: str | None = None
     drop: str | None = None
     out: str = ""
     name: str | None = None

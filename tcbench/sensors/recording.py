@@ -6,7 +6,9 @@ an MSRA's frequency difference in Hz, a gyro's rate in deg/s, an accelerometer's
 accelerometer kinds, an optional ``position`` (``+0g``, ``+1g``, ``-0g``, ``-1g``, or empty outside
 a four-position test). Other columns are rejected. The kinds are :mod:`tcbench.sensors.kinds`.
 The sidecar ``<stem>.json`` holds the sensor kind, units, sample rate, device id and a free-form
-``extra`` object; it is optional when reading and always written.
+``extra`` object; it is optional when reading and always written. One key of ``extra`` has a
+contract: ``axis``, the sensor axis a single-axis recording measures (``x``, ``y`` or ``z``), or
+absent when unknown (:func:`recording_axis`).
 
 Every problem raises :class:`RecordingError` with one line naming the file and, where it applies,
 the row and column. Rows are numbered like a user counts data rows: the first row below the
@@ -59,6 +61,7 @@ from tcbench.sensors.recording_schema import (
 )
 
 __all__ = [
+    "AXES",
     "COLUMNS",
     "FORMATS",
     "NUMERIC_COLUMNS",
@@ -68,10 +71,12 @@ __all__ = [
     "Recording",
     "RecordingError",
     "RecordingMeta",
+    "check_axis",
     "check_sensor",
     "known_units",
     "make_recording",
     "read_recording",
+    "recording_axis",
     "sidecar_path",
     "standard_units",
     "write_recording",
@@ -143,6 +148,27 @@ def make_recording(
     rec = Recording(pd.DataFrame(columns, copy=False), meta)
     rec.data = _checked(rec, None, None)[0]
     return rec
+
+
+AXES = ("x", "y", "z")
+
+
+def check_axis(axis: Any) -> str:
+    """``axis`` if it names a sensor axis (x, y or z), else one line saying what it must be."""
+    if not isinstance(axis, str) or axis not in AXES:
+        raise RecordingError(f"axis must be x, y or z, got {axis!r}")
+    return axis
+
+
+def recording_axis(meta: RecordingMeta) -> str | None:
+    """The sensor axis (x, y or z) a recording's sidecar states in ``extra.axis``; None when it
+    states none. Any other value is a :class:`RecordingError`."""
+    if "axis" not in meta.extra:
+        return None
+    try:
+        return check_axis(meta.extra["axis"])
+    except RecordingError as err:
+        raise RecordingError(f"extra.axis: {err.problem}") from None
 
 
 def sidecar_path(path: str | Path) -> Path:

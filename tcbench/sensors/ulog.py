@@ -6,7 +6,8 @@ A topic instance is a table of fields (``timestamp``, ``timestamp_sample`` in µ
 ``x``, ``y``, ``z``, ``temperature`` in °C, ...); the default column map reads the sample clock,
 the temperature and the three axes in PX4's units (rad/s for ``sensor_gyro``, m/s^2 for
 ``sensor_accel``), and any field can be named instead, with a unit, as for a CSV file
-(:func:`tcbench.sensors.importer.import_table`).
+(:func:`tcbench.sensors.importer.import_table`). The fields ``x``, ``y``, ``z`` are the sensor's
+axes: :func:`field_axis` names the axis a field is.
 """
 
 from __future__ import annotations
@@ -17,9 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from tcbench.sensors import kinds
-from tcbench.sensors.recording import RecordingError
-
-AXES = ("x", "y", "z")
+from tcbench.sensors.recording import AXES, RecordingError
 
 
 @dataclass(frozen=True)
@@ -48,6 +47,11 @@ def default_axes(sensor: str) -> list[str]:
     """``x:UNIT``, ``y:UNIT``, ``z:UNIT`` in the unit PX4 logs the sensor's topic in."""
     unit = topics()[sensor][1]
     return [f"{a}:{unit}" for a in AXES]
+
+
+def field_axis(field: str) -> str | None:
+    """The sensor axis of a topic field (``x``, ``y`` or ``z``), None for any other field."""
+    return field if field in AXES else None
 
 
 def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
