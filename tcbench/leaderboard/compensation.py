@@ -9,6 +9,14 @@ method cannot rank on the few restarts it finished; raw and the oracle are deter
 ``p_vs_next``: Wilcoxon signed-rank p-value of the primary metric against the next row, paired
 by seed (NaN below 6 shared seeds). ``note`` flags a method whose median is below the oracle's,
 the physical limit: it cannot be compensating the sensor better than its own noise allows.
+
+Runs on the user's recordings are keyed by the content hash of their data (``accel_chamber-files-
+<hash>``, :func:`tcbench.tasks.specs.device_key`): each set of files has its own board, which names
+them, and a board whose test files are among its training files says its scores are in-sample.
+One run per job is kept: the newest finished per (task, method, config, seed), so two configs of
+one method both count and :func:`label_configs` names them apart; the limits (oracle,
+oracle_thermometer), the simulator's truth whatever the pipeline or learner settings beside them,
+one per (task, method, seed).
 """
 
 from __future__ import annotations
@@ -47,6 +55,8 @@ class CompensationBoard:
     protocol: str
     table: pd.DataFrame
     runs: pd.DataFrame
+    data: str = ""  # the user's recordings the runs trained and tested on (empty: simulated)
+    in_sample: str = ""  # the test files that are training files too
 
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -59,7 +69,9 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
             "method": t.get("tcbench.method"), "seed": int(t.get("tcbench.seed", -1)),
             "sweep": t.get("tcbench.sweep_id"), "config_hash": t.get("tcbench.config_hash"),
             "start_time": r.info.start_time, "error_message": t.get("tcbench.error", ""),
-            "task_name": t.get("tcbench.task_name"), **r.data.metrics,
+            "task_name": t.get("tcbench.task_name"), "data_hash": t.get("tcbench.data_hash", ""),
+            "train_files": t.get("tcbench.train_files", ""), "test_files": t.get("tcbench.test_files", ""),
+            "in_sample": t.get("tcbench.in_sample", ""), "params": dict(r.data.params), **r.data.metrics,
         })
     return pd.DataFrame(rows)
 
@@ -213,13 +225,100 @@ def _gyro_notes(table: pd.DataFrame) -> list[str]:
 
 
 def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[CompensationBoard]:
-    """One board per compensation task in ``runs`` (one run per job); ``protocol_of`` maps a
-    task name to its protocol (:func:`tcbench.tasks.specs.protocols`)."""
+    """One board per compensation task in ``runs`` (one run per job: the newest finished per
+    task, method, config and seed); ``protocol_of`` maps a task name to its protocol
+    (:func:`tcbench.tasks.specs.protocols`)."""
     out = []
-    for task, g in one_run_per_job(runs, ("task", "method", "seed")).groupby("task", sort=True):
+    for task, g in _one_run_per_job(runs).groupby("task", sort=True):
+        g = label_configs(g)
         protocol = protocol_of[str(g["task_name"].iloc[0])]
-        out.append(CompensationBoard(str(task), protocol, summarise(g, protocol), g))
+        table = _mark_in_sample(summarise(g, protocol), g)
+        out.append(CompensationBoard(str(task), protocol, table, g, _data_line(g), _tag_values(g, "in_sample")))
     return out
+
+
+def _one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
+    """The newest finished run per task, method, config and seed; per task, method and seed for
+    the limits, whose names leave out the settings they do not depend on (the gyro pipeline)."""
+    limit = runs["method"].isin(list(LIMITS.values()))
+    kept = [one_run_per_job(runs[~limit]), one_run_per_job(runs[limit], ("task", "method", "seed"))]
+    return pd.concat([k for k in kept if not k.empty] or [runs.iloc[:0]]).sort_index()
+
+
+HIDDEN_KEYS = ("seed", "progress", "tracking.")  # params that are not part of a job's config hash
+LABEL_KEYS = 3  # differing config keys named in a label; beyond them the config hash tells them apart
+LABEL_VALUE_CHARS = 40
+
+
+def _config_params(params: object) -> dict[str, str]:
+    items = params.items() if isinstance(params, dict) else ()
+    return {str(k): str(v) for k, v in items if not str(k).startswith(HIDDEN_KEYS)}
+
+
+def _short(value: str) -> str:
+    return value if len(value) <= LABEL_VALUE_CHARS else value[:LABEL_VALUE_CHARS - 1] + "…"
+
+
+def label_configs(runs: pd.DataFrame) -> pd.DataFrame:
+    """``runs`` with each method that ran under several configs on the board relabelled by the
+    config keys whose values differ between them: ``BP-gd [learner.epochs=50]`` beside ``BP-gd
+    [learner.epochs=100]`` (the Hydra overrides that separate them; beyond :data:`LABEL_KEYS` keys,
+    or when the params do not tell them apart, the config hash too). A method with one config, and
+    a limit, keeps its name."""
+    if runs.empty or "config_hash" not in runs:
+        return runs
+    hashes = runs["config_hash"].fillna("").astype(str)
+    method = runs["method"].copy()
+    for name, g in runs.groupby("method", sort=False):
+        h = hashes[g.index]
+        if h.nunique() < 2 or name in LIMITS.values():
+            continue
+        configs = {c: _config_params(g.loc[h == c, "params"].iloc[0] if "params" in g else None)
+                   for c in sorted(h.unique())}
+        keys = sorted({k for p in configs.values() for k in p})
+        differing = [k for k in keys if len({p.get(k) for p in configs.values()}) > 1]
+        labels = {}
+        for c, p in configs.items():
+            parts = [f"{k}={_short(p.get(k, '–'))}" for k in differing[:LABEL_KEYS]]
+            if len(differing) > LABEL_KEYS:
+                parts.append(f"+{len(differing) - LABEL_KEYS} keys")
+            labels[c] = parts
+        unique = len({tuple(v) for v in labels.values()}) == len(labels) and len(differing) <= LABEL_KEYS
+        for c, parts in labels.items():
+            parts = parts if unique else [*parts, f"config {c[:8] or 'unknown'}"]
+            method[h[h == c].index] = f"{name} [{', '.join(parts)}]"
+    return runs.assign(method=method)
+
+
+def _tag_values(runs: pd.DataFrame, column: str) -> str:
+    """The distinct non-empty values of a tag column over ``runs``, joined (empty without)."""
+    if column not in runs:
+        return ""
+    values = [str(v) for v in runs[column].dropna().unique() if str(v)]
+    return " | ".join(sorted(values))
+
+
+def _data_line(runs: pd.DataFrame) -> str:
+    """What the board's runs trained and tested on, when that is the user's recordings."""
+    digest = _tag_values(runs, "data_hash")
+    if not digest:
+        return ""
+    return (f"Data: the user's recordings (content hash {digest} of the training then the test files, tables "
+            f"and sidecars): training files {_tag_values(runs, 'train_files')}; test files "
+            f"{_tag_values(runs, 'test_files')}.")
+
+
+IN_SAMPLE_NOTE = "in-sample: tested on training data"
+
+
+def _mark_in_sample(table: pd.DataFrame, runs: pd.DataFrame) -> pd.DataFrame:
+    """The note of every row with a run whose test files are among its training files."""
+    if table.empty or "in_sample" not in runs:
+        return table
+    marked = set(runs.loc[runs["in_sample"].fillna("").astype(str) != "", "method"])
+    notes = [f"{IN_SAMPLE_NOTE}; {n}" if m in marked and n else IN_SAMPLE_NOTE if m in marked else n
+             for m, n in zip(table["method"], table["note"], strict=True)]
+    return table.assign(note=notes)
 
 
 def _plot(board: CompensationBoard, path: Path) -> Path:
@@ -277,6 +376,9 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
     }[board.protocol]
     lines = [
         f"# Compensation leaderboard: {board.task}", "",
+        *([board.data, ""] if board.data else []),
+        *([f"**In-sample:** train_files and test_files share {board.in_sample}: the test scores are in-sample, "
+           "not held out (the rows are marked in note).", ""] if board.in_sample else []),
         f"Source: {source}. Metrics are means over the test recordings; {conv}.",
         f"Rows are ordered by the median of {primary} over restarts (seeds); ci95 = bootstrap 95 % "
         "interval of that median; best_by_train = the run with the smallest training RMSE (the paper's "

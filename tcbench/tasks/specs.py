@@ -43,9 +43,14 @@ def bbob_key(task: dict[str, Any]) -> str:
 
 def device_key(task: dict[str, Any]) -> str:
     """``msra_fulltemp-dev0`` (``-rec<N>`` for other recordings, ``-<effect>.<param>=<v>`` for
-    changed effects; ``<task>-files`` on the user's recordings)."""
+    changed effects; ``<task>-files-<hash>`` on the user's recordings, the hash of their content,
+    training files then test files (:func:`tcbench.sensors.data_hash.content_hash`), so runs on
+    other data never share a key). :class:`~tcbench.sensors.data_hash.DataHashError` when a file
+    cannot be read."""
     if task.get("train_files"):
-        return f"{task['name']}-files"
+        from tcbench.sensors.data_hash import content_hash
+
+        return f"{task['name']}-files-{content_hash(task['train_files'], task.get('test_files') or [])}"
     key = f"{task['name']}-dev{task.get('device_seed', 0)}"
     if task.get("recordings_seed", 0) != 0:
         key += f"-rec{task.get('recordings_seed')}"

@@ -4,6 +4,7 @@ scored with the paper's metrics and figures."""
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -11,11 +12,16 @@ import numpy as np
 
 from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
+from tcbench.errors import ConfigError
 from tcbench.runner.compensation_config import learner_of
 from tcbench.runner.config import validate
 from tcbench.runner.kinds import JobKind, JobNames
 from tcbench.runner.loop import CompensationResult, VMDTuning, run_compensation
+from tcbench.sensors.data_hash import DataHashError, content_hash, shared_recordings
 from tcbench.tasks import task_spec
+
+log = logging.getLogger(__name__)
+TAG_FILES_CHARS = 1000  # the file lists in a run's tags, cut beyond this
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
@@ -38,6 +44,37 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
     front = pipeline(task)  # type: ignore[arg-type]
     back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
     return "+".join(p for p in (front, back) if p) or "raw"
+
+
+def in_sample(task: dict[str, Any]) -> list[str]:
+    """The test files of ``task`` that are also training files (the same path or the same bytes)."""
+    if not task.get("train_files") or not task.get("test_files"):
+        return []
+    return shared_recordings(task["train_files"], task["test_files"])
+
+
+def in_sample_warning(shared: list[str]) -> str:
+    """The one line a run that tests on its training data warns with."""
+    its = "its" if len(shared) == 1 else "their"
+    return f"train_files and test_files share {', '.join(shared)}: {its} test scores are in-sample"
+
+
+def _listed(paths: list[str]) -> str:
+    text = ", ".join(str(p) for p in paths)
+    return text if len(text) <= TAG_FILES_CHARS else text[:TAG_FILES_CHARS - 1] + "…"
+
+
+def data_tags(task: dict[str, Any]) -> dict[str, str]:
+    """Tags of a run on the user's recordings: the content hash of its data (training then test
+    files, :func:`~tcbench.sensors.data_hash.content_hash`), the files as given and, when it tests
+    on training data, ``tcbench.in_sample`` naming the shared files; none on simulated data."""
+    train, test = list(task.get("train_files") or []), list(task.get("test_files") or [])
+    if not train:
+        return {}
+    tags = {"tcbench.data_hash": content_hash(train, test), "tcbench.train_files": _listed(train),
+            "tcbench.test_files": _listed(test)}
+    shared = in_sample(task)
+    return tags | ({"tcbench.in_sample": _listed(shared)} if shared else {})
 
 
 def score_document(score: Score) -> dict[str, Any]:
@@ -117,13 +154,20 @@ class CompensationKind(JobKind):
 
     def names(self, c: dict[str, Any]) -> JobNames:
         learner = learner_of(c)
-        tkey = task_spec(str(c["task"]["name"])).key(c["task"])
+        try:
+            tkey = task_spec(str(c["task"]["name"])).key(c["task"])
+            data = data_tags(c["task"])
+        except DataHashError as exc:
+            raise ConfigError(str(exc)) from None
         method = compensation_label(learner, c["optimiser"], c["task"])
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
-                        {"tcbench.task_name": str(c["task"]["name"])})
+                        {"tcbench.task_name": str(c["task"]["name"]), **data})
 
     def execute(self, c: dict[str, Any]) -> CompensationResult:
         validate(c)
+        shared = in_sample(c["task"])
+        if shared:
+            log.warning("%s", in_sample_warning(shared))
         optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
         learner = {k: v for k, v in learner_of(c).items() if k != "label"}
         return run_compensation(c["task"], learner, optimiser, c["budget"], c["seed"], c["progress"])
