@@ -46,3 +46,16 @@ def test_the_leaderboard_reads_calibrations_keyed_by_content(workdir: Path, caps
     two = next(t for t in tables.values() if len(t) == 4)
     assert two["config"].nunique() == 2 and set(two["split"]) == {"fit 0 -> score 1,2", "fit 0,1 -> score 2"}
     assert two.loc[0, "method"] == "poly3" and (two["x_best"] >= 1).all()
+
+
+def test_testing_on_the_training_data_warns(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.x:rad/s", "out=rec", "name=x",
+                       "tracking.enabled=false")
+    assert code == 0, err
+    for ext in ("csv", "json"):
+        shutil.copy(workdir / "rec" / f"x.{ext}", workdir / "rec" / f"copy.{ext}")
+    code, _, err = run(capsys, "calibrate", "recording=rec/x.csv", "out=cal", "methods=[raw,poly3]",
+                       "test_recordings=[rec/copy.csv]", "tracking.enabled=false")
+    assert code == 0 and err == ["tcbench: warning: test_recordings: rec/copy.csv holds the same data as rec/x.csv: "
+                                 "its scores are in-sample"], err

@@ -177,6 +177,10 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     if not split.held_out and not others:
         print("tcbench: warning: every part is fitted and no test_recordings= is given: the scores are "
               "in-sample and no method is ranked", file=sys.stderr)
+    own_hash = _content_hash(cfg.recording)
+    for path in (p for p in cfg.test_recordings if _content_hash(p) == own_hash):
+        print(f"tcbench: warning: test_recordings: {path} holds the same data as {cfg.recording}: its scores are "
+              "in-sample", file=sys.stderr)
     whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
     jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
@@ -296,10 +300,9 @@ def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str) -> dict[str,
 
 
 def _content_hash(path: str) -> str:
-    from tcbench.data_hash import content_hash
-    from tcbench.sensors.recording import sidecar_path
+    from tcbench.sensors.data_hash import content_hash
 
-    return content_hash([Path(path), sidecar_path(Path(path))])
+    return content_hash([path])
 
 
 def _export_fit(rec: Any, whole: Any, cfg: CalibrateConfig) -> dict[str, Any] | None:
