@@ -51,6 +51,13 @@ def test_nothing_refers_to_a_path_outside_the_repository() -> None:
     assert not found, "\n".join(found)
 
 
+def test_the_location_is_defined_once() -> None:
+    """Code and tests take ``data/real/`` from :mod:`tcbench.data_paths` (the tests through conftest)."""
+    defining = sorted(path.relative_to(ROOT).as_posix() for path in scanned_files()
+                      if re.search(r"""["']data["'] / ["']real["']""", path.read_text(encoding="utf-8", errors="replace")))
+    assert defining == ["tcbench/data_paths.py"]
+
+
 def test_every_data_real_path_named_exists() -> None:
     """Every ``data/real/...`` path a script, test or document names is in the repository."""
     named = {m for path in scanned_files() for m in DATA_PATH.findall(path.read_text(encoding="utf-8",
