@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PX4_LOG
 
 from tcbench.cli import main
 from tcbench.metrics.report import analyse
@@ -19,8 +20,6 @@ from tcbench.sensors.devices import unit
 from tcbench.sensors.recording import read_recording, write_recording
 from tcbench.sensors.simulate import simulate_recording
 
-REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real"
-PX4_LOG = REAL / "px4_ulog_samples" / "sample_log_small.ulg"
 G0 = 9.80665
 
 

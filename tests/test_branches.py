@@ -3,17 +3,13 @@ nowhere else (soak noise, quantisation, a small overshoot)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PAN_CSV
 
 from tcbench.diagnose.real_records import tofupilot_gyro
 from tcbench.signal.branches import temperature_branches
-
-PAN = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "pan_lsm6dsm_tvac_cooling" / \
-    "pan_lsm6dsm_tvac_cooling.csv"
 
 
 def test_the_tofupilot_cycle_is_cool_heat_cool() -> None:
@@ -30,7 +26,7 @@ def test_the_tofupilot_cycle_is_cool_heat_cool() -> None:
 
 
 def test_the_pan_cooling_is_one_branch() -> None:
-    table = pd.read_csv(PAN)
+    table = pd.read_csv(PAN_CSV)
     (branch,) = temperature_branches(table["time_s"].to_numpy(), table["temp_c"].to_numpy())
     assert branch.direction == "cooling" and branch.span_c > 5 and (branch.start, branch.stop) == (0, len(table))
 

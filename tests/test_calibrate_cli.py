@@ -10,12 +10,10 @@ import mlflow
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PAN_CSV
 
 from tcbench.cli import main
 from tcbench.diagnose.real_records import TOFUPILOT_CSV
-
-PAN = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "pan_lsm6dsm_tvac_cooling" / \
-    "pan_lsm6dsm_tvac_cooling.csv"
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[str]]:
@@ -109,7 +107,7 @@ def test_a_record_that_only_cools_is_cut_into_time_blocks(workdir: Path, capsys:
     """The PAN gyro cools once (one branch): with nothing said, it is cut into five time blocks,
     fitted on 0, 2, 4 and scored on the two between — held out, and the first line says so —, the
     cubic far below the raw bias there; ``blocks=``/``train_branches=`` choose otherwise."""
-    code, _, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
+    code, _, err = run(capsys, "import", f"csv={PAN_CSV}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
                        "output=gyro_x_dps:deg/s", "drop=spike_flag", "out=rec", "name=pan-x",
                        "tracking.enabled=false")
     assert code == 0, err

@@ -12,10 +12,8 @@ import pytest
 
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.plan import SURROGATE
-from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
+from tcbench.diagnose.real_records import tofupilot_gyro
 from tcbench.diagnose.report import write_report
-
-pytestmark = pytest.mark.skipif(not TOFUPILOT_CSV.exists(), reason=f"{TOFUPILOT_CSV} not present")
 
 TEMPERATURE_EFFECTS = {"thermal_lag", "hysteresis", "temperature_cubic", "temperature_rate"}
 WITHIN_REFERENCE = 1.25  # the target: final held-out RMSE within this factor of the reference

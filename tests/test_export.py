@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import PX4_LOG
 
 from tcbench.cli import main
 from tcbench.compensation.ardupilot import ardupilot_correction, ardupilot_parameters
@@ -120,8 +121,7 @@ def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytes
     export needs neither axis= nor device_id=, and the id is the log's."""
     from tcbench.sensors.ulog import read_topic
 
-    log = Path(__file__).resolve().parents[1] / "data" / "real" / "px4_ulog_samples" / "sample_log_small.ulg"
-    code, _, err = run(capsys, "import", f"csv={log}", "sensor=gyro", "out=rec", "name=log", "tracking.enabled=false")
+    code, _, err = run(capsys, "import", f"csv={PX4_LOG}", "sensor=gyro", "out=rec", "name=log", "tracking.enabled=false")
     assert code == 0, err
     for a in AXES:
         code, _, err = run(capsys, "calibrate", f"recording=rec/log-sensor_gyro-0-{a}.csv", f"out=cal/{a}",
@@ -130,7 +130,7 @@ def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytes
     code, _, err = run(capsys, "export", "calibrations=[cal/x,cal/y,cal/z]", "out=params")
     assert code == 0, err
     script = (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()
-    logged = read_topic(log, "gyro")[0].device_id
+    logged = read_topic(PX4_LOG, "gyro")[0].device_id
     assert script[0] == f"param set TC_G0_ID {logged}" and logged
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PAN_CSV, PX4_LOG
 
 from tcbench.cli import main
 from tcbench.metrics import gyro
@@ -17,9 +18,6 @@ from tcbench.sensors.importer import import_csv
 from tcbench.sensors.recording import make_recording, read_recording
 from tcbench.sensors.segments import segments
 from tcbench.signal.allan import allan_deviation, allan_deviation_segments
-
-REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "real"
-PAN = REAL / "pan_lsm6dsm_tvac_cooling" / "pan_lsm6dsm_tvac_cooling.csv"
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[str]]:
@@ -170,9 +168,6 @@ def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixtur
                        "tracking.enabled=false")
     assert code == 2 and len(err) == 1 and "no column 'imu.gyro.w'" in err[0], err
     assert not (workdir / "rec2").exists()
-
-
-PX4_LOG = REAL / "px4_ulog_samples" / "sample_log_small.ulg"
 
 
 def test_a_px4_log_imports_every_gyro_instance_and_axis(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -343,9 +338,8 @@ def test_continuous_gyro_rate_vs_temperature_by_bins(tmp_path: Path) -> None:
 
 
 # -- the real PAN recording --------------------------------------------------------------------------
-@pytest.mark.skipif(not PAN.exists(), reason="real recordings not present")
 def test_pan_lsm6dsm_cooling(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run(capsys, "import", f"csv={PAN}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
+    code, out, err = run(capsys, "import", f"csv={PAN_CSV}", "sensor=gyro", "time=time_s:s", "temperature=temp_c:degC",
                          "output=gyro_x_dps:deg/s", "drop=spike_flag", "device_id=pan-etu-lsm6dsm", "out=rec")
     assert code == 0, err
     assert "6247 samples in 25 segments at 50 Hz, 3 rows dropped where spike_flag is nonzero" in out
@@ -356,7 +350,7 @@ def test_pan_lsm6dsm_cooling(workdir: Path, capsys: pytest.CaptureFixture[str]) 
     assert m["rate_temp_slope_dps_per_c"] == pytest.approx(0.0298, abs=0.0005)  # PROVENANCE.md
     assert m["rate_temp_r"] > 0.998
     # the logged rad/s column lacks the x0.5 correction of gyro_x_dps: twice the rate after conversion
-    logged = import_csv(PAN, "gyro", {"time_s": "time_s:s", "temperature_c": "temp_c:degC",
+    logged = import_csv(PAN_CSV, "gyro", {"time_s": "time_s:s", "temperature_c": "temp_c:degC",
                                       "output": "gyro_x_rads_logged:rad/s"}, drop=["spike_flag"])
     dps = read_recording("rec/pan_lsm6dsm_tvac_cooling.csv")
     np.testing.assert_allclose(logged.output, 2.0 * dps.output, rtol=1e-5)

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import PX4_LOG, TOFUPILOT_CSV
 
 from tcbench.cli import main
 from tcbench.sensors.importer import import_csv
@@ -22,9 +23,7 @@ from tcbench.sensors.recording import (
     write_recording,
 )
 
-REAL = Path(__file__).resolve().parents[1] / "data" / "real"
-TOFU = REAL / "tofupilot_imu_chamber" / "imu_raw_data.csv"  # tab-separated; timestamp in us, gyro in rad/s, degC
-PX4_LOG = REAL / "px4_ulog_samples" / "sample_log_small.ulg"
+TOFU = TOFUPILOT_CSV  # tab-separated; timestamp in us, gyro in rad/s, degC
 NO_AXIS = "axis unknown (axes=x|y|z to record it)"
 
 

@@ -1,4 +1,4 @@
-"""Diagnose the real PAN LSM6DSM cooling run (``../shared/data/real/pan_lsm6dsm_tvac_cooling``).
+"""Diagnose the real PAN LSM6DSM cooling run (``data/real/pan_lsm6dsm_tvac_cooling``).
 
 Conversion to schema v1, one recording per gyro axis (documented in README.md):
 ``time_s`` and ``temp_c`` as in the provenance file (temperature from the datasheet transfer
@@ -19,11 +19,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tcbench.data_paths import REAL_DATA
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
-DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "real" / "pan_lsm6dsm_tvac_cooling"
+DATA = REAL_DATA / "pan_lsm6dsm_tvac_cooling"
 
 
 def convert(csv: Path, axis: str) -> Recording:

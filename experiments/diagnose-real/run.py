@@ -1,7 +1,7 @@
 """Diagnose every gyro axis of the real recordings and hold each final model against the
 physics-agnostic reference (issue 23, item 6), in one command.
 
-Records (PROVENANCE.md beside each under ``../shared/data/real/``):
+Records (PROVENANCE.md beside each under the repository's ``data/real/``):
 - ``tofupilot``: the 70.7-min chamber cycle, -17.6 -> 74 -> 35 degC at about 2 Hz
   (:func:`tcbench.diagnose.real_records.tofupilot_gyro`);
 - ``pan_lsm6dsm``: the 2-h thermal-vacuum cooling run, 25 bursts of 5 s at about 50 Hz
@@ -71,7 +71,7 @@ def diagnose_record(record: str, out: Path) -> tuple[list[str], list[str]]:
     the summary rows and the per-axis sections."""
     load, title, source = RECORDS[record]
     if not source.exists():
-        raise SystemExit(f"run.py: {source} not found (the shared data folder beside the project)")
+        raise SystemExit(f"run.py: {source} not found (the repository's data/real/, data/real/README.md)")
     rows: list[str] = []
     sections: list[str] = []
     for axis in ("x", "y", "z"):

@@ -1,6 +1,6 @@
 """Diagnose every gyro axis of the real tofupilot chamber cycle and compare with the reference.
 
-``../shared/data/real/tofupilot_imu_chamber/imu_raw_data.csv`` (PROVENANCE.md there): a static
+``data/real/tofupilot_imu_chamber/imu_raw_data.csv`` (PROVENANCE.md there): a static
 IMU cooled to -17.6 degC, heated to 74 degC and cooled to 35 degC in 70.7 min at about 2 Hz.
 Each axis is converted by :func:`tcbench.diagnose.real_records.tofupilot_gyro` (tab-separated,
 us to s, rad/s to deg/s, first sample dropped), diagnosed, and its report written to

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 here=experiments/real-imu
-data=${TCBENCH_REAL_DATA:-../shared/data/real}
+data=data/real                  # the repository's real recordings (data/real/README.md)
 work=${WORK:-$here/runs}        # the imported recordings and the MLflow store (generated, git-ignored)
 out=${OUT:-leaderboards/real-imu}
 restarts=${RESTARTS:-5}
@@ -16,6 +16,9 @@ mkdir -p "$work"
 export MLFLOW_TRACKING_URI="sqlite:///$PWD/$work/mlflow.db"
 tofu="$data/tofupilot_imu_chamber/imu_raw_data.csv"
 pan="$data/pan_lsm6dsm_tvac_cooling/pan_lsm6dsm_tvac_cooling.csv"
+for f in "$tofu" "$pan"; do
+    [[ -f $f ]] || { echo "run.sh: $f not found (data/real/README.md)" >&2; exit 2; }
+done
 
 echo "== import"
 tcbench import "csv=$tofu" sensor=gyro time=timestamp:us temperature=imu.temperature:degC \
