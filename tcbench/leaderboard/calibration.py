@@ -42,6 +42,7 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
         base = {"run_id": r.info.run_id, "status": r.info.status, "start_time": r.info.start_time,
                 "recording": t.get("tcbench.recording") or t.get("tcbench.task", "").removeprefix("calibrate-"),
                 "data_hash": t.get("tcbench.data_hash", ""), "sensor": t.get("tcbench.sensor", ""),
+                "unit": t.get("tcbench.unit", ""),
                 "config_hash": t.get("tcbench.config_hash", ""), "held_out": t.get("tcbench.held_out") == "true",
                 "split": t.get("tcbench.split", ""),
                 "error_message": t.get("tcbench.error", ""), "seed": 0}
@@ -86,8 +87,10 @@ def write(board: CalibrationBoard, out: Path, source: str) -> dict[str, Path]:
     paths = {"md": out / f"{board.task}.md", "csv": out / f"{board.task}.csv"}
     failed = board.runs[board.runs["status"] != "FINISHED"].drop_duplicates("run_id")
     sensor = ", ".join(sorted(set(board.runs["sensor"]) - {""}))
+    unit = ", ".join(sorted(set(board.runs["unit"]) - {""})) or "its output unit"
     lines = [f"# Calibrations of {board.recording}", "",
-             f"{sensor} recording, content {board.data_hash} (sha256 of the recording and its sidecar); from {source}. "
+             f"{sensor} recording, content {board.data_hash} (sha256 of the recording and its sidecar); drift in "
+             f"{unit}; from {source}. "
              "held_out_drift: the RMS of the residual's running mean over every held-out sample of the calibration; "
              "fit_drift: the same on the fitted parts; x_best: held-out drift over the best of the same calibration. "
              "A calibration that held nothing out is in_sample and not ranked.", ""]

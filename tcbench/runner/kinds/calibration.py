@@ -41,7 +41,7 @@ class CalibrateKind(JobKind):
     def record(self, run: Any, outcome: CalibrationOutcome, c: dict[str, Any], where: Path) -> list[Path]:
         about = outcome.about
         run.set_tag("tcbench.sensor", outcome.sensor)
-        for key in ("recording", "axis", "best"):
+        for key in ("recording", "axis", "best", "unit"):
             if about.get(key) is not None:
                 run.set_tag(f"tcbench.{key}", str(about[key]))
         run.set_tag("tcbench.data_hash", str(about.get("content_hash", "")))
