@@ -1,6 +1,8 @@
 """What ``tcbench diagnose`` does with its config: the checks made before any work
-(:func:`check_diagnose`) and the diagnosis with its report (:func:`diagnose_recording`). It runs
-as a job of :mod:`tcbench.runner.kinds.diagnosis` through :func:`tcbench.runner.job.run_job`."""
+(:func:`check_diagnose`) and the diagnosis with its report (:func:`diagnose_recording`); a record
+shorter than a full diagnosis needs gets the short-record report of the tests its length allows
+(:mod:`tcbench.diagnose.short_record`). It runs as a job of :mod:`tcbench.runner.kinds.diagnosis`
+through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
@@ -25,7 +27,8 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class DiagnosisOutcome:
-    """A diagnosis and the files of its report (``report.json``, ``report.md``, ``model.yaml``, plots)."""
+    """A diagnosis and the files of its report (``report.json``, ``report.md``, ``model.yaml``, plots),
+    or a short record's report (``report.json``, ``report.md``)."""
 
     diagnosis: Any
     written: dict[str, Path]
@@ -68,7 +71,11 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     from tcbench.sensors.recording import sidecar_path
     from tcbench.staging import InputOverwriteError
 
+    from tcbench.diagnose.plan import min_full_duration_s
+
     rec, sensor, declared = check_diagnose(cfg)
+    if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s():
+        return _short_record(cfg, rec, sensor)
     try:
         diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
     except DiagnosisDataError as exc:
@@ -85,3 +92,32 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
           f"{diag.final['rmse_heldout']:.4g} {diag.unit}, white noise {diag.noise['white_sigma']:.4g} {diag.unit}")
     print(f"  wrote {', '.join(str(p) for p in written.values())}")
     return DiagnosisOutcome(diag, written)
+
+
+def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str) -> DiagnosisOutcome:
+    """The short-record report of ``rec``, written to ``out``; prints what ran and what needs more time."""
+    from tcbench.diagnose.short_record import short_record
+    from tcbench.diagnose.short_report import write_short_report
+    from tcbench.sensors.recording import sidecar_path
+    from tcbench.staging import InputOverwriteError
+
+    report = short_record(rec, sensor, name=Path(cfg.recording).name)
+    inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
+    try:
+        written = write_short_report(report, cfg.out, inputs)
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc) from None
+    except OSError as exc:
+        raise cannot_write(cfg.out, exc, "the report") from None
+    print(f"tcbench: {report.verdict}")
+    ran = [f"{t.id} ({t.status})" for t in report.tests if t.ran]
+    print(f"  ran: {', '.join(ran) or 'nothing'}")
+    for t in report.tests:
+        if not t.ran:
+            print(f"  not run: {t.id}: {t.reason}")
+    if report.needs_more_time:
+        print("  needs more time: " + ", ".join(f"{r['id']} ({r['needs_s']:.0f} s)" for r in report.needs_more_time))
+    if cfg.model:
+        print(f"  {cfg.model} is not used: the short-record tests fit no model")
+    print(f"  wrote {', '.join(str(p) for p in written.values())}")
+    return DiagnosisOutcome(report, written)

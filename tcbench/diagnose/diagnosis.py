@@ -27,10 +27,10 @@ from tcbench.diagnose.open_terms import TERMS, is_open, kind_of, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate, why_no_allan
 from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S, NonMean
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
-from tcbench.diagnose.plan import SURROGATE
+from tcbench.diagnose.plan import SURROGATE, min_full_duration_s
 from tcbench.diagnose.reference import Reference, reference_fit
 from tcbench.diagnose.surrogate import LEVEL
-from tcbench.diagnose.signals import MIN_DURATION_S, DiagnosisData, prepare
+from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
@@ -240,11 +240,13 @@ def diagnose(
     declared: dict[str, dict[str, float]] | None = None,
     name: str = "",
     threshold: float = DETECTION_THRESHOLD,
-    min_duration_s: float = MIN_DURATION_S,
+    min_duration_s: float | None = None,
 ) -> Diagnosis:
     """Diagnose ``rec`` against the minimal model plus the effects ``declared`` already modelled
     (``{effect_id: params}``). Raises :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a
-    recording that cannot show anything, or that is shorter than ``min_duration_s``.
+    recording that cannot show anything, or that is shorter than ``min_duration_s`` (default
+    :func:`~tcbench.diagnose.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short_record`
+    tells what a shorter one can).
 
     Where the thermometer smoothing fitted to the profile (:func:`~tcbench.diagnose.signals.fitted_window_s`)
     is shorter than the default, the record is diagnosed at both windows, and the default is kept
@@ -254,6 +256,7 @@ def diagnose(
     cycle, 7.5 s against 120 s made the final model 1.5x worse), while on a short record with
     nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
     paid for like a term, is the judge the diagnosis uses for everything else."""
+    min_duration_s = min_full_duration_s() if min_duration_s is None else min_duration_s
     nonmean = NonMean.before(rec)  # a coarse thermometer staircase widens the smoothing window
     if nonmean.default_smooth_s >= DEFAULT_SMOOTH_S:
         return _diagnose(rec, nonmean, sensor, declared or {}, name, threshold, min_duration_s)
@@ -272,7 +275,7 @@ def diagnose(
 
 
 def _diagnose(rec: Recording, nonmean: NonMean, sensor: str | None, declared: dict[str, dict[str, float]],
-              name: str, threshold: float, min_duration_s: float = MIN_DURATION_S) -> Diagnosis:
+              name: str, threshold: float, min_duration_s: float) -> Diagnosis:
     """:func:`diagnose` with the non-mean detectors' thermometer reading ``nonmean``."""
     data = nonmean.prefit(prepare(rec, sensor, smooth_s=nonmean.smooth_s, min_duration_s=min_duration_s))  # output lattice; clipping
     base = base_model(declared)

@@ -15,6 +15,11 @@ slow noise. Both need time spans that fit the recording:
   it and the diagnosis uses a surrogate test instead
   (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric bootstrap under a noise
   model with the spectrum of the candidate model's own residual.
+- **The shortest record** (:func:`min_full_duration_s`): five folds of one block each, a block
+  two smoothing windows long: 20 min at the default 120 s window. Shorter, a fold holds less
+  than one whole block, or none, and its held-out samples are predicted by the smoothed
+  thermometer of their own neighbours. A shorter record gets the tests its length allows
+  (:mod:`tcbench.diagnose.short_record`).
 """
 
 from __future__ import annotations
@@ -23,9 +28,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
 from tcbench.diagnose.signals import DiagnosisData
 
 FOLDS = 5
+BLOCK_WINDOWS = 2.0  # a CV block spans at least this many thermometer-smoothing windows
 MAX_BLOCK_S = 900.0
 BLOCKS_PER_RECORD = 24
 CLUSTERS_PER_RECORD = 32
@@ -54,8 +61,15 @@ class StatsPlan:
 def plan_for(data: DiagnosisData) -> StatsPlan:
     """The statistics for ``data`` (see module doc)."""
     span = float(data.t_s[-1] - data.t_s[0])
-    block_s = float(np.clip(span / BLOCKS_PER_RECORD, min(2.0 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
+    block_s = float(np.clip(span / BLOCKS_PER_RECORD, min(BLOCK_WINDOWS * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
     cluster_s = float(np.clip(span / CLUSTERS_PER_RECORD, min(2.5 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
     n_clusters = int(np.floor(span / cluster_s)) + 1
     test = ROBUST_WALD if n_clusters >= MIN_CLUSTERS else SURROGATE
     return StatsPlan(block_s, FOLDS, cluster_s, n_clusters, test)
+
+
+def min_full_duration_s(smooth_s: float = DEFAULT_SMOOTH_S) -> float:
+    """The shortest record (s) a full diagnosis takes: :data:`FOLDS` cross-validation folds of one
+    block each, a block :data:`BLOCK_WINDOWS` thermometer-smoothing windows of ``smooth_s`` long
+    (1200 s at the default 120 s window)."""
+    return FOLDS * BLOCK_WINDOWS * smooth_s

@@ -51,7 +51,6 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.nd
     return value, slope
 
 
-MIN_DURATION_S = 1800.0  # a recording shorter than this is refused unless a caller asks for less
 MIN_WINDOW_SAMPLES = 10  # a fitted smoothing window never holds fewer samples than this
 FFT_WINDOW = 255  # longer Savitzky-Golay windows convolve by FFT (a 120 s window at 100 Hz holds 12001 samples)
 
@@ -216,14 +215,15 @@ def prepare(
     sensor: str | None = None,
     *,
     smooth_s: float = 120.0,
-    min_duration_s: float = MIN_DURATION_S,
+    min_duration_s: float = 0.0,
     min_span_c: float = 2.0,
     min_samples: int = 200,
 ) -> DiagnosisData:
     """Arrays for diagnosing ``rec``; ``sensor`` overrides the sidecar's kind.
 
     Raises :class:`DiagnosisDataError` (one line) when the recording is shorter than
-    ``min_duration_s`` or ``min_samples``, its temperature spans less than ``min_span_c``, or
+    ``min_duration_s`` (``diagnose`` asks :func:`tcbench.diagnose.plan.min_full_duration_s`) or
+    ``min_samples``, its temperature spans less than ``min_span_c``, or
     its output has no noise to measure.
     """
     kind = sensor or rec.meta.sensor

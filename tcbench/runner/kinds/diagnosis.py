@@ -1,7 +1,9 @@
 """The diagnosis job kind: ``tcbench diagnose`` on one recording (:mod:`tcbench.commands.diagnosis`).
 Its MLflow run carries the effects found (tag ``tcbench.effects_found``, their parameters as
 params ``found.<effect>.<param>``), the verdict, the held-out RMSEs before and after (also in
-white-noise sigmas) and the report, plots and ``model.yaml`` as artifacts."""
+white-noise sigmas) and the report, plots and ``model.yaml`` as artifacts. The run of a short
+record carries its verdict, each test's status (tags ``tcbench.short.<test>``), their numbers as
+metrics ``<test>.<value>`` and ``report.json``/``report.md`` as artifacts."""
 
 from __future__ import annotations
 
@@ -45,13 +47,20 @@ class DiagnoseKind(JobKind):
         return diagnose_recording(self.config(c))
 
     def record(self, run: Any, outcome: DiagnosisOutcome, c: dict[str, Any], where: Path) -> list[Path]:
+        from tcbench.diagnose.short_record import ShortRecordReport  # loaded by execute already
+
         diag = outcome.diagnosis
-        run.set_tag("tcbench.effects_found", ",".join(diag.effect_ids) or "none")
         run.set_tag("tcbench.verdict", str(diag.verdict)[:4900])
         run.set_tag("tcbench.sensor", str(diag.sensor))
-        run.log_params({f"found.{e['id']}.{k}": f"{v:.6g}" for e in diag.effects
-                        for k, v in e.get("params", {}).items() if isinstance(v, (int, float))})
-        run.log_metrics(diagnosis_metrics(diag))
+        if isinstance(diag, ShortRecordReport):
+            for key, value in diag.tags().items():
+                run.set_tag(key, value)
+            run.log_metrics(diag.metrics())
+        else:
+            run.set_tag("tcbench.effects_found", ",".join(diag.effect_ids) or "none")
+            run.log_params({f"found.{e['id']}.{k}": f"{v:.6g}" for e in diag.effects
+                            for k, v in e.get("params", {}).items() if isinstance(v, (int, float))})
+            run.log_metrics(diagnosis_metrics(diag))
         announce(run, c)
         return [p for p in outcome.written.values() if Path(p).is_file()]
 

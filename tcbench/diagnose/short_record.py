@@ -1,0 +1,195 @@
+"""What a record too short for a full diagnosis can tell (shorter than
+:func:`tcbench.diagnose.plan.min_full_duration_s`).
+
+A full diagnosis scores every effect held out by five-fold blocked cross-validation, and needs a
+block of two thermometer-smoothing windows per fold. A 200 s record cannot give that, but it
+still answers three questions (:mod:`tcbench.diagnose.short_tests`): does the output move with
+temperature (the slope), does its level step (at the start of a temperature ramp or anywhere),
+and how large and how white is its noise. :func:`short_record` runs the tests the record's
+samples and temperature allow and lists, with the duration each needs, the ones it cannot run.
+
+The thermometer is smoothed as in a diagnosis (:func:`~tcbench.diagnose.signals.fitted_window_s`
+over at most the default window); the input, when it varies, is a column of every fit; the
+step found, when significant, is a column of the slope's fit and both are removed from the
+residual the noise test reads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from tcbench.diagnose.discover import NODE_SPANS, NODE_TAU_S
+from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
+from tcbench.diagnose.plan import FOLDS, min_full_duration_s
+from tcbench.diagnose.short_tests import (
+    ALPHA,
+    MIN_FIT_SAMPLES,
+    NOT_RUN,
+    SIGNIFICANT,
+    ShortTest,
+    basis,
+    level_step,
+    temperature_slope,
+    white_noise,
+)
+from tcbench.diagnose.signals import MAD_TO_SIGMA, fitted_window_s, smooth_temperature
+from tcbench.sensors import kinds
+from tcbench.sensors.recording import Recording
+from tcbench.sensors.segments import segments
+
+MIN_SLOPE_SPAN_C = 0.5  # a temperature slope needs the smoothed thermometer to move this much
+RAMP_SHARE = 0.5  # a ramp starts where |dT/dt| rises through this share of its largest value
+ONE_WAY_CORR = 0.9  # |corr(time, temperature)| above which a temperature slope is also a drift in time
+DRIFT = ("a drift in time (ageing, warm-up, a random walk): the temperature moves one way on this record; "
+         "one that heats and cools tells them apart")
+SEED = 0  # the surrogates' generator: a report is repeatable
+
+
+@dataclass
+class ShortRecordReport:
+    """The report of a short record: the tests run (:class:`~tcbench.diagnose.short_tests.ShortTest`)
+    and those it needs more time for (``{id, needs_s, what}``)."""
+
+    sensor: str
+    unit: str
+    recording: str
+    duration_s: float
+    samples: int
+    sample_rate_hz: float
+    temperature_span_c: float
+    smooth_s: float
+    ramp_starts_s: list[float]
+    tests: list[ShortTest]
+    needs_more_time: list[dict[str, Any]]
+
+    @property
+    def full_duration_s(self) -> float:
+        return min_full_duration_s()
+
+    @property
+    def ran(self) -> list[str]:
+        return [t.id for t in self.tests if t.ran]
+
+    @property
+    def verdict(self) -> str:
+        """One line: the record is short, each test's outcome."""
+        parts = []
+        for t in self.tests:
+            if not t.ran:
+                parts.append(f"{t.id} not run")
+            elif t.id == "level_step" and t.status == SIGNIFICANT:
+                where = " at a ramp start" if t.values.get("at_ramp_start") else ""
+                parts.append(f"level_step {t.status} ({t.values['size']:.4g} {self.unit} at "
+                             f"{t.values['time_s']:.4g} s{where})")
+            elif t.id == "temperature_slope" and t.status == SIGNIFICANT:
+                parts.append(f"temperature_slope {t.status} ({t.values['slope_per_c']:.4g} {self.unit}/degC)")
+            else:
+                parts.append(f"{t.id} {t.status}")
+        return (f"short record ({self.duration_s:.4g} s of the {self.full_duration_s:.4g} s a full diagnosis "
+                f"needs): {'; '.join(parts)}")
+
+    def to_json(self) -> dict[str, Any]:
+        """``report.json`` of a short record."""
+        return {
+            "report": "short_record", "sensor": self.sensor, "unit": self.unit, "recording": self.recording,
+            "verdict": self.verdict, "duration_s": self.duration_s, "samples": self.samples,
+            "sample_rate_hz": self.sample_rate_hz, "temperature_span_c": self.temperature_span_c,
+            "thermometer_smooth_s": self.smooth_s, "ramp_starts_s": self.ramp_starts_s,
+            "full_diagnosis_needs_s": self.full_duration_s, "level": ALPHA,
+            "tests": [t.to_json() for t in self.tests], "needs_more_time": self.needs_more_time,
+        }
+
+    def tags(self) -> dict[str, str]:
+        """MLflow tags: the report kind and each test's status."""
+        return {"tcbench.report": "short_record", **{f"tcbench.short.{t.id}": t.status for t in self.tests}}
+
+    def metrics(self) -> dict[str, float]:
+        """MLflow metrics: duration, each test's numbers (scalars only) and 1/0 for significant."""
+        out = {"duration_s": self.duration_s, "full_diagnosis_needs_s": self.full_duration_s}
+        for t in self.tests:
+            out |= {f"{t.id}.{k}": float(v) for k, v in t.values.items()
+                    if isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)}
+            if t.ran:
+                out[f"{t.id}.significant"] = float(t.status == SIGNIFICANT)
+        return out
+
+
+def needs_more_time(duration_s: float) -> list[dict[str, Any]]:
+    """What a full diagnosis would test and the record length each needs, for a record of ``duration_s``."""
+    full = min_full_duration_s()
+    node = max(full, NODE_SPANS * float(NODE_TAU_S[0]))
+    rows = [
+        {"id": "effect_attribution", "needs_s": full,
+         "what": (f"the full diagnosis (thermal lag, hysteresis, warm-up, ageing, temperature rate, cubic, "
+                  f"nonlinearity, bias instability, the open-world terms, saturation, quantisation, outliers), "
+                  f"each scored held out by {FOLDS}-fold blocked cross-validation: {FOLDS} folds of one block of "
+                  f"two {DEFAULT_SMOOTH_S:g}-s thermometer-smoothing windows")},
+        {"id": "second_node", "needs_s": node,
+         "what": f"a second thermal node: more than {NODE_SPANS:g} times its shortest time constant "
+                 f"({NODE_TAU_S[0]:g} s)"},
+    ]
+    return [r for r in rows if duration_s < r["needs_s"]]
+
+
+def ramp_starts(t_s: np.ndarray, rate_c_per_s: np.ndarray) -> np.ndarray:
+    """Times where |dT/dt| rises through :data:`RAMP_SHARE` of its largest value."""
+    a = np.abs(rate_c_per_s)
+    if a.size < 2 or not a.max() > 0:
+        return np.empty(0)
+    above = a >= RAMP_SHARE * a.max()
+    return t_s[np.flatnonzero(above[1:] & ~above[:-1]) + 1]
+
+
+def _white_sigma(y: np.ndarray, same: np.ndarray) -> float:
+    """Per-sample white sigma from first differences at constant input in one segment (MAD, or
+    RMS on an output on a coarse grid)."""
+    d = np.diff(y)[same]
+    if d.size < 2:
+        return 0.0
+    sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    return sigma if sigma > 0 else float(np.sqrt(np.mean(d * d) / 2.0))
+
+
+def short_record(rec: Recording, sensor: str | None = None, name: str = "") -> ShortRecordReport:
+    """The tests ``rec`` supports (see module doc), whatever its length."""
+    kind = str(sensor or rec.meta.sensor)
+    unit = str((rec.meta.units or {}).get("output", kinds.get(kind).output_unit))
+    t, temp, u, y = rec.time_s, rec.temperature_c, rec.input, rec.output
+    n = t.size
+    duration_s = float(t[-1] - t[0]) if n else 0.0
+    rate_hz = float(rec.meta.sample_rate_hz or (1.0 / np.median(np.diff(t)) if n > 1 else 1.0))
+    window_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S) if n > 1 else DEFAULT_SMOOTH_S
+    temp_s, rate = smooth_temperature(t, temp, window_s) if n > 1 else (temp, np.zeros(n))
+    span_c = float(np.ptp(temp_s)) if n else 0.0
+    moves = n > 1 and np.ptp(u) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
+    same = (np.diff(segments(t)) == 0) & (np.abs(np.diff(u)) <= 1e-9 * max(1.0, float(np.max(np.abs(u)))))
+    sigma = _white_sigma(y, same) if n > 1 else 0.0
+    columns = [np.ones(n), *([u] if moves else [])]
+    starts = ramp_starts(t, rate) if span_c >= MIN_SLOPE_SPAN_C else np.empty(0)
+    slope_ok = span_c >= MIN_SLOPE_SPAN_C
+    base = np.column_stack([*columns, *([temp_s - temp_s.mean()] if slope_ok else [])])
+    step, step_column = level_step(t, y, base, np.random.default_rng(SEED), sigma)
+    if step.ran and starts.size:
+        gap = float(np.min(np.abs(starts - step.values["time_s"])))
+        step.values |= {"nearest_ramp_start_s": float(starts[np.argmin(np.abs(starts - step.values["time_s"]))]),
+                        "at_ramp_start": gap <= window_s / 2.0}
+    others = np.column_stack([*columns, *([step_column] if step_column is not None else [])])
+    if slope_ok or n < MIN_FIT_SAMPLES:
+        slope = temperature_slope(temp_s, y, others)
+        if slope.ran and abs(float(np.corrcoef(t, temp_s)[0, 1])) > ONE_WAY_CORR:
+            slope.values["confusable_with"] = DRIFT
+    else:
+        slope = ShortTest("temperature_slope", "slope of the output against temperature", NOT_RUN,
+                          reason=f"needs the temperature to change by {MIN_SLOPE_SPAN_C:g} degC; "
+                                 f"this record's changes by {span_c:.3g} degC")
+    fit = np.column_stack([others, *([temp_s] if slope_ok else [])])
+    q = basis(fit) if n else fit
+    residual = y - q @ (q.T @ y)
+    noise = white_noise(t, residual, sigma, rate_hz)
+    return ShortRecordReport(
+        sensor=kind, unit=unit, recording=name, duration_s=duration_s, samples=int(n), sample_rate_hz=rate_hz,
+        temperature_span_c=span_c, smooth_s=float(window_s), ramp_starts_s=[float(s) for s in starts],
+        tests=[slope, step, noise], needs_more_time=needs_more_time(duration_s))
