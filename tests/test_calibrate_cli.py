@@ -193,3 +193,24 @@ def test_fitted_on_one_recording_scored_on_another(workdir: Path, capsys: pytest
                            "tracking.enabled=false")
         assert code == 2 and len(err) == 1 and words in err[0], err
     assert not (workdir / "bad").exists()
+
+
+def test_a_short_record_is_calibrated_without_the_diagnosed_model(workdir: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """12 minutes of the tofupilot gyro: the default methods run, the model is left out with one
+    line saying why (blocks 0, 2, 4 of five: 7.2 min; a diagnosis needs 20 min), and the rest are ranked
+    on the held-out parts."""
+    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.sensors.recording import make_recording, write_recording
+
+    full = tofupilot_gyro("x")
+    keep = full.time_s - full.time_s[0] < 12 * 60
+    short = make_recording(full.time_s[keep], full.temperature_c[keep], full.input[keep], full.output[keep],
+                           sensor="gyro", sample_rate_hz=full.meta.sample_rate_hz, device_id="short")
+    write_recording(short, workdir / "short.csv")
+    code, out, err = run(capsys, "calibrate", "recording=short.csv", "out=cal", "tracking.enabled=false")
+    assert code == 0, err
+    assert err == ["tcbench: model left out: the fitted parts last 7.2 min and a diagnosis needs 20 min "
+                   "(tcbench diagnose reports what a short record can tell)"], err
+    summary = json.loads((workdir / "cal" / "calibration.json").read_text())
+    assert set(summary["drift"]) == {"raw", "poly3", "poly3_rate", "bp", "elman"}

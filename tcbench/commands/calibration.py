@@ -169,6 +169,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     name = Path(cfg.recording).name
     methods = list(dict.fromkeys(cfg.methods))
+    if "model" in methods and (short := _too_short_to_diagnose(rec, split)):
+        methods.remove("model")
+        print(f"tcbench: model left out: {short}", file=sys.stderr)
     scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
     if cfg.test_recordings:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
@@ -338,15 +341,26 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     print(line)
 
 
+def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
+    """Why the fitted parts are too short for the ``model`` method's diagnosis, or None."""
+    from tcbench.diagnose.plan import min_full_duration_s
+
+    t = rec.time_s
+    fitted_s = sum(float(t[split.parts[k].stop - 1] - t[split.parts[k].start]) for k in split.train)
+    need_s = min_full_duration_s()
+    if fitted_s >= need_s:
+        return None
+    return (f"the fitted parts last {fitted_s / 60:.1f} min and a diagnosis needs {need_s / 60:.0f} min "
+            "(tcbench diagnose reports what a short record can tell)")
+
+
 def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig) -> tuple[Any, Any]:
     """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
-    kept as gaps) and the model it fitted, for the ``model`` method. The parts may be shorter
-    than a diagnosis of its own asks (30 min): down to five cross-validation folds of two
-    thermometer-smoothing windows each (20 min)."""
+    kept as gaps) and the model it fitted, for the ``model`` method. The parts must be as long
+    as any full diagnosis (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min)."""
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.model_file import to_sensor_model
-    from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
-    from tcbench.diagnose.plan import FOLDS
+    from tcbench.diagnose.plan import min_full_duration_s
     from tcbench.diagnose.report import model_spec
     from tcbench.diagnose.signals import DiagnosisDataError
     from tcbench.sensors.recording import make_recording
@@ -356,7 +370,7 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig) -> tuple[Any, Any]:
                           sensor=rec.meta.sensor, sample_rate_hz=rec.meta.sample_rate_hz, device_id=rec.meta.device_id)
     try:
         diag = diagnose(part, name=f"{Path(cfg.recording).name} (training parts)",
-                        min_duration_s=FOLDS * 2 * DEFAULT_SMOOTH_S)
+                        min_duration_s=min_full_duration_s())
     except DiagnosisDataError as exc:
         raise CommandError(f"methods: model: the training parts cannot be diagnosed ({exc}); fit on more parts, "
                            "or leave model out of methods") from None
