@@ -124,7 +124,7 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     bins) and predicts on bins too (:meth:`OffsetModel.offset`). Fitted on the first branch of
     the tofupilot cycle (2 Hz, up to 3 degC/min) with ten seeds, the held-out drift on samples and
     on 5-s bins differ by less than the seeds' spread on every gyro axis, either way (coarser
-    bins began to cost bp on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``)."""
+    bins began to cost both networks on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``)."""
     if method not in METHODS:
         raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
     if method == "raw":
