@@ -71,3 +71,41 @@ def test_a_diagnosed_model_compensates_what_it_describes() -> None:
     assert np.std(res) == pytest.approx(white, rel=0.05) and abs(np.mean(res)) < 3 * white / np.sqrt(res.size)
     with pytest.raises(ValueError, match="fitted by tcbench diagnose"):
         fit("model", [rec])
+
+
+def _smooth_record(seconds: float, noise: float, seed: int) -> Record:
+    """A 1 Hz record of a cubic offset in a chamber cycle's temperature plus white noise."""
+    t = np.arange(0.0, seconds, 1.0)
+    temp = 20.0 + 30.0 * np.sin(2.0 * np.pi * t / seconds)
+    offset = 0.02 + 1e-3 * (temp - 20.0) - 2e-5 * (temp - 20.0) ** 2
+    out = offset + np.random.default_rng(seed).normal(0.0, noise, t.size)
+    return record(t, temp, out, np.zeros_like(t))
+
+
+def test_binned_training_gives_the_per_sample_fit_of_a_smooth_offset() -> None:
+    """bp trained on 5-s bin means and on every sample, from the same seed and normalisation,
+    ends at the same network up to a small part of the offset's span; both take out the offset."""
+    rec = _smooth_record(7200.0, 2e-3, 0)
+    truth = rec.output - np.random.default_rng(0).normal(0.0, 2e-3, rec.t_s.size)
+    span = np.ptp(truth)
+    binned, every = fit("bp", [rec], seed=3), fit("bp", [rec], seed=3, bin_s=None)
+    assert binned.bin_s == 5.0 and every.bin_s is None
+    a, b = binned.offset(rec), every.offset(rec)
+    assert np.max(np.abs(a - b)) < 0.03 * span
+    for off in (a, b):
+        assert np.sqrt(np.mean((off - truth) ** 2)) < 0.03 * span
+
+
+def test_binned_elman_steps_once_per_bin() -> None:
+    """elman trained on bins runs on the record's bins, its output interpolated between the bins'
+    mean times, and takes out most of a smooth offset on a cycle it did not see."""
+    train, test = _smooth_record(7200.0, 2e-3, 1), _smooth_record(7200.0, 2e-3, 2)
+    model = fit("elman", [train], seed=0)
+    coarse = test.binned(5.0)
+    assert coarse.t_s.size == 1440 and coarse.t_s[0] == 2.0
+    on_bins = model.learner.predict(np.column_stack([coarse.temp_c, coarse.rate_c_per_s]))
+    np.testing.assert_allclose(model.offset(test), np.interp(test.t_s, coarse.t_s, on_bins), rtol=0.0, atol=1e-15)
+    res = residual(model, test)
+    assert scores(res, test.t_s)["drift_rms"] < 0.2 * scores(test.output - test.truth, test.t_s)["drift_rms"]
+    with pytest.raises(ValueError, match="bin_s must be > 0 or None"):
+        fit("bp", [train], bin_s=0.0)

@@ -16,6 +16,7 @@ from tcbench.diagnose.signals import (
     DiagnosisDataError,
     local_linear,
     smooth_temperature,
+    smoothed_value,
 )
 from tcbench.sensors.recording import make_recording, write_recording
 from tcbench.sensors.thermal import first_order_lag
@@ -72,6 +73,18 @@ def test_smoothing_keeps_corners_and_handles_bursts() -> None:
     burst = np.concatenate([k * 300 + np.arange(0, 5, 0.02) for k in range(20)])
     v, r = smooth_temperature(burst, 25 - burst / 3600, 120.0)
     assert np.allclose(r, -1 / 3600, rtol=1e-6) and np.allclose(v, 25 - burst / 3600)
+
+
+def test_the_value_alone_is_the_smoothed_value() -> None:
+    """smoothed_value gives smooth_temperature's value bit for bit: on a continuous record (the
+    local quadratic), on bursts (each its own quadratic) and on sparse segments (the local line)."""
+    rng = np.random.default_rng(4)
+    continuous = np.arange(0.0, 3600.0)
+    bursts = np.concatenate([k * 300 + np.arange(0, 5, 0.02) for k in range(20)])
+    sparse = np.concatenate([k * 60 + np.arange(3.0) for k in range(100)])  # 3 samples a minute
+    for t in (continuous, bursts, sparse):
+        x = 20.0 + np.sin(t / 500.0) + rng.normal(0.0, 0.01, t.size)
+        np.testing.assert_array_equal(smoothed_value(t, x, 120.0), smooth_temperature(t, x, 120.0)[0])
 
 
 def _cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:

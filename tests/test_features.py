@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tcbench.compensation.features import temperature_rate_c_per_s
+from tcbench.compensation.features import bin_means, running_mean, temperature_rate_c_per_s
 
 
 def _loop_reference(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> np.ndarray:
@@ -53,3 +53,30 @@ def test_rejects_bad_input() -> None:
         temperature_rate_c_per_s(np.arange(3.0), np.zeros(3), window_s=0.0)
     with pytest.raises(ValueError, match="samples"):
         temperature_rate_c_per_s(np.arange(3.0), np.zeros(4))
+
+
+def test_running_mean_is_the_valid_convolution() -> None:
+    rng = np.random.default_rng(2)
+    x = 1e3 + rng.normal(0.0, 1.0, 5000)  # a large mean: the prefix sums grow to 5e6
+    for width in (1, 7, 60, 5000):
+        np.testing.assert_allclose(running_mean(x, width), np.convolve(x, np.ones(width) / width, "valid"),
+                                   rtol=0.0, atol=1e-10)
+    with pytest.raises(ValueError, match="width must be 1..5000"):
+        running_mean(x, 0)
+
+
+def test_bin_means_keep_the_mean_and_skip_gaps() -> None:
+    rng = np.random.default_rng(3)
+    t_s = np.r_[np.arange(0.0, 95.0, 1.0), np.arange(300.0, 312.0, 1.0)]  # a gap of 205 s
+    cols = rng.normal(0.0, 1.0, (t_s.size, 2))
+    t_bin, means = bin_means(t_s, cols, 10.0)
+    assert means.shape == (12, 2)  # 0-9 .. 90-94 (10 bins), then 300-309 and 310-311: none in the gap
+    counts = np.r_[[10] * 9, 5, 10, 2]
+    np.testing.assert_allclose(counts @ means / counts.sum(), cols.mean(axis=0), rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(means[0], cols[:10].mean(axis=0), rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(t_bin[[0, 9, 10, 11]], [4.5, 92.0, 304.5, 310.5])
+    same_t, same = bin_means(t_s, cols, 0.5)  # a bin per sample: the samples themselves
+    np.testing.assert_array_equal(same_t, t_s)
+    np.testing.assert_array_equal(same, cols)
+    with pytest.raises(ValueError, match="bin_s must be > 0"):
+        bin_means(t_s, cols, 0.0)

@@ -12,7 +12,8 @@ Methods, each a function of what a flight controller can read (the thermometer a
   expansion of an offset seen through a thermal lag, which the heating and cooling branches
   of a cycle tell apart.
 - ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`, their defaults) on
-  ``[T, dT/dt]``, trained from the run's seed.
+  ``[T, dT/dt]``, trained from the run's seed on the means of :data:`TRAIN_BIN_S` time bins of
+  the training parts (see :func:`fit`).
 - ``model``: the diagnosed physics. ``tcbench diagnose`` on the training parts fits a model
   (polynomial core, thermal lag, hysteresis, warm-up, steps ...; :mod:`tcbench.diagnose`), and its
   deterministic output is the offset (:mod:`tcbench.compensation.fitted_model`); the command
@@ -32,12 +33,13 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.compensation.features import temperature_rate_c_per_s
+from tcbench.compensation.features import bin_means, running_mean, temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 
 METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman", "model")
 LEARNERS = ("bp", "elman")
 RATE_WINDOW_S = 120.0
+TRAIN_BIN_S = 5.0  # the networks' training bins: see fit()
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,13 @@ class Record:
     def part(self, start: int, stop: int) -> Record:
         return Record(*(getattr(self, f)[start:stop] for f in ("t_s", "temp_c", "output", "truth", "rate_c_per_s")))
 
+    def binned(self, bin_s: float) -> Record:
+        """The record averaged over time bins of ``bin_s`` from its first sample
+        (:func:`~tcbench.compensation.features.bin_means`): one row per bin, every column its mean."""
+        t_s, cols = bin_means(self.t_s, np.column_stack([self.temp_c, self.output, self.truth, self.rate_c_per_s]),
+                              bin_s)
+        return Record(t_s, *(np.ascontiguousarray(c) for c in cols.T))
+
 
 def record(t_s: np.ndarray, temp_c: np.ndarray, output: np.ndarray, truth: np.ndarray) -> Record:
     """A :class:`Record` of a whole recording, its temperature rate computed once."""
@@ -72,23 +81,50 @@ class OffsetModel:
     rate_coef: float = 0.0
     learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
     sensor_model: Any = None  # a diagnosed PolynomialModel
+    bin_s: float | None = None  # the learner's training bins (s); a sequential one also runs on them
 
     def offset(self, rec: Record) -> np.ndarray:
+        """The offset at each sample of ``rec``. A sequential learner (``elman``) trained on bins
+        steps once per bin: it runs on the record's bin means and its output is interpolated
+        linearly between the bins' mean times (held beyond the first and last), so a sample reads
+        the bin after its own, up to ``1.5 bin_s`` ahead."""
         if self.sensor_model is not None:
             from tcbench.compensation.fitted_model import deterministic_output
 
             return deterministic_output(self.sensor_model, rec.t_s, rec.temp_c, rec.truth) - rec.truth
         if self.learner is not None:
-            inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
-            return np.asarray(self.learner.predict(inputs), dtype=np.float64).reshape(-1)
+            if self.bin_s and self.learner.sequential:
+                coarse = rec.binned(self.bin_s)
+                return np.interp(rec.t_s, coarse.t_s, _predicted(self.learner, coarse))
+            return _predicted(self.learner, rec)
         if self.cubic is None:
             return np.zeros_like(rec.output)
         return self.cubic.offset(rec.temp_c) + self.rate_coef * rec.rate_c_per_s
 
 
-def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
+def _predicted(learner: Any, rec: Record) -> np.ndarray:
+    """A fitted learner's output on ``[T, dT/dt]`` of ``rec``."""
+    inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
+    return np.asarray(learner.predict(inputs), dtype=np.float64).reshape(-1)
+
+
+def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None = TRAIN_BIN_S) -> OffsetModel:
     """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``; a
-    network's initial weights drawn from ``seed``."""
+    network's initial weights drawn from ``seed``.
+
+    A network (``bp``, ``elman``) is trained on the means of ``bin_s`` time bins of each training
+    record (:meth:`Record.binned`; ``None``: on every sample), its normalisation fitted to the
+    samples. Approximation: the inputs ``[T, dT/dt]`` carry nothing faster than the thermometer's
+    changes (the rate is a 120-s trailing slope), so a network whose output is nearly constant
+    within a bin sees, in the mean squared error of the samples (bins of nearly equal counts),
+    the error of the bin means plus the within-bin variance of the target (noise, which no
+    parameter changes): the same minimum and gradient to first order in the within-bin change of
+    the inputs, on fewer rows (5 s at 1 Hz: 5x fewer). ``bp`` then predicts each sample; ``elman``,
+    a recurrence, steps once per bin (its context one bin back, its training window ``window``
+    bins) and predicts on bins too (:meth:`OffsetModel.offset`). Fitted on the first branch of
+    the tofupilot cycle (2 Hz, up to 3 degC/min) with ten seeds, the held-out drift on samples and
+    on 5-s bins differ by less than the seeds' spread on every gyro axis, either way (coarser
+    bins began to cost both networks on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``)."""
     if method not in METHODS:
         raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
     if method == "raw":
@@ -101,9 +137,15 @@ def fit(method: str, train: Sequence[Record], seed: int = 0) -> OffsetModel:
     if method in LEARNERS:
         from tcbench.learners import registry
 
+        if bin_s is not None and not bin_s > 0:
+            raise ValueError(f"bin_s must be > 0 or None, got {bin_s}")
         learner = registry.create(method, 2, None, np.random.default_rng(seed))
-        learner.fit(np.column_stack([temp, rate]), target)
-        return OffsetModel(method, learner=learner)
+        learner.scale_to(np.column_stack([temp, rate]), target)
+        rows = [r.binned(bin_s) for r in train] if bin_s else list(train)
+        learner.fit(np.column_stack([np.concatenate([r.temp_c for r in rows]),
+                                     np.concatenate([r.rate_c_per_s for r in rows])]),
+                    np.concatenate([r.output - r.truth for r in rows]))
+        return OffsetModel(method, learner=learner, bin_s=bin_s)
     cubic = fit_offset(temp, target)
     if method == "poly3":
         return OffsetModel("poly3", cubic)
@@ -128,6 +170,5 @@ def scores(res: np.ndarray, t_s: np.ndarray, drift_window_s: float = 60.0) -> di
     """RMS of a residual, and of its centred running mean over ``drift_window_s``."""
     dt = float(np.median(np.diff(t_s))) if t_s.size > 1 else 1.0
     width = max(1, int(round(drift_window_s / dt)))
-    kernel = np.ones(width) / width
-    smooth = np.convolve(res, kernel, mode="valid") if res.size >= width else np.array([res.mean()])
+    smooth = running_mean(res, width) if res.size >= width else np.array([res.mean()])
     return {"rms": float(np.sqrt(np.mean(res ** 2))), "drift_rms": float(np.sqrt(np.mean(smooth ** 2)))}

@@ -50,3 +50,35 @@ def temperature_rate_c_per_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: floa
     num = n * sty - st * sy
     ok = (n >= 2) & (den > 0)
     return np.where(ok, num / np.where(ok, den, 1.0), 0.0)
+
+
+def running_mean(x: np.ndarray, width: int) -> np.ndarray:
+    """Means of every ``width`` consecutive values of ``x`` (``np.convolve(x, ones(width) / width,
+    "valid")``, ``x.size - width + 1`` values) from compensated prefix sums (:func:`_prefix_sums`):
+    O(n) whatever the width, and as precise as the direct sums."""
+    v = np.asarray(x, dtype=np.float64).reshape(-1)
+    if not 1 <= width <= v.size:
+        raise ValueError(f"width must be 1..{v.size}, got {width}")
+    high, low = _prefix_sums(v)
+    return ((high[width:] - high[:-width]) + (low[width:] - low[:-width])) / width
+
+
+def bin_means(t_s: np.ndarray, columns: np.ndarray, bin_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Means over consecutive time bins ``[t_0 + k bin_s, t_0 + (k+1) bin_s)`` of the samples at
+    increasing times ``t_s``: the bins' mean times and the means of each column of ``columns``
+    (n, c), one row per bin that holds a sample (an empty bin, a gap, gives no row). Every sample
+    counts once, so the count-weighted mean of the bin means is the mean of the samples."""
+    t = np.asarray(t_s, dtype=np.float64).reshape(-1)
+    cols = np.asarray(columns, dtype=np.float64)
+    cols = cols.reshape(t.size, -1)
+    if not bin_s > 0:
+        raise ValueError(f"bin_s must be > 0, got {bin_s}")
+    if t.size == 0:
+        return t.copy(), cols.copy()
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t_s must be strictly increasing")
+    index = np.floor((t - t[0]) / bin_s).astype(np.int64)
+    starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
+    counts = np.diff(np.r_[starts, t.size]).astype(np.float64)
+    t_mean_s = t[0] + np.add.reduceat(t - t[0], starts) / counts
+    return t_mean_s, np.add.reduceat(cols, starts, axis=0) / counts[:, None]

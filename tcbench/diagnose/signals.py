@@ -82,14 +82,27 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
     averaging gains. Sparser segments take the local line over ``window_s`` or, if wider, three
     segment spacings, which reaches across the gaps.
     """
+    value, rate = _smoothed(t_s, temp_c, window_s, with_rate=True)
+    assert rate is not None
+    return value, rate
+
+
+def smoothed_value(t_s: np.ndarray, x: np.ndarray, window_s: float) -> np.ndarray:
+    """The value of :func:`smooth_temperature` alone (the same numbers, without computing the
+    rate), for the noise propagation that smooths many series."""
+    return _smoothed(t_s, x, window_s, with_rate=False)[0]
+
+
+def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
+              with_rate: bool) -> tuple[np.ndarray, np.ndarray | None]:
     seg = segments(t_s)
     value = np.empty_like(temp_c)
-    rate = np.empty_like(temp_c)
+    rate = np.empty_like(temp_c) if with_rate else None
     starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
     bounds = np.append(starts, t_s.size)
     spacing = (t_s[-1] - t_s[0]) / max(starts.size, 1)
     short_window = max(window_s, 3.0 * spacing) if starts.size > 1 else window_s
-    wide_value, wide_rate = local_linear(t_s, temp_c, short_window)
+    wide: tuple[np.ndarray, np.ndarray] | None = None  # the local line, computed if a segment needs it
     for a, b in pairwise(bounds):
         n = b - a
         fs = (n - 1) / max(t_s[b - 1] - t_s[a], 1e-12)
@@ -98,9 +111,13 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
             w = n if n % 2 else n - 1
         if n >= w >= 5:
             value[a:b] = savgol(temp_c[a:b], w)
-            rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
+            if rate is not None:
+                rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
         else:
-            value[a:b], rate[a:b] = wide_value[a:b], wide_rate[a:b]
+            wide = local_linear(t_s, temp_c, short_window) if wide is None else wide
+            value[a:b] = wide[0][a:b]
+            if rate is not None:
+                rate[a:b] = wide[1][a:b]
     return value, rate
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tcbench.diagnose.design import Designer, Model
-from tcbench.diagnose.signals import lagged, smooth_temperature
+from tcbench.diagnose.signals import lagged, smoothed_value
 
 DELTA_C = 0.01  # step of the numerical temperature slope
 
@@ -35,7 +35,7 @@ def propagated_noise(designer: Designer, model: Model, beta: np.ndarray, seed: i
     """One realisation of the thermometer noise as the fitted model sees it (output unit)."""
     d = designer.data
     rng = np.random.default_rng(seed)
-    eps = smooth_temperature(d.t_s, rng.standard_normal(d.n) * thermometer_sigma(designer), d.smooth_s)[0]
+    eps = smoothed_value(d.t_s, rng.standard_normal(d.n) * thermometer_sigma(designer), d.smooth_s)
     if model.lag_tau_s:
         eps = lagged(d.t_s, eps, model.lag_tau_s)
     return output_slope(designer, model, beta) * eps
@@ -53,5 +53,5 @@ def thermometer_variance(designer: Designer, model: Model, beta: np.ndarray, z: 
     w = output_slope(designer, model, beta) * z
     if model.lag_tau_s:
         w = lagged(d.t_s, w[::-1], model.lag_tau_s)[::-1]
-    w = smooth_temperature(d.t_s, w, d.smooth_s)[0]
+    w = smoothed_value(d.t_s, w, d.smooth_s)
     return float(sigma_t**2 * (w @ w))
