@@ -214,3 +214,16 @@ def test_a_short_record_is_calibrated_without_the_diagnosed_model(workdir: Path,
                    "(tcbench diagnose reports what a short record can tell)"], err
     summary = json.loads((workdir / "cal" / "calibration.json").read_text())
     assert set(summary["drift"]) == {"raw", "poly3", "poly3_rate", "bp", "elman"}
+
+
+def test_the_residual_plot_envelope_keeps_every_spike_in_few_points() -> None:
+    from tcbench.commands.calibration import _envelope
+
+    rng = np.random.default_rng(4)
+    x, y = np.arange(86_400.0), rng.normal(size=86_400)
+    y[[5, 40_000, 86_399]] = [30.0, -40.0, 25.0]  # spikes, one in the unbinned tail
+    ex, ey = _envelope(x, y, points=4000)
+    assert ex.size <= 4100 and (np.diff(ex) > 0).all()
+    assert {30.0, -40.0, 25.0} <= set(ey.tolist())
+    small = _envelope(x[:50], y[:50])
+    assert small[0].size == 50

@@ -27,6 +27,7 @@ from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
 AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
+PLOT_POINTS = 4000  # points per line of the residual plot (a min/max envelope beyond)
 
 
 @dataclass
@@ -418,6 +419,22 @@ def _plain(value: Any) -> Any:
     return value.tolist() if hasattr(value, "tolist") else str(value)
 
 
+def _envelope(x: np.ndarray, y: np.ndarray, points: int = PLOT_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """At most about ``points`` points of a long line, drawn as it would look: in each of
+    ``points / 2`` runs of consecutive samples, the sample of the lowest and of the highest ``y``,
+    in time order (a spike survives; the plot only, never a score)."""
+    n = y.size
+    per = -(-2 * n // points)  # samples per run, rounded up
+    if per <= 2:
+        return x, y
+    runs = n // per
+    head = np.arange(runs * per).reshape(runs, per)
+    lo, hi = np.argmin(y[head], axis=1), np.argmax(y[head], axis=1)
+    pick = np.sort(np.column_stack([head[np.arange(runs), lo], head[np.arange(runs), hi]]), axis=1).ravel()
+    pick = np.concatenate([pick, np.arange(runs * per, n)])
+    return x[pick], y[pick]
+
+
 def _plot(path: Path, rec: Any, split: Split, residuals: dict[str, np.ndarray], unit: str,
           cfg: CalibrateConfig) -> Path:
     """Residual against time and against temperature, per method, training branches shaded."""
@@ -432,11 +449,11 @@ def _plot(path: Path, rec: Any, split: Split, residuals: dict[str, np.ndarray], 
         b = split.parts[k]
         ax_t.axvspan(t_min[b.start], t_min[b.stop - 1], color="0.9", zorder=0)
     for m, res in residuals.items():
-        ax_t.plot(t_min, res, lw=0.7, label=m)
-        ax_c.plot(rec.temperature_c, res, lw=0.5, label=m)
+        ax_t.plot(*_envelope(t_min, res), lw=0.7, label=m)
+        ax_c.plot(*_envelope(rec.temperature_c, res), lw=0.5, label=m)
     ax_t.set(xlabel="time (min); shaded: fitted", ylabel=f"residual ({unit})", title=Path(cfg.recording).name)
     ax_c.set(xlabel="thermometer (degC)", ylabel=f"residual ({unit})", title="against temperature")
-    ax_t.legend(fontsize=8)
+    ax_t.legend(fontsize=8, loc="upper left")
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
