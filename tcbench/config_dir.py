@@ -9,6 +9,7 @@ in site-packages as ``tcbench/conf/``; an editable install (``pip install -e .``
 
 from __future__ import annotations
 
+from importlib.metadata import entry_points
 from importlib.resources import files
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from tcbench.errors import ConfigError
 CONFIG_MODULE = "tcbench.conf"
 SEARCH_PATH = f"pkg://{CONFIG_MODULE}"  # Hydra's config_path / search-path entry for them
 CONFIG_NAME = "config"
+PLUGIN_CONFIGS = "tcbench.configs"  # entry-point group naming the config packages of plugins
 
 
 def conf_dir() -> Path:
@@ -28,3 +30,14 @@ def conf_dir() -> Path:
             f"tcbench's configs are not at {root}: reinstall tcbench (pip install -e . in a clone); "
             "a leftover tcbench/conf/ folder from before the configs moved to conf/ can hide them: delete it")
     return root
+
+
+def plugin_packages() -> list[str]:
+    """The config packages installed plugins name in :data:`PLUGIN_CONFIGS`, in entry-point name order."""
+    return [ep.value for ep in sorted(entry_points(group=PLUGIN_CONFIGS), key=lambda e: e.name)]
+
+
+def group_options(group: str) -> list[str]:
+    """The options of the config group ``group`` (``optimiser``: fa, ifa, ... and the plugins'), sorted."""
+    folders = [conf_dir() / group, *(Path(str(files(p))) / group for p in plugin_packages())]
+    return sorted({f.stem for folder in folders if folder.is_dir() for f in folder.glob("*.yaml")})

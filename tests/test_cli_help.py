@@ -64,7 +64,7 @@ def test_help_wins_after_arguments(capsys: pytest.CaptureFixture[str]) -> None:
 
 def test_help_shows_the_defaults_the_command_parses() -> None:
     text = cli_help.usage("simulate")
-    assert "  sensor=null " in text and "  protocol=fulltemp " in text and "tracking.experiment=simulations" in text
+    assert "  sensor=null " in text and "  protocol=null " in text and "tracking.experiment=simulations" in text
     assert "  recording=(required) " in cli_help.usage("diagnose") and "  out=diagnosis " in cli_help.usage("diagnose")
 
 

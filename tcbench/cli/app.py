@@ -4,10 +4,12 @@ and the checks made before any job starts. Every job of every command runs throu
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import logging
 import os
 import re
+import shutil
 from pathlib import Path
 from dataclasses import dataclass
 from typing import Any
@@ -17,18 +19,16 @@ from hydra import compose, initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
 from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
-from omegaconf.errors import ConfigAttributeError, OmegaConfBaseException
+from omegaconf.errors import ConfigAttributeError, ConfigKeyError, OmegaConfBaseException
 
+from tcbench.cli.main import VALUE_FLAGS
 from tcbench.commands import schemas as command_schemas
-from tcbench.runner.config import ConfigError, as_dict, register_schema
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
-from tcbench.runner.job import run_job
-from tcbench.runner.kinds import kind_of
+from tcbench.errors import ConfigError, did_you_mean
+from tcbench.runner.schema import as_dict, register_schema
 
-# Hydra flags followed by a value; those that change where configs come from make tcbench
-# skip its up-front check (each job still validates its own config).
-VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
-CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
+SLURM_LAUNCHER = "hydra_plugins.hydra_submitit_launcher.submitit_launcher.SlurmLauncher"
+SLURM_COMMANDS = ("sbatch", "srun")  # submitit submits with sbatch, and refuses to start without srun
 log = logging.getLogger(__name__)
 
 register_schema()
@@ -37,6 +37,8 @@ command_schemas.register()
 
 def _task(cfg: DictConfig) -> None:
     """Hydra task function: one job per call."""
+    from tcbench.runner.job import run_job
+
     run_job(cfg)
 
 
@@ -82,19 +84,42 @@ def _known_options(group: str) -> list[str]:
     return sorted(p.stem for p in (conf_dir() / group).glob("*.yaml"))
 
 
-def _explain(exc: Exception) -> str:
-    """One line for a Hydra/OmegaConf composition error."""
+def _no_such_key(key: str, known: Any) -> str:
+    """The line for an unknown key, with the known key of the same parent it probably meant."""
+    head, _, leaf = key.rpartition(".")
+    meant = did_you_mean(leaf, known)
+    return f"{key}: no such config key" + (f"; did you mean {'.'.join(p for p in (head, meant) if p)!r}?"
+                                           if meant else "")
+
+
+def _schema_keys(config_name: str) -> list[str]:
+    """The top-level keys of a primary config's schema."""
+    from tcbench.runner.schema import JobConfig
+
+    schema = JobConfig if config_name == CONFIG_NAME else command_schemas.SCHEMAS.get(config_name)
+    return [f.name for f in dataclasses.fields(schema)] if schema is not None else []
+
+
+def _explain(exc: Exception, config_name: str = CONFIG_NAME) -> str:
+    """One line for a Hydra/OmegaConf composition error of the primary config ``config_name``
+    (an unknown key or option with the known one it probably meant)."""
     if isinstance(exc, MissingConfigException) and exc.missing_cfg_file and "/" in exc.missing_cfg_file:
         group, name = exc.missing_cfg_file.split("/", 1)
-        known = ", ".join(exc.options or _known_options(group))
-        return f"unknown {group} {name!r}; known: {known}"
+        options = exc.options or _known_options(group)
+        meant = did_you_mean(name, options)
+        return f"unknown {group} {name!r}; known: {', '.join(options)}" + (f"; did you mean {meant!r}?"
+                                                                              if meant else "")
     cause = exc.__cause__
     if isinstance(cause, OmegaConfBaseException):
-        key = getattr(cause, "full_key", None) or "config"
-        if isinstance(cause, ConfigAttributeError):
-            return f"{key}: no such config key"
+        key = str(getattr(cause, "full_key", None) or "config")
+        if isinstance(cause, ConfigAttributeError | ConfigKeyError):
+            parent = cause.parent_node
+            return _no_such_key(key, [k for k in parent if k != "hydra" or key.startswith("hydra.")]
+                                if parent is not None else [])
         return f"{key}: {str(cause).strip().splitlines()[0]}"
     text = str(exc).strip()
+    if unmatched := re.match(r"Could not override '([^']+)'\. No match in the defaults list", text):  # a group's name
+        return _no_such_key(unmatched[1], _schema_keys(config_name))
     return text.splitlines()[0] if text else type(exc).__name__
 
 
@@ -104,7 +129,7 @@ def compose_job(overrides: list[str], config_name: str = CONFIG_NAME, hydra_cfg:
     try:
         return compose(config_name, overrides=overrides, return_hydra_config=hydra_cfg)
     except (HydraException, OmegaConfBaseException, ValueError) as exc:
-        raise ConfigError(_explain(exc)) from None
+        raise ConfigError(_explain(exc, config_name)) from None
 
 
 def _override_positions(args: list[str]) -> list[int]:
@@ -139,7 +164,11 @@ def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None 
     """A composed job config, checked by its kind before anything runs (:meth:`JobKind.plan_check`);
     the plain config. ``written`` collects the outputs of a sweep's jobs: a second job writing
     the same file or folder is a ConfigError."""
+    from tcbench.commands.inputs import check_inputs_exist
+    from tcbench.runner.kinds import kind_of
+
     c = as_dict(cfg)
+    check_inputs_exist(c)  # named before the readers of the inputs are imported
     kind = kind_of(c)
     kind.plan_check(kind.prepare(c))
     if written is not None:
@@ -147,10 +176,22 @@ def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None 
     return c
 
 
-def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list[str]]]:
-    """The fixed overrides of a command line and its swept keys with their values (the config's
-    own ``hydra.sweeper.params`` included, the command line winning); call inside
-    ``initialize_config_module``."""
+def check_launcher(launcher: Any) -> None:
+    """A ConfigError when the sweep's launcher (``hydra.launcher`` of the composed config) cannot
+    run here: submitit's SLURM launcher on a machine without SLURM's commands."""
+    if launcher is None or launcher.get("_target_") != SLURM_LAUNCHER:
+        return
+    if missing := [c for c in SLURM_COMMANDS if shutil.which(c) is None]:
+        raise ConfigError(f"hydra/launcher=submitit_slurm needs SLURM, but {' and '.join(missing)} "
+                          f"{'is' if len(missing) == 1 else 'are'} not on PATH here: run the sweep on a SLURM "
+                          "login node, or here with hydra/launcher=submitit_local, hydra/launcher=joblib or "
+                          "tcbench's launcher (hydra.launcher.n_jobs=2)")
+
+
+def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list[str]], Any]:
+    """The fixed overrides of a command line, its swept keys with their values (the config's
+    own ``hydra.sweeper.params`` included, the command line winning) and, with ``-m``, the
+    ``hydra.launcher`` config that will run them; call inside ``initialize_config_module``."""
     multirun = "-m" in args or "--multirun" in args
     parser = OverridesParser.create()
     try:
@@ -162,6 +203,7 @@ def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list
     if sweeps and not multirun:
         key = next(iter(sweeps))
         raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
+    launcher = None
     if multirun:
         first = [f"{k}={v[0]}" for k, v in sweeps.items()]
         base = compose_job(fixed + first, config_name, hydra_cfg=True)
@@ -171,14 +213,15 @@ def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list
                 (o,) = parser.parse_overrides([f"{key}={value}"])
                 vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
                 sweeps[key] = [str(v) for v in vals]
-    return fixed, sweeps
+        launcher = base.hydra.get("launcher")
+    return fixed, sweeps, launcher
 
 
 def expand(args: list[str], config_name: str) -> list[tuple[list[str], dict[str, Any]]]:
     """Every job of a command line, composed: its swept ``key=value`` and its plain config."""
     conf_dir()
     with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
-        fixed, sweeps = _sweep(args, config_name)
+        fixed, sweeps, _ = _sweep(args, config_name)  # run here in turn, not on the launcher
         keys = list(sweeps)
         jobs = []
         for combo in itertools.product(*sweeps.values()):
@@ -190,9 +233,12 @@ def expand(args: list[str], config_name: str) -> list[tuple[list[str], dict[str,
 def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
     """Compose and check every job of a command line; raise ConfigError (or the kind's one-line
     error) on the first bad one."""
+    from tcbench.runner.kinds import kind_of
+
     conf_dir()  # one line naming the problem when the installed configs are missing
     with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
-        fixed, sweeps = _sweep(args, config_name)
+        fixed, sweeps, launcher = _sweep(args, config_name)
+        check_launcher(launcher)
         seeds = sweeps.pop("seed", None)
         keys = list(sweeps)
         combos = list(itertools.product(*sweeps.values())) or [()]

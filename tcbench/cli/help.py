@@ -1,7 +1,7 @@
-"""Usage text of tcbench's key=value commands (simulate, import, metrics, diagnose, leaderboard,
-list, quickstart), generated from the schema of each command's primary config
-(:mod:`tcbench.commands.schemas`), so the parameters and defaults shown are the ones the command
-uses. ``tcbench run``'s help is Hydra's."""
+"""Usage text of tcbench's commands, generated from the schema of each command's primary config
+(:mod:`tcbench.commands.schemas`; ``tcbench run``'s :mod:`tcbench.runner.schema` with its config
+groups), so the parameters and defaults shown are the ones the command uses. Built without Hydra,
+OmegaConf or the tasks' libraries: ``--help`` answers at once."""
 
 from __future__ import annotations
 
@@ -17,6 +17,18 @@ TRACKING = {
     "tracking.experiment": "MLflow experiment the run is filed under",
     "tracking.sweep_id": "the sweep's id in MLflow (null: a new one per command)",
     "tracking.resume": "skip a job whose config already FINISHED in the experiment (re-run a killed sweep)",
+}
+RUN_PARAMS = {
+    "task": "the task, an option of the group task (task.<key>=VALUE sets one of its keys)",
+    "optimiser": "the optimiser, an option of the group optimiser (optimiser.<key>=VALUE sets one of its keys)",
+    "learner": "compensation tasks: the learner, an option of the group learner (null: bp)",
+    "experiment": "a whole study in one file, an option of the group experiment (experiment=paper_fa_ifa)",
+    "seed": "run seed: the task instance and the optimiser's streams derive from it",
+    "budget": "objective evaluations per run, initial population included",
+    "progress": "a progress bar per run",
+    **TRACKING,
+    "tracking.plots": "a figure per run (null: for single runs and compensation runs, not in optimisation sweeps)",
+    "tracking.ioh_dir": "also write each run in IOHprofiler's format into this folder (null: no)",
 }
 # keys of the shared schema that these commands accept and ignore (``tcbench run`` uses them)
 IGNORED = ("tracking.plots", "tracking.ioh_dir")
@@ -63,7 +75,8 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "sensor": "msra (resonant accelerometer), gyro or accel (capacitive accelerometer); `tcbench list what=sensors` "
                       "(null: msra, or the model file's)",
-            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static, accel chamber|multipos|static",
+            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static, accel chamber|multipos|static "
+                        "(null: the sensor's default, msra fulltemp, gyro oven, accel chamber)",
             "device_seed": "which unit of the device population (integer >= 0)",
             "seed": "the run's noise draw (integer >= 0)",
             "out": "output folder",
@@ -352,4 +365,49 @@ def usage(name: str) -> str:
               *spec.options,
               "", "examples:", *(f"  {e}" for e in spec.examples),
               "", textwrap.fill(f"output: {spec.output}", width=100, subsequent_indent="  ")]
+    return "\n".join(lines)
+
+
+def _group_defaults(top: dict[str, Any]) -> dict[str, Any]:
+    """The config groups of ``config.yaml``'s defaults list and the option each chooses (None for null)."""
+    return {k: v for entry in top.get("defaults", []) if isinstance(entry, dict)
+            for k, v in entry.items() if not k.startswith("override ")}
+
+
+def run_usage() -> str:
+    """The ``--help`` text of ``tcbench run``: the header and footer of ``conf/config.yaml``'s
+    ``hydra.help``, the options of every config group, and every key of
+    :class:`~tcbench.runner.schema.JobConfig` with its default (the default task's and
+    optimiser's keys as their option files give them)."""
+    import yaml
+
+    from tcbench.config_dir import CONFIG_NAME, conf_dir, group_options
+    from tcbench.runner.schema import JobConfig
+
+    root = conf_dir()
+    top = yaml.safe_load((root / f"{CONFIG_NAME}.yaml").read_text(encoding="utf-8"))
+    text = top["hydra"]["help"]
+    groups = _group_defaults(top)
+    options = {group: group_options(group) for group in sorted(groups)}
+    rows: list[tuple[str, str]] = []
+    for key, default in parameters(JobConfig):
+        if key in groups:
+            choice = groups[key]
+            rows.append((f"{key}={_shown(choice)}", RUN_PARAMS[key]))
+            if choice is not None:
+                values = yaml.safe_load((root / key / f"{choice}.yaml").read_text(encoding="utf-8")) or {}
+                rows += [(f"  {key}.{k}={_shown(v)}", "") for k, v in values.items() if k not in {"name", "defaults"}]
+        else:
+            value = top.get(key, default) if "." not in key else \
+                (top.get(key.split(".")[0]) or {}).get(key.split(".", 1)[1], default)
+            rows.append((f"{key}={_shown(value)}", RUN_PARAMS.get(key, "")))
+    keys = dict(parameters(JobConfig))
+    rows += [(f"{g}={_shown(choice)}", RUN_PARAMS.get(g, "")) for g, choice in groups.items() if g not in keys]
+    width = max(len(left) for left, meaning in rows if meaning) + 2
+    lines = [text["header"].rstrip(), "", "== Configuration groups ==",
+             "Compose your configuration from those groups (group=option)", "",
+             *(f"{group}: {', '.join(names)}" for group, names in options.items()), "",
+             "parameters (key=value, default after =; `tcbench run task=sphere --cfg job` prints a choice's):",
+             *(f"  {left:{width}s}{meaning}".rstrip() for left, meaning in rows), "",
+             text["footer"].rstrip()]
     return "\n".join(lines)

@@ -40,6 +40,10 @@ HYDRA_FLAGS = HYDRA_INFO_FLAGS | {
     "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun",
 }
 HELP_FLAGS = {"-h", "--help"}
+# Hydra flags followed by a value; those that change where configs come from make tcbench
+# skip its up-front check (each job still validates its own config).
+VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
+CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
 
 
 class UserError(Exception):
@@ -108,15 +112,9 @@ def _app_command(command: str, argv: list[str]) -> int:
     ``conf/<command>.yaml``. One job runs here (no Hydra output folder); ``-m`` sweeps run through
     Hydra's launcher like ``tcbench run``'s, but those of :data:`IN_TURN` one after another here.
     Every job is checked before the first starts."""
-    from hydra import initialize_config_module
-
     from tcbench.cli import help as cli_help
-    from tcbench.cli.app import compose_job
-    from tcbench.runner.config import ConfigError, as_dict
-    from tcbench.config_dir import CONFIG_MODULE
-    from tcbench.runner.job import FAILURES, JobFailure, run_job
 
-    if any(a in HELP_FLAGS for a in argv):
+    if any(a in HELP_FLAGS for a in argv):  # the help of the schema: nothing else imported
         print(cli_help.usage(command))
         return 0
     args: list[str] = []
@@ -154,6 +152,14 @@ def _app_command(command: str, argv: list[str]) -> int:
         return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri,
                              None if checked.resume else checked.jobs)
     args = [_hydra_value(a) for a in args]
+    from hydra import initialize_config_module
+
+    from tcbench.cli.app import compose_job
+    from tcbench.commands.inputs import check_inputs_exist
+    from tcbench.config_dir import CONFIG_MODULE
+    from tcbench.errors import ConfigError
+    from tcbench.runner.schema import as_dict
+
     try:
         with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
             composed = compose_job(args, command)
@@ -163,6 +169,7 @@ def _app_command(command: str, argv: list[str]) -> int:
             print(OmegaConf.to_yaml(composed), end="")
             return 0
         c = as_dict(composed)  # one job: its work makes the checks once (run_job), no check ahead
+        check_inputs_exist(c)  # but a missing input file is named before its readers are imported
     except ConfigError as exc:
         raise UserError(str(exc)) from None
     if command in IN_TURN:
@@ -172,6 +179,8 @@ def _app_command(command: str, argv: list[str]) -> int:
             return work(c)
         except ConfigError as exc:
             raise UserError(str(exc)) from None
+    from tcbench.runner.job import FAILURES, JobFailure, run_job
+
     c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
     FAILURES.clear()
     with _quiet_job_log():
@@ -201,8 +210,8 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     from hydra.errors import HydraException
     from omegaconf.errors import OmegaConfBaseException
 
-    from tcbench.cli.app import CONFIG_SOURCE_FLAGS, hydra_app, plan, with_overrides
-    from tcbench.runner.config import ConfigError
+    from tcbench.cli.app import hydra_app, plan, with_overrides
+    from tcbench.errors import ConfigError
 
     info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
     if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
@@ -296,14 +305,19 @@ def _failures_report(jobs: int) -> int:
 
 
 def cmd_run(args: list[str]) -> int:
-    from tcbench.cli.app import VALUE_FLAGS
-    from tcbench.runner.job import FAILURES
-
-    after_value_flag = False
+    after_value_flag, flags = False, []
     for a in args:
-        if not after_value_flag and (flag := _flag_name(a)) is not None and flag not in HYDRA_FLAGS:
-            raise _unknown_option("run", flag)
+        if not after_value_flag and (flag := _flag_name(a)) is not None:
+            if flag not in HYDRA_FLAGS:
+                raise _unknown_option("run", flag)
+            flags.append(flag)
         after_value_flag = a in VALUE_FLAGS
+    if HELP_FLAGS & set(flags) and not CONFIG_SOURCE_FLAGS & set(flags):  # configs from elsewhere: Hydra's help
+        from tcbench.cli import help as cli_help
+
+        print(cli_help.run_usage())
+        return 0
+    from tcbench.runner.job import FAILURES
 
     FAILURES.clear()  # this command's jobs only
     checked = _run_sweep(args)
@@ -319,7 +333,7 @@ def _in_turn(command: str, args: list[str]) -> int:
     """A ``-m`` sweep of a command of :data:`IN_TURN`: every job checked, then each run here in
     turn; the worst exit code."""
     from tcbench.cli.app import claim_outputs, expand
-    from tcbench.runner.config import ConfigError
+    from tcbench.errors import ConfigError
 
     check, work = IN_TURN[command]
     try:
@@ -342,7 +356,7 @@ def _in_turn(command: str, args: list[str]) -> int:
 
 def _check_list(c: dict[str, object]) -> None:
     from tcbench.commands.schemas import LISTS
-    from tcbench.runner.config import ConfigError
+    from tcbench.errors import ConfigError
 
     if c.get("what") not in LISTS:
         raise ConfigError(f"what={c.get('what')}: expected one of {', '.join(LISTS)}")

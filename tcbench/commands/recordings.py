@@ -53,27 +53,51 @@ def _fitted_model(cfg: SimulateConfig) -> Any:
         raise CommandError(f"{cfg.model}: {exc}") from None
 
 
+def simulated_protocol(cfg: SimulateConfig) -> str:
+    """The protocol a simulation runs: ``protocol``, else its sensor kind's default (the kind of
+    ``sensor``, of the model file when ``sensor`` is null, msra without either)."""
+    if cfg.protocol is not None:
+        return cfg.protocol
+    from tcbench.sensors import kinds
+
+    sensor = cfg.sensor
+    if sensor is None and cfg.model:
+        from tcbench.diagnose.model_file import ModelFileError, read_model
+
+        try:
+            sensor = read_model(str(cfg.model)).sensor
+        except ModelFileError as exc:
+            raise CommandError(str(exc)) from None
+    try:
+        return str(kinds.get(sensor or "msra").default_protocol)
+    except ValueError as exc:
+        raise CommandError(str(exc)) from None
+
+
 def simulation_stem(cfg: SimulateConfig) -> str:
     """The file stem of a simulation: ``name``, or ``<sensor>-<protocol>-dev<N>-seed<N>`` (for
     a model file ``<model stem>-<protocol>-seed<N>``)."""
     if cfg.name is not None:
         return cfg.name
     if cfg.model:
-        return f"{Path(str(cfg.model)).stem}-{cfg.protocol}-seed{cfg.seed}"
-    return f"{cfg.sensor or 'msra'}-{cfg.protocol}-dev{cfg.device_seed}-seed{cfg.seed}"
+        return f"{Path(str(cfg.model)).stem}-{simulated_protocol(cfg)}-seed{cfg.seed}"
+    return f"{cfg.sensor or 'msra'}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}"
 
 
 def check_simulate(cfg: SimulateConfig) -> Any:
     """Every argument of a simulation, before any work; the fitted model of ``model=`` (None
-    without one). Sets ``cfg.sensor`` when it was null."""
-    from tcbench.sensors.simulate import protocol_names
+    without one). Sets ``cfg.sensor`` and ``cfg.protocol`` when they were null."""
+    from tcbench.sensors import kinds
 
     fitted = _fitted_model(cfg) if cfg.model else None
     cfg.sensor = cfg.sensor or "msra"
     try:
-        names = protocol_names(cfg.sensor)
+        kind = kinds.get(cfg.sensor)
     except ValueError as exc:
         raise CommandError(str(exc)) from None
+    names = list(kind.protocols)
+    if cfg.protocol is None:
+        cfg.protocol = kind.default_protocol
     if cfg.protocol not in names:
         raise CommandError(f"unknown protocol {cfg.protocol!r} for {cfg.sensor}; known: {', '.join(names)}")
     if cfg.format not in {"csv", "parquet"}:

@@ -18,11 +18,12 @@ class SimulateConfig:
     (``protocol_params.duration_s=3600``); ``effects.<id>.<param>=`` changes or adds an effect
     (``effects.hysteresis.amplitude=0.02``); ``without=[white_noise]`` drops some. ``model=PATH``
     simulates a fitted-model file (:mod:`tcbench.diagnose.model_file`) instead of a device: the
-    sensor comes from the file (``sensor`` null), effect changes and ``without`` still apply."""
+    sensor comes from the file (``sensor`` null), effect changes and ``without`` still apply.
+    ``protocol`` null is the sensor kind's default (:attr:`~tcbench.sensors.kinds.SensorKind.default_protocol`)."""
 
     kind: str = "simulate"
     sensor: str | None = None  # null: msra, or the model file's sensor
-    protocol: str = "fulltemp"
+    protocol: str | None = None  # null: the sensor kind's default (msra fulltemp, gyro oven, accel chamber)
     device_seed: int = 0
     seed: int = 0
     out: str = "recordings"

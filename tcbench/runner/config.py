@@ -1,7 +1,7 @@
-"""Structured config of a tcbench job and its validation.
+"""Validation of a tcbench job's config.
 
-The dataclasses are registered with Hydra's ConfigStore as ``base_config`` so OmegaConf checks
-types at composition; :func:`validate` then checks the task's keys against its schema
+Its schema (:mod:`.schema`, re-exported here) is registered with Hydra's ConfigStore as
+``base_config`` so OmegaConf checks types at composition; :func:`validate` then checks the task's keys against its schema
 (:class:`TaskConfig` for function tasks, :class:`MSRATaskConfig` for compensation tasks), ranges
 and names (task, dimension, optimiser and learner names and parameters, budget against one
 generation) and raises :class:`ConfigError` with one line that names the offending key.
@@ -10,13 +10,11 @@ generation) and raises :class:`ConfigError` with one line that names the offendi
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from hydra.core.config_store import ConfigStore
-from omegaconf import MISSING, DictConfig, OmegaConf
+from omegaconf import DictConfig
 
 from tcbench.runner.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
@@ -31,32 +29,7 @@ from tcbench.tasks.schemas import (  # noqa: F401 - the schemas' home before tas
     MSRATaskConfig,
     TaskConfig,
 )
-from tcbench.tracking.config import TrackingConfig
-
-
-@dataclass
-class JobConfig:
-    """One optimisation job: task, optimiser, seed and evaluation budget."""
-
-    task: dict[str, Any] = field(default_factory=lambda: {"name": MISSING})
-    optimiser: dict[str, Any] = field(default_factory=lambda: {"name": MISSING})
-    learner: dict[str, Any] | None = None
-    seed: int = 0
-    budget: int = 1000
-    progress: bool = False
-    tracking: TrackingConfig = field(default_factory=TrackingConfig)
-
-
-def register_schema() -> None:
-    """Make the structured schema available to Hydra as ``base_config``."""
-    ConfigStore.instance().store(name="base_config", node=JobConfig)
-
-
-def as_dict(cfg: DictConfig | dict[str, Any]) -> dict[str, Any]:
-    """Plain, resolved dict of a (sub)config."""
-    if isinstance(cfg, DictConfig):
-        return OmegaConf.to_container(cfg, resolve=True)  # type: ignore[return-value]
-    return dict(cfg)
+from tcbench.runner.schema import JobConfig, as_dict, register_schema  # noqa: F401 - their home before schema.py
 
 
 def checked_task(task: dict[str, Any], schema: type) -> dict[str, Any]:

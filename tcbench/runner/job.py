@@ -20,7 +20,7 @@ from typing import Any
 
 import yaml
 
-from tcbench.runner.config import as_dict
+from tcbench.runner.schema import as_dict
 from tcbench.errors import ConfigError, error_line
 from tcbench.runner.kinds import JobKind, kind_of
 

@@ -52,6 +52,9 @@ class RecordingKind(JobKind):
 class SimulateKind(RecordingKind):
     name, tag, schema = "simulate", "simulation", SimulateConfig
 
+    def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
+        return {**c, "protocol": recordings.simulated_protocol(self.config(c))}  # the kind's default made explicit
+
     def check(self, c: dict[str, Any]) -> None:
         recordings.check_simulate(self.config(c))
 

@@ -44,6 +44,8 @@ class SensorKind:
         from the output unit to it (``°/h``, 3600 for a gyro in deg/s).
     ulog_topic, ulog_unit: PX4's topic of this kind and the unit it logs the axes in.
     px4_letter: the letter of PX4's thermal-calibration parameters (``TC_G*``, ``TC_A*``).
+    default_protocol: the protocol ``tcbench simulate`` runs when none is given (None: the first
+        of ``protocols``).
     """
 
     name: str
@@ -63,6 +65,7 @@ class SensorKind:
     ulog_unit: str | None = None
     px4_letter: str | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
+    default_protocol: str | None = None
 
     def __post_init__(self) -> None:
         if self.input_field not in INPUT_FIELDS:
@@ -70,6 +73,11 @@ class SensorKind:
                              f"got {self.input_field!r}")
         if not self.protocols:
             raise ValueError(f"sensor kind {self.name!r} has no protocol")
+        if self.default_protocol is None:
+            object.__setattr__(self, "default_protocol", next(iter(self.protocols)))
+        elif self.default_protocol not in self.protocols:
+            raise ValueError(f"sensor kind {self.name!r}: default_protocol {self.default_protocol!r} is not one of its "
+                             f"protocols ({', '.join(self.protocols)})")
 
     @property
     def units(self) -> dict[str, str]:

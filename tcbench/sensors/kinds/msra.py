@@ -14,6 +14,7 @@ KIND = SensorKind(
     output_range=(-1.0e6, 1.0e6),  # a frequency difference well below the ~30 kHz resonance
     device=msra_unit,
     protocols={"roomtemp": protocols.msra_roomtemp, "fulltemp": protocols.msra_fulltemp},
+    default_protocol="fulltemp",  # the paper's full-temperature test
     positions=True,
     noise_unit="µg",
     noise_scale=float("nan"),  # Hz -> µg needs the device's scale factor (metrics read it from the sidecar)
