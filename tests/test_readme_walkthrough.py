@@ -1,0 +1,48 @@
+"""The README's walkthrough of a user's own IMU (import, diagnose, calibrate, export, leaderboard,
+on the tofupilot and PAN recordings the repository carries) runs as written: every command of
+its block, in order, from a folder that holds only the repository's data."""
+
+from __future__ import annotations
+
+import json
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from tcbench.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def walkthrough() -> list[list[str]]:
+    """The commands of the README's block under "Your own IMU, end to end", continuations joined."""
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("### Your own IMU, end to end"):]
+    block = re.search(r"```bash\n(.*?)```", section, re.S).group(1)  # type: ignore[union-attr]
+    return [shlex.split(line) for line in block.replace("\\\n", " ").splitlines() if line.strip()]
+
+
+def test_the_walkthrough_block_is_what_this_test_runs() -> None:
+    commands = walkthrough()
+    assert [c[1] for c in commands] == ["import", "diagnose", "calibrate", "export", "import", "calibrate",
+                                        "leaderboard"]
+    assert all(c[0] == "tcbench" for c in commands)
+
+
+@pytest.mark.slow
+def test_the_readme_walkthrough_runs(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (workdir / "data").symlink_to(ROOT / "data")
+    for command in walkthrough():
+        assert main(command[1:]) == 0, " ".join(command)
+    out = capsys.readouterr().out
+    mine = workdir / "my-imu"
+    px4 = (mine / "params" / "px4_tc_params.txt").read_text().splitlines()
+    assert px4[0] == "param set TC_G0_ID 2293768" and len(px4) == 1 + 12 + 3 + 1
+    assert (mine / "params" / "ardupilot_tcal.parm").read_text().startswith("INS_TCAL1_ENABLE 1")
+    pan = json.loads((mine / "calibration" / "pan-x" / "calibration.json").read_text())
+    assert pan["held_out_parts"] == [1, 3] and pan["axis"] == "x"
+    boards = sorted(p.name for p in (mine / "boards").glob("calibration-*.md"))
+    assert len(boards) == 4, boards  # three tofupilot axes and the PAN gyro, one board each
+    assert out.count("best held out:") == 4
