@@ -215,7 +215,7 @@ def test_a_px4_log_records_the_axis_of_each_field(workdir: Path, capsys: pytest.
             meta = read_recording(workdir / "rec" / f"px4-sensor_gyro-{i}-{a}.csv").meta
             assert recording_axis(meta) == a and meta.extra["axis"] == a
             assert isinstance(meta.extra["source"]["px4_device_id"], int) and meta.extra["source"]["instance"] == i
-    assert out.count(f"  time=timestamp_sample [us], temperature=temperature [degC], output=x [rad/s] -> deg/s; "
+    assert out.count("  time=timestamp_sample [us], temperature=temperature [degC], output=x [rad/s] -> deg/s; "
                      "axis x\n") == 3
 
     code, _, err = run(capsys, "import", f"csv={PX4_LOG}", "sensor=gyro", "time=timestamp", "out=bad",

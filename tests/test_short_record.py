@@ -8,7 +8,6 @@ import contextlib
 import io
 import json
 import os
-from pathlib import Path
 
 import mlflow
 import numpy as np

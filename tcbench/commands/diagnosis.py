@@ -66,12 +66,9 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
 def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     """Diagnose the recording, write its report and print the verdict."""
     from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.plan import min_full_duration_s
     from tcbench.diagnose.report import write_report
     from tcbench.diagnose.signals import DiagnosisDataError
-    from tcbench.sensors.recording import sidecar_path
-    from tcbench.staging import InputOverwriteError
-
-    from tcbench.diagnose.plan import min_full_duration_s
 
     rec, sensor, declared = check_diagnose(cfg)
     if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s():
@@ -80,13 +77,7 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
         diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
-    inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
-    try:
-        written = write_report(diag, cfg.out, inputs)
-    except InputOverwriteError as exc:
-        raise overwrite_error(exc) from None
-    except OSError as exc:
-        raise cannot_write(cfg.out, exc, "the report") from None
+    written = _written(write_report, diag, cfg)
     print(f"tcbench: {diag.verdict}")
     print(f"  baseline RMSE held-out {diag.baseline['rmse_heldout']:.4g} {diag.unit}, final "
           f"{diag.final['rmse_heldout']:.4g} {diag.unit}, white noise {diag.noise['white_sigma']:.4g} {diag.unit}")
@@ -94,21 +85,27 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     return DiagnosisOutcome(diag, written)
 
 
-def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str) -> DiagnosisOutcome:
-    """The short-record report of ``rec``, written to ``out``; prints what ran and what needs more time."""
-    from tcbench.diagnose.short_record import short_record
-    from tcbench.diagnose.short_report import write_short_report
+def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
+    """``writer(report, out, inputs)``, its failures as one line (never over an input)."""
     from tcbench.sensors.recording import sidecar_path
     from tcbench.staging import InputOverwriteError
 
-    report = short_record(rec, sensor, name=Path(cfg.recording).name)
     inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
     try:
-        written = write_short_report(report, cfg.out, inputs)
+        return writer(report, cfg.out, inputs)
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
     except OSError as exc:
         raise cannot_write(cfg.out, exc, "the report") from None
+
+
+def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str) -> DiagnosisOutcome:
+    """The short-record report of ``rec``, written to ``out``; prints what ran and what needs more time."""
+    from tcbench.diagnose.short_record import short_record
+    from tcbench.diagnose.short_report import write_short_report
+
+    report = short_record(rec, sensor, name=Path(cfg.recording).name)
+    written = _written(write_short_report, report, cfg)
     print(f"tcbench: {report.verdict}")
     ran = [f"{t.id} ({t.status})" for t in report.tests if t.ran]
     print(f"  ran: {', '.join(ran) or 'nothing'}")
