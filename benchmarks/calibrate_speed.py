@@ -36,9 +36,10 @@ from typing import Any
 import numpy as np
 from common import add_json, blas_threads, command_line, environment, environment_line, parser_for, write_json
 
+from tcbench.data_paths import REAL_DATA
+
 DEFAULT_JSON = Path(__file__).with_name("calibrate_speed.json")
-REPO = Path(__file__).resolve().parents[1]
-TOFUPILOT = REPO / "data" / "real" / "tofupilot_imu_chamber" / "imu_raw_data.csv"
+TOFUPILOT = REAL_DATA / "tofupilot_imu_chamber" / "imu_raw_data.csv"
 HOURS = 24.0
 DEFAULT_METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman", "model")
 LONG_S = 20.0  # a step taking longer is timed once

@@ -76,10 +76,12 @@ def test_diagnose_sweeps_a_fleet_and_tracks_each_diagnosis(workdir: Path,
 
 def test_a_failed_job_of_a_sweep_is_recorded_and_the_sweep_goes_on(workdir: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
-    """A recording the diagnosis cannot use (constant temperature) fails its job only."""
+    """A recording the diagnosis cannot use (constant temperature, long enough for a full
+    diagnosis: a shorter one gets the short-record report) fails its job only."""
     rec, _ = concealed_recording("gyro", None, 5)
     good = write_recording(rec, workdir / "good.csv")
-    assert main(["simulate", "name=flat", "out=.", *SHORT_GYRO, "tracking.enabled=false"]) == 0
+    flat = [a for a in SHORT_GYRO if not a.startswith("protocol_params.duration_s")] + ["protocol_params.duration_s=1500"]
+    assert main(["simulate", "name=flat", "out=.", *flat, "tracking.enabled=false"]) == 0
     code = main(["diagnose", "-m", f"recording={good},flat.csv", "out=fleet/${stem:recording}"])
     out = capsys.readouterr().out
     assert code == 1 and "1 finished, 1 failed" in out and "FAILED" in out

@@ -258,7 +258,9 @@ def test_failed_import_leaves_earlier_output(tmp_path: Path, capsys: pytest.Capt
 
 
 def test_missing_argument_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(capsys, "import", "csv=x.csv", "sensor=gyro", "time=t:s", "output=y:deg/s", f"out={tmp_path}")
+    (tmp_path / "x.csv").write_text("t,temp,y\n0,20,1\n1,21,2\n")
+    code, _, err = run(capsys, "import", f"csv={tmp_path / 'x.csv'}", "sensor=gyro", "time=t:s", "output=y:deg/s",
+                       f"out={tmp_path / 'out'}")
     assert code == 2 and len(err) == 1 and "missing temperature=" in err[0]
 
 
