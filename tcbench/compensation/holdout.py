@@ -16,19 +16,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.compensation.features import running_mean
+
 BLOCKS_MIN = 10  # the bootstrap needs some blocks: fewer held-out blocks than this shortens them
 DRAWS = 2000
 LEVEL = 0.95
 
 
-def running_mean(res: np.ndarray, dt_s: float, window_s: float) -> np.ndarray:
-    """The centred running mean of ``res`` over ``window_s`` (its valid part; the mean of the
-    whole part when it is shorter than a window), by cumulative sums."""
+def drift_track(res: np.ndarray, dt_s: float, window_s: float) -> np.ndarray:
+    """The running mean of ``res`` over ``window_s`` (its valid part; the mean of the whole part
+    when it is shorter than a window), as the drift score reads it."""
     width = max(1, int(round(window_s / dt_s)))
     if res.size < width:
         return np.array([res.mean()]) if res.size else np.array([])
-    c = np.concatenate([[0.0], np.cumsum(res, dtype=np.float64)])
-    return (c[width:] - c[:-width]) / width
+    return running_mean(res, width)
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,7 @@ def block_sums(residuals: Mapping[str, Sequence[np.ndarray]], dt_s: Sequence[flo
     squares: dict[str, list[np.ndarray]] = {m: [] for m in residuals}
     counts: list[np.ndarray] = []
     for k in range(len(first)):
-        tracks = {m: running_mean(parts[k], dt_s[k], window_s) for m, parts in residuals.items()}
+        tracks = {m: drift_track(parts[k], dt_s[k], window_s) for m, parts in residuals.items()}
         n = next(iter(tracks.values())).size
         per = max(1, int(round(block_s / dt_s[k])))
         edges = np.arange(0, n, per)
