@@ -68,9 +68,9 @@ def checked_store(track: TrackingConfig) -> None:
         return
     if not str(track.experiment or "").strip():
         raise CommandError("tracking.experiment: give the MLflow experiment a name, or tracking.enabled=false")
-    from tcbench.tracking import store as tracking
+    from tcbench.tracking import checks
 
     try:
-        tracking.check_store(track.uri, create=True)  # made when the results are logged
-    except tracking.StoreError as exc:
+        checks.check_store(track.uri, create=True)  # made when the results are logged
+    except checks.StoreError as exc:
         raise CommandError(str(exc)) from None

@@ -27,7 +27,13 @@ from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 from tcbench._version import __version__  # noqa: E402
-from tcbench.errors import error_line  # noqa: E402
+from tcbench.tracking.checks import (  # noqa: E402,F401 - the checks are part of this module's interface
+    StoreError,
+    check_store,
+    first_line,
+    sqlite_path,
+    tracking_uri,
+)
 
 TAG_PREFIX = "tcbench."
 log = logging.getLogger(__name__)
@@ -35,16 +41,6 @@ log = logging.getLogger(__name__)
 # reports the error it raises in one line (the run FAILED with it, or the command's error).
 logging.getLogger("mlflow.store.db.utils").setLevel(logging.CRITICAL)
 _BATCH = 1000
-
-
-def tracking_uri(uri: str | None = None) -> str:
-    """The store to use: explicit ``uri``, else ``$MLFLOW_TRACKING_URI``, else ./mlflow.db."""
-    if uri:
-        return uri
-    env = os.environ.get("MLFLOW_TRACKING_URI")
-    if env:
-        return env
-    return f"sqlite:///{Path.cwd() / 'mlflow.db'}"
 
 
 def client(uri: str | None = None) -> MlflowClient:
@@ -70,12 +66,6 @@ def experiment_id(c: MlflowClient, name: str) -> str:
         return found.experiment_id
 
 
-def sqlite_path(uri: str | None = None) -> Path | None:
-    """The database file of a local SQLite store; None for any other store."""
-    resolved = tracking_uri(uri)
-    return Path(resolved[len("sqlite:///"):]) if resolved.startswith("sqlite:///") else None
-
-
 @contextmanager
 def store_lock(uri: str | None = None) -> Iterator[None]:
     """Exclusive lock on a local SQLite store (a ``<db>.lock`` file beside it) while held; a no-op
@@ -89,74 +79,6 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
 
     with locked(db):
         yield
-
-
-class StoreError(Exception):
-    """The tracking store cannot be used: one line saying why."""
-
-
-def first_line(exc: BaseException) -> str:
-    """One line of an exception's text (a database error's own message where it wraps one)."""
-    return error_line(str(getattr(exc, "orig", None) or exc))[:300] or type(exc).__name__
-
-
-def _http_problem(uri: str, timeout_s: float) -> str | None:
-    """Why the MLflow server at ``uri`` cannot be used, asked once with a short timeout (MLflow's
-    own client retries a dead server for minutes), or None."""
-    import urllib.error
-    import urllib.request
-    from urllib.parse import urlsplit
-
-    parts = urlsplit(uri)
-    if not parts.hostname:
-        return "no host in the address"
-    try:
-        port = parts.port or (443 if parts.scheme == "https" else 80)
-        with socket.create_connection((parts.hostname, port), timeout=timeout_s):
-            pass
-    except (OSError, ValueError) as exc:
-        return f"nothing answers at {parts.netloc} ({getattr(exc, 'strerror', None) or exc})"
-    probe = uri.rstrip("/") + "/api/2.0/mlflow/experiments/search?max_results=1"
-    try:
-        with urllib.request.urlopen(probe, timeout=timeout_s) as reply:  # noqa: S310 - http(s) only
-            json.loads(reply.read(1 << 20) or b"{}")
-    except urllib.error.HTTPError as exc:
-        if exc.code in (401, 403):
-            return None  # a server that wants credentials: MLflow's client sends them
-        return f"does not answer as an MLflow server (HTTP {exc.code} for {probe})"
-    except (OSError, ValueError) as exc:
-        return f"does not answer as an MLflow server ({getattr(exc, 'reason', None) or exc})"
-    return None
-
-
-def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str:
-    """The resolved store URI if the store can be used, checked once and quickly; else a
-    :class:`StoreError` with one line. ``create=False`` (reading, e.g. a leaderboard) refuses a
-    local store that does not exist instead of making an empty one."""
-    resolved = tracking_uri(uri)
-    db = sqlite_path(resolved)
-    if db is not None:
-        if db.is_dir():
-            raise StoreError(f"tracking store {db} is a folder, not a database file")
-        if not create and not db.exists():
-            raise StoreError(f"no tracking store at {db}: run a sweep here first, or name the store "
-                             "(MLFLOW_TRACKING_URI, tracking.uri=, --tracking-uri)")
-        from tcbench.outputs import folder_problem
-
-        if create and (problem := folder_problem(db.parent)):
-            raise StoreError(f"tracking store {db}: its folder {db.parent} {problem}")
-        return resolved
-    if resolved.startswith(("http://", "https://")):
-        problem = _http_problem(resolved, timeout_s)
-    else:
-        try:
-            MlflowClient(tracking_uri=resolved).search_experiments(max_results=1)
-            problem = None
-        except Exception as exc:  # noqa: BLE001 - any failure of an unknown store is the user's to fix
-            problem = first_line(exc)
-    if problem:
-        raise StoreError(f"tracking store {resolved}: {problem}")
-    return resolved
 
 
 def prepare_store(uri: str | None, experiment: str) -> str:
