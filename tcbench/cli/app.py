@@ -21,7 +21,7 @@ from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, ConfigKeyError, OmegaConfBaseException
 
-from tcbench.cli.main import VALUE_FLAGS
+from tcbench.cli.flags import VALUE_FLAGS
 from tcbench.commands import schemas as command_schemas
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
 from tcbench.errors import ConfigError, did_you_mean

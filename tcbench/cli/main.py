@@ -34,16 +34,13 @@ with, and runs nothing; -m sweeps.
 """
 
 
-HYDRA_INFO_FLAGS = {"--help", "-h", "--hydra-help", "--info", "-i", "--cfg", "-c", "--shell-completion", "-sc"}
-HYDRA_FLAGS = HYDRA_INFO_FLAGS | {
-    "--version", "--resolve", "-p", "--package", "-r", "--run", "-m", "--multirun", "-cp", "--config-path",
-    "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun",
-}
-HELP_FLAGS = {"-h", "--help"}
-# Hydra flags followed by a value; those that change where configs come from make tcbench
-# skip its up-front check (each job still validates its own config).
-VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
-CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
+from tcbench.cli.flags import (  # noqa: E402 - after the usage text
+    CONFIG_SOURCE_FLAGS,
+    HELP_FLAGS,
+    HYDRA_FLAGS,
+    HYDRA_INFO_FLAGS,
+    VALUE_FLAGS,
+)
 
 
 class UserError(Exception):

@@ -226,8 +226,8 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
             residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
     summary, about = _ranked(table, held, steps, cfg, unit, drift_key)
-    about |= _about(cfg, rec, split, unit)
-    about["export"] = _export_fit(rec, whole, cfg)
+    about |= _about(cfg, rec, split, unit, own_hash)
+    about["export"] = _export_fit(whole)
     out = Path(cfg.out)
     try:
         with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)]) as tmp:
@@ -286,7 +286,7 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[flo
     return summary, ranking
 
 
-def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str) -> dict[str, Any]:
+def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash: str) -> dict[str, Any]:
     """What ``calibration.json`` says of the recording and the split."""
     from tcbench.sensors.recording import RecordingError, recording_axis
 
@@ -295,7 +295,7 @@ def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str) -> dict[str,
         axis = cfg.axis or recording_axis(rec.meta)
     except RecordingError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
-    return {"recording": Path(cfg.recording).name, "content_hash": _content_hash(cfg.recording),
+    return {"recording": Path(cfg.recording).name, "content_hash": content_hash,
             "sensor": rec.meta.sensor, "unit": unit, "axis": axis,
             "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
             "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train,
@@ -309,7 +309,7 @@ def _content_hash(path: str) -> str:
     return content_hash([path])
 
 
-def _export_fit(rec: Any, whole: Any, cfg: CalibrateConfig) -> dict[str, Any] | None:
+def _export_fit(whole: Any) -> dict[str, Any] | None:
     """The cubic an autopilot is given: ``poly3`` refitted on the whole record (the held-out scores
     judged the method; the parameters use every sample), in the recording's output unit."""
     from tcbench.compensation.px4 import fit_offset

@@ -42,7 +42,9 @@ def ardupilot_parameters(sensors: Mapping[str, Mapping[str, OffsetPolynomial]], 
         raise ValueError("imu 1..3")
     if not sensors:
         raise ValueError("no sensor to export")
-    every = [p for s, axes in sensors.items() for p in axes.values() if _letters(s)]
+    for sensor in sensors:
+        _letters(sensor)  # a kind ArduPilot calibrates, or one line
+    every = [p for axes in sensors.values() for p in axes.values()]
     if not every:
         raise ValueError("no axis to export")
     lo, hi = max(p.tmin_c for p in every), min(p.tmax_c for p in every)
