@@ -45,20 +45,25 @@ def test_the_env_checks_and_splits_three_cycles_to_two() -> None:
 def test_the_limits_bound_every_baseline(baselines) -> None:
     oracle, thermo, raw = baselines["oracle"]["drift_ug"], baselines["oracle_thermometer"]["drift_ug"], \
         baselines["raw"]["drift_ug"]
-    assert thermo == pytest.approx(oracle, rel=0.05)  # a 0.01 degC thermometer costs almost nothing here
+    # the thermometer sits apart from the element and moves at each power-on: a real floor (measured 158
+    # against 74 µg on device 0)
+    assert thermo > 1.3 * oracle
     for name in ("model", "lagpoly", "poly3"):
-        assert oracle * 0.98 < baselines[name]["drift_ug"] < raw / 10, name
+        assert thermo < baselines[name]["drift_ug"] < raw / 10, name
     assert baselines["raw"]["gain_drift_ug"] == 1.0 and raw > 1000.0
 
 
-def test_a_temperature_polynomial_cannot_close_the_loop_and_the_diagnosed_model_can(baselines) -> None:
+def test_a_temperature_polynomial_cannot_close_the_loop_and_the_rate_term_can(baselines) -> None:
     """The cooling-minus-heating difference at one thermometer reading is untouched by any function of
     that reading (poly3 leaves the raw loop but for the spread of readings inside a 1 degC bin); the
-    diagnosed lag and hysteresis close most of it."""
-    raw, poly, model, oracle = (baselines[k]["hysteresis_ug"] for k in ("raw", "poly3", "model", "oracle"))
+    cubic with a rate term tells heating from cooling and closes part of it (measured 698 against 1 213 µg)."""
+    raw, poly, oracle = (baselines[k]["hysteresis_ug"] for k in ("raw", "poly3", "oracle"))
     assert poly == pytest.approx(raw, rel=0.01)
-    assert oracle < model < 0.6 * raw
-    assert baselines["model"]["drift_ug"] < baselines["poly3"]["drift_ug"]
+    env = gym.make(ENV, learner="poly", learner_params={"form": "bias_rate"}).unwrapped
+    env.reset(seed=0)
+    rate = env.score(None)[0].summary()
+    assert oracle < rate["hysteresis_ug"] < 0.7 * raw
+    assert rate["drift_ug"] < baselines["poly3"]["drift_ug"]
 
 
 def test_the_model_baseline_is_the_chamber_tasks_only() -> None:

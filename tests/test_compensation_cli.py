@@ -53,7 +53,7 @@ def test_baselines_and_leaderboard(workdir: Path) -> None:
 
 
 def test_zero_bias_job(workdir: Path) -> None:
-    out = tcbench("run", "task=msra_zerobias", "learner=poly", "optimiser=none", cwd=workdir)
+    out = tcbench("run", "task=msra_zerobias", "learner=lagpoly", "optimiser=none", cwd=workdir)
     assert out.returncode == 0, out.stderr
     client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     (run,) = client.search_runs([client.get_experiment_by_name("tcbench").experiment_id])
@@ -73,7 +73,7 @@ def foreign_files(workdir: Path) -> tuple[str, str]:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, lagpoly, model, oracle, oracle_thermometer, poly, raw"),
+        (["learner=nope"], "unknown learner 'nope'; known: bp, elman, lagpoly, memoriser, model, oracle, oracle_thermometer, poly, raw"),
         (["learner.hidden=0"], "learner bp: hidden"),
         (["learner.training=sgd"], "learner bp: training"),
         (["task.n_train=0"], "n_train and n_test must be integers >= 1"),

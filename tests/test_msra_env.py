@@ -74,9 +74,12 @@ def test_polynomial_baseline_near_the_limit() -> None:
     env.reset(seed=0)
     score, history = env.score(None)
     s, oracle = score.summary(), env.score_baseline("oracle").summary()
+    thermo = env.score_baseline("oracle_thermometer").summary()
     assert history.stopped == "closed_form"
-    assert oracle["bias_variation_ug"] <= s["bias_variation_ug"] < 3 * oracle["bias_variation_ug"]
-    assert s["halfg_error_ug"] < 20.0
+    # on new power-ons (next_run) the cubic sits at the limit of a compensator that knows the device but not
+    # this power-on (measured 47.5 against 47.2 µg), far above the die-temperature oracle (5.6 µg)
+    assert 3 * oracle["bias_variation_ug"] < s["bias_variation_ug"] < 1.5 * thermo["bias_variation_ug"]
+    assert s["halfg_error_ug"] < 100.0
 
 
 def test_training_from_a_searched_start_is_deterministic(fulltemp) -> None:
@@ -91,11 +94,16 @@ def test_training_from_a_searched_start_is_deterministic(fulltemp) -> None:
 
 
 def test_zero_bias_task_compensates() -> None:
+    """At room temperature the runs of four power-ons span ~3 degC between their ambients, and each
+    starts at its own turn-on bias: a cubic in the thermometer fitted across them confounds the two
+    and ends worse than raw (measured 324 against 290 µg); the lag-aware polynomial compensates."""
     env = gym.make("tcbench/MSRA-ZeroBias-v0", learner="poly").unwrapped
     env.reset(seed=0)
     s = env.score(None)[0].summary()
     o = env.score_baseline("oracle").summary()
-    assert o["zb_zero_start_ug"] < s["zb_zero_start_ug"] < s["raw_zb_zero_start_ug"]
+    lag = env.score_baseline("lagpoly").summary()
+    assert o["zb_zero_start_ug"] < lag["zb_zero_start_ug"] < 0.6 * s["raw_zb_zero_start_ug"]
+    assert s["zb_zero_start_ug"] > lag["zb_zero_start_ug"]
 
 
 def _write(tmp: Path, name: str, rec) -> str:
@@ -109,7 +117,8 @@ def test_file_recordings_replace_simulated(tmp_path: Path) -> None:
     env = gym.make("tcbench/MSRA-FullTemp-v0", learner="poly", train_files=paths[:2], test_files=paths[2:]).unwrapped
     env.reset(seed=0)
     assert env.data.source == "files" and env.data.test[0].truth is None
-    assert env.score(None)[0].summary()["bias_variation_ug"] < 100.0
+    s = env.score(None)[0].summary()
+    assert s["bias_variation_ug"] < 0.01 * s["raw_bias_variation_ug"]
     with pytest.raises(TaskDataError, match="oracle needs the simulator's truth"):
         env.score_baseline("oracle")
 

@@ -51,8 +51,8 @@ def test_truth_matches_the_recording(fulltemp: Run) -> None:
     np.testing.assert_array_equal(truth.t_s, rec.time_s)
     np.testing.assert_array_equal(truth.input, rec.input)
     assert truth.temp_die_c.shape == truth.output_det.shape == truth.sensitivity_per_input.shape
-    # the die lags the thermometer but spans the same range
-    assert abs(truth.temp_die_c.min() - rec.temperature_c.min()) < 1.0
+    # the die lags the package; the thermometer reads the package 1-3 degC apart (its placement)
+    assert abs(truth.temp_die_c.min() - rec.temperature_c.min()) < 4.0
     sf = rec.meta.extra["scale_factor_hz_per_g"]
     assert np.all(np.abs(truth.sensitivity_per_input / sf - 1.0) < 0.05)
 
@@ -124,21 +124,27 @@ def test_oracle_rejects_mismatched_lengths(roomtemp: Run) -> None:
 
 
 def test_the_thermometer_limited_oracle_reads_the_recorded_thermometer(roomtemp: Run) -> None:
-    """``output_det_thermometer`` is the noise-free model fed the recording's own thermometer
-    column, smoothed over 61 samples; with a thermometer far coarser than the sensor's (1 degC
-    steps, as a Bosch part reads) the two oracles part, the thermometer-limited one the worse."""
+    """``output_det_thermometer`` is the device's noise-free model (not this power-on's) fed the
+    package temperature the device's thermometer placement implies from the recording's own
+    thermometer column, smoothed over 61 samples; with a thermometer far coarser than the sensor's
+    (1 degC steps, as a Bosch part reads) the two oracles part further, the thermometer-limited one
+    the worse."""
+    import dataclasses
+
     from scipy.ndimage import uniform_filter1d
 
-    from tcbench.sensors.simulate import build_profile
+    from tcbench.sensors.runs import placement
+    from tcbench.sensors.simulate import prepare_run
     from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 
     rec, truth = roomtemp
     det = unit("msra", 0).model.without(*STOCHASTIC_EFFECTS)
-    profile = build_profile("msra", "roomtemp", np.random.default_rng(np.random.SeedSequence(0).spawn(3)[0]))
-    profile.temp_c = uniform_filter1d(rec.temperature_c, 61, mode="nearest")
+    profile = prepare_run("msra", "roomtemp", 0, 0).profile
+    smoothed = uniform_filter1d(rec.temperature_c, 61, mode="nearest")
+    profile = dataclasses.replace(profile, temp_c=placement("msra", 0).package_c(smoothed, profile.dt_s))
     np.testing.assert_allclose(truth.output_det_thermometer, det.simulate(profile, np.random.default_rng(0)),
                                rtol=0, atol=1e-9)
-    assert 0 < np.std(truth.output_det_thermometer - truth.output_det) < 0.1 * np.std(rec.output - truth.output_det)
+    assert np.std(truth.output_det_thermometer - truth.output_det) > 0
 
     coarse = {"thermometer_quantisation": {"step_c": 1.0}}
     rough, rough_truth = simulate_recording("msra", "roomtemp", 0, 0, coarse), simulate_truth("msra", "roomtemp", 0, 0, coarse)

@@ -78,10 +78,13 @@ SPECS: dict[str, CommandHelp] = {
             "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static, accel chamber|multipos|static "
                         "(null: the sensor's default, msra fulltemp, gyro oven, accel chamber)",
             "device_seed": "which unit of the device population (integer >= 0)",
-            "seed": "the run's noise draw (integer >= 0)",
+            "seed": "which run of the device (integer >= 0): a new power-on (turn-on bias and scale factor, hysteresis "
+                    "state, chamber timing within tolerance, the thermometer's offset and gradient) and new noise",
+            "power_on": "null: the run's own power-on; N: replay run N's power-on with this run's noise (only the noise "
+                        "differs: the replay tier)",
             "out": "output folder",
             "format": "csv or parquet",
-            "name": "file stem (null: <sensor>-<protocol>-dev<device_seed>-seed<seed>)",
+            "name": "file stem (null: <sensor>-<protocol>-dev<device_seed>-seed<seed>[-poweron<N>])",
             "protocol_params": "protocol_params.<keyword>=VALUE overrides a protocol keyword (duration_s=3600)",
             "effects": "effects.<effect>.<param>=VALUE changes or adds an effect (effects.hysteresis.amplitude=0.02)",
             "without": "effects to drop, e.g. 'without=[white_noise]'",

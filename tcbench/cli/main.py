@@ -388,9 +388,10 @@ def _list(c: dict[str, object]) -> int:
             print(f"  {name:10s} {lentry.cls.__module__}.{lentry.cls.__name__}  (from {lentry.package}; {kind})")
         for name, err in learners.broken().items():
             print(f"  {name:10s} BROKEN: {err}")
-        print("  raw, oracle, oracle_thermometer, lagpoly, model  baselines: no compensation; the simulator's truth "
-              "(the physical limit); its model fed the thermometer (the limit of what a compensator reads); the "
-              "lag-aware polynomial; the model tcbench diagnose fits (accel_chamber)")
+        print("  raw, memoriser, oracle, oracle_thermometer, lagpoly, model  baselines: no compensation; the training "
+              "runs' mean output at the same time (no physics); the simulator's truth (the physical limit); its model "
+              "fed the thermometer (the limit of what a compensator reads); the lag-aware polynomial; the model "
+              "tcbench diagnose fits (accel_chamber)")
     if what in {"all", "sensors"}:
         from tcbench.sensors import kinds as sensor_kinds
 

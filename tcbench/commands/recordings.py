@@ -76,12 +76,14 @@ def simulated_protocol(cfg: SimulateConfig) -> str:
 
 def simulation_stem(cfg: SimulateConfig) -> str:
     """The file stem of a simulation: ``name``, or ``<sensor>-<protocol>-dev<N>-seed<N>`` (for
-    a model file ``<model stem>-<protocol>-seed<N>``)."""
+    a model file ``<model stem>-<protocol>-seed<N>``), ``-poweron<N>`` after it when the run
+    replays another's power-on."""
     if cfg.name is not None:
         return cfg.name
+    replay = "" if cfg.power_on is None else f"-poweron{cfg.power_on}"
     if cfg.model:
-        return f"{Path(str(cfg.model)).stem}-{simulated_protocol(cfg)}-seed{cfg.seed}"
-    return f"{cfg.sensor or 'msra'}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}"
+        return f"{Path(str(cfg.model)).stem}-{simulated_protocol(cfg)}-seed{cfg.seed}{replay}"
+    return f"{cfg.sensor or 'msra'}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}{replay}"
 
 
 def check_simulate(cfg: SimulateConfig) -> Any:
@@ -102,8 +104,8 @@ def check_simulate(cfg: SimulateConfig) -> Any:
         raise CommandError(f"unknown protocol {cfg.protocol!r} for {cfg.sensor}; known: {', '.join(names)}")
     if cfg.format not in {"csv", "parquet"}:
         raise CommandError(f"format must be csv or parquet, got {cfg.format!r}")
-    if cfg.device_seed < 0 or cfg.seed < 0:
-        raise CommandError("device_seed and seed must be non-negative integers")
+    if cfg.device_seed < 0 or cfg.seed < 0 or (cfg.power_on is not None and cfg.power_on < 0):
+        raise CommandError("device_seed, seed and power_on must be non-negative integers")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
     file_stem(simulation_stem(cfg))
@@ -120,7 +122,7 @@ def simulate(cfg: SimulateConfig) -> RecordingOutcome:
     try:
         rec = simulate_recording(cfg.sensor, cfg.protocol, cfg.device_seed, cfg.seed,
                                  effects=cfg.effects, without=tuple(cfg.without), model=fitted,
-                                 **cfg.protocol_params)
+                                 power_on=cfg.power_on, **cfg.protocol_params)
     except (TypeError, ValueError) as exc:
         raise CommandError(str(exc)) from None
     path = out / f"{stem}.{cfg.format}"

@@ -26,6 +26,7 @@ class SimulateConfig:
     protocol: str | None = None  # null: the sensor kind's default (msra fulltemp, gyro oven, accel chamber)
     device_seed: int = 0
     seed: int = 0
+    power_on: int | None = None  # null: the run's own power-on; N: run N's power-on, this run's noise (a replay)
     out: str = "recordings"
     format: str = "csv"
     name: str | None = None

@@ -15,9 +15,19 @@ Two tasks of seed 000 §3 on the MSRA, and one on an ordinary accelerometer:
   ``output - prediction`` (g). The rate input lets a learner tell heating from cooling (the
   lag and the package's hysteresis open a loop between them).
 
-Recordings are simulated from the sensors package (one device, several runs that differ by
-their run seed) or read from schema-v1 files (for example real ones); simulated ones keep the
-simulator's truth for the oracle.
+Recordings are simulated from the sensors package or read from schema-v1 files (for example
+real ones); simulated ones keep the simulator's truth for the oracle. A simulated task draws its
+test runs on one of four tiers (:data:`SPLITS`, PHYSICS.md §9), from easiest to hardest:
+
+- ``replay``: the training runs' power-on again, with new noise (the signal replayed: a
+  diagnostic, not a benchmark — a memoriser of the training runs wins here);
+- ``next_run`` (the default): new power-ons of the same device under the same programme (turn-on
+  bias and scale factor, hysteresis state, chamber timing and the thermometer differ,
+  :mod:`tcbench.sensors.runs`);
+- ``new_profile``: new power-ons under a programme the training never saw (:data:`NEW_PROFILE`:
+  the holds in reverse order and ramps twice as fast; for the room-temperature test, a room 5 °C
+  warmer);
+- ``new_device``: the training runs on some units of the population, the test runs on others.
 """
 
 from __future__ import annotations
@@ -31,6 +41,7 @@ import numpy as np
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.metrics.accelerometer import four_position
 from tcbench.metrics.report import DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G
+from tcbench.sensors.data_hash import shared_recordings
 from tcbench.sensors.recording import Recording, RecordingError, read_recording
 from tcbench.sensors.simulate import simulate_recording
 from tcbench.sensors.truth import Truth, simulate_truth
@@ -40,6 +51,15 @@ SENSORS = {"fulltemp": "msra", "roomtemp": "msra", "chamber": "accel"}  # the ki
 # (train, test) recordings: seed 000 §3.2's for the MSRA; three and two chamber cycles otherwise
 DEFAULT_SPLIT = {"fulltemp": (3, 2), "roomtemp": (4, 2), "chamber": (3, 2)}
 TRAIN_ON = ("positions", "all")
+SPLITS = ("replay", "next_run", "new_profile", "new_device")
+DEFAULT_TIER = "next_run"
+# what the new_profile tier changes in its test runs' programme (simulate_recording's arguments)
+NEW_PROFILE: dict[str, dict[str, object]] = {
+    "fulltemp": {"reverse": True, "ramp_scale": 2.0},
+    "chamber": {"reverse": True, "ramp_scale": 2.0},
+    "roomtemp": {"ambient_c": 28.0},
+    "oven": {"reverse": True, "ramp_scale": 2.0},  # the gyro's (tcbench.compensation.gyro.data)
+}
 
 
 class TaskDataError(ValueError):
@@ -113,22 +133,71 @@ def recording_seed(recordings_seed: int, index: int) -> int:
     return 100 * int(recordings_seed) + int(index)
 
 
-@functools.lru_cache(maxsize=8)
-def _simulated(protocol: str, device_seed: int, seed: int) -> TaskRecording:
-    rec = simulate_recording(SENSORS[protocol], protocol, device_seed, seed)
-    truth = simulate_truth(SENSORS[protocol], protocol, device_seed, seed)
-    return TaskRecording(f"dev{device_seed}-seed{seed}", rec, truth)
+def check_tier(split: object) -> None:
+    """A :class:`TaskDataError` unless ``split`` is one of :data:`SPLITS`."""
+    if split not in SPLITS:
+        raise TaskDataError(f"unknown split {split!r}; known: {', '.join(SPLITS)} (default {DEFAULT_TIER})")
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One simulated run of a task: the device, the run seed, whose power-on it runs (None: its
+    own) and the programme's changes (``simulate_recording`` keyword arguments, as sorted pairs)."""
+
+    device_seed: int
+    seed: int
+    power_on: int | None = None
+    changes: tuple[tuple[str, object], ...] = ()
+
+    @property
+    def name(self) -> str:
+        replay = "" if self.power_on is None else f"-replay{self.power_on}"
+        profile = "-newprofile" if self.changes else ""
+        return f"dev{self.device_seed}-seed{self.seed}{replay}{profile}"
+
+
+def split_runs(protocol: str, split: str, device_seed: int, recordings_seed: int, n_train: int,
+               n_test: int) -> tuple[list[RunSpec], list[RunSpec]]:
+    """The training and test runs of a simulated task on tier ``split`` (:data:`SPLITS`); a
+    :class:`TaskDataError` for an unknown tier, or for one whose test runs would be training runs."""
+    check_tier(split)
+    seeds = [recording_seed(recordings_seed, i) for i in range(n_train + n_test)]
+    d = int(device_seed)
+    train = [RunSpec(d + i if split == "new_device" else d, s) for i, s in enumerate(seeds[:n_train])]
+    test_seeds = seeds[n_train:]
+    if split == "replay":
+        train = [RunSpec(d, s, seeds[0]) for s in seeds[:n_train]]
+        test = [RunSpec(d, s, seeds[0]) for s in test_seeds]
+    elif split == "new_profile":
+        test = [RunSpec(d, s, None, tuple(sorted(NEW_PROFILE[protocol].items()))) for s in test_seeds]
+    elif split == "new_device":
+        test = [RunSpec(d + n_train + j, s) for j, s in enumerate(test_seeds)]
+    else:
+        test = [RunSpec(d, s) for s in test_seeds]
+    if reused := set(train) & set(test):
+        raise TaskDataError(f"split {split!r} would test on its own training run {sorted(reused, key=str)[0].name}")
+    return train, test
+
+
+@functools.lru_cache(maxsize=16)
+def _simulated(protocol: str, run: RunSpec) -> TaskRecording:
+    args = dict(run.changes)
+    rec = simulate_recording(SENSORS[protocol], protocol, run.device_seed, run.seed, power_on=run.power_on, **args)
+    truth = simulate_truth(SENSORS[protocol], protocol, run.device_seed, run.seed, power_on=run.power_on, **args)
+    return TaskRecording(run.name, rec, truth)
 
 
 def simulated_data(protocol: str, device_seed: int, recordings_seed: int, n_train: int, n_test: int,
-                   train_on: str = "positions", rate_window_s: float = 120.0) -> MSRAData:
-    """``n_train + n_test`` simulated runs of device ``device_seed``; the first ``n_train`` train."""
+                   train_on: str = "positions", rate_window_s: float = 120.0,
+                   split: str = DEFAULT_TIER) -> MSRAData:
+    """``n_train`` training and ``n_test`` test runs of device ``device_seed`` on tier ``split``
+    (see the module docstring)."""
     check_split(protocol, n_train, n_test, train_on, rate_window_s)
-    recs = [_simulated(protocol, int(device_seed), recording_seed(recordings_seed, i))
-            for i in range(n_train + n_test)]
+    train_runs, test_runs = split_runs(protocol, split, device_seed, recordings_seed, n_train, n_test)
+    recs = [_simulated(protocol, run) for run in train_runs + test_runs]
     sf = float(recs[0].recording.meta.extra.get("scale_factor_hz_per_g") or 1.0)
-    return MSRAData(protocol, recs[:n_train], recs[n_train:], sf, train_on, rate_window_s,
-                    "simulated", {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed)})
+    return MSRAData(protocol, recs[:n_train], recs[n_train:], sf, train_on, rate_window_s, "simulated",
+                    {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed), "split": split})
 
 
 def check_split(protocol: str, n_train: int, n_test: int, train_on: str, rate_window_s: float) -> None:
@@ -178,6 +247,9 @@ def file_data(protocol: str, train_files: list[str], test_files: list[str], trai
     check_split(protocol, len(train_files), len(test_files), train_on, rate_window_s)
     train = [_load(p, protocol, "training") for p in train_files]
     test = [_load(p, protocol, "test") for p in test_files]
+    if shared := shared_recordings(train_files, test_files):
+        raise TaskDataError(f"{shared[0]} is both a training and a test recording (the same data); a task never "
+                            "tests on its own training runs")
     sfs = [r.recording.meta.extra.get("scale_factor_hz_per_g") for r in train + test if r.recording.meta.extra]
     default = DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G if SENSORS[protocol] == "msra" else 1.0
     sf = float(next((s for s in sfs if s), default))

@@ -1,5 +1,6 @@
 """Compensation methods on a static-input task (MSRA, accelerometer chamber): a learner, no
-compensation (raw), the lag-aware polynomial (lagpoly), and the two oracles (the diagnosed
+compensation (raw), the memoriser (no physics: the training runs' mean output at the same time
+since the start, the sanity row of PHYSICS.md §9), the lag-aware polynomial (lagpoly), and the two oracles (the diagnosed
 model, ``model``, is fitted by the diagnosis: :mod:`tcbench.tasks.diagnosed`).
 
 Each method is a *compensator*: a function of a test recording and an output array (the
@@ -18,7 +19,7 @@ from tcbench.compensation.lagpoly import fit_lag_poly
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.learners.base import Learner
 
-BASELINES = ("raw", "oracle", "oracle_thermometer", "lagpoly", "model")
+BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer", "lagpoly", "model")
 Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
 
 
@@ -41,6 +42,43 @@ def learner_compensator(data: MSRAData, learner: Learner) -> Compensator:
 def raw_compensator(data: MSRAData) -> Compensator:
     """No compensation: the output itself (its unit)."""
     return lambda tr, output: np.asarray(output, dtype=np.float64)
+
+
+def memorised(recordings: list[TaskRecording], column: str = "output") -> Callable[[np.ndarray], np.ndarray]:
+    """The recordings' mean ``column`` at the same time since their start, as a function of a
+    record's times (past a shorter run's end, the mean of the runs still going; past the longest,
+    its last value)."""
+    recs = [tr.recording for tr in recordings]
+    dt_s = min(float(np.median(np.diff(r.time_s))) for r in recs)
+    durations = [float(r.time_s[-1] - r.time_s[0]) for r in recs]
+    grid = np.arange(0.0, max(durations) + dt_s / 2, dt_s)
+    grid = grid[grid <= max(durations)]  # the longest run covers every point
+    rows = [np.interp(grid, r.time_s - r.time_s[0], getattr(r, column), right=np.nan) for r in recs]
+    mean = np.nanmean(np.stack(rows), axis=0)
+    return lambda t_s: np.interp(np.asarray(t_s) - t_s[0], grid, mean)
+
+
+def memorised_output(recordings: list[TaskRecording]) -> Callable[[np.ndarray], np.ndarray]:
+    """:func:`memorised` output (the memoriser's correction)."""
+    return memorised(recordings, "output")
+
+
+def memoriser_compensator(data: MSRAData) -> Compensator:
+    """No physics: the training runs' mean output (and applied input) at the same time since their
+    start, taken from a test run's output (``inverse``: the memorised input plus the output's
+    departure from the memorised output, over the scale factor). On a test run that replays the
+    training signal it is near the limit; on a new power-on it should lose to a cubic in
+    temperature (PHYSICS.md §9)."""
+    output, applied = memorised(data.train, "output"), memorised(data.train, "input")
+
+    def compensate(tr: TaskRecording, out: np.ndarray) -> np.ndarray:
+        t = tr.recording.time_s
+        y = np.asarray(out, dtype=np.float64)
+        if data.form == "inverse":
+            return applied(t) + (y - output(t)) / data.scale_factor_hz_per_g
+        return y - output(t)
+
+    return compensate
 
 
 def lagpoly_compensator(data: MSRAData) -> Compensator:

@@ -34,6 +34,7 @@ from tcbench.leaderboard.files import (
     write_board_files,
 )
 from tcbench.tables import markdown_table
+from tcbench.compensation.data import DEFAULT_TIER
 from tcbench.compensation.scoring import FLAGS, METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
 
@@ -57,6 +58,12 @@ class CompensationBoard:
     runs: pd.DataFrame
     data: str = ""  # the user's recordings the runs trained and tested on (empty: simulated)
     in_sample: str = ""  # the test files that are training files too
+    split: str = ""  # the tier the simulated test runs were drawn on (tcbench.compensation.data.SPLITS)
+
+    @property
+    def stem(self) -> str:
+        """File stem: the task, with the tier after it unless it is the default ``next_run``."""
+        return self.task if self.split in ("", DEFAULT_TIER) else f"{self.task}.{self.split}"
 
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -71,9 +78,18 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
             "start_time": r.info.start_time, "error_message": t.get("tcbench.error", ""),
             "task_name": t.get("tcbench.task_name"), "data_hash": t.get("tcbench.data_hash", ""),
             "train_files": t.get("tcbench.train_files", ""), "test_files": t.get("tcbench.test_files", ""),
-            "in_sample": t.get("tcbench.in_sample", ""), "params": dict(r.data.params), **r.data.metrics,
+            "in_sample": t.get("tcbench.in_sample", ""), "split": _split_of(dict(r.data.params)),
+            "params": dict(r.data.params), **r.data.metrics,
         })
     return pd.DataFrame(rows)
+
+
+def _split_of(params: dict[str, str]) -> str:
+    """The tier of a run's simulated test runs: ``task.split``; ``files`` for the user's recordings;
+    ``before tiers`` for a run made before tiers existed (its runs differed in noise alone)."""
+    if params.get("task.train_files", "None") not in ("None", "", "null"):
+        return "files"
+    return params.get("task.split", "before tiers")
 
 
 def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
@@ -92,7 +108,7 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             row[f"median_{s}"] = float(np.median(x)) if x.size else np.nan
             row[f"ci95_{s}"] = f"{low:.3g}–{high:.3g}" if np.isfinite(low) else "–"
             if m == primary:
-                row["ci_high_primary"] = high
+                row["ci_high_primary"], row["ci_low_primary"] = high, low
             row[f"best_by_train_{s}"] = float(best[m]) if best is not None else np.nan
             raw = ok[f"raw_{m}"].to_numpy(float) if f"raw_{m}" in ok else np.array([])
             if m not in NO_GAIN:
@@ -115,7 +131,7 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     for column, limit in LIMITS.items():
         table[column] = _ratio_to(table, protocol, limit)
     table["note"] = _notes(table, protocol)
-    return table.drop(columns="ci_high_primary")
+    return table.drop(columns=["ci_high_primary", "ci_low_primary"])
 
 
 LIMITS = {"x_oracle": "oracle", "x_thermo": "oracle_thermometer"}  # ratio column -> the limit row it divides by
@@ -128,12 +144,23 @@ def _ratio_to(table: pd.DataFrame, protocol: str, limit: str) -> np.ndarray:
     return primary / float(row.iloc[0]) if not row.empty and float(row.iloc[0]) > 0 else np.full(len(table), np.nan)
 
 
+def _limit_low(table: pd.DataFrame, limit: str, primary: str) -> float:
+    """The low end of a limit row's interval (its median for a single run; NaN without the row):
+    a method is below a limit only when its own interval ends under it."""
+    row = table.loc[table["method"] == limit]
+    if row.empty:
+        return float("nan")
+    low = float(row["ci_low_primary"].iloc[0])
+    return low if np.isfinite(low) else float(row[primary].iloc[0])
+
+
 PROBE_FAILS = 10.0  # a ±0.5 g error this many times the oracle's: the method learned the trained levels
 
 
 def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
     """Flag what a median alone hides. Below the physical limit: the upper end of the median's
-    95 % interval is under the oracle's value (one draw of the noise, no interval of its own).
+    95 % interval is under the low end of the oracle's (over its run draws; its value when it ran once);
+    below the thermometer-limited oracle likewise.
     Fails the ±0.5 g probe (fulltemp): its error is over :data:`PROBE_FAILS` times the oracle's —
     a model of the trained acceleration levels, not of the sensor, whatever its Table 2 figure.
     And (fulltemp) when the paper's pick, the best of the restarts by training RMSE, fails the
@@ -144,7 +171,8 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
         return [""] * len(table)
     if protocol == "gyro":
         return _gyro_notes(table)
-    limit = float(oracle[primary].iloc[0])
+    limit = _limit_low(table, "oracle", primary)
+    thermo = _limit_low(table, "oracle_thermometer", primary)
     probe_limit = float(oracle["median_halfg_ug"].iloc[0]) if "median_halfg_ug" in oracle else np.nan
     notes = []
     for row in table.itertuples(index=False):
@@ -153,7 +181,11 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
             continue
         parts = []
         if row.ci_high_primary < limit:  # NaN (a single run) compares False
-            parts.append(f"below the physical limit (ci95 up to {row.ci_high_primary:.3g} < {limit:.3g})")
+            parts.append(f"below the physical limit (ci95 up to {row.ci_high_primary:.3g} < the oracle's from "
+                         f"{limit:.3g})")
+        elif row.ci_high_primary < thermo:
+            parts.append(f"below the thermometer-limited oracle (ci95 up to {row.ci_high_primary:.3g} < its from "
+                         f"{thermo:.3g}): it knows this power-on, which no compensator fitted on other runs can")
         probe, picked = getattr(row, "median_halfg_ug", np.nan), getattr(row, "best_by_train_halfg_ug", np.nan)
         if probe > PROBE_FAILS * probe_limit:
             parts.append(f"fails the ±0.5 g probe ({probe:.2g} µg, oracle {probe_limit:.2g})")
@@ -165,16 +197,18 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
 
 MSRA_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
-    "physical limit); oracle_thermometer = the same model fed the thermometer reading (smoothed over 60 s) instead: "
-    "the limit of a compensator that knows the physics and reads what a real one reads; poly3 = bias and scale "
+    "physical limit); oracle_thermometer = the device's model (not this power-on's) fed the package temperature its "
+    "thermometer's reading implies (smoothed over 60 s): the limit of a compensator that knows the device exactly, "
+    "not this power-on, and reads what a real one reads; memoriser = no physics, the training runs' mean output at "
+    "the same time since the start (it wins only where the test runs replay the training signal); poly3 = bias and scale "
     "factor cubic in temperature (least squares); lagpoly = the same in the thermometer passed through a "
     "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
     "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by seed.")
 FULLTEMP_NOTE = (
     " note: \"below the physical limit\" when even the upper end of the median's 95 % interval is under the "
-    "oracle's; a method below it is not better physics but has learned the trained acceleration levels (−1, 0, "
-    "+1 g), which the ±0.5 g probe (halfg: the 0 g samples moved to ±0.5 g) shows; \"fails the ±0.5 g probe\" "
+    "low end of the oracle's (over its run draws); a method below it is not better physics but has learned the "
+    "trained acceleration levels (−1, 0, +1 g), which the ±0.5 g probe (halfg: the 0 g samples moved to ±0.5 g) shows; \"fails the ±0.5 g probe\" "
     "when its error is over ten times the oracle's, whatever its bias figure: a network near the limit on Table 2 "
     "that fails it has fitted the three trained levels rather than the sensor, one far from the limit is simply "
     "wrong between them. The paper's selection rule (best of "
@@ -182,8 +216,10 @@ FULLTEMP_NOTE = (
     "than the median restart.")
 CHAMBER_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
-    "physical limit); oracle_thermometer = the same model fed the thermometer reading (smoothed over 60 s); "
-    "poly3 = bias cubic in the thermometer, as flight stacks ship it (least squares); poly3_rate = the same plus "
+    "physical limit); oracle_thermometer = the device's model (not this power-on's) fed the package "
+    "temperature its thermometer's reading implies (smoothed over 60 s): the limit of a compensator that knows the "
+    "device exactly, not this power-on; memoriser = no physics, the training runs' mean output at the same time "
+    "since the start; poly3 = bias cubic in the thermometer, as flight stacks ship it (least squares); poly3_rate = the same plus "
     "a cubic times the temperature rate (the inputs the networks get); lagpoly = cubic in the thermometer passed "
     "through a first-order lag, lag and degree by leave-one-recording-out error; model = the physics tcbench "
     "diagnose fitted on the first training cycle (lag, hysteresis, warm-up ...), run noise-free on the test "
@@ -196,13 +232,27 @@ GYRO_KEY = (
     "universal soft threshold at the deepest level the record allows unless named -L<level>), then "
     "the drift learner (BAS-elman = BAS-initialised Elman on [T, dT/dt]; (T) = temperature input only); "
     "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
-    "limit); oracle_thermometer = the simulator's drift model fed the thermometer reading (smoothed over 60 s) "
-    "instead of the true temperature; x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
+    "limit); oracle_thermometer = the device's drift model (not this power-on's) fed the package temperature "
+    "its thermometer's reading implies (smoothed over 60 s); memoriser = no physics, the training run's mean "
+    "output at the same time since the start subtracted; x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by "
     "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
 
 
+SPLIT_LINES = {
+    "replay": "**Split replay:** the test runs replay the training runs' power-on with new noise: a diagnostic, "
+              "not a benchmark (a memoriser of the training signal wins here).",
+    "next_run": "**Split next_run:** the test runs are new power-ons of the same device under the same programme "
+                "(turn-on bias and scale factor, hysteresis state, chamber timing and the thermometer differ; "
+                "PHYSICS.md §9).",
+    "new_profile": "**Split new_profile:** the test runs are new power-ons under a programme the training never "
+                   "saw (the holds in reverse order, ramps twice as fast; a room 5 °C warmer for the zero-bias test).",
+    "new_device": "**Split new_device:** the training runs are of some units of the population, the test runs of "
+                  "others.",
+    "before tiers": "**Runs made before split tiers:** simulated runs then differed in their noise alone (what "
+                    "`replay` is now); their held-out scores measure a replay of the training signal.",
+}
 KEYS = {"gyro": GYRO_KEY, "chamber": CHAMBER_KEY, "fulltemp": MSRA_KEY + FULLTEMP_NOTE, "roomtemp": MSRA_KEY}
 
 
@@ -229,11 +279,13 @@ def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[Compensation
     task, method, config and seed); ``protocol_of`` maps a task name to its protocol
     (:func:`tcbench.tasks.specs.protocols`)."""
     out = []
-    for task, g in _one_run_per_job(runs).groupby("task", sort=True):
+    runs = runs.assign(split=runs["split"].fillna("")) if "split" in runs else runs.assign(split="")
+    for (task, split), g in _one_run_per_job(runs).groupby(["task", "split"], sort=True):
         g = label_configs(g)
         protocol = protocol_of[str(g["task_name"].iloc[0])]
         table = _mark_in_sample(summarise(g, protocol), g)
-        out.append(CompensationBoard(str(task), protocol, table, g, _data_line(g), _tag_values(g, "in_sample")))
+        out.append(CompensationBoard(str(task), protocol, table, g, _data_line(g), _tag_values(g, "in_sample"),
+                                     str(split)))
     return out
 
 
@@ -351,8 +403,8 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
 def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Path]:
     """Write ``<task>.md``, ``<task>.csv`` and ``<task>.png`` into ``out_dir`` (atomically)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = {"md": out_dir / f"{board.task}.md", "csv": out_dir / f"{board.task}.csv",
-             "png": out_dir / f"{board.task}.png"}
+    paths = {"md": out_dir / f"{board.stem}.md", "csv": out_dir / f"{board.stem}.csv",
+             "png": out_dir / f"{board.stem}.png"}
     _plot(board, paths["png"])
     primary = PRIMARY[board.protocol]
     failed = board.runs[board.runs["status"] != "FINISHED"]
@@ -375,7 +427,8 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
                 "measures both)",
     }[board.protocol]
     lines = [
-        f"# Compensation leaderboard: {board.task}", "",
+        f"# Compensation leaderboard: {board.task}" + (f" — split {board.split}" if board.split else ""), "",
+        *([SPLIT_LINES.get(board.split, ""), ""] if board.split in SPLIT_LINES else []),
         *([board.data, ""] if board.data else []),
         *([f"**In-sample:** train_files and test_files share {board.in_sample}: the test scores are in-sample, "
            "not held out (the rows are marked in note).", ""] if board.in_sample else []),

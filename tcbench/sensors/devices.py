@@ -1,17 +1,24 @@
 """Device populations: a device seed draws one unit's parameters from a realistic spread.
 
-Repeated experiments on one device differ only by the run seed (noise, ambient); different
-device seeds differ like different parts from one wafer lot. The spreads are set so the raw
+Runs of one device differ by their run seed: a new power-on (:mod:`tcbench.sensors.runs`: the
+turn-on draws below, the chamber's timing, the hysteresis state, the thermometer) and new noise;
+different device seeds differ like different parts from one wafer lot. The spreads are set so the raw
 metrics of the population span the seed papers' raw figures (see
 ``experiments/raw-sensors/README.md``); the calibration choices are stated next to each draw.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from tcbench.sensors import kinds
-from tcbench.sensors.models import MSRA, Gyro, Unit, gyro_effects, msra_effects
+from tcbench.sensors.models import MSRA, Gyro, SensorModel, Unit, gyro_effects, msra_effects
+
+SLOPE_REPEAT = 0.01  # the temperature slope's run-to-run change, relative std (PHYSICS.md §9: about 1 %)
+MSRA_SLOPE_REPEAT = 0.001  # a resonant part's (see msra_power_on)
+AGEING_DAYS = 30.0  # a run falls uniformly within this many days of the device's first
 
 
 def device_rng(kind: str, device_seed: int) -> np.random.Generator:
@@ -73,6 +80,45 @@ def gyro_unit(device_seed: int) -> Unit:
         effects=gyro_effects(**draws),
     )
     return Unit(f"gyro-{device_seed:04d}", model, draws)
+
+
+def msra_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
+    """An MSRA's power-on: turn-on bias 100 µg (std; resonator 1's frequency moved), scale factor
+    50 ppm, bias slope 0.1 %, ageing 2 µg per day over up to :data:`AGEING_DAYS` days. A resonant
+    part sits at the repeatable end of PHYSICS.md §9's ranges: seed 000's zero-bias stability is
+    110-190 µg, and its compensated test sets' bias variation (33-37 µg over a 39 000 µg span, Table 2)
+    bounds the slope's run-to-run change near 0.1 %."""
+    if not isinstance(model, MSRA):
+        return model, {}  # a fitted model: no turn-on draws of this part
+    sf = model.scale_factor_hz_per_g
+    days = rng.uniform(0.0, AGEING_DAYS)
+    draws = {"turn_on_bias_ug": rng.normal(0.0, 100.0), "scale_factor_ppm": rng.normal(0.0, 50.0),
+             "slope_change": rng.normal(0.0, MSRA_SLOPE_REPEAT), "days": days, "aged_ug": days * rng.normal(0.0, 2.0)}
+    f0_1, f0_2 = model.f0_hz
+    c1 = [t + s for t, s in zip(model.tce_ppm_per_k, model.stress_ppm_per_k, strict=True)]
+    slope_hz_per_k = (f0_1 * c1[0] - f0_2 * c1[1]) * 1e-6
+    shift_hz = (draws["turn_on_bias_ug"] + draws["aged_ug"]) * 1e-6 * sf
+    stress_1 = model.stress_ppm_per_k[0] + draws["slope_change"] * slope_hz_per_k / f0_1 * 1e6
+    return dataclasses.replace(
+        model, f0_hz=(f0_1 + shift_hz, f0_2),
+        k_hz_per_g=tuple(k * (1.0 + draws["scale_factor_ppm"] * 1e-6) for k in model.k_hz_per_g),  # type: ignore[arg-type]
+        stress_ppm_per_k=(stress_1, model.stress_ppm_per_k[1]),
+    ), {k: float(v) for k, v in draws.items()}
+
+
+def gyro_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
+    """A gyro's power-on: turn-on bias 20 deg/h (std), scale factor 300 ppm, bias slope 1 %,
+    ageing 0.3 deg/h per day over up to :data:`AGEING_DAYS` days."""
+    if not isinstance(model, Gyro):
+        return model, {}  # a fitted model: no turn-on draws of this part
+    days = rng.uniform(0.0, AGEING_DAYS)
+    draws = {"turn_on_bias_dph": rng.normal(0.0, 20.0), "scale_factor_ppm": rng.normal(0.0, 300.0),
+             "slope_change": rng.normal(0.0, SLOPE_REPEAT), "days": days, "aged_dph": days * rng.normal(0.0, 0.3)}
+    return dataclasses.replace(
+        model, b0_dph=model.b0_dph + draws["turn_on_bias_dph"] + draws["aged_dph"],
+        sf0_ppm=model.sf0_ppm + draws["scale_factor_ppm"],
+        b1_dph_per_k=model.b1_dph_per_k * (1.0 + draws["slope_change"]),
+    ), {k: float(v) for k, v in draws.items()}
 
 
 def unit(sensor: str, device_seed: int) -> Unit:

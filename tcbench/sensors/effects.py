@@ -96,12 +96,13 @@ class TemperatureRate(Effect):
         return self.coef_per_c_per_s * s.temp_rate_c_per_s
 
 
-def play_operator(temp_c: np.ndarray, width_c: float) -> np.ndarray:
+def play_operator(temp_c: np.ndarray, width_c: float, start_state: float = 0.0) -> np.ndarray:
     """Play (backlash) operator of half-width ``width_c``: the state lags the input by at most
-    ``width_c`` and only moves when pushed. Sequential by nature, so it runs over the thermal
-    samples (1 Hz or slower in the protocols), not over output samples."""
+    ``width_c`` and only moves when pushed; it starts ``start_state`` half-widths below the input
+    (+1: the history before was a heating, -1 a cooling). Sequential by nature, so it runs over the
+    thermal samples (1 Hz or slower in the protocols), not over output samples."""
     out = np.empty_like(temp_c)
-    y = float(temp_c[0])
+    y = float(temp_c[0]) - float(np.clip(start_state, -1.0, 1.0)) * width_c
     for i, x in enumerate(temp_c.tolist()):
         y = min(max(y, x - width_c), x + width_c)
         out[i] = y
@@ -111,16 +112,18 @@ def play_operator(temp_c: np.ndarray, width_c: float) -> np.ndarray:
 @dataclass(frozen=True)
 class Hysteresis(Effect):
     """``amplitude * s(t)``, ``s = (T_die - play(T_die)) / width`` in [-1, 1]: +1 after heating,
-    -1 after cooling, remembered through a soak."""
+    -1 after cooling, remembered through a soak; ``start_state`` is where the history before the
+    run left it."""
 
     id: ClassVar[str] = "hysteresis"
     amplitude: float = 0.0
     width_c: float = 2.0
+    start_state: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
         step = max(1, int(round(1.0 / s.dt_s)))  # the play operator on a <= 1 Hz grid
         coarse = s.temp_die_c[::step]
-        state = (coarse - play_operator(coarse, self.width_c)) / self.width_c
+        state = (coarse - play_operator(coarse, self.width_c, self.start_state)) / self.width_c
         return self.amplitude * np.interp(s.t_s, s.t_s[::step], state)
 
 

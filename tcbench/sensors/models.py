@@ -148,11 +148,13 @@ def msra_effects(
 class Gyro(SensorModel):
     """Dual-mass vibratory gyroscope (PHYSICS.md §2).
 
-    ``w_out = (1 + sf dT) (W + b0 + b1 dT + b2 dT^2)`` with ``dT = T_die - ref`` and the bias in
-    deg/h; the cubic and rate terms, lag and noise are effects.
+    ``w_out = (1 + sf0 + sf dT) (W + b0 + b1 dT + b2 dT^2)`` with ``dT = T_die - ref`` and the
+    bias in deg/h; ``sf0`` is the scale factor's turn-on error; the cubic and rate terms, lag and
+    noise are effects.
     """
 
     kind = "gyro"
+    sf0_ppm: float = 0.0
     sf_ppm_per_k: float = -280.0
     b0_dph: float = 0.0
     b1_dph_per_k: float = 1.10
@@ -171,7 +173,7 @@ class Gyro(SensorModel):
         out *= DPH
         out += s.rate_dps
         dt *= self.sf_ppm_per_k * 1e-6
-        dt += 1.0
+        dt += 1.0 + self.sf0_ppm * 1e-6
         out *= dt
         return out
 

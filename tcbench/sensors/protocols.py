@@ -17,6 +17,7 @@ sensor's ``thermal_lag`` effect).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -24,6 +25,7 @@ import numpy as np
 
 from tcbench.sensors import kinds
 from tcbench.sensors.thermal import Segment, first_order_lag, gauss_markov, segment_index, setpoint
+from tcbench.sensors.timing import MIN_SOAK_S, Timing, current_timing
 
 MAX_LEVELS = 1000  # temperature levels of an oven run
 MAX_SAMPLES = 100_000_000  # a longer profile is refused before any array is made (8 bytes x columns each)
@@ -97,7 +99,9 @@ def _from_segments(
     sample_rate_hz: float,
     chamber: Chamber,
 ) -> Profile:
-    """Sample a segment programme: set-point -> chamber air -> package, inputs per segment."""
+    """Sample a segment programme: set-point -> chamber air -> package, inputs per segment, as
+    the current run's chamber runs it (:func:`as_run`)."""
+    segments, start_c, chamber = as_run(segments, start_c, chamber, current_timing())
     thermal_dt = min(1.0, 1.0 / sample_rate_hz)
     check_length(programme_s(segments, start_c, chamber.ramp_c_per_min), sample_rate_hz, thermal_dt)
     t_th, sp = setpoint(segments, start_c, chamber.ramp_c_per_min, thermal_dt)
@@ -123,6 +127,23 @@ def _from_segments(
         name, sensor, sample_rate_hz, t, temp, accel, cross, rate, labels,
         {"chamber_ramp_c_per_min": chamber.ramp_c_per_min, "package_tau_s": chamber.package_tau_s},
     )
+
+
+def as_run(segments: list[Segment], start_c: float, chamber: Chamber,
+           timing: Timing) -> tuple[list[Segment], float, Chamber]:
+    """A programme as one run runs it: the holds in reverse order (``timing.reverse``; a leading
+    hold at the start temperature stays first), soaks of at least :data:`MIN_SOAK_S` scaled, the
+    start point moved and the ramp rate scaled."""
+    if timing.reverse:
+        starts = [i for i, seg in enumerate(segments) if seg.duration_s >= MIN_SOAK_S] or [0]
+        starts = [0] + [i for i in starts if i > 0]
+        groups = [segments[a:b] for a, b in zip(starts, starts[1:] + [len(segments)], strict=True)]
+        first = [groups.pop(0)] if groups[0][0].target_c == start_c and len(groups) > 1 else []
+        segments = [seg for group in first + groups[::-1] for seg in group]
+    durations = timing.soaks(np.array([seg.duration_s for seg in segments]))
+    segments = [dataclasses.replace(seg, duration_s=float(d)) for seg, d in zip(segments, durations, strict=True)]
+    chamber = dataclasses.replace(chamber, ramp_c_per_min=chamber.ramp_c_per_min * timing.ramp_scale)
+    return segments, start_c + timing.start_offset_c, chamber
 
 
 def four_position_nodes(
@@ -177,6 +198,9 @@ def msra_roomtemp(
     power-on, on top of an ambient that wanders (Gauss-Markov, std ``wander_c``).
     """
     check_length(duration_s, sample_rate_hz)
+    timing = current_timing()
+    ambient_c += timing.ambient_offset_c
+    self_heating_c *= timing.self_heating_scale
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
     thermal_dt = max(1.0 / sample_rate_hz, 1.0)
     coarse_t = np.arange(0.0, duration_s + thermal_dt, thermal_dt)
@@ -216,6 +240,7 @@ def gyro_static(
     """A long run at rest and constant temperature (for Allan variance). The constant columns
     are read-only broadcast views, so a 24 h run at 100 Hz holds one full-length array (time)."""
     check_length(duration_s, sample_rate_hz)
+    temp_c += current_timing().start_offset_c
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
     zeros = np.broadcast_to(np.float64(0.0), t.shape)
     return Profile("static", "gyro", sample_rate_hz, t, np.broadcast_to(np.float64(temp_c), t.shape), zeros, zeros, zeros)

@@ -9,13 +9,15 @@ noise-free output, and the sensitivity of that output to the applied input. The 
 minus ``output_det`` is the noise alone (white, flicker, random walk and quantisation); the oracle
 (:mod:`tcbench.compensation.oracle`) is built on it.
 
-It also returns what a compensator that knows the simulator's model could reconstruct when it
-reads only the thermometer, as every real compensator does: the same noise-free model fed the
-recorded thermometer reading (its noise, its 0.01 degC resolution, the thermometer-stage effects)
-after a centred mean over :data:`THERMOMETER_SMOOTH_S`, instead of the true package temperature.
-The die's lag behind the package is part of the model, so it is reconstructed from the reading;
-what is lost is the thermometer's own noise and resolution, as they pass through the model (the
-thermometer-limited oracle).
+It also returns what a compensator that knows the device exactly could reconstruct when it reads
+only the thermometer, as every real compensator does (the thermometer-limited oracle): the
+device's model (with the run's effect changes) and where its thermometer sits (the offset and
+heat-flow gradient of :func:`tcbench.sensors.runs.placement`), fed the package temperature that
+placement implies from the recorded reading after a centred mean over
+:data:`THERMOMETER_SMOOTH_S`. What it cannot know is this power-on (turn-on bias, scale factor and
+slope, the hysteresis state, the thermometer's run-to-run offset and gradient), the thermometer's
+noise and its 0.01 degC resolution: a real floor above the die-temperature oracle, the one any
+compensator fitted on other runs faces.
 """
 
 from __future__ import annotations
@@ -29,10 +31,9 @@ from scipy.ndimage import uniform_filter1d
 
 from tcbench.sensors import effects as fx
 from tcbench.sensors import kinds
-from tcbench.sensors.devices import unit
 from tcbench.sensors.models import SensorModel, _signals
 from tcbench.sensors.protocols import Profile
-from tcbench.sensors.simulate import build_profile, thermometer_reading
+from tcbench.sensors.simulate import prepare_run, thermometer_reading
 
 STOCHASTIC_EFFECTS = ("white_noise", "bias_instability", "random_walk", "quantisation", "noise_temperature", "noise_time")
 # The thermometer-limited oracle's smoothing of the reading: a centred mean over a minute averages
@@ -53,8 +54,9 @@ class Truth:
     sensitivity_per_input: d output_det / d input (Hz/g for the MSRA, output per deg/s for
         the gyro), by a central difference with the input shifted by +-the kind's ``input_step``.
     input: the applied input (g or deg/s), the recording's ``input``.
-    output_det_thermometer: the noise-free output of the same model fed the recorded thermometer
-        reading, smoothed (see the module docstring), in place of the true package temperature.
+    output_det_thermometer: the noise-free output of the device's model (not this power-on's) fed the
+        package temperature implied by the recorded thermometer reading, smoothed (see the module
+        docstring).
     """
 
     t_s: np.ndarray
@@ -83,18 +85,17 @@ def simulate_truth(
     seed: int = 0,
     effects: dict[str, dict[str, float]] | None = None,
     without: tuple[str, ...] | list[str] = (),
-    **protocol_params: Any,
+    **run_params: Any,
 ) -> Truth:
     """Truth of the run ``simulate_recording(sensor, protocol, device_seed, seed, effects,
-    without, **protocol_params)`` would record (same arguments, same device and profile)."""
-    device = unit(sensor, device_seed)
-    model = device.model.with_effects(effects or {}).without(*without)
-    profile_seq, _, thermometer_seq = np.random.SeedSequence(seed).spawn(3)
-    profile = build_profile(sensor, protocol, np.random.default_rng(profile_seq), **protocol_params)
-    reading = thermometer_reading(profile, model, np.random.default_rng(thermometer_seq))  # as the recording holds it
+    without, **run_params)`` would record (same arguments: same device, power-on and profile)."""
+    run = prepare_run(sensor, protocol, device_seed, seed, effects, without, **run_params)
+    profile = run.profile
+    det = run.model.without(*STOCHASTIC_EFFECTS)
+    reading = thermometer_reading(profile, run.model, run.thermometer_rng, run.power_on.placement)  # as recorded
     width = max(1, int(round(THERMOMETER_SMOOTH_S * profile.sample_rate_hz)) | 1)
-    read_profile = dataclasses.replace(profile, temp_c=uniform_filter1d(reading, width, mode="nearest"))
-    det = model.without(*STOCHASTIC_EFFECTS)
+    smoothed = uniform_filter1d(reading, width, mode="nearest")
+    read_profile = dataclasses.replace(profile, temp_c=run.placement.package_c(smoothed, profile.dt_s))
     temp_die_c = fx.die_temperature(list(det.effects), _signals(profile, det.ref_c))
     step = kinds.get(sensor).input_step  # outputs are at most quadratic in the input: the difference is exact
     plus = _deterministic(det, _shifted(profile, step))
@@ -105,5 +106,5 @@ def simulate_truth(
         output_det=_deterministic(det, profile),
         sensitivity_per_input=(plus - minus) / (2.0 * step),
         input=profile.input.copy(),
-        output_det_thermometer=_deterministic(det, read_profile),
+        output_det_thermometer=_deterministic(run.nominal.without(*STOCHASTIC_EFFECTS), read_profile),
     )

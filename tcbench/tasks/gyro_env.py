@@ -26,12 +26,13 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from tcbench.compensation.data import TaskDataError
+from tcbench.compensation.data import DEFAULT_TIER, TaskDataError, check_tier
 from tcbench.compensation.gyro.cache import cached_front
 from tcbench.compensation.gyro.data import GyroData, check_effects, check_settings
 from tcbench.compensation.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.compensation.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.compensation.gyro.tuning import PAPER_BEST, tuning_window
+from tcbench.compensation.methods import memorised_output
 from tcbench.compensation.oracle import oracle_inverse
 from tcbench.compensation.scoring import Score
 from tcbench.learners.base import FitHistory, Learner
@@ -42,7 +43,7 @@ from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
-BASELINES = ("raw", "oracle", "oracle_thermometer")
+BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
@@ -64,6 +65,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     budget: candidate evaluations per episode.
     device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s: the simulated oven
         runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks).
+    split: the tier the simulated test runs are drawn on (:data:`~tcbench.compensation.data.SPLITS`;
+        default ``next_run``, new power-ons).
     train_files, test_files: schema-v1 gyro recordings instead.
     decomposition, k, alpha, denoise, tfpf_window, wavelet_level, noise_above, drift_below, inputs,
         rate_window_s, learner_block_s: the pipeline (:class:`~tcbench.compensation.gyro.pipeline.PipelineConfig`);
@@ -90,7 +93,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  rate_window_s: float = 120.0, learner_block_s: float = 10.0,
                  bandwidth_amplitude_dps: float = 0.005, effects: dict[str, dict[str, float]] | None = None,
                  tuner: str = "mopso", tuning_budget: int = 440, tuning_samples: int = 2048,
-                 tuner_params: dict[str, Any] | None = None) -> None:
+                 tuner_params: dict[str, Any] | None = None, split: str = DEFAULT_TIER) -> None:
         if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
@@ -107,6 +110,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if not (is_real(bandwidth_amplitude_dps) and bandwidth_amplitude_dps > 0):
             raise ValueError(f"bandwidth_amplitude_dps must be > 0, got {bandwidth_amplitude_dps}")
         try:
+            check_tier(split)
             check_settings(sample_rate_hz, hold_s, n_train, n_test)
             self.effects = check_effects(effects)
         except TaskDataError as exc:
@@ -120,6 +124,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self.needs_tuning = decomposition == "vmd" and (k is None or alpha is None)
         self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), int(recordings_seed)
         self.n_train, self.n_test = int(n_train), int(n_test)
+        self.split = split
         self.train_files, self.test_files = train_files, test_files
         self.sample_rate_hz, self.hold_s = float(sample_rate_hz), float(hold_s)
         self.amplitude_dps = float(bandwidth_amplitude_dps)
@@ -173,7 +178,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError("VMD k and alpha are unset: give task.k and task.alpha, or tune them first "
                              "(tcbench run does, on tcbench/Gyro-VMDTuning-v0)")
         self.data = load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
-                                   self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects)
+                                   self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects,
+                                   self.split)
         self.pipeline = ParallelPipeline(self.config)
         learner_rng = np.random.default_rng(int(self.np_random.integers(0, 2**63 - 1)))
         if self.learner_name is not None:
@@ -216,13 +222,19 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
 
     def score_baseline(self, which: str, bandwidth: bool = True) -> Score:
         """``raw`` (the pipeline without drift compensation: the recorded output itself for the
-        serial pipeline without a denoiser), ``oracle`` (the simulator's truth) or
+        serial pipeline without a denoiser), ``memoriser`` (the training runs' mean output at the
+        same time since the start subtracted: no physics), ``oracle`` (the simulator's truth) or
         ``oracle_thermometer`` (the simulator's model fed the thermometer reading)."""
         if self.data is None or self.pipeline is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which == "raw":
             self.pipeline.learner = None
             return self._score_pipeline(float("nan"), bandwidth)
+        if which == "memoriser":
+            memo = memorised_output(self.data.train)
+            recs = [score_record(tr, lambda y, tr=tr: y - memo(tr.recording.time_s), self.amplitude_dps, None,
+                                 bandwidth) for tr in self.data.test]
+            return Score("gyro", recs)
         if which not in ("oracle", "oracle_thermometer"):
             raise ValueError(f"unknown baseline {which!r}; known: {', '.join(BASELINES)}")
         if not self.data.has_truth:

@@ -17,7 +17,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from tcbench.compensation.data import TaskDataError
+from tcbench.compensation.data import DEFAULT_TIER, TaskDataError
 from tcbench.compensation.gyro.data import (
     GyroData,
     check_effects,
@@ -34,6 +34,7 @@ from tcbench.compensation.gyro.tuning import (
     tuning_window,
     vmd_objectives,
 )
+from tcbench.sensors.data_hash import shared_recordings
 from tcbench.tasks.checks import is_integer
 from tcbench.tasks.function_env import as_batch, check_budget
 from tcbench.tasks.ids import GYRO_VMDTUNING_ID
@@ -44,11 +45,17 @@ ENV_ID = GYRO_VMDTUNING_ID
 
 def load_gyro_data(device_seed: int, recordings_seed: int, train_files: list[str] | None,
                    test_files: list[str] | None, sample_rate_hz: float, hold_s: float,
-                   n_train: int = 1, n_test: int = 1, effects: dict[str, dict[str, float]] | None = None) -> GyroData:
-    """Simulated oven runs (the device's ``effects`` changed), or the files when ``train_files`` is given."""
+                   n_train: int = 1, n_test: int = 1, effects: dict[str, dict[str, float]] | None = None,
+                   split: str = DEFAULT_TIER) -> GyroData:
+    """Simulated oven runs (the device's ``effects`` changed, test runs on tier ``split``), or the
+    files when ``train_files`` is given."""
     if train_files:
-        return file_gyro_data(list(train_files), list(test_files or train_files))
-    return simulated_gyro_data(device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s, effects)
+        data = file_gyro_data(list(train_files), list(test_files or train_files))  # no test files: tuning only
+        if test_files and (shared := shared_recordings(train_files, test_files)):
+            raise TaskDataError(f"{shared[0]} is both a training and a test recording (the same data); a task never "
+                                "tests on its own training runs")
+        return data
+    return simulated_gyro_data(device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s, effects, split)
 
 
 class GyroVMDTuningEnv(gym.Env[np.ndarray, np.ndarray]):

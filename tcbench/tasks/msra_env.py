@@ -26,7 +26,9 @@ import numpy as np
 from tcbench.compensation import methods
 from tcbench.compensation.data import (
     DEFAULT_SPLIT,
+    DEFAULT_TIER,
     PROTOCOLS,
+    SPLITS,
     MSRAData,
     TaskDataError,
     check_split,
@@ -70,6 +72,8 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     device_seed: the simulated device; recordings_seed: fixes the recordings (None: from reset).
     n_train, n_test: recordings to train on and to test on (default 3/2 fulltemp and chamber,
         4/2 roomtemp).
+    split: the tier the simulated test runs are drawn on (:data:`~tcbench.compensation.data.SPLITS`):
+        ``replay``, ``next_run`` (default: new power-ons), ``new_profile`` or ``new_device``.
     train_files, test_files: schema-v1 recordings instead of simulated ones.
     train_on: ``positions`` (fulltemp: the labelled four-position samples) or ``all`` rows.
     rate_window_s: trailing window of the temperature-rate input (roomtemp, chamber), in s.
@@ -93,6 +97,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         train_on: str = "positions",
         rate_window_s: float = 120.0,
         bias_form: str = "plus",
+        split: str = DEFAULT_TIER,
     ) -> None:
         if task not in TASKS:
             raise ValueError(f"unknown static-input task {task!r}; known: {', '.join(TASKS)}")
@@ -108,6 +113,9 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError(f"bias_form must be one of {', '.join(BIAS_FORMS)}, got {bias_form!r}")
         if (train_files is None) != (test_files is None):
             raise ValueError("give both train_files and test_files, or neither")
+        if split not in SPLITS:
+            raise ValueError(f"unknown split {split!r}; known: {', '.join(SPLITS)} (default {DEFAULT_TIER})")
+        self.split = split
         d_train, d_test = DEFAULT_SPLIT[self.protocol]
         self.n_train = len(train_files) if train_files else (d_train if n_train is None else n_train)
         self.n_test = len(test_files) if test_files else (d_test if n_test is None else n_test)
@@ -151,7 +159,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if rseed is None:
             rseed = int(self.np_random.integers(0, 2**31 - 1))
         return simulated_data(self.protocol, self.device_seed, rseed, self.n_train, self.n_test,
-                              self.train_on, self.rate_window_s)
+                              self.train_on, self.rate_window_s, self.split)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None
               ) -> tuple[np.ndarray, dict[str, Any]]:
@@ -190,7 +198,8 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         return score_outputs(self.data, methods.learner_compensator(self.data, self.learner), self.bias_form, rmse)
 
     def score_baseline(self, which: str) -> Score:
-        """``raw`` (no compensation), ``oracle`` (the simulator's truth: noise alone),
+        """``raw`` (no compensation), ``memoriser`` (the training runs' mean output at the same time
+        since the start: no physics), ``oracle`` (the simulator's truth: noise alone),
         ``oracle_thermometer`` (the simulator's model fed the thermometer reading), ``lagpoly``
         or (chamber) ``model``, the model diagnosed on the first training recording."""
         if self.data is None:
@@ -199,6 +208,8 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError(f"unknown baseline {which!r} of task {self.task}; known: {', '.join(self.baselines)}")
         if which == "raw":
             return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
+        if which == "memoriser":
+            return score_outputs(self.data, methods.memoriser_compensator(self.data), self.bias_form)
         if which == "lagpoly":
             return score_outputs(self.data, methods.lagpoly_compensator(self.data), self.bias_form)
         if which == "model":

@@ -46,6 +46,7 @@ class MSRATaskConfig:
     train_on: str = "positions"
     rate_window_s: float = 120.0
     bias_form: str = "plus"
+    split: str = "next_run"
 
 
 @dataclass
@@ -70,6 +71,7 @@ class GyroTaskConfig(GyroTuningTaskConfig):
 
     n_train: int = 1
     n_test: int = 1
+    split: str = "next_run"
     test_files: list | None = None
     decomposition: str = "vmd"
     k: int | None = None

@@ -2,8 +2,8 @@
 
 Seed 001 §4.1 records two oven runs of one gyroscope (1 h at room temperature, 60 degC, then
 10 degC steps held 1 h down to -40 degC) and trains on one, tests on the other. tcbench
-simulates them (one device, run seeds ``100 * recordings_seed + i``, the simulator's truth kept
-for the oracle) or reads schema-v1 gyro recordings (for example real ones; no oracle). The
+simulates them (one device, run seeds ``100 * recordings_seed + i``, test runs on a split tier of
+:mod:`tcbench.compensation.data`, the simulator's truth kept for the oracle) or reads schema-v1 gyro recordings (for example real ones; no oracle). The
 pipeline needs a continuous record at one sample rate: a recording with gaps (a logger's
 bursts) or an uneven clock is refused with one line naming the file.
 """
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tcbench.compensation.data import TaskDataError, TaskRecording, recording_seed
+from tcbench.compensation.data import DEFAULT_TIER, RunSpec, TaskDataError, TaskRecording, split_runs
 from tcbench.sensors.recording import RecordingError, read_recording
 from tcbench.sensors.simulate import simulate_recording
 from tcbench.sensors.truth import simulate_truth
@@ -59,12 +59,12 @@ def recording_key(tr: TaskRecording) -> str:
 
 
 @functools.lru_cache(maxsize=4)
-def _simulated(device_seed: int, seed: int, sample_rate: float, hold_s: float, effects_json: str) -> TaskRecording:
-    params = {"sample_rate_hz": sample_rate, "hold_s": hold_s, "room_s": hold_s}
+def _simulated(run: RunSpec, sample_rate: float, hold_s: float, effects_json: str) -> TaskRecording:
+    params = {"sample_rate_hz": sample_rate, "hold_s": hold_s, "room_s": hold_s, **dict(run.changes)}
     effects = json.loads(effects_json)
-    rec = simulate_recording("gyro", "oven", device_seed, seed, effects, **params)
-    truth = simulate_truth("gyro", "oven", device_seed, seed, effects, **params)
-    return TaskRecording(f"dev{device_seed}-seed{seed}", rec, truth)
+    rec = simulate_recording("gyro", "oven", run.device_seed, run.seed, effects, power_on=run.power_on, **params)
+    truth = simulate_truth("gyro", "oven", run.device_seed, run.seed, effects, power_on=run.power_on, **params)
+    return TaskRecording(run.name, rec, truth)
 
 
 def check_effects(effects: dict[str, dict[str, float]] | None) -> dict[str, dict[str, float]]:
@@ -100,15 +100,16 @@ def check_settings(sample_rate: float, hold_s: float, n_train: int, n_test: int)
 
 def simulated_gyro_data(device_seed: int, recordings_seed: int, n_train: int = 1, n_test: int = 1,
                         sample_rate: float = 10.0, hold_s: float = 3600.0,
-                        effects: dict[str, dict[str, float]] | None = None) -> GyroData:
-    """``n_train + n_test`` simulated oven runs of gyro ``device_seed`` (its effects changed by
-    ``effects``, see :func:`check_effects`); the first ``n_train`` train."""
+                        effects: dict[str, dict[str, float]] | None = None, split: str = DEFAULT_TIER) -> GyroData:
+    """``n_train`` training and ``n_test`` test oven runs of gyro ``device_seed`` (its effects
+    changed by ``effects``, see :func:`check_effects`) on tier ``split``
+    (:func:`tcbench.compensation.data.split_runs`)."""
     check_settings(sample_rate, hold_s, n_train, n_test)
     changes = json.dumps(check_effects(effects), sort_keys=True)
-    recs = [_simulated(int(device_seed), recording_seed(recordings_seed, i), float(sample_rate), float(hold_s),
-                       changes) for i in range(n_train + n_test)]
+    train, test = split_runs("oven", split, device_seed, recordings_seed, n_train, n_test)
+    recs = [_simulated(run, float(sample_rate), float(hold_s), changes) for run in train + test]
     return GyroData(recs[:n_train], recs[n_train:], "simulated",
-                    {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed),
+                    {"device_seed": int(device_seed), "recordings_seed": int(recordings_seed), "split": split,
                      "sample_rate_hz": float(sample_rate), "hold_s": float(hold_s), "effects": json.loads(changes)})
 
 

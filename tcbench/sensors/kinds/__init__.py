@@ -46,6 +46,10 @@ class SensorKind:
     px4_letter: the letter of PX4's thermal-calibration parameters (``TC_G*``, ``TC_A*``).
     default_protocol: the protocol ``tcbench simulate`` runs when none is given (None: the first
         of ``protocols``).
+    power_on: what a new power-on changes in a unit's model, ``(model, rng) -> (model as it runs,
+        {draw: value})`` (turn-on bias and scale factor, PHYSICS.md §9; :mod:`tcbench.sensors.runs`);
+        None: the model is the same at every power-on (the chamber timing and the thermometer
+        still vary).
     """
 
     name: str
@@ -66,6 +70,7 @@ class SensorKind:
     px4_letter: str | None = None
     extra: Mapping[str, Any] = field(default_factory=dict)
     default_protocol: str | None = None
+    power_on: Callable[[Any, Any], tuple[Any, dict[str, float]]] | None = None
 
     def __post_init__(self) -> None:
         if self.input_field not in INPUT_FIELDS:

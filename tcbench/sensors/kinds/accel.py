@@ -2,9 +2,9 @@
 
 Model (``Accel``)::
 
-    a_out = (1 + s1 dT + s2 dT^2) (a_eff + k2 a_eff^2) + b0 + b1 dT + b2 dT^2 + effects
+    a_out = (1 + sf0 + s1 dT + s2 dT^2) (a_eff + k2 a_eff^2) + b0 + b1 dT + b2 dT^2 + effects
 
-with ``dT = T_die - ref_c`` and ``a_eff = a cos(delta) + a_cross sin(delta)`` (misalignment
+with ``dT = T_die - ref_c``, ``sf0`` the scale factor's turn-on error, and ``a_eff = a cos(delta) + a_cross sin(delta)`` (misalignment
 ``delta``). The effects are the library's: ``thermal_lag`` (the stress state trails the on-chip
 thermometer), ``hysteresis`` (package and solder stress remembers heating against cooling),
 ``warmup``, ``white_noise`` (velocity random walk), ``bias_instability`` (flicker) and
@@ -17,17 +17,19 @@ run at constant temperature (Allan variance).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from tcbench.sensors import effects as fx
-from tcbench.sensors.devices import device_rng
+from tcbench.sensors.devices import AGEING_DAYS, SLOPE_REPEAT, device_rng
 from tcbench.sensors.kinds import SensorKind
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.protocols import Chamber, Profile, _from_segments, check_length, four_position_nodes
 from tcbench.sensors.thermal import Segment
+from tcbench.sensors.timing import current_timing
 
 UG = 1e-6  # g per micro-g
 
@@ -37,6 +39,7 @@ class Accel(SensorModel):
     """Capacitive MEMS accelerometer core (see the module docstring); output in g."""
 
     kind = "accel"
+    sf0_ppm: float = 0.0
     bias_mg: float = 0.0
     b1_mg_per_k: float = 0.2
     b2_ug_per_k2: float = 0.0
@@ -48,7 +51,7 @@ class Accel(SensorModel):
     def core(self, s: fx.Signals) -> np.ndarray:
         dt = s.temp_die_c - self.ref_c
         a_eff = s.accel_g * math.cos(self.misalignment_rad) + s.cross_g * math.sin(self.misalignment_rad)
-        gain = 1.0 + (self.sf_ppm_per_k + self.sf2_ppm_per_k2 * dt) * 1e-6 * dt
+        gain = 1.0 + self.sf0_ppm * 1e-6 + (self.sf_ppm_per_k + self.sf2_ppm_per_k2 * dt) * 1e-6 * dt
         bias = 1e-3 * (self.bias_mg + self.b1_mg_per_k * dt) + self.b2_ug_per_k2 * UG * dt * dt
         return gain * (a_eff + self.k2_per_g * a_eff * a_eff) + bias
 
@@ -104,6 +107,21 @@ def accel_unit(device_seed: int) -> Unit:
     return Unit(f"accel-{device_seed:04d}", model, draws)
 
 
+def accel_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
+    """A consumer accelerometer's power-on: turn-on bias 3 mg (std), scale factor 500 ppm, bias
+    slope 1 %, ageing 20 µg per day over up to :data:`~tcbench.sensors.devices.AGEING_DAYS` days."""
+    if not isinstance(model, Accel):
+        return model, {}  # a fitted model: no turn-on draws of this part
+    days = rng.uniform(0.0, AGEING_DAYS)
+    draws = {"turn_on_bias_mg": rng.normal(0.0, 3.0), "scale_factor_ppm": rng.normal(0.0, 500.0),
+             "slope_change": rng.normal(0.0, SLOPE_REPEAT), "days": days, "aged_mg": days * rng.normal(0.0, 0.02)}
+    return dataclasses.replace(
+        model, bias_mg=model.bias_mg + draws["turn_on_bias_mg"] + draws["aged_mg"],
+        sf0_ppm=model.sf0_ppm + draws["scale_factor_ppm"],
+        b1_mg_per_k=model.b1_mg_per_k * (1.0 + draws["slope_change"]),
+    ), {k: float(v) for k, v in draws.items()}
+
+
 def _gravity(gravity_g: float) -> tuple[float, float]:
     """(along, across) the axis for a static unit with ``gravity_g`` of gravity along it."""
     if not -1.0 <= gravity_g <= 1.0:
@@ -148,6 +166,7 @@ def static(duration_s: float = 7200.0, temp_c: float = 25.0, gravity_g: float = 
            sample_rate_hz: float = 100.0) -> Profile:
     """A long run at rest and constant temperature (Allan variance)."""
     check_length(duration_s, sample_rate_hz)
+    temp_c += current_timing().start_offset_c
     along, across = _gravity(gravity_g)
     t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
     zeros = np.broadcast_to(np.float64(0.0), t.shape)
@@ -164,6 +183,7 @@ KIND = SensorKind(
     input_range=(-1000.0, 1000.0),
     output_range=(-1000.0, 1000.0),
     device=accel_unit,
+    power_on=accel_power_on,
     protocols={"chamber": chamber, "multipos": multipos, "static": static},
     positions=True,
     noise_unit="µg",

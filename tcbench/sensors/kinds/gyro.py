@@ -1,7 +1,7 @@
 """Seed 001's dual-mass vibratory gyroscope: output the rate in deg/s."""
 
 from tcbench.sensors import protocols
-from tcbench.sensors.devices import gyro_unit
+from tcbench.sensors.devices import gyro_power_on, gyro_unit
 from tcbench.sensors.kinds import SensorKind
 
 KIND = SensorKind(
@@ -13,6 +13,7 @@ KIND = SensorKind(
     input_range=(-20000.0, 20000.0),  # MEMS gyros measure up to a few thousand deg/s
     output_range=(-20000.0, 20000.0),
     device=gyro_unit,
+    power_on=gyro_power_on,
     protocols={"oven": protocols.gyro_oven, "static": protocols.gyro_static},
     noise_unit="°/h",
     noise_scale=3600.0,

@@ -1,7 +1,7 @@
 """Seed 000's micro-silicon resonant accelerometer: output the resonators' frequency difference in Hz."""
 
 from tcbench.sensors import protocols
-from tcbench.sensors.devices import msra_unit
+from tcbench.sensors.devices import msra_power_on, msra_unit
 from tcbench.sensors.kinds import SensorKind
 
 KIND = SensorKind(
@@ -13,6 +13,7 @@ KIND = SensorKind(
     input_range=(-1000.0, 1000.0),  # accelerometers measure up to a few hundred g
     output_range=(-1.0e6, 1.0e6),  # a frequency difference well below the ~30 kHz resonance
     device=msra_unit,
+    power_on=msra_power_on,
     protocols={"roomtemp": protocols.msra_roomtemp, "fulltemp": protocols.msra_fulltemp},
     default_protocol="fulltemp",  # the paper's full-temperature test
     positions=True,
