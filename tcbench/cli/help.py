@@ -197,6 +197,8 @@ SPECS: dict[str, CommandHelp] = {
                         "scores (the plot shows the first)",
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
+            "screen": "drop the training parts' handling bursts, spikes and thermometer glitches before any model is "
+                      "fitted (reported); false: fit every sample",
             "axis": "x, y or z: the recording's axis when its sidecar does not say (tcbench import axes= records it)",
             "test_recordings": "other recordings of the same kind and unit to score the fitted models on, every "
                                "part of them held out: train on one record, test on others",

@@ -115,6 +115,7 @@ class CalibrateConfig:
     test_recordings: list[str] = field(default_factory=list)  # more records to score on, every part held out
     true_input: str | None = None  # VALUE[:unit]: the static record's true input (an axis along gravity: -1:g)
     axis: str | None = None  # x, y or z: the recording's axis when its sidecar does not say (for tcbench export)
+    screen: bool = True  # drop the training parts' bursts, spikes and thermometer glitches before any fit
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
 
 

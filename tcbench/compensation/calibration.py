@@ -13,12 +13,19 @@ Methods, each a function of what a flight controller can read (the thermometer a
   of a cycle tell apart.
 - ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`, their defaults) on
   ``[T, dT/dt]``, trained from the run's seed on the means of :data:`TRAIN_BIN_S` time bins of
-  the training parts (see :func:`fit`).
+  the training parts (see :func:`fit`). Their temperature input is held to the training range
+  (as PX4 holds its cubic): beyond it a network gives its value at the edge. The rate input is
+  not held (a lag's first-order term is linear in it, and one direction of a cycle only shows
+  one sign of it).
 - ``model``: the diagnosed physics. ``tcbench diagnose`` on the training parts fits a model
   (polynomial core, thermal lag, hysteresis, warm-up, steps ...; :mod:`tcbench.diagnose`), and its
   deterministic output is the offset (:mod:`tcbench.compensation.fitted_model`); the command
   (:mod:`tcbench.commands.calibration`) runs the diagnosis and hands the model in with
   :func:`from_model`.
+
+The training parts are screened first (:mod:`tcbench.compensation.screening`: handling bursts,
+spikes and thermometer glitches dropped, the parts cut at their gaps; the command does it and
+hands the pieces in), so every method is fitted on the same samples.
 
 The scores of a branch: the RMS of the residual (output minus true input minus the model's
 offset), and the RMS of its running mean over ``drift_window_s`` (the drift, with the white
@@ -82,6 +89,7 @@ class OffsetModel:
     learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
     sensor_model: Any = None  # a diagnosed PolynomialModel
     bin_s: float | None = None  # the learner's training bins (s); a sequential one also runs on them
+    temp_range_c: tuple[float, float] | None = None  # a learner's training temperatures: its input is held to them
 
     def offset(self, rec: Record) -> np.ndarray:
         """The offset at each sample of ``rec``. A sequential learner (``elman``) trained on bins
@@ -95,16 +103,19 @@ class OffsetModel:
         if self.learner is not None:
             if self.bin_s and self.learner.sequential:
                 coarse = rec.binned(self.bin_s)
-                return np.interp(rec.t_s, coarse.t_s, _predicted(self.learner, coarse))
-            return _predicted(self.learner, rec)
+                return np.interp(rec.t_s, coarse.t_s, _predicted(self.learner, coarse, self.temp_range_c))
+            return _predicted(self.learner, rec, self.temp_range_c)
         if self.cubic is None:
             return np.zeros_like(rec.output)
         return self.cubic.offset(rec.temp_c) + self.rate_coef * rec.rate_c_per_s
 
 
-def _predicted(learner: Any, rec: Record) -> np.ndarray:
-    """A fitted learner's output on ``[T, dT/dt]`` of ``rec``."""
-    inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
+def _predicted(learner: Any, rec: Record, temp_range_c: tuple[float, float] | None = None) -> np.ndarray:
+    """A fitted learner's output on ``[T, dT/dt]`` of ``rec``, ``T`` held to ``temp_range_c``
+    (as PX4 holds its cubic to ``TMIN..TMAX``: beyond its training temperatures a network's
+    output is whatever its activations extrapolate to, so it gives its value at the edge)."""
+    temp = rec.temp_c if temp_range_c is None else np.clip(rec.temp_c, *temp_range_c)
+    inputs = np.column_stack([temp, rec.rate_c_per_s])
     return np.asarray(learner.predict(inputs), dtype=np.float64).reshape(-1)
 
 
@@ -145,7 +156,7 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
         learner.fit(np.column_stack([np.concatenate([r.temp_c for r in rows]),
                                      np.concatenate([r.rate_c_per_s for r in rows])]),
                     np.concatenate([r.output - r.truth for r in rows]))
-        return OffsetModel(method, learner=learner, bin_s=bin_s)
+        return OffsetModel(method, learner=learner, bin_s=bin_s, temp_range_c=(float(temp.min()), float(temp.max())))
     cubic = fit_offset(temp, target)
     if method == "poly3":
         return OffsetModel("poly3", cubic)
