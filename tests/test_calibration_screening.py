@@ -31,21 +31,22 @@ def _static(t: np.ndarray, temp: np.ndarray, seed: int, burst_s: float = 0.0) ->
 
 
 T = np.arange(0.0, 3600.0, 0.5)
-TRAIN = _static(T, 50.0 - 40.0 * T / 3600.0, 0, burst_s=30.0)  # cools 50 -> 10 degC, then the burst
-TEST = _static(T, 10.0 + 40.0 * T / 3600.0, 1)  # heats back
+CYCLE = 30.0 + 20.0 * np.cos(2.0 * np.pi * T / 3600.0)  # cools 50 -> 10 degC and heats back in an hour
+TRAIN = _static(T, CYCLE, 0, burst_s=30.0)  # the burst at its end
+TEST = _static(T, CYCLE, 1)  # the next cycle
 
 
 def _drift(model_record: Record, method: str, train: list[Record]) -> float:
     return scores(residual(fit(method, train, seed=0), model_record), model_record.t_s)["drift_rms"]
 
 
-@pytest.mark.parametrize("method", ["bp", "elman", "poly3"])
+@pytest.mark.parametrize("method", ["bp", "bp_gd", "elman", "poly3"])
 def test_a_handling_burst_ruins_an_unscreened_fit_and_screening_removes_it(method: str) -> None:
     raw = scores(TEST.output - TEST.truth, TEST.t_s)["drift_rms"]
     screened = screen(TRAIN)
     assert screened.dropped["burst"]["runs"] == 1 and screened.dropped_samples == 60 + 10  # 30 s and the 5-s guard
     assert screened.dropped.get("spike", {}).get("runs", 0) == 0
-    assert _drift(TEST, method, [TRAIN]) > 2.0 * raw  # fitted through the burst: far worse than no correction
+    assert _drift(TEST, method, [TRAIN]) > 1.5 * raw  # fitted through the burst: worse than no correction
     assert _drift(TEST, method, screened.pieces) < raw  # screened: better than no correction
 
 
@@ -91,7 +92,7 @@ def test_a_learner_is_held_to_its_training_temperatures(method: str) -> None:
 
 
 def _write_cycle(workdir: Path) -> Path:
-    """A gyro record that cools (the burst at its end) and heats back, in deg/s."""
+    """A gyro record of two chamber cycles (the burst at the end of the first), in deg/s."""
     from tcbench.sensors.recording import make_recording, write_recording
 
     t = np.concatenate([TRAIN.t_s, TEST.t_s + 3600.0])
@@ -105,7 +106,7 @@ def test_the_calibration_says_when_it_is_worse_than_raw(workdir: Path, capsys: p
     path = _write_cycle(workdir)
     for screen_on in (False, True):
         out_dir = f"cal-{screen_on}"
-        code = main(["calibrate", f"recording={path}", f"out={out_dir}", "methods=[raw,poly3]",
+        code = main(["calibrate", f"recording={path}", f"out={out_dir}", "methods=[raw,poly3]", "train_branches=[0,1]",
                      f"screen={str(screen_on).lower()}", "tracking.enabled=false"])
         captured = capsys.readouterr()
         assert code == 0, captured.err

@@ -239,6 +239,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     about |= _about(cfg, rec, split, unit, own_hash)
     about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
     about["range"] = _range(screening.pieces, held_temp)
+    about["training"] = _training(fitted)
     about["export"] = _export_fit(whole, cfg.screen)
     out = Path(cfg.out)
     try:
@@ -312,6 +313,26 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[
     return summary, ranking
 
 
+def _training(fitted: dict[str, list[Any]]) -> dict[str, Any]:
+    """How each fitted method was trained, one line each (the networks' algorithm, epochs and
+    restarts; what the diagnosed model explains but does not compensate)."""
+    from tcbench.compensation.fitted_model import dropped_terms
+    from tcbench.compensation.training import describe
+
+    out: dict[str, Any] = {}
+    for m, runs in fitted.items():
+        if runs and runs[0].training:
+            out[m] = {"line": describe(m, [r.training for r in runs]), "runs": [r.training for r in runs]}
+        elif m == "model" and runs:
+            dropped = dropped_terms(runs[0].sensor_model)
+            out[m] = {"line": "model: tcbench diagnose on the screened training parts (least squares); compensates "
+                              "with its temperature terms only, not with "
+                              + (", ".join(dropped) if dropped else "any clock-keyed term (none was fitted)")
+                              + " (keyed to the calibration run's clock or its rig: explained, not compensated)",
+                      "dropped": dropped}
+    return out
+
+
 def _range(pieces: list[Any], held_temp: list[np.ndarray]) -> dict[str, Any]:
     """The fitted temperatures and how far the held-out ones go beyond them (share of samples)."""
     lo = float(min(p.temp_c.min() for p in pieces))
@@ -327,12 +348,12 @@ def _range(pieces: list[Any], held_temp: list[np.ndarray]) -> dict[str, Any]:
 def _range_line(about: dict[str, Any]) -> str | None:
     """One line when held-out samples lie beyond the fitted temperatures: who is held at the edge."""
     r = about.get("range", {})
-    if not r.get("beyond_share"):
+    if r.get("beyond_share", 0.0) < 0.001:
         return None
     (lo, hi), (hlo, hhi) = r["fitted_c"], r["held_out_c"]
-    return (f"held out beyond the fitted {lo:.1f}..{hi:.1f} degC: {r['beyond_share']:.0%} of the samples "
-            f"({hlo:.1f}..{hhi:.1f} degC); poly3, poly3_rate's cubic, bp and elman are held at the edge there, "
-            "poly3_rate's rate term and model carry on")
+    return (f"held out beyond the fitted {lo:.1f}..{hi:.1f} degC: {r['beyond_share']:.1%} of the samples "
+            f"({hlo:.1f}..{hhi:.1f} degC); poly3, poly3_rate's cubic, bp and elman are held at the edge there "
+            "(the networks' rate input too), poly3_rate's rate term and model carry on")
 
 
 def _worse_line(about: dict[str, Any]) -> str | None:
@@ -471,14 +492,17 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: d
     if cfg.test_recordings:
         lines.append(f"Also scored on every part of {', '.join(map(str, cfg.test_recordings))}.")
     if cfg.restarts > 1:
-        lines.append(f"The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+        lines.append(f"The networks (bp, bp_gd, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
                      f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}.")
+
     screening = about["screening"]
     lines.append(f"Training parts {'screened' if screening['enabled'] else 'not screened (screen=false)'} "
                  f"(tcbench.compensation.screening: departures beyond {screening['min_z']:g} robust sigmas or the "
                  f"Bonferroni bound from a {screening['window_s']:g}-s running median, widened by "
                  f"{screening['guard_s']:g} s; thermometer glitches; cut at gaps): "
                  f"{screening['line'].removeprefix('screened: ')}.")
+    if about.get("training"):
+        lines.append("\n\nTraining:\n\n" + "".join(f"- {t['line']}\n" for t in about["training"].values()))
     ranking = ""
     if about.get("held_out"):
         verdicts = [ln for ln in (_range_line(about), _worse_line(about)) if ln]

@@ -106,7 +106,7 @@ class CalibrateConfig:
     recording: str = ""
     out: str = "calibration"
     train_branches: list[int] | None = None
-    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman", "model"])
+    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model"])
     seed: int = 0
     restarts: int = 1  # networks per learner method (seeds seed, seed+1, ...): the board gives their median
     min_swing_c: float = 5.0
