@@ -62,6 +62,11 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
         assert lo <= point <= hi and (m in summary["tied"]) == (m != summary["best"] and lo <= 1.0), m
     assert (": a tie with" in best) == bool(summary["tied"]) and summary["ratio_hi"] < 1.0 and not summary["tied"]
     assert all(summary["x_raw"][m][0] < 1.0 for m in ("poly3", "model")) and summary["worse_than_raw"] == []
+    parts = summary["per_part"]  # each held-out branch on its own: the fit-on-one-run, test-on-another answer
+    assert [p["part"] for p in parts] == ["gyro-y:1", "gyro-y:2"]
+    for p in parts:
+        assert p["best"] == min(p["drift"], key=p["drift"].get) and p["x_raw"]["raw"] == [1.0, 1.0, 1.0]
+        assert all(lo <= x <= hi for x, lo, hi in p["x_raw"].values())
     md = (workdir / "cal" / "calibration.md").read_text()
     for words in ("- bp: LM (at most 200 iterations", "- bp_gd: GD (at most 1000 epochs; ran 1000",
                   "- elman: ADAM (at most 500 epochs", "- model: tcbench diagnose on the screened training parts",

@@ -209,6 +209,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     held: dict[str, list[list[np.ndarray]]] = {m: [[] for _ in runs] for m, runs in fitted.items()}
     held_raw: list[np.ndarray] = []
     held_temp: list[np.ndarray] = []
+    held_labels: list[str] = []
     steps: list[float] = []
     drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
     for path, r, parts, fitted_parts in [(cfg.recording, rec, split.parts, split.train),
@@ -223,6 +224,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
                 steps.append(dt_s)
                 held_raw.append((r.output - r.input)[b.start:b.stop])
                 held_temp.append(r.temperature_c[b.start:b.stop])
+                held_labels.append(f"{Path(path).stem}:{k}")
             for m, runs in every.items():
                 s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
                 if role == "test":
@@ -236,6 +238,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
             residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
     summary, about = _ranked(table, held, held_raw, steps, cfg, unit, drift_key)
+    about["per_part"] = _per_part(held, held_raw, steps, held_labels, cfg)
     about |= _about(cfg, rec, split, unit, own_hash)
     about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
     about["range"] = _range(screening.pieces, held_temp)
@@ -311,6 +314,29 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[
         ranking["ratio_to_raw"] = list(to_raw[best])
     ranking["worse_than_raw"] = [m for m in order if m != "raw" and to_raw[m][0] > 1.0]
     return summary, ranking
+
+
+def _per_part(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], steps: list[float],
+              labels: list[str], cfg: CalibrateConfig) -> list[dict[str, Any]]:
+    """Each held-out part on its own (``recording:part``): every method's drift, its ratio to
+    raw's and to the part's best with their block-bootstrap intervals, the best and its ties —
+    the fit-on-one-run, test-on-another answer when the parts are runs."""
+    from tcbench.compensation.holdout import block_sums, ratio_interval
+
+    out = []
+    for k, label in enumerate(labels):
+        runs = {f"{m}#{i}": [per[i][k]] for m, per in held.items() for i in range(len(per))} | \
+            {"raw-ref#0": [held_raw[k]]}
+        sums = block_sums(runs, [steps[k]], cfg.drift_window_s)
+        squares = {m: np.mean([sums.squares[f"{m}#{i}"] for i in range(len(per))], axis=0) for m, per in held.items()}
+        pooled = type(sums)(squares | {"raw-ref": sums.squares["raw-ref#0"]}, sums.counts, sums.block_s)
+        best = min(held, key=lambda m: pooled.drift(m))
+        to_best = {m: list(ratio_interval(pooled, m, best, seed=cfg.seed)) for m in held}
+        out.append({"part": label, "best": best, "blocks": int(sums.counts.size), "block_s": sums.block_s,
+                    "drift": {m: pooled.drift(m) for m in held}, "raw_drift": pooled.drift("raw-ref"),
+                    "x_raw": {m: list(ratio_interval(pooled, m, "raw-ref", seed=cfg.seed)) for m in held},
+                    "x_best": to_best, "tied": [m for m in held if m != best and not to_best[m][1] > 1.0]})
+    return out
 
 
 def _training(fitted: dict[str, list[Any]]) -> dict[str, Any]:
