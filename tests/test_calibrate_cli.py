@@ -35,7 +35,7 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
     code, out, err = run(capsys, "calibrate", f"recording={gyro_y}", "out=cal")
     assert code == 0, err
     table = pd.read_csv(workdir / "cal" / "calibration.csv")
-    assert sorted(set(table["method"])) == ["bp", "elman", "model", "poly3", "poly3_rate", "raw"]
+    assert sorted(set(table["method"])) == ["bp", "bp_gd", "elman", "model", "poly3", "poly3_rate", "raw"]
     assert table.groupby("method")["direction"].apply(list).to_dict()["raw"] == ["cooling", "heating", "cooling"]
     drift = table.pivot(index="branch", columns="method", values="drift_rms_deg_per_s")
     assert (table.loc[table["branch"] == 0, "role"] == "train").all()
@@ -49,14 +49,29 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
     assert not (workdir / "cal" / "px4_tc_params.txt").exists()  # one axis alone: tcbench export writes them
     assert (workdir / "cal" / "residuals.png").stat().st_size > 10_000
     lines = out.strip().splitlines()
-    assert lines[0].startswith("calibrate gyro-y.csv (gyro, output in deg/s): fitting raw, poly3, poly3_rate, bp, "
+    assert lines[0].startswith("calibrate gyro-y.csv (gyro, output in deg/s): fitting raw, poly3, poly3_rate, bp, bp_gd, "
                                "elman, model on temperature branch 0 (cooling 51.6 -> -17.5 degC); scoring on "
                                "temperature branches 1, 2 (held out)"), lines[0]
     summary = json.loads((workdir / "cal" / "calibration.json").read_text())
     best = next(ln for ln in lines if ln.startswith("best held out"))  # the last line but MLflow's
     assert best.startswith(f"best held out: {summary['best']}, drift ") and "95% block bootstrap" in best, best
-    assert summary["best"] == "model" and summary["next"] in {"bp", "elman", "poly3", "poly3_rate"}
+    assert summary["best"] == "model" and summary["next"] in {"bp", "bp_gd", "elman", "poly3", "poly3_rate"}
     assert summary["ratio_lo"] <= summary["ratio_to_next"] <= summary["ratio_hi"]
+    # every ratio carries its interval; a method the interval cannot tell from the best is a tie
+    for m, (point, lo, hi) in summary["x_best"].items():
+        assert lo <= point <= hi and (m in summary["tied"]) == (m != summary["best"] and lo <= 1.0), m
+    assert (": a tie with" in best) == bool(summary["tied"]) and summary["ratio_hi"] < 1.0 and not summary["tied"]
+    assert all(summary["x_raw"][m][0] < 1.0 for m in ("poly3", "model")) and summary["worse_than_raw"] == []
+    parts = summary["per_part"]  # each held-out branch on its own: the fit-on-one-run, test-on-another answer
+    assert [p["part"] for p in parts] == ["gyro-y:1", "gyro-y:2"]
+    for p in parts:
+        assert p["best"] == min(p["drift"], key=p["drift"].get) and p["x_raw"]["raw"] == [1.0, 1.0, 1.0]
+        assert all(lo <= x <= hi for x, lo, hi in p["x_raw"].values())
+    md = (workdir / "cal" / "calibration.md").read_text()
+    for words in ("- bp: LM (at most 200 iterations", "- bp_gd: GD (at most 1000 epochs; ran 1000",
+                  "- elman: ADAM (at most 500 epochs", "- model: tcbench diagnose on the screened training parts",
+                  "0 of 2687 training samples dropped"):
+        assert words in md, words
     held = table[table["role"] == "test"]
     pooled = {m: np.sqrt(np.average(g["drift_rms_deg_per_s"] ** 2)) for m, g in held.groupby("method")}
     assert min(pooled, key=pooled.get) == summary["best"]  # the ranking agrees with the long table
@@ -213,7 +228,7 @@ def test_a_short_record_is_calibrated_without_the_diagnosed_model(workdir: Path,
     assert err == ["tcbench: model left out: the fitted parts last 7.2 min and a diagnosis needs 20 min "
                    "(tcbench diagnose reports what a short record can tell)"], err
     summary = json.loads((workdir / "cal" / "calibration.json").read_text())
-    assert set(summary["drift"]) == {"raw", "poly3", "poly3_rate", "bp", "elman"}
+    assert set(summary["drift"]) == {"raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman"}
 
 
 def test_the_residual_plot_envelope_keeps_every_spike_in_few_points() -> None:

@@ -2,7 +2,8 @@
 # Real IMU records end to end: the six axes of the tofupilot chamber cycle (gyro and accelerometer)
 # and the three PAN LSM6DSM gyro axes, imported as a user would, then their metrics, a diagnosis
 # of each whole record and the calibration board (every offset model fitted on one part, scored on
-# the others). Results under leaderboards/real-imu/.
+# the others), and the cross-run table (each run fitted alone, scored on every other). Results under
+# leaderboards/real-imu/.
 # Usage (from the repository root, with tcbench installed): bash experiments/real-imu/run.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -50,6 +51,19 @@ tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration-both/\${st
     "restarts=$restarts"
 tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g 'train_branches=[0,1]' \
     "out=$out/calibration-both/tofupilot-imu.acc.z" "restarts=$restarts"
+echo "== cross-run: each run fitted alone and scored on the others (tofupilot: branches 1, 2; branch 0 above)"
+for i in 1 2; do
+    tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration-cross/\${stem:recording}.fit$i" \
+        "train_branches=[$i]" "restarts=$restarts"
+    tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g "train_branches=[$i]" \
+        "out=$out/calibration-cross/tofupilot-imu.acc.z.fit$i" "restarts=$restarts"
+done
+echo "== cross-run: PAN, each of its five time blocks fitted alone and scored on the other four"
+# one block spans 1.2 degC: too little for a diagnosis (2 degC at least), so no model here
+for i in 0 1 2 3 4; do
+    tcbench calibrate -m "recording=${pan_axes%,}" "out=$out/calibration-cross/\${stem:recording}.fit$i" blocks=5 \
+        "train_branches=[$i]" drift_window_s=5 "restarts=$restarts" 'methods=[raw,poly3,poly3_rate,bp,bp_gd,elman]'
+done
 echo "== board"
-python "$here/summarise.py" --calibrations "$out/calibration" "$out/calibration-both" --recordings "$work/rec" \
-    --diagnoses "$out/diagnosis" --out "$out"
+python "$here/summarise.py" --calibrations "$out/calibration" "$out/calibration-both" --cross "$out/calibration-cross" \
+    --recordings "$work/rec" --diagnoses "$out/diagnosis" --out "$out"

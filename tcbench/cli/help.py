@@ -193,13 +193,17 @@ SPECS: dict[str, CommandHelp] = {
                               "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
             "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
                       "(a record that only cools: train_branches=[0,2,4] blocks=5)",
-            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp, elman "
-                       "(the seed papers' networks on [T, dT/dt])",
+            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp (trained by "
+                       "Levenberg-Marquardt when the rows allow), bp_gd (gradient descent, 1000 epochs), elman (Adam) "
+                       "(the seed papers' networks on [T, dT/dt]), model (the diagnosed physics without its "
+                       "clock-keyed terms)",
             "seed": "the networks' initial weights",
             "restarts": "networks per learner method, seeds seed, seed+1, ...: the board gives the median of their "
                         "scores (the plot shows the first)",
             "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
             "drift_window_s": "the drift score's running mean (s)",
+            "screen": "drop the training parts' handling bursts, spikes and thermometer glitches before any model is "
+                      "fitted (reported); false: fit every sample",
             "axis": "x, y or z: the recording's axis when its sidecar does not say (tcbench import axes= records it)",
             "test_recordings": "other recordings of the same kind and unit to score the fitted models on, every "
                                "part of them held out: train on one record, test on others",

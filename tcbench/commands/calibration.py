@@ -1,8 +1,11 @@
 """What ``tcbench calibrate`` does: cut a static recording into parts — its temperature branches,
-or with ``blocks=N`` time blocks (:mod:`tcbench.signal.branches`) —, fit each offset model
+or with ``blocks=N`` time blocks (:mod:`tcbench.signal.branches`) —, screen the training parts
+(:mod:`tcbench.compensation.screening`: bursts, spikes, thermometer glitches dropped, reported),
+fit each offset model
 (:mod:`tcbench.compensation.calibration`) on the training parts, score it on every part (and on
 every part of ``test_recordings``), rank the methods on the held-out parts with a block-bootstrap
-interval (:mod:`tcbench.compensation.holdout`), and write the long table (``calibration.md`` and
+interval on every ratio (:mod:`tcbench.compensation.holdout`; a best whose interval against the
+next reaches 1 is a tie), say in one line when a method is worse than raw held out, and write the long table (``calibration.md`` and
 ``.csv``), the residual plots and ``calibration.json`` (the ranking, and the cubic refitted on the
 whole record with the recording's sensor, unit, axis and device id, which ``tcbench export``
 turns into PX4 and ArduPilot parameters).
@@ -165,6 +168,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     from tqdm import tqdm
 
     from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
+    from tcbench.compensation.screening import screened_all
 
     rec, split, others = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
@@ -187,6 +191,8 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
               "in-sample", file=sys.stderr)
     whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
     train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
+    screening = screened_all(train, cfg.screen)
+    print(screening.describe() if cfg.screen else "not screened (screen=false): " + screening.describe(), flush=True)
     jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
     fitted: dict[str, list[Any]] = {m: [] for m in methods}
     diagnosis = None
@@ -194,13 +200,16 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         for m, r in bar:
             bar.set_postfix_str(m)
             if m == "model":
-                diagnosis = _diagnosed(rec, split, cfg)
+                diagnosis = _diagnosed(rec, split, cfg, screening.keep)
                 fitted[m].append(from_model(diagnosis[1]))
             else:
-                fitted[m].append(fit(m, train, cfg.seed + r))
+                fitted[m].append(fit(m, screening.pieces, cfg.seed + r))
     rows: list[dict[str, Any]] = []
     residuals: dict[str, np.ndarray] = {}
     held: dict[str, list[list[np.ndarray]]] = {m: [[] for _ in runs] for m, runs in fitted.items()}
+    held_raw: list[np.ndarray] = []
+    held_temp: list[np.ndarray] = []
+    held_labels: list[str] = []
     steps: list[float] = []
     drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
     for path, r, parts, fitted_parts in [(cfg.recording, rec, split.parts, split.train),
@@ -213,6 +222,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
             role = "train" if k in fitted_parts else "test"
             if role == "test":
                 steps.append(dt_s)
+                held_raw.append((r.output - r.input)[b.start:b.stop])
+                held_temp.append(r.temperature_c[b.start:b.stop])
+                held_labels.append(f"{Path(path).stem}:{k}")
             for m, runs in every.items():
                 s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
                 if role == "test":
@@ -225,9 +237,13 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         if own:
             residuals = {m: runs[0] for m, runs in every.items()}
     table = pd.DataFrame(rows)
-    summary, about = _ranked(table, held, steps, cfg, unit, drift_key)
+    summary, about = _ranked(table, held, held_raw, steps, cfg, unit, drift_key)
+    about["per_part"] = _per_part(held, held_raw, steps, held_labels, cfg)
     about |= _about(cfg, rec, split, unit, own_hash)
-    about["export"] = _export_fit(whole)
+    about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
+    about["range"] = _range(screening.pieces, held_temp)
+    about["training"] = _training(fitted)
+    about["export"] = _export_fit(whole, cfg.screen)
     out = Path(cfg.out)
     try:
         with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)]) as tmp:
@@ -247,11 +263,14 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     return CalibrationOutcome(table, written, str(rec.meta.sensor), summary, about)
 
 
-def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[float], cfg: CalibrateConfig,
-            unit: str, drift_key: str) -> tuple[Any, dict[str, Any]]:
+def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], steps: list[float],
+            cfg: CalibrateConfig, unit: str, drift_key: str) -> tuple[Any, dict[str, Any]]:
     """One row per method: its held-out drift and RMS (every held-out sample pooled; the networks'
-    restarts averaged in the squares), its drift on the fitted parts and its ratio to the best;
-    and the ranking with the best method's margin over the next and its block-bootstrap interval."""
+    restarts averaged in the squares), its drift on the fitted parts, its ratio to the best's and
+    to raw's drift, each with its block-bootstrap interval (``held_raw``: the raw residual of the
+    held-out parts, scored even when ``raw`` is not among the methods); and the ranking: the best
+    method, its margin over the next with its interval, the methods the interval cannot tell from
+    the best (a tie), and those worse than raw."""
     import pandas as pd
 
     from tcbench.compensation.holdout import LEVEL, block_sums, ratio_interval
@@ -261,29 +280,116 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], steps: list[flo
     if not steps:
         summary = pd.DataFrame({"method": list(held), f"fit_drift_{_slug(unit)}": [fit_drift.get(m) for m in held]})
         return summary, {"held_out": False}
-    runs = {f"{m}#{i}": parts for m, per in held.items() for i, parts in enumerate(per)}
+    runs = {f"{m}#{i}": parts for m, per in held.items() for i, parts in enumerate(per)} | {"raw-ref#0": held_raw}
     sums = block_sums(runs, steps, cfg.drift_window_s)
     squares = {m: np.mean([sums.squares[f"{m}#{i}"] for i in range(len(per))], axis=0) for m, per in held.items()}
-    pooled = type(sums)(squares, sums.counts, sums.block_s)
+    pooled = type(sums)(squares | {"raw-ref": sums.squares["raw-ref#0"]}, sums.counts, sums.block_s)
     rms = {m: float(np.sqrt(np.mean([np.mean(np.concatenate(parts) ** 2) for parts in per]))) for m, per in held.items()}
     order = sorted(held, key=lambda m: (np.isnan(pooled.drift(m)), pooled.drift(m)))
     best = order[0]
+    to_best = {m: ratio_interval(pooled, m, best, seed=cfg.seed) for m in order}
+    to_raw = {m: ratio_interval(pooled, m, "raw-ref", seed=cfg.seed) for m in order}
     summary = pd.DataFrame({
         "method": order,
         f"held_out_drift_{_slug(unit)}": [pooled.drift(m) for m in order],
         f"held_out_rms_{_slug(unit)}": [rms[m] for m in order],
         f"fit_drift_{_slug(unit)}": [float(fit_drift.get(m, np.nan)) for m in order],
-        "x_best": [pooled.drift(m) / pooled.drift(best) if pooled.drift(best) > 0 else np.nan for m in order],
+        "x_best": [to_best[m][0] for m in order],
+        "x_best_lo": [to_best[m][1] for m in order],
+        "x_best_hi": [to_best[m][2] for m in order],
+        "x_raw": [to_raw[m][0] for m in order],
+        "x_raw_lo": [to_raw[m][1] for m in order],
+        "x_raw_hi": [to_raw[m][2] for m in order],
     })
     ranking: dict[str, Any] = {"held_out": True, "best": best, "best_drift": pooled.drift(best),
                                "block_s": pooled.block_s, "blocks": int(pooled.counts.size), "level": LEVEL,
-                               "drift": {m: pooled.drift(m) for m in order}}
+                               "drift": {m: pooled.drift(m) for m in order}, "raw_drift": pooled.drift("raw-ref"),
+                               "x_raw": {m: list(to_raw[m]) for m in order},
+                               "x_best": {m: list(to_best[m]) for m in order}}
     if len(order) > 1:
         point, lo, hi = ratio_interval(pooled, best, order[1], seed=cfg.seed)
-        ranking |= {"next": order[1], "ratio_to_next": point, "ratio_lo": lo, "ratio_hi": hi}
-        if "raw" in order and best != "raw":
-            ranking["ratio_to_raw"] = list(ratio_interval(pooled, best, "raw", seed=cfg.seed))
+        ranking |= {"next": order[1], "ratio_to_next": point, "ratio_lo": lo, "ratio_hi": hi,
+                    "tied": [m for m in order[1:] if not to_best[m][1] > 1.0]}
+    if best != "raw":
+        ranking["ratio_to_raw"] = list(to_raw[best])
+    ranking["worse_than_raw"] = [m for m in order if m != "raw" and to_raw[m][0] > 1.0]
     return summary, ranking
+
+
+def _per_part(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], steps: list[float],
+              labels: list[str], cfg: CalibrateConfig) -> list[dict[str, Any]]:
+    """Each held-out part on its own (``recording:part``): every method's drift, its ratio to
+    raw's and to the part's best with their block-bootstrap intervals, the best and its ties —
+    the fit-on-one-run, test-on-another answer when the parts are runs."""
+    from tcbench.compensation.holdout import block_sums, ratio_interval
+
+    out = []
+    for k, label in enumerate(labels):
+        runs = {f"{m}#{i}": [per[i][k]] for m, per in held.items() for i in range(len(per))} | \
+            {"raw-ref#0": [held_raw[k]]}
+        sums = block_sums(runs, [steps[k]], cfg.drift_window_s)
+        squares = {m: np.mean([sums.squares[f"{m}#{i}"] for i in range(len(per))], axis=0) for m, per in held.items()}
+        pooled = type(sums)(squares | {"raw-ref": sums.squares["raw-ref#0"]}, sums.counts, sums.block_s)
+        best = min(held, key=lambda m: pooled.drift(m))
+        to_best = {m: list(ratio_interval(pooled, m, best, seed=cfg.seed)) for m in held}
+        out.append({"part": label, "best": best, "blocks": int(sums.counts.size), "block_s": sums.block_s,
+                    "drift": {m: pooled.drift(m) for m in held}, "raw_drift": pooled.drift("raw-ref"),
+                    "x_raw": {m: list(ratio_interval(pooled, m, "raw-ref", seed=cfg.seed)) for m in held},
+                    "x_best": to_best, "tied": [m for m in held if m != best and not to_best[m][1] > 1.0]})
+    return out
+
+
+def _training(fitted: dict[str, list[Any]]) -> dict[str, Any]:
+    """How each fitted method was trained, one line each (the networks' algorithm, epochs and
+    restarts; what the diagnosed model explains but does not compensate)."""
+    from tcbench.compensation.fitted_model import dropped_terms
+    from tcbench.compensation.training import describe
+
+    out: dict[str, Any] = {}
+    for m, runs in fitted.items():
+        if runs and runs[0].training:
+            out[m] = {"line": describe(m, [r.training for r in runs]), "runs": [r.training for r in runs]}
+        elif m == "model" and runs:
+            dropped = dropped_terms(runs[0].sensor_model)
+            out[m] = {"line": "model: tcbench diagnose on the screened training parts (least squares); compensates "
+                              "with its temperature terms only, not with "
+                              + (", ".join(dropped) if dropped else "any clock-keyed term (none was fitted)")
+                              + " (keyed to the calibration run's clock or its rig: explained, not compensated)",
+                      "dropped": dropped}
+    return out
+
+
+def _range(pieces: list[Any], held_temp: list[np.ndarray]) -> dict[str, Any]:
+    """The fitted temperatures and how far the held-out ones go beyond them (share of samples)."""
+    lo = float(min(p.temp_c.min() for p in pieces))
+    hi = float(max(p.temp_c.max() for p in pieces))
+    out: dict[str, Any] = {"fitted_c": [lo, hi]}
+    if held_temp:
+        temp = np.concatenate(held_temp)
+        out |= {"held_out_c": [float(temp.min()), float(temp.max())],
+                "beyond_share": float(np.mean((temp < lo) | (temp > hi)))}
+    return out
+
+
+def _range_line(about: dict[str, Any]) -> str | None:
+    """One line when held-out samples lie beyond the fitted temperatures: who is held at the edge."""
+    r = about.get("range", {})
+    if r.get("beyond_share", 0.0) < 0.001:
+        return None
+    (lo, hi), (hlo, hhi) = r["fitted_c"], r["held_out_c"]
+    return (f"held out beyond the fitted {lo:.1f}..{hi:.1f} degC: {r['beyond_share']:.1%} of the samples "
+            f"({hlo:.1f}..{hhi:.1f} degC); poly3, poly3_rate's cubic, bp and elman are held at the edge there "
+            "(the networks' rate input too), poly3_rate's rate term and model carry on")
+
+
+def _worse_line(about: dict[str, Any]) -> str | None:
+    """One line when a method's held-out drift is above raw's (the calibration makes it worse)."""
+    worse = about.get("worse_than_raw") or []
+    if not worse:
+        return None
+    each = ", ".join(f"{m} {about['x_raw'][m][0]:.2f}x [{about['x_raw'][m][1]:.2f}, {about['x_raw'][m][2]:.2f}]"
+                     for m in worse)
+    return f"WORSE THAN RAW held out (drift over raw's): {each}"
 
 
 def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash: str) -> dict[str, Any]:
@@ -309,16 +415,20 @@ def _content_hash(path: str) -> str:
     return content_hash([path])
 
 
-def _export_fit(whole: Any) -> dict[str, Any] | None:
-    """The cubic an autopilot is given: ``poly3`` refitted on the whole record (the held-out scores
-    judged the method; the parameters use every sample), in the recording's output unit."""
+def _export_fit(whole: Any, screen: bool = True) -> dict[str, Any] | None:
+    """The cubic an autopilot is given: ``poly3`` refitted on the whole record, screened as the
+    training parts are (the held-out scores judged the method; the parameters use every kept
+    sample), in the recording's output unit."""
     from tcbench.compensation.px4 import fit_offset
+    from tcbench.compensation.screening import screen as screened
 
+    kept = screened(whole, screen).pieces
     try:
-        cubic = fit_offset(whole.temp_c, whole.output - whole.truth)
+        cubic = fit_offset(np.concatenate([p.temp_c for p in kept]),
+                           np.concatenate([p.output - p.truth for p in kept]))
     except ValueError:
         return None
-    return {"method": "poly3", "fitted_on": "the whole record", "x": list(cubic.x), "tref_c": cubic.tref_c,
+    return {"method": "poly3", "fitted_on": "the whole record" + (", screened" if screen else ""), "x": list(cubic.x), "tref_c": cubic.tref_c,
             "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c}
 
 
@@ -332,14 +442,22 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     if not about.get("held_out"):
         print("nothing held out: no method is ranked")
         return
+    for line in (_range_line(about), _worse_line(about)):
+        if line:
+            print(line)
+    print(_best_line(about, unit))
+
+
+def _best_line(about: dict[str, Any], unit: str) -> str:
+    """``best held out: model, drift ...; 0.70x poly3's [0.55, 0.90] (...)``, or a tie."""
     line = f"best held out: {about['best']}, drift {about['best_drift']:.4g} {unit}"
     if "next" in about:
         line += (f"; {about['ratio_to_next']:.2f}x {about['next']}'s [{about['ratio_lo']:.2f}, "
                  f"{about['ratio_hi']:.2f}] ({about['level']:.0%} block bootstrap over {about['blocks']} "
                  f"blocks of {about['block_s']:.0f} s)")
-        if about["ratio_hi"] >= 1.0:
-            line += f": not told apart from {about['next']}"
-    print(line)
+        if about["tied"]:
+            line += f": a tie with {', '.join(about['tied'])} (the interval reaches 1)"
+    return line
 
 
 def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
@@ -355,10 +473,11 @@ def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
             "(tcbench diagnose reports what a short record can tell)")
 
 
-def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig) -> tuple[Any, Any]:
+def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | None = None) -> tuple[Any, Any]:
     """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
-    kept as gaps) and the model it fitted, for the ``model`` method. The parts must be as long
-    as any full diagnosis (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min)."""
+    kept as gaps; ``keep``: the rows screening kept, per training row) and the model it fitted,
+    for the ``model`` method. The parts must be as long as any full diagnosis
+    (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min)."""
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.model_file import to_sensor_model
     from tcbench.diagnose.plan import min_full_duration_s
@@ -367,6 +486,8 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig) -> tuple[Any, Any]:
     from tcbench.sensors.recording import make_recording
 
     rows = np.concatenate([np.arange(split.parts[k].start, split.parts[k].stop) for k in split.train])
+    if keep is not None:
+        rows = rows[keep]
     part = make_recording(rec.time_s[rows], rec.temperature_c[rows], rec.input[rows], rec.output[rows],
                           sensor=rec.meta.sensor, sample_rate_hz=rec.meta.sample_rate_hz, device_id=rec.meta.device_id)
     try:
@@ -389,23 +510,34 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: d
     written = {"csv": tmp / "calibration.csv", "md": tmp / "calibration.md", "json": tmp / "calibration.json"}
     table.to_csv(written["csv"], index=False)
     note = "" if about.get("held_out") else "\nNothing was held out: the scores are in-sample only.\n"
-    lines = [f"{rec.meta.sensor} recording, output in {unit}; {len(split.parts)} {split.noun}s ({split.how}); "
+    lines = [f"{rec.meta.sensor} recording, output in {unit}; {len(split.parts)} "
+             f"{split.noun.replace('branch', 'branche')}s ({split.how}); "
              f"fitted on {split.describe(split.train)}, scored on every part.",
              f"drift = RMS of the residual's {cfg.drift_window_s:g}-s running mean (output minus true input minus "
              "the model's offset); rms = RMS of the residual."]
     if cfg.test_recordings:
         lines.append(f"Also scored on every part of {', '.join(map(str, cfg.test_recordings))}.")
     if cfg.restarts > 1:
-        lines.append(f"The networks (bp, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
+        lines.append(f"The networks (bp, bp_gd, elman) are {cfg.restarts} restarts each (seeds {cfg.seed}.."
                      f"{cfg.seed + cfg.restarts - 1}): their median; the plot shows seed {cfg.seed}.")
+
+    screening = about["screening"]
+    lines.append(f"Training parts {'screened' if screening['enabled'] else 'not screened (screen=false)'} "
+                 f"(tcbench.compensation.screening: departures beyond {screening['min_z']:g} robust sigmas or the "
+                 f"Bonferroni bound from a {screening['window_s']:g}-s running median, widened by "
+                 f"{screening['guard_s']:g} s; thermometer glitches; cut at gaps): "
+                 f"{screening['line'].removeprefix('screened: ')}.")
+    if about.get("training"):
+        lines.append("\n\nTraining:\n\n" + "".join(f"- {t['line']}\n" for t in about["training"].values()))
     ranking = ""
     if about.get("held_out"):
-        ranking = (f"\n## Held out\n\nEvery held-out sample pooled; x_best = held-out drift over the best's. "
-                   f"Best: **{about['best']}**"
-                   + (f", {about['ratio_to_next']:.2f}x {about['next']}'s drift [{about['ratio_lo']:.2f}, "
-                      f"{about['ratio_hi']:.2f}] ({about['level']:.0%} block bootstrap, {about['blocks']} blocks of "
-                      f"{about['block_s']:g} s)" if "next" in about else "")
-                   + f".\n\n{markdown_table(summary.round(6))}\n")
+        verdicts = [ln for ln in (_range_line(about), _worse_line(about)) if ln]
+        ranking = (f"\n## Held out\n\nEvery held-out sample pooled; x_best = held-out drift over the best's, x_raw = "
+                   f"over raw's, each with its {about['level']:.0%} block-bootstrap interval (_lo, _hi; "
+                   f"{about['blocks']} blocks of {about['block_s']:g} s, every method on the same draws). "
+                   + _best_line(about, unit).replace("best held out: ", "Best: ") + ".\n\n"
+                   + "".join(f"- {v}\n" for v in verdicts) + ("\n" if verdicts else "")
+                   + f"{markdown_table(summary.round(6))}\n")
     written["md"].write_text(f"# Calibration of {Path(cfg.recording).name}\n\n{' '.join(lines)}\n{note}{ranking}\n"
                              f"## Every part\n\n{markdown_table(table.drop(columns=['recording']) if not cfg.test_recordings else table)}"
                              "\n\n![residuals](residuals.png)\n")

@@ -107,7 +107,7 @@ class CalibrateConfig:
     recording: str = ""
     out: str = "calibration"
     train_branches: list[int] | None = None
-    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "elman", "model"])
+    methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model"])
     seed: int = 0
     restarts: int = 1  # networks per learner method (seeds seed, seed+1, ...): the board gives their median
     min_swing_c: float = 5.0
@@ -116,6 +116,7 @@ class CalibrateConfig:
     test_recordings: list[str] = field(default_factory=list)  # more records to score on, every part held out
     true_input: str | None = None  # VALUE[:unit]: the static record's true input (an axis along gravity: -1:g)
     axis: str | None = None  # x, y or z: the recording's axis when its sidecar does not say (for tcbench export)
+    screen: bool = True  # drop the training parts' bursts, spikes and thermometer glitches before any fit
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="calibrations"))
 
 

@@ -11,14 +11,26 @@ Methods, each a function of what a flight controller can read (the thermometer a
   window, :func:`tcbench.compensation.features.temperature_rate_c_per_s`): the first-order
   expansion of an offset seen through a thermal lag, which the heating and cooling branches
   of a cycle tell apart.
-- ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`, their defaults) on
-  ``[T, dT/dt]``, trained from the run's seed on the means of :data:`TRAIN_BIN_S` time bins of
-  the training parts (see :func:`fit`).
+- ``bp``, ``elman``: the seed papers' networks (:mod:`tcbench.learners`) on ``[T, dT/dt]``,
+  ``bp`` trained by Levenberg-Marquardt when the rows allow it, ``bp_gd`` the same network by
+  the paper's gradient descent (1000 epochs), ``elman`` by Adam (:mod:`tcbench.compensation.training`),
+  from the run's seed on the means of :data:`TRAIN_BIN_S` time bins of
+  the training parts (see :func:`fit`). Their inputs are held to the box they were trained on
+  (as PX4 holds its cubic to its temperature range): beyond it a network gives its value at the
+  edge, never an extrapolation of its activations. A fit on one direction of a cycle has seen one
+  sign of the rate only, so it cannot tell the other direction anything.
 - ``model``: the diagnosed physics. ``tcbench diagnose`` on the training parts fits a model
-  (polynomial core, thermal lag, hysteresis, warm-up, steps ...; :mod:`tcbench.diagnose`), and its
-  deterministic output is the offset (:mod:`tcbench.compensation.fitted_model`); the command
+  (polynomial core, thermal lag, hysteresis, warm-up, steps ...; :mod:`tcbench.diagnose`), and
+  the deterministic output of what a compensator can run of it is the offset: its temperature
+  terms, driven by the thermometer's history, without the terms keyed to the calibration run's
+  clock (steps, transients, warm-up, ageing) or its rig's lines — what the diagnosis explains is
+  not all that a compensator may use (:mod:`tcbench.compensation.fitted_model`); the command
   (:mod:`tcbench.commands.calibration`) runs the diagnosis and hands the model in with
   :func:`from_model`.
+
+The training parts are screened first (:mod:`tcbench.compensation.screening`: handling bursts,
+spikes and thermometer glitches dropped, the parts cut at their gaps; the command does it and
+hands the pieces in), so every method is fitted on the same samples.
 
 The scores of a branch: the RMS of the residual (output minus true input minus the model's
 offset), and the RMS of its running mean over ``drift_window_s`` (the drift, with the white
@@ -36,8 +48,8 @@ import numpy as np
 from tcbench.compensation.features import bin_means, running_mean, temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 
-METHODS = ("raw", "poly3", "poly3_rate", "bp", "elman", "model")
-LEARNERS = ("bp", "elman")
+METHODS = ("raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")
+LEARNERS = ("bp", "bp_gd", "elman")
 RATE_WINDOW_S = 120.0
 TRAIN_BIN_S = 5.0  # the networks' training bins: see fit()
 
@@ -82,6 +94,9 @@ class OffsetModel:
     learner: Any = None  # a fitted tcbench learner on [T, dT/dt]
     sensor_model: Any = None  # a diagnosed PolynomialModel
     bin_s: float | None = None  # the learner's training bins (s); a sequential one also runs on them
+    temp_range_c: tuple[float, float] | None = None  # a learner's training temperatures: its input is held to them
+    rate_range: tuple[float, float] | None = None  # and its training rates (degC/s)
+    training: dict[str, Any] | None = None  # how a network was trained (tcbench.compensation.training)
 
     def offset(self, rec: Record) -> np.ndarray:
         """The offset at each sample of ``rec``. A sequential learner (``elman``) trained on bins
@@ -91,26 +106,36 @@ class OffsetModel:
         if self.sensor_model is not None:
             from tcbench.compensation.fitted_model import deterministic_output
 
-            return deterministic_output(self.sensor_model, rec.t_s, rec.temp_c, rec.truth) - rec.truth
+            return deterministic_output(self.sensor_model, rec.t_s, rec.temp_c, rec.truth,
+                                        clock_terms=False) - rec.truth
         if self.learner is not None:
             if self.bin_s and self.learner.sequential:
                 coarse = rec.binned(self.bin_s)
-                return np.interp(rec.t_s, coarse.t_s, _predicted(self.learner, coarse))
-            return _predicted(self.learner, rec)
+                return np.interp(rec.t_s, coarse.t_s, _predicted(self.learner, coarse, self.temp_range_c,
+                                                                 self.rate_range))
+            return _predicted(self.learner, rec, self.temp_range_c, self.rate_range)
         if self.cubic is None:
             return np.zeros_like(rec.output)
         return self.cubic.offset(rec.temp_c) + self.rate_coef * rec.rate_c_per_s
 
 
-def _predicted(learner: Any, rec: Record) -> np.ndarray:
-    """A fitted learner's output on ``[T, dT/dt]`` of ``rec``."""
-    inputs = np.column_stack([rec.temp_c, rec.rate_c_per_s])
+def _predicted(learner: Any, rec: Record, temp_range_c: tuple[float, float] | None = None,
+               rate_range: tuple[float, float] | None = None) -> np.ndarray:
+    """A fitted learner's output on ``[T, dT/dt]`` of ``rec``, ``T`` held to ``temp_range_c`` and
+    ``dT/dt`` to ``rate_range`` (as PX4 holds its cubic to ``TMIN..TMAX``: beyond its training
+    inputs a network's output is whatever its activations extrapolate to, so it gives its value
+    at the edge of the box it was trained on)."""
+    temp = rec.temp_c if temp_range_c is None else np.clip(rec.temp_c, *temp_range_c)
+    rate = rec.rate_c_per_s if rate_range is None else np.clip(rec.rate_c_per_s, *rate_range)
+    inputs = np.column_stack([temp, rate])
     return np.asarray(learner.predict(inputs), dtype=np.float64).reshape(-1)
 
 
-def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None = TRAIN_BIN_S) -> OffsetModel:
+def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None = TRAIN_BIN_S,
+        bp_training: str = "lm") -> OffsetModel:
     """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``; a
-    network's initial weights drawn from ``seed``.
+    network's initial weights drawn from ``seed``; ``bp`` trained by Levenberg-Marquardt when
+    the rows allow it (``bp_training=gd``: gradient descent; :mod:`tcbench.compensation.training`).
 
     A network (``bp``, ``elman``) is trained on the means of ``bin_s`` time bins of each training
     record (:meth:`Record.binned`; ``None``: on every sample), its normalisation fitted to the
@@ -135,17 +160,14 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     target = np.concatenate([r.output - r.truth for r in train])
     rate = np.concatenate([r.rate_c_per_s for r in train])
     if method in LEARNERS:
-        from tcbench.learners import registry
+        from tcbench.compensation.training import fit_network
 
         if bin_s is not None and not bin_s > 0:
             raise ValueError(f"bin_s must be > 0 or None, got {bin_s}")
-        learner = registry.create(method, 2, None, np.random.default_rng(seed))
-        learner.scale_to(np.column_stack([temp, rate]), target)
-        rows = [r.binned(bin_s) for r in train] if bin_s else list(train)
-        learner.fit(np.column_stack([np.concatenate([r.temp_c for r in rows]),
-                                     np.concatenate([r.rate_c_per_s for r in rows])]),
-                    np.concatenate([r.output - r.truth for r in rows]))
-        return OffsetModel(method, learner=learner, bin_s=bin_s)
+        network, algorithm = ("bp", "gd") if method == "bp_gd" else (method, bp_training)
+        learner, training = fit_network(network, train, seed, bin_s, algorithm)
+        return OffsetModel(method, learner=learner, bin_s=bin_s, temp_range_c=(float(temp.min()), float(temp.max())),
+                           rate_range=(float(rate.min()), float(rate.max())), training=training)
     cubic = fit_offset(temp, target)
     if method == "poly3":
         return OffsetModel("poly3", cubic)
@@ -157,7 +179,10 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
 
 
 def from_model(sensor_model: Any) -> OffsetModel:
-    """The ``model`` method: a diagnosed :class:`~tcbench.sensors.fitted.PolynomialModel` as the offset."""
+    """The ``model`` method: a diagnosed :class:`~tcbench.sensors.fitted.PolynomialModel` as the
+    offset, as a compensator runs it: without the terms keyed to the calibration run's clock
+    (steps, transients, warm-up, ageing) or its rig's lines
+    (:func:`tcbench.compensation.fitted_model.compensator`; the diagnosis still reports them)."""
     return OffsetModel("model", sensor_model=sensor_model)
 
 
