@@ -3,7 +3,6 @@ run merged or dropped, training and testing on the same data warned about and ma
 
 from __future__ import annotations
 
-import logging
 import shutil
 from pathlib import Path
 
@@ -96,34 +95,26 @@ def test_two_configs_of_one_method_on_one_file_both_count(workdir: Path) -> None
     assert five != ten  # two trainings, not one counted twice
 
 
-def test_training_on_the_test_data_warns_and_is_marked(workdir: Path, caplog: pytest.LogCaptureFixture) -> None:
+def test_training_on_the_test_data_is_refused(workdir: Path) -> None:
+    """A task never tests on its own training runs: a test file that is a training file fails the job
+    with one line naming it (recorded as failed), and a held-out job runs."""
     c = [_cycle(workdir, f"c{i}", i) for i in range(2)]
-    with caplog.at_level(logging.WARNING):
-        assert not isinstance(run_job(_job(c, c[1:], POLY)), JobFailure)
-    warned = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
-    assert warned == [f"train_files and test_files share {c[1]}: its test scores are in-sample"]
-    caplog.clear()
-    with caplog.at_level(logging.WARNING):
-        assert not isinstance(run_job(_job(c[:1], c[1:], POLY)), JobFailure)  # held out: no warning
-    assert not [r for r in caplog.records if r.levelno == logging.WARNING]
-    marked, held_out = sorted(_boards(), key=lambda b: not b.in_sample)
-    assert marked.in_sample == c[1] and not held_out.in_sample
-    assert marked.table["note"].str.startswith(board.IN_SAMPLE_NOTE).all()
+    failed = run_job(_job(c, c[1:], POLY))
+    assert isinstance(failed, JobFailure)
+    assert f"{c[1]} is both a training and a test recording" in failed.error
+    assert not isinstance(run_job(_job(c[:1], c[1:], POLY)), JobFailure)  # held out
+    (held_out,) = [b for b in _boards() if not b.in_sample]
     assert not held_out.table["note"].str.contains("in-sample").any()
-    md = board.write(marked, workdir / "lb", "test")["md"].read_text()
-    assert f"**In-sample:** train_files and test_files share {c[1]}" in md
 
 
-def test_a_copy_of_a_training_file_is_in_sample_too(workdir: Path, caplog: pytest.LogCaptureFixture) -> None:
+def test_a_copy_of_a_training_file_is_refused_too(workdir: Path) -> None:
     a = _cycle(workdir, "a", 0)
     shutil.copy(a, workdir / "b.csv")
     shutil.copy(workdir / "a.json", workdir / "b.json")
     untracked = _job([a], [str(workdir / "b.csv")], POLY)
     untracked["tracking"]["enabled"] = False
-    with caplog.at_level(logging.WARNING):
-        assert not isinstance(run_job(untracked), JobFailure)
-    warned = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
-    assert warned == [f"train_files and test_files share {workdir / 'b.csv'}: its test scores are in-sample"]
+    failed = run_job(untracked)
+    assert isinstance(failed, JobFailure) and failed.user and "(the same data)" in failed.error
 
 
 def test_the_limits_count_once_per_seed_whatever_the_settings_beside_them() -> None:

@@ -38,3 +38,33 @@ def test_notes_use_the_interval_and_the_probe() -> None:
     note = table.loc["picked_worse", "note"]
     assert "below" not in note and "fails the ±0.5 g probe" in note and "best-by-train pick fails it worse (3e+05 µg)" in note
     assert "ci_high_primary" not in table.columns
+
+
+def test_below_a_limit_is_decided_on_the_limits_interval_too() -> None:
+    """A limit over 30 run draws has an interval: a method is below it only when its interval ends
+    under the limit's; below the thermometer-limited oracle alone is named as such."""
+    rng = np.random.default_rng(1)
+    runs = pd.concat([
+        _runs("oracle", rng.uniform(2.0, 4.0, 30), np.full(30, 3.0)),
+        _runs("oracle_thermometer", rng.uniform(6.0, 10.0, 30), np.full(30, 3.0)),
+        _runs("inside", rng.uniform(7.5, 8.5, 30), np.full(30, 4.0)),   # under the thermometer's median, not its interval
+        _runs("learned_the_run", rng.uniform(5.0, 5.2, 30), np.full(30, 4.0)),
+    ], ignore_index=True)
+    table = summarise(runs, "fulltemp").set_index("method")
+    assert table.loc["inside", "note"] == ""
+    assert table.loc["learned_the_run", "note"].startswith("below the thermometer-limited oracle (ci95 up to 5.")
+    assert "ci_low_primary" not in table.columns
+
+
+def test_boards_are_named_by_their_tier() -> None:
+    from tcbench.leaderboard.compensation import boards
+
+    frames = []
+    for split in ("next_run", "replay"):
+        r = _runs("raw", np.full(3, 4e4), np.full(3, 4e4))
+        r["split"], r["task"], r["task_name"], r["config_hash"] = split, "msra_fulltemp-dev0", "msra_fulltemp", "h"
+        r["run_id"], r["start_time"], r["data_hash"], r["in_sample"] = [f"{split}{i}" for i in range(3)], 0, "", ""
+        frames.append(r)
+    made = {b.split: b for b in boards(pd.concat(frames, ignore_index=True), {"msra_fulltemp": "fulltemp"})}
+    assert set(made) == {"next_run", "replay"}
+    assert made["next_run"].stem == "msra_fulltemp-dev0" and made["replay"].stem == "msra_fulltemp-dev0.replay"

@@ -28,7 +28,8 @@ LIMITS = ("oracle", "oracle_thermometer")
 def device_table(boards: Path) -> pd.DataFrame:
     """One row per device: the drawn physics, then each method's median drift over the limit's."""
     rows = []
-    for path in sorted(boards.glob("accel_chamber-dev*.csv"), key=lambda p: int(re.findall(r"dev(\d+)", p.stem)[0])):
+    next_run = [p for p in boards.glob("accel_chamber-dev*.csv") if "." not in p.stem]  # tier boards: <task>.<tier>
+    for path in sorted(next_run, key=lambda p: int(re.findall(r"dev(\d+)", p.stem)[0])):
         device = int(re.findall(r"dev(\d+)", path.stem)[0])
         board = pd.read_csv(path).set_index("method")
         drift = board["median_drift_ug"]

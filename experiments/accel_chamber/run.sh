@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The accelerometer chamber task's board: BP (IFA and random initial weights; GD and LM) over 30
-# seeds, BAS-Elman over 10, and the baselines (raw, poly3, poly3_rate, lagpoly, the diagnosed model,
-# both oracles) on device 0; the baselines on devices 1-9; then leaderboards/accel-chamber/ (one board
-# per device, and devices.md across them). About 40 min on 2 cores.
+# The accelerometer chamber task's board on the next_run tier (new power-ons): BP (IFA and random
+# initial weights; GD and LM) over 30 seeds, BAS-Elman over 10 on device 0; the baselines (raw, the
+# memoriser, poly3, poly3_rate, lagpoly, the diagnosed model) on devices 0-9, and both limits over 30
+# draws of the cycles on each; the replay tier's contrast on device 0; then leaderboards/accel-chamber/
+# (one board per device and tier, and devices.md across them).
 # Usage (from the repository root, tcbench installed): bash experiments/accel_chamber/run.sh
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -12,17 +13,27 @@ export MLFLOW_TRACKING_URI="sqlite:///$PWD/$here/mlflow.db"
 rm -f "$here/mlflow.db"
 sweep=accel-chamber-$(date -u +%Y%m%dT%H%M%S)
 common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra.launcher.n_jobs=2)
+# The default tier, next_run: the test cycles are new power-ons of the device.
 tcbench run -m experiment=accel_chamber "${common[@]}"
 tcbench run -m task=accel_chamber learner=elman optimiser=bas 'seed=range(10)' budget=510 \
   tracking.experiment=accel-chamber "${common[@]}"
-tcbench run -m task=accel_chamber learner=raw,oracle,oracle_thermometer,lagpoly,model optimiser=none \
+tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=raw,memoriser,lagpoly,model optimiser=none \
   tracking.experiment=accel-chamber "${common[@]}"
-tcbench run -m task=accel_chamber learner=poly learner.form=bias,bias_rate optimiser=none \
-  tracking.experiment=accel-chamber "${common[@]}"
-tcbench run -m task=accel_chamber 'task.device_seed=range(1,10)' \
-  learner=raw,oracle,oracle_thermometer,lagpoly,model optimiser=none tracking.experiment=accel-chamber "${common[@]}"
-tcbench run -m task=accel_chamber 'task.device_seed=range(1,10)' learner=poly learner.form=bias,bias_rate \
+tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=poly learner.form=bias,bias_rate \
   optimiser=none tracking.experiment=accel-chamber "${common[@]}"
+# The limits over 30 draws of the cycles (recordings drawn from the run seed), each device.
+tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=oracle,oracle_thermometer optimiser=none \
+  'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
+# The replay tier on device 0, the diagnostic the boards stood on before power-ons: the test cycles
+# replay the training cycles' power-on with new noise.
+tcbench run -m task=accel_chamber task.split=replay learner=raw,memoriser,lagpoly,model optimiser=none \
+  tracking.experiment=accel-chamber "${common[@]}"
+tcbench run -m task=accel_chamber task.split=replay learner=poly learner.form=bias,bias_rate optimiser=none \
+  tracking.experiment=accel-chamber "${common[@]}"
+tcbench run -m task=accel_chamber task.split=replay learner=bp learner.training=lm optimiser=ifa 'seed=range(10)' \
+  tracking.experiment=accel-chamber "${common[@]}"
+tcbench run -m task=accel_chamber task.split=replay learner=oracle,oracle_thermometer optimiser=none \
+  'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment accel-chamber --sweep "$sweep" --out "$out"
 python "$here/devices.py" --boards "$out"

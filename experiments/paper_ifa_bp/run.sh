@@ -13,8 +13,19 @@ rm -f "$here/mlflow.db"
 sweep=paper-ifa-bp-$(date -u +%Y%m%dT%H%M%S)
 common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra/launcher=joblib hydra.launcher.n_jobs=2)
 tcbench run -m experiment=paper_ifa_bp "${common[@]}"
-tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,oracle,oracle_thermometer,lagpoly,poly optimiser=none \
+tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,memoriser,lagpoly,poly optimiser=none \
   tracking.experiment=paper-ifa-bp "${common[@]}"
+# the limits over 30 draws of the runs (recordings drawn from the run seed)
+tcbench run -m task=msra_zerobias,msra_fulltemp learner=oracle,oracle_thermometer optimiser=none 'seed=range(30)' \
+  task.recordings_seed=null tracking.experiment=paper-ifa-bp "${common[@]}"
+# the replay tier (the test runs replay the training runs' power-on, new noise): what the boards measured
+# before power-ons, for the seed claims' contrast
+tcbench run -m task=msra_zerobias,msra_fulltemp task.split=replay learner=raw,memoriser,lagpoly,poly optimiser=none \
+  tracking.experiment=paper-ifa-bp "${common[@]}"
+tcbench run -m task=msra_zerobias,msra_fulltemp task.split=replay learner=bp learner.training=gd,lm optimiser=ifa \
+  'seed=range(30)' tracking.experiment=paper-ifa-bp "${common[@]}"
+tcbench run -m task=msra_zerobias,msra_fulltemp task.split=replay learner=oracle,oracle_thermometer optimiser=none \
+  'seed=range(30)' task.recordings_seed=null tracking.experiment=paper-ifa-bp "${common[@]}"
 # the cubic with the networks' inputs on zero bias: [T, dT/dt] (poly3_rate)
 tcbench run task=msra_zerobias learner=poly learner.form=bias_rate optimiser=none tracking.experiment=paper-ifa-bp \
   "${common[@]}"

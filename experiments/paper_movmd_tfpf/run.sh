@@ -23,7 +23,9 @@ serial=(task.decomposition=none task.denoise=none)
 # the device as simulated by default (flicker ~33 deg/h, PHYSICS.md §6).
 # the honest baselines first (this also creates the tracking store before parallel sweeps use it):
 # raw output, the oracle (true drift removed, noise untouched), a polynomial in T and dT/dt
-run 1 "${serial[@]}" learner=raw,oracle,oracle_thermometer,poly optimiser=none
+run 1 "${serial[@]}" learner=raw,memoriser,poly optimiser=none
+run 15 "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds" task.recordings_seed=null
+run 16 "${serial[@]}" task.split=replay learner=raw,memoriser,poly optimiser=none
 # the paper's method over 30 restarts, beside wavelet denoising alone and BP on temperature
 run 2 learner=elman optimiser=bas "seed=$seeds" &
 run 3 task.decomposition=none task.denoise=wavelet learner=raw optimiser=none
@@ -39,7 +41,8 @@ run 14 learner=elman optimiser=cmaes "seed=$seeds"  # CMA-ES (plugins/tcbench-pe
 # the same device with 3 deg/h of flicker instead of ~33: where temperature drift, not flicker,
 # dominates the soak means, what does each method compensate?
 low=('task.effects={bias_instability:{b:8.3e-4}}')
-run 8 "${low[@]}" "${serial[@]}" learner=raw,oracle,oracle_thermometer,poly optimiser=none
+run 8 "${low[@]}" "${serial[@]}" learner=raw,memoriser,poly optimiser=none
+run 17 "${low[@]}" "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds" task.recordings_seed=null
 run 9 "${low[@]}" learner=elman optimiser=bas "seed=$seeds" &
 run 10 "${low[@]}" task.decomposition=none task.denoise=wavelet learner=raw optimiser=none
 run 11 "${low[@]}" learner=raw optimiser=none

@@ -290,10 +290,11 @@ def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[Compensation
 
 
 def _one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
-    """The newest finished run per task, method, config and seed; per task, method and seed for
-    the limits, whose names leave out the settings they do not depend on (the gyro pipeline)."""
+    """The newest finished run per task, tier, method, config and seed; per task, tier, method and
+    seed for the limits, whose names leave out the settings they do not depend on (the gyro pipeline)."""
     limit = runs["method"].isin(list(LIMITS.values()))
-    kept = [one_run_per_job(runs[~limit]), one_run_per_job(runs[limit], ("task", "method", "seed"))]
+    kept = [one_run_per_job(runs[~limit], ("task", "split", "method", "config_hash", "seed")),
+            one_run_per_job(runs[limit], ("task", "split", "method", "seed"))]
     return pd.concat([k for k in kept if not k.empty] or [runs.iloc[:0]]).sort_index()
 
 

@@ -64,7 +64,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         ``oracle``: the simulator's true drift removed, noise untouched).
     budget: candidate evaluations per episode.
     device_seed, recordings_seed, n_train, n_test, sample_rate_hz, hold_s: the simulated oven
-        runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks).
+        runs (seed 001: one to train, one to test, 10 Hz, 1 h soaks); ``recordings_seed`` None draws
+        them from the reset seed (a row over draws, e.g. the limits).
     split: the tier the simulated test runs are drawn on (:data:`~tcbench.compensation.data.SPLITS`;
         default ``next_run``, new power-ons).
     train_files, test_files: schema-v1 gyro recordings instead.
@@ -84,7 +85,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     baselines = BASELINES  # no lagpoly: the drift pipeline has its own learners
 
     def __init__(self, learner: str | None = "elman", learner_params: dict[str, Any] | None = None,
-                 budget: int = 1000, device_seed: int = 0, recordings_seed: int = 0, n_train: int = 1,
+                 budget: int = 1000, device_seed: int = 0, recordings_seed: int | None = 0, n_train: int = 1,
                  n_test: int = 1, train_files: list[str] | None = None, test_files: list[str] | None = None,
                  sample_rate_hz: float = 10.0, hold_s: float = 3600.0, decomposition: str = "vmd",
                  k: int | None = PAPER_BEST[0], alpha: float | None = PAPER_BEST[1], denoise: str = "tfpf",
@@ -96,7 +97,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  tuner_params: dict[str, Any] | None = None, split: str = DEFAULT_TIER) -> None:
         if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
-        for name, value in (("device_seed", device_seed), ("recordings_seed", recordings_seed)):
+        for name, value in (("device_seed", device_seed), ("recordings_seed", 0 if recordings_seed is None else recordings_seed)):
             if not is_integer(value) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value}")
         if (train_files is None) != (test_files is None):
@@ -122,7 +123,11 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self.config = PipelineConfig(**pipeline, **({"k": k} if k is not None else {}),
                                      **({"alpha": alpha} if alpha is not None else {}))
         self.needs_tuning = decomposition == "vmd" and (k is None or alpha is None)
-        self.budget, self.device_seed, self.recordings_seed = int(budget), int(device_seed), int(recordings_seed)
+        if recordings_seed is None and self.needs_tuning:
+            raise ValueError("recordings_seed null draws the runs from the run seed; give task.k and task.alpha (or "
+                             "decomposition none or emd), since VMD is tuned on fixed recordings")
+        self.budget, self.device_seed = int(budget), int(device_seed)
+        self.recordings_seed = None if recordings_seed is None else int(recordings_seed)
         self.n_train, self.n_test = int(n_train), int(n_test)
         self.split = split
         self.train_files, self.test_files = train_files, test_files
@@ -148,7 +153,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         """Read the user's recordings (``train_files``/``test_files``) as the task will; a
         :class:`~tcbench.compensation.data.TaskDataError` naming what is wrong. No-op when simulated."""
         if self.train_files:
-            load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
+            load_gyro_data(self.device_seed, 0, self.train_files, self.test_files,
                            self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects)
 
     def _make_learner(self, rng: np.random.Generator) -> Learner:
@@ -177,7 +182,10 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if self.needs_tuning:
             raise ValueError("VMD k and alpha are unset: give task.k and task.alpha, or tune them first "
                              "(tcbench run does, on tcbench/Gyro-VMDTuning-v0)")
-        self.data = load_gyro_data(self.device_seed, self.recordings_seed, self.train_files, self.test_files,
+        rseed = self.recordings_seed
+        if rseed is None:
+            rseed = int(self.np_random.integers(0, 2**31 - 1))
+        self.data = load_gyro_data(self.device_seed, rseed, self.train_files, self.test_files,
                                    self.sample_rate_hz, self.hold_s, self.n_train, self.n_test, self.effects,
                                    self.split)
         self.pipeline = ParallelPipeline(self.config)

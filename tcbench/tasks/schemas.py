@@ -69,6 +69,7 @@ class GyroTaskConfig(GyroTuningTaskConfig):
     ``tuner_params`` and ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]``
     when they are null."""
 
+    recordings_seed: int | None = 0
     n_train: int = 1
     n_test: int = 1
     split: str = "next_run"
