@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 import pytest
 
 from tcbench.compensation.data import SPLITS, TaskDataError, file_data, split_runs
@@ -62,3 +64,22 @@ def test_the_memoriser_loses_to_a_cubic_on_the_default_split(task: str, form: st
     assert memoriser > 2.0 * cubic
     replayed = _primary(task, "replay", None, "memoriser")
     assert replayed < memoriser / 5.0  # the same baseline on a replay: the tier is what it measures
+
+
+def test_the_memorised_output_is_the_runs_mean_at_the_same_time() -> None:
+    """Mean of the runs at the same time since their start; past a shorter run's end the runs still
+    going; past the longest its last value."""
+    from tcbench.compensation.data import TaskRecording
+    from tcbench.compensation.methods import memorised
+    from tcbench.sensors.recording import make_recording
+
+    def rec(n: int, level: float, start_s: float) -> TaskRecording:
+        t = start_s + np.arange(n, dtype=float)
+        return TaskRecording("r", make_recording(t, np.full(n, 20.0), np.zeros(n), np.full(n, level) + t - start_s,
+                                                 sensor="accel", sample_rate_hz=1.0, device_id="x"))
+
+    memo = memorised([rec(10, 0.0, 100.0), rec(20, 2.0, 5.0)])
+    got = memo(50.0 + np.arange(25, dtype=float))  # a test run of its own clock
+    np.testing.assert_allclose(got[:10], np.arange(10) + 1.0)   # both runs: (t + t + 2) / 2
+    np.testing.assert_allclose(got[10:20], np.arange(10, 20) + 2.0)  # the longer run alone
+    np.testing.assert_allclose(got[20:], 21.0)  # held at the longest run's last value

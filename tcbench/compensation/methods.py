@@ -1,7 +1,8 @@
 """Compensation methods on a static-input task (MSRA, accelerometer chamber): a learner, no
 compensation (raw), the memoriser (no physics: the training runs' mean output at the same time
-since the start, the sanity row of PHYSICS.md §9), the lag-aware polynomial (lagpoly), and the two oracles (the diagnosed
-model, ``model``, is fitted by the diagnosis: :mod:`tcbench.tasks.diagnosed`).
+since the start, the sanity row of PHYSICS.md §9), the lag-aware polynomial (lagpoly), and the
+two oracles (the diagnosed model, ``model``, is fitted by the diagnosis:
+:mod:`tcbench.tasks.diagnosed`).
 
 Each method is a *compensator*: a function of a test recording and an output array (the
 recorded one, or a probe of it) returning the compensated output (g for fulltemp, Hz for
@@ -56,11 +57,6 @@ def memorised(recordings: list[TaskRecording], column: str = "output") -> Callab
     rows = [np.interp(grid, r.time_s - r.time_s[0], getattr(r, column), right=np.nan) for r in recs]
     mean = np.nanmean(np.stack(rows), axis=0)
     return lambda t_s: np.interp(np.asarray(t_s) - t_s[0], grid, mean)
-
-
-def memorised_output(recordings: list[TaskRecording]) -> Callable[[np.ndarray], np.ndarray]:
-    """:func:`memorised` output (the memoriser's correction)."""
-    return memorised(recordings, "output")
 
 
 def memoriser_compensator(data: MSRAData) -> Compensator:

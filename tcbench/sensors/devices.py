@@ -82,6 +82,18 @@ def gyro_unit(device_seed: int) -> Unit:
     return Unit(f"gyro-{device_seed:04d}", model, draws)
 
 
+def turn_on_draws(rng: np.random.Generator, unit: str, bias_std: float, scale_factor_ppm_std: float,
+                  slope_repeat: float, ageing_std_per_day: float) -> dict[str, float]:
+    """One power-on's draws (bias and ageing in ``unit``): the days since the device's first run
+    (uniform up to :data:`AGEING_DAYS`), the turn-on bias, the scale factor's turn-on error (ppm),
+    the temperature slope's relative change, and the bias aged by over those days."""
+    days = float(rng.uniform(0.0, AGEING_DAYS))
+    return {f"turn_on_bias_{unit}": float(rng.normal(0.0, bias_std)),
+            "scale_factor_ppm": float(rng.normal(0.0, scale_factor_ppm_std)),
+            "slope_change": float(rng.normal(0.0, slope_repeat)), "days": days,
+            f"aged_{unit}": days * float(rng.normal(0.0, ageing_std_per_day))}
+
+
 def msra_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
     """An MSRA's power-on: turn-on bias 100 µg (std; resonator 1's frequency moved), scale factor
     50 ppm, bias slope 0.1 %, ageing 2 µg per day over up to :data:`AGEING_DAYS` days. A resonant
@@ -91,9 +103,7 @@ def msra_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorM
     if not isinstance(model, MSRA):
         return model, {}  # a fitted model: no turn-on draws of this part
     sf = model.scale_factor_hz_per_g
-    days = rng.uniform(0.0, AGEING_DAYS)
-    draws = {"turn_on_bias_ug": rng.normal(0.0, 100.0), "scale_factor_ppm": rng.normal(0.0, 50.0),
-             "slope_change": rng.normal(0.0, MSRA_SLOPE_REPEAT), "days": days, "aged_ug": days * rng.normal(0.0, 2.0)}
+    draws = turn_on_draws(rng, "ug", 100.0, 50.0, MSRA_SLOPE_REPEAT, 2.0)
     f0_1, f0_2 = model.f0_hz
     c1 = [t + s for t, s in zip(model.tce_ppm_per_k, model.stress_ppm_per_k, strict=True)]
     slope_hz_per_k = (f0_1 * c1[0] - f0_2 * c1[1]) * 1e-6
@@ -103,7 +113,7 @@ def msra_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorM
         model, f0_hz=(f0_1 + shift_hz, f0_2),
         k_hz_per_g=tuple(k * (1.0 + draws["scale_factor_ppm"] * 1e-6) for k in model.k_hz_per_g),  # type: ignore[arg-type]
         stress_ppm_per_k=(stress_1, model.stress_ppm_per_k[1]),
-    ), {k: float(v) for k, v in draws.items()}
+    ), draws
 
 
 def gyro_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
@@ -111,14 +121,12 @@ def gyro_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorM
     ageing 0.3 deg/h per day over up to :data:`AGEING_DAYS` days."""
     if not isinstance(model, Gyro):
         return model, {}  # a fitted model: no turn-on draws of this part
-    days = rng.uniform(0.0, AGEING_DAYS)
-    draws = {"turn_on_bias_dph": rng.normal(0.0, 20.0), "scale_factor_ppm": rng.normal(0.0, 300.0),
-             "slope_change": rng.normal(0.0, SLOPE_REPEAT), "days": days, "aged_dph": days * rng.normal(0.0, 0.3)}
+    draws = turn_on_draws(rng, "dph", 20.0, 300.0, SLOPE_REPEAT, 0.3)
     return dataclasses.replace(
         model, b0_dph=model.b0_dph + draws["turn_on_bias_dph"] + draws["aged_dph"],
         sf0_ppm=model.sf0_ppm + draws["scale_factor_ppm"],
         b1_dph_per_k=model.b1_dph_per_k * (1.0 + draws["slope_change"]),
-    ), {k: float(v) for k, v in draws.items()}
+    ), draws
 
 
 def unit(sensor: str, device_seed: int) -> Unit:

@@ -81,8 +81,9 @@ def _number(where: str, value: Any) -> float:
 
 @dataclass(frozen=True)
 class Run:
-    """One simulated run, ready to draw: the device's model with the run's changes (``nominal``), the
-    model as it runs this power-on (``model``), the profile, the power-on, the device's thermometer placement, and the noise streams."""
+    """One simulated run, ready to draw: the device's model with the run's changes (``nominal``),
+    the model as it runs this power-on (``model``), the profile, the power-on, the device's
+    thermometer placement, and the noise streams."""
 
     device: Unit
     nominal: SensorModel
@@ -159,8 +160,9 @@ def simulate_recording(
     (a profile the training never saw). ``effects`` changes or adds effects (``{id: {param:
     value}}``), ``without`` removes some. ``model`` (e.g. a fitted
     :class:`~tcbench.sensors.fitted.PolynomialModel`) replaces the device's model; the device is
-    then ``fitted-<sensor>`` and ``device_seed`` is only recorded. The sidecar's ``extra`` records
-    everything needed to reproduce it."""
+    then ``fitted-<sensor>``, ``device_seed`` is only recorded, and only the chamber's timing varies
+    between runs (the model describes one record as its thermometer read it). The sidecar's
+    ``extra`` records everything needed to reproduce it."""
     run = prepare_run(sensor, protocol, device_seed, seed, effects, without, model=model, power_on=power_on,
                       reverse=reverse, ramp_scale=ramp_scale, **protocol_params)
     model, profile = run.model, run.profile
@@ -175,6 +177,7 @@ def simulate_recording(
         "without": list(without),
         "device_draws": run.device.draws,
         "power_on": run.power_on.describe(),
+        "programme_changes": {"reverse": bool(reverse), "ramp_scale": float(ramp_scale)},
         "scale_factor_hz_per_g": getattr(run.device.model, "scale_factor_hz_per_g", None),
         **profile.info,
     }

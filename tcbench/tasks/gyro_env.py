@@ -32,7 +32,7 @@ from tcbench.compensation.gyro.data import GyroData, check_effects, check_settin
 from tcbench.compensation.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.compensation.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.compensation.gyro.tuning import PAPER_BEST, tuning_window
-from tcbench.compensation.methods import memorised_output
+from tcbench.compensation.methods import memorised
 from tcbench.compensation.oracle import oracle_inverse
 from tcbench.compensation.scoring import Score
 from tcbench.learners.base import FitHistory, Learner
@@ -97,7 +97,8 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                  tuner_params: dict[str, Any] | None = None, split: str = DEFAULT_TIER) -> None:
         if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
-        for name, value in (("device_seed", device_seed), ("recordings_seed", 0 if recordings_seed is None else recordings_seed)):
+        drawn = recordings_seed is None  # the runs drawn from the reset seed
+        for name, value in (("device_seed", device_seed), ("recordings_seed", 0 if drawn else recordings_seed)):
             if not is_integer(value) or value < 0:
                 raise ValueError(f"{name} must be a non-negative integer, got {value}")
         if (train_files is None) != (test_files is None):
@@ -239,7 +240,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             self.pipeline.learner = None
             return self._score_pipeline(float("nan"), bandwidth)
         if which == "memoriser":
-            memo = memorised_output(self.data.train)
+            memo = memorised(self.data.train, "output")
             recs = [score_record(tr, lambda y, tr=tr: y - memo(tr.recording.time_s), self.amplitude_dps, None,
                                  bandwidth) for tr in self.data.test]
             return Score("gyro", recs)

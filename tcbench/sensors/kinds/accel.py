@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors import effects as fx
-from tcbench.sensors.devices import AGEING_DAYS, SLOPE_REPEAT, device_rng
+from tcbench.sensors.devices import SLOPE_REPEAT, device_rng, turn_on_draws
 from tcbench.sensors.kinds import SensorKind
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.protocols import Chamber, Profile, _from_segments, check_length, four_position_nodes
@@ -109,17 +109,15 @@ def accel_unit(device_seed: int) -> Unit:
 
 def accel_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
     """A consumer accelerometer's power-on: turn-on bias 3 mg (std), scale factor 500 ppm, bias
-    slope 1 %, ageing 20 µg per day over up to :data:`~tcbench.sensors.devices.AGEING_DAYS` days."""
+    slope 1 %, ageing 20 µg per day (:func:`~tcbench.sensors.devices.turn_on_draws`)."""
     if not isinstance(model, Accel):
         return model, {}  # a fitted model: no turn-on draws of this part
-    days = rng.uniform(0.0, AGEING_DAYS)
-    draws = {"turn_on_bias_mg": rng.normal(0.0, 3.0), "scale_factor_ppm": rng.normal(0.0, 500.0),
-             "slope_change": rng.normal(0.0, SLOPE_REPEAT), "days": days, "aged_mg": days * rng.normal(0.0, 0.02)}
+    draws = turn_on_draws(rng, "mg", 3.0, 500.0, SLOPE_REPEAT, 0.02)
     return dataclasses.replace(
         model, bias_mg=model.bias_mg + draws["turn_on_bias_mg"] + draws["aged_mg"],
         sf0_ppm=model.sf0_ppm + draws["scale_factor_ppm"],
         b1_mg_per_k=model.b1_mg_per_k * (1.0 + draws["slope_change"]),
-    ), {k: float(v) for k, v in draws.items()}
+    ), draws
 
 
 def _gravity(gravity_g: float) -> tuple[float, float]:
