@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 import pytest
 
 from tcbench.compensation.data import SPLITS, TaskDataError, file_data, split_runs
