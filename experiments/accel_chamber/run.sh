@@ -30,7 +30,7 @@ tcbench run -m task=accel_chamber task.split=replay learner=raw,memoriser,lagpol
   tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber task.split=replay learner=poly learner.form=bias,bias_rate optimiser=none \
   tracking.experiment=accel-chamber "${common[@]}"
-tcbench run -m task=accel_chamber task.split=replay learner=bp learner.training=lm optimiser=ifa 'seed=range(10)' \
+tcbench run -m task=accel_chamber task.split=replay learner=bp learner.training=lm optimiser=ifa 'seed=range(4)' \
   tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber task.split=replay learner=oracle,oracle_thermometer optimiser=none \
   'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
