@@ -45,7 +45,7 @@ def test_with_an_input_it_solves_for_it() -> None:
                                                           ("tcbench/MSRA-ZeroBias-v0", "zb_zero_start_ug", "replay")])
 def test_within_the_target_of_the_thermometer_limited_oracle(env_id: str, metric: str, split: str) -> None:
     """Full temperature, new power-ons: within 1.3x of the limit of a compensator that knows the device
-    but not this power-on (measured 53.3 against 47.2 µg), which is far above the die-temperature oracle.
+    but not this power-on (measured 46.6 against 39.1 µg), which is far above the die-temperature oracle.
     Zero bias: only where the test runs replay the training power-on (on new power-ons the runs' turn-on
     biases and ambients confound a fit across them: tests/test_msra_env.py)."""
     env = gym.make(env_id, split=split).unwrapped
