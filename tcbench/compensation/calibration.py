@@ -45,37 +45,15 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.compensation.features import bin_means, running_mean, temperature_rate_c_per_s
+from tcbench.compensation.features import running_mean, temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
+from tcbench.compensation.record import Record
+from tcbench.compensation.training import fit_network
 
 METHODS = ("raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")
 LEARNERS = ("bp", "bp_gd", "elman")
 RATE_WINDOW_S = 120.0
 TRAIN_BIN_S = 5.0  # the networks' training bins: see fit()
-
-
-@dataclass(frozen=True)
-class Record:
-    """The part of a static record a calibration reads: time (s), thermometer (°C), the
-    output and the true input (same unit), and the temperature rate (°C/s) the trailing window
-    reads there (:func:`record` computes it once, on the whole record, so a part keeps the rate
-    its past gives it)."""
-
-    t_s: np.ndarray
-    temp_c: np.ndarray
-    output: np.ndarray
-    truth: np.ndarray
-    rate_c_per_s: np.ndarray
-
-    def part(self, start: int, stop: int) -> Record:
-        return Record(*(getattr(self, f)[start:stop] for f in ("t_s", "temp_c", "output", "truth", "rate_c_per_s")))
-
-    def binned(self, bin_s: float) -> Record:
-        """The record averaged over time bins of ``bin_s`` from its first sample
-        (:func:`~tcbench.compensation.features.bin_means`): one row per bin, every column its mean."""
-        t_s, cols = bin_means(self.t_s, np.column_stack([self.temp_c, self.output, self.truth, self.rate_c_per_s]),
-                              bin_s)
-        return Record(t_s, *(np.ascontiguousarray(c) for c in cols.T))
 
 
 def record(t_s: np.ndarray, temp_c: np.ndarray, output: np.ndarray, truth: np.ndarray) -> Record:
@@ -160,8 +138,6 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     target = np.concatenate([r.output - r.truth for r in train])
     rate = np.concatenate([r.rate_c_per_s for r in train])
     if method in LEARNERS:
-        from tcbench.compensation.training import fit_network
-
         if bin_s is not None and not bin_s > 0:
             raise ValueError(f"bin_s must be > 0 or None, got {bin_s}")
         network, algorithm = ("bp", "gd") if method == "bp_gd" else (method, bp_training)

@@ -17,12 +17,11 @@ windows of 32 steps).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from tcbench.compensation.calibration import Record
+from tcbench.compensation.record import Record
 
 BP_TRAININGS = ("lm", "gd")
 LM_ROWS_PER_PARAM = 5
