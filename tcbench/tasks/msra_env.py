@@ -28,10 +28,10 @@ from tcbench.compensation.data import (
     DEFAULT_SPLIT,
     DEFAULT_TIER,
     PROTOCOLS,
-    SPLITS,
     MSRAData,
     TaskDataError,
     check_split,
+    check_tier,
     file_data,
     simulated_data,
 )
@@ -113,8 +113,10 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError(f"bias_form must be one of {', '.join(BIAS_FORMS)}, got {bias_form!r}")
         if (train_files is None) != (test_files is None):
             raise ValueError("give both train_files and test_files, or neither")
-        if split not in SPLITS:
-            raise ValueError(f"unknown split {split!r}; known: {', '.join(SPLITS)} (default {DEFAULT_TIER})")
+        try:
+            check_tier(split)
+        except TaskDataError as exc:
+            raise ValueError(str(exc)) from None
         self.split = split
         d_train, d_test = DEFAULT_SPLIT[self.protocol]
         self.n_train = len(train_files) if train_files else (d_train if n_train is None else n_train)
