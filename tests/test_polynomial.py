@@ -91,3 +91,36 @@ def test_inverse_form_needs_a_varying_target() -> None:
     model = PolynomialModel(2, {"form": "inverse"})
     with pytest.raises(ValueError, match="not determined"):
         model.fit(np.c_[out_hz, temp_c], np.zeros_like(temp_c))
+
+
+@pytest.mark.parametrize("form", ["bias", "inverse"])
+def test_per_run_offsets_recover_the_shape_the_runs_share(form: str) -> None:
+    """Three power-ons, each at its own ambient with its own turn-on bias (0, +3, -2 Hz): pooled, the
+    cubic bends to the offsets; fitted within runs it recovers the shared shape exactly, up to the
+    mean offset (+1/3 Hz)."""
+    rng = np.random.default_rng(3)
+    temps = [rng.uniform(lo, lo + 6.0, 300) for lo in (10.0, 20.0, 30.0)]
+    offsets_hz = (0.0, 3.0, -2.0)
+    accel = [rng.choice([-1.0, 0.0, 1.0], 300) for _ in temps]
+    bias = [150.0 - 0.16 * (t - 25) + 2e-4 * (t - 25) ** 2 + o for t, o in zip(temps, offsets_hz, strict=True)]
+    k = 200.0
+    outputs = [b + k * a for b, a in zip(bias, accel, strict=True)]
+    runs = np.repeat(np.arange(3), 300)
+    temp_c = np.concatenate(temps)
+    if form == "bias":
+        x, y = np.c_[temp_c, temp_c * 0.0], np.concatenate(bias)
+        truth = 150.0 - 0.16 * (temp_c - 25) + 2e-4 * (temp_c - 25) ** 2 + 1.0 / 3.0
+    else:
+        x, y = np.c_[np.concatenate(outputs), temp_c], np.concatenate(accel)
+        truth = (x[:, 0] - (150.0 - 0.16 * (temp_c - 25) + 2e-4 * (temp_c - 25) ** 2 + 1.0 / 3.0)) / k
+    within = create("poly", 2, {"degree": 3, "form": form, "offsets": "per_run"})
+    assert within.uses_runs
+    within.fit(x, y, runs=runs)
+    np.testing.assert_allclose(within.predict(x), truth, atol=1e-8)
+    pooled = create("poly", 2, {"degree": 3, "form": form})
+    pooled.fit(x, y)
+    assert np.max(np.abs(pooled.predict(x) - truth)) > 0.1 * (1.0 if form == "bias" else 1.0 / k)
+    with pytest.raises(ValueError, match="needs the run of each training row"):
+        create("poly", 2, {"degree": 3, "form": form, "offsets": "per_run"}).fit(x, y)
+    with pytest.raises(ValueError, match="offsets must be one of shared, per_run"):
+        PolynomialParams(offsets="each")

@@ -15,6 +15,9 @@ common=("tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep" hydra/launc
 tcbench run -m experiment=paper_ifa_bp "${common[@]}"
 tcbench run -m task=msra_zerobias,msra_fulltemp learner=raw,memoriser,lagpoly,poly optimiser=none \
   tracking.experiment=paper-ifa-bp "${common[@]}"
+# the cubic fitted within runs (a constant per power-on: its turn-on bias), on the default tier and the replay
+tcbench run -m task=msra_zerobias,msra_fulltemp task.split=next_run,replay learner=poly learner.offsets=per_run \
+  optimiser=none tracking.experiment=paper-ifa-bp "${common[@]}"
 # the limits over 30 draws of the runs (recordings drawn from the run seed)
 tcbench run -m task=msra_zerobias,msra_fulltemp learner=oracle,oracle_thermometer optimiser=none 'seed=range(30)' \
   task.recordings_seed=null tracking.experiment=paper-ifa-bp "${common[@]}"

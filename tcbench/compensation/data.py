@@ -122,6 +122,11 @@ class MSRAData:
             ys.append(y[rows])
         return np.concatenate(xs), np.concatenate(ys)
 
+    def training_runs(self, sequential: bool = False) -> np.ndarray:
+        """The training recording (its index in :attr:`train`) of each row of :meth:`training_set`."""
+        sizes = [self.training_rows(tr.recording, sequential).size for tr in self.train]
+        return np.repeat(np.arange(len(sizes)), sizes)
+
     def compensate(self, output: np.ndarray, prediction: np.ndarray) -> np.ndarray:
         """Compensated output from a learner's prediction over every row: the prediction in g
         (fulltemp), or ``output - prediction`` in the output unit (roomtemp: Hz, chamber: g)."""

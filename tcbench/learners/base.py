@@ -101,6 +101,7 @@ class Learner(ABC):
     Params: ClassVar[type[LearnerParams]] = LearnerParams
     searchable: ClassVar[bool] = True  # a flat parameter vector an optimiser may initialise
     sequential: ClassVar[bool] = False  # rows form one time-ordered sequence (recurrent models)
+    uses_runs: bool = False  # fit() takes runs= (each training row's run), e.g. per-run offsets
 
     def __init__(self, n_inputs: int, params: LearnerParams | dict[str, Any] | None = None,
                  rng: np.random.Generator | None = None) -> None:

@@ -13,6 +13,12 @@ Two forms, chosen by the task (``form="auto"`` is a placeholder the task must re
   lag (``b(T - tau dT/dt) ~ b(T) - tau b'(T) dT/dt``, so ``r`` has the degree of ``b'``) plus a
   gradient term constant in ``T``.
 
+``offsets="per_run"`` fits the temperature polynomials *within* runs: each training run gets
+its own constant term (its turn-on bias, PHYSICS.md §9), and the model keeps their mean. Pooled
+over power-ons at different ambients, a shared constant lets the run-to-run offsets bend the
+polynomial (a cubic then extrapolates them into the next run); the task passes the run of each
+training row (``fit(..., runs=)``).
+
 Everything is solved in the normalised [-1, 1] units of :class:`~tcbench.learners.base.Scaler`
 (an affine change of units keeps both model forms), so the temperature is on [-1, 1] over the
 training data and the polynomials are Chebyshev series there, which keeps the solve well
@@ -37,6 +43,7 @@ from numpy.polynomial import chebyshev
 from tcbench.learners.base import FitHistory, Learner, LearnerParams
 
 FORMS = ("auto", "inverse", "bias", "bias_rate")
+OFFSETS = ("shared", "per_run")
 MAX_DEGREE = 6
 AUTO_ERROR = "poly: form 'auto' must be resolved by the task; set form=inverse or form=bias"
 
@@ -49,10 +56,13 @@ class PolynomialParams(LearnerParams):
     form: "inverse" (inputs [output, temperature] -> applied input), "bias" (temperature ->
         output bias), "bias_rate" ([temperature, rate] -> bias) or "auto" (the task chooses;
         fitting with "auto" is an error).
+    offsets: "shared" (one constant term over every training row) or "per_run" (a constant per
+        training run, the temperature shape fitted within runs; the model keeps their mean).
     """
 
     degree: int = 3
     form: str = "auto"
+    offsets: str = "shared"
 
     def __post_init__(self) -> None:
         if isinstance(self.degree, bool) or not isinstance(self.degree, (int, np.integer)) \
@@ -60,6 +70,8 @@ class PolynomialParams(LearnerParams):
             raise ValueError(f"poly: degree must be an integer in 1..{MAX_DEGREE}, got {self.degree!r}")
         if self.form not in FORMS:
             raise ValueError(f"poly: form must be one of {', '.join(FORMS)}, got {self.form!r}")
+        if self.offsets not in OFFSETS:
+            raise ValueError(f"poly: offsets must be one of {', '.join(OFFSETS)}, got {self.offsets!r}")
 
 
 class PolynomialModel(Learner):
@@ -77,6 +89,11 @@ class PolynomialModel(Learner):
             raise ValueError(f"poly: form 'inverse' takes 2 inputs [output, temperature], got {self.n_inputs}")
         self._coef: np.ndarray | None = None
         self._form: str | None = None  # the form the coefficients belong to
+
+    @property
+    def uses_runs(self) -> bool:
+        """Whether :meth:`fit` needs the run of each training row (``offsets="per_run"``)."""
+        return self.settings.offsets == "per_run"
 
     # -- the flat parameter vector -------------------------------------------------------
     def _fitted(self) -> np.ndarray:
@@ -115,8 +132,10 @@ class PolynomialModel(Learner):
             return basis
         return np.hstack([basis, basis[:, :-1] * x[:, 1:2]])
 
-    def fit(self, inputs: np.ndarray, targets: np.ndarray, init: np.ndarray | None = None) -> FitHistory:
-        """One least-squares solve in normalised units; ``init`` is ignored (closed form).
+    def fit(self, inputs: np.ndarray, targets: np.ndarray, init: np.ndarray | None = None,
+            runs: np.ndarray | None = None) -> FitHistory:
+        """One least-squares solve in normalised units; ``init`` is ignored (closed form);
+        ``runs`` is each row's training run (needed by ``offsets="per_run"``, else ignored).
         Raises ``ValueError`` if the data cannot determine the coefficients (e.g. form
         ``inverse`` with a target that does not vary at the training temperatures)."""
         start = time.perf_counter()
@@ -130,7 +149,12 @@ class PolynomialModel(Learner):
         else:
             design = self._design(x, form)
             rhs = y
+        onehot = self._run_columns(runs, len(rhs))
+        if onehot is not None:  # a constant per run in place of the shared one (Chebyshev T_0 = 1)
+            design = np.hstack([onehot, design[:, 1:]])
         coef, _, rank, _ = np.linalg.lstsq(design, rhs, rcond=None)
+        if onehot is not None:
+            coef = np.concatenate([[coef[:onehot.shape[1]].mean()], coef[onehot.shape[1]:]])
         if rank < design.shape[1]:
             why = ("the target must vary at each temperature" if form == "inverse"
                    else "need more distinct temperatures than the degree"
@@ -141,6 +165,18 @@ class PolynomialModel(Learner):
         loss = float(0.5 * np.mean((self._predict_scaled(x) - y) ** 2))
         return FitHistory(loss=[loss], iterations=1, stopped="closed_form",
                           seconds=time.perf_counter() - start)
+
+    def _run_columns(self, runs: np.ndarray | None, n_rows: int) -> np.ndarray | None:
+        """One indicator column per training run (``offsets="per_run"`` with two runs or more)."""
+        if not self.uses_runs:
+            return None
+        if runs is None:
+            raise ValueError("poly: offsets 'per_run' needs the run of each training row (fit(..., runs=))")
+        runs = np.asarray(runs).reshape(-1)
+        if runs.size != n_rows:
+            raise ValueError(f"poly: runs has {runs.size} entries for {n_rows} training rows")
+        labels, index = np.unique(runs, return_inverse=True)
+        return None if labels.size < 2 else np.eye(labels.size)[index]
 
     def _predict_scaled(self, x: np.ndarray) -> np.ndarray:
         coef = self._fitted()

@@ -143,7 +143,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         self.f_opt = 0.0
         self.target_precision = 0.0
         self.data: MSRAData | None = None
-        self._x = self._y = None
+        self._x = self._y = self._runs = None
         self._reset_counters()
 
     def check_files(self) -> None:
@@ -171,6 +171,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if self.learner_name is not None:
             self.learner = make_learner(self.learner_name, self.learner_params, self.data.form, learner_rng)
             self._x, self._y = self.data.training_set(self.learner.sequential)
+            self._runs = self.data.training_runs(self.learner.sequential)
             if self.learner.searchable:
                 self.learner.scale_to(self._x, self._y)
         self._reset_counters()
@@ -182,7 +183,8 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         recordings before and after (steps 4-6 of seed 000 Fig. 5)."""
         if self.data is None or self.learner is None:
             raise RuntimeError("call reset() on an env with a learner before score()")
-        history = self.learner.fit(self._x, self._y, init=init)  # the training set built by reset()
+        runs = {"runs": self._runs} if self.learner.uses_runs else {}
+        history = self.learner.fit(self._x, self._y, init=init, **runs)  # the training set built by reset()
         final = self.learner.get_params()
         checkpoints = {}
         for epochs, params in sorted(history.snapshots.items()):  # shorter budgets of the same training

@@ -25,7 +25,7 @@ TAG_FILES_CHARS = 1000  # the file lists in a run's tags, cut beyond this
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``poly3`` (``poly3_rate`` with the temperature rate), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
+    """Leaderboard name: ``raw``, ``oracle``, ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
     the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``."""
     if learner.get("label"):
         return str(learner["label"])
@@ -33,6 +33,7 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
     if name in BASELINES or name == "poly":
         label = f"poly{learner.get('degree', 3)}" if name == "poly" else name
         label += "_rate" if name == "poly" and learner.get("form") == "bias_rate" else ""
+        label += "_runs" if name == "poly" and learner.get("offsets") == "per_run" else ""
     else:
         opt = str(optimiser.get("label") or optimiser["name"])
         prefix = "random" if opt == "none" else opt.upper()
