@@ -224,7 +224,8 @@ def main() -> None:
              "constant per power-on). halfg_error_ug (not in the paper) = RMS error of the compensated output when "
              "the 0 g samples are moved to ±0.5 g, accelerations no training sample had (µg).", ""]
     frames = []
-    tiers = [t for t in SPLITS if t in set(runs["split"])]
+    tiers = [t for t in (DEFAULT_TIER, *SPLITS) if t in set(runs["split"])]
+    tiers = list(dict.fromkeys(tiers))  # the default tier first
     for tier in tiers:
         at = runs[runs["split"] == tier]
         learners = sorted(m for m in at["method"].unique() if m not in BASELINES)
