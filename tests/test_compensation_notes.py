@@ -68,3 +68,16 @@ def test_boards_are_named_by_their_tier() -> None:
     made = {b.split: b for b in boards(pd.concat(frames, ignore_index=True), {"msra_fulltemp": "fulltemp"})}
     assert set(made) == {"next_run", "replay"}
     assert made["next_run"].stem == "msra_fulltemp-dev0" and made["replay"].stem == "msra_fulltemp-dev0.replay"
+
+
+def test_a_board_with_no_finished_run_still_writes(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """A board whose only run never finished (stopped before it logged a metric) is written with
+    the run listed as failed; its plot has nothing to put on a log axis."""
+    from tcbench.leaderboard.compensation import boards, write
+
+    r = _runs("raw", np.full(1, np.nan), np.full(1, np.nan)).assign(status="KILLED")
+    r["split"], r["task"], r["task_name"], r["config_hash"] = "next_run", "msra_fulltemp-dev0", "msra_fulltemp", "h"
+    r["run_id"], r["start_time"], r["data_hash"], r["in_sample"], r["error_message"] = "k0", 0, "", "", ""
+    (board,) = boards(r, {"msra_fulltemp": "fulltemp"})
+    paths = write(board, tmp_path, "a test")
+    assert paths["png"].stat().st_size > 0 and "KILLED" in paths["md"].read_text()

@@ -391,7 +391,9 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
         if y.size:
             ax.hlines(np.median(y), i - 0.3, i + 0.3, color="k")
     ax.set_xticks(range(len(order)), order, rotation=30, ha="right")
-    ax.set_yscale("log")
+    values = done[primary].to_numpy(float) if primary in done else np.array([])
+    if np.any(np.isfinite(values) & (values > 0)):  # log scale needs a positive value to show
+        ax.set_yscale("log")
     ax.set_ylabel(primary.replace("_ug", " (µg)").replace("_", " "))
     ax.set_title(f"{board.task}: {primary} per restart (line: median)")
     ax.grid(True, which="both", axis="y", alpha=0.3)
