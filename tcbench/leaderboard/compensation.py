@@ -201,7 +201,9 @@ MSRA_KEY = (
     "thermometer's reading implies (smoothed over 60 s): the limit of a compensator that knows the device exactly, "
     "not this power-on, and reads what a real one reads; memoriser = no physics, the training runs' mean output at "
     "the same time since the start (it wins only where the test runs replay the training signal); poly3 = bias and scale "
-    "factor cubic in temperature (least squares); lagpoly = the same in the thermometer passed through a "
+    "factor cubic in temperature (least squares); poly3_runs = the same fitted within runs (a constant per power-on, "
+    "its turn-on bias; learner.offsets=per_run); poly3_rate = the bias cubic plus a cubic times the temperature rate; "
+    "lagpoly = the cubic in the thermometer passed through a "
     "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
     "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by seed.")
