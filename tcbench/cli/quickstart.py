@@ -1,8 +1,8 @@
 """``tcbench quickstart``: the main job in about a minute.
 
 1. Compensation: the paper's IFA-BP (seed 000 §3) on the simulated MSRA zero-bias task, a few
-   trainings (``tcbench run -m experiment=quickstart``), beside raw, the polynomial, the
-   lag-aware polynomial and the oracle (the physical limit) — every job through the normal runner, one MLflow run each —
+   trainings (``tcbench run -m experiment=quickstart``), beside raw, the memoriser, the polynomial
+   (pooled and within runs), the lag-aware polynomial and the oracle (the physical limit) — every job through the normal runner, one MLflow run each —
    then a small leaderboard.
 2. Diagnosis: a simulated MSRA recording with one effect hidden under the noise
    (:func:`~tcbench.diagnose.concealed.concealed_recording`), diagnosed as ``tcbench diagnose``
@@ -108,7 +108,10 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     checked = run_sweep(["-m", "experiment=quickstart", *tracked, f"budget={cfg.budget}",
                          f"learner.epochs={cfg.epochs}", f"seed=range({n_bp})"])
     assert checked is not None
-    run_sweep(["-m", "experiment=quickstart", "learner=raw,poly,lagpoly,oracle", "optimiser=none", "seed=0", *tracked])
+    baselines = ("raw", "memoriser", "poly", "lagpoly", "oracle")
+    run_sweep(["-m", "experiment=quickstart", f"learner={','.join(baselines)}", "optimiser=none", "seed=0", *tracked])
+    run_sweep(["-m", "experiment=quickstart", "learner=poly", "learner.offsets=per_run", "optimiser=none", "seed=0",
+               *tracked])
     status = sweep_report(sweep, checked.experiment, checked.tracking_uri)
     board_paths = _leaderboard(checked.experiment, sweep, checked.tracking_uri, out / "leaderboard")
     compensation_s = time.monotonic() - started
@@ -122,7 +125,7 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     uri = tracking.tracking_uri(checked.tracking_uri)
     print(_rule("Where everything is"))
     print(f"MLflow store: {uri} (experiment {checked.experiment!r}, sweep {sweep}: "
-          f"{n_bp + 4} compensation runs and the diagnosis run {run_id})")
+          f"{n_bp + len(baselines) + 1} compensation runs and the diagnosis run {run_id})")
     print(f"  browse: mlflow ui --backend-store-uri {uri}")
     print(f"Leaderboard: {', '.join(str(p.resolve()) for p in board_paths)}")
     print(f"Diagnosis report and plots: {', '.join(str(p.resolve()) for p in diag_paths)}")
@@ -155,7 +158,10 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
               "the compensated 0 g output, mean of the 2 test recordings, µg; lower is better). "
               "oracle = the simulator's own model at the true die temperature: noise alone, the physical limit; "
               "lagpoly = a straight line or low polynomial in the thermometer passed through a first-order lag "
-              "(the die trails the thermometer), its lag chosen by leave-one-recording-out error.")
+              "(the die trails the thermometer), its lag chosen by leave-one-recording-out error; poly3 = a cubic "
+              "in the thermometer, poly3_runs the same fitted within runs (a constant per power-on); memoriser = "
+              "the training runs' mean output at the same time since power-on (no temperature at all). The test "
+              "runs are new power-ons of the device (task.split=next_run).")
         rows = [[r.rank, r.method, r.runs, r.failed, getattr(r, f"median_{s}"), getattr(r, f"ci95_{s}"),
                  getattr(r, f"median_{s}") / limit, getattr(r, f"gain_{s}")]
                 for r in t.itertuples(index=False)]
