@@ -129,7 +129,7 @@ def test_staging_merges_folders(tmp_path: Path) -> None:
         (tmp / "m").mkdir()
         (tmp / "m" / "old.png").write_text("1")
         (tmp / "m" / "same.json").write_text("1")
-    with staged_dir(tmp_path / "out") as tmp:
+    with staged_dir(tmp_path / "out", overwrite=True) as tmp:  # a file of the same name: replaced only when asked
         (tmp / "m").mkdir()
         (tmp / "m" / "same.json").write_text("2")
     assert listing(tmp_path) == ["out", "out/m", "out/m/old.png", "out/m/same.json"]

@@ -35,5 +35,5 @@ tcbench run -m task=accel_chamber task.split=replay learner=bp learner.training=
 tcbench run -m task=accel_chamber task.split=replay learner=oracle,oracle_thermometer optimiser=none \
   'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
-tcbench leaderboard --experiment accel-chamber --sweep "$sweep" --out "$out"
+tcbench leaderboard --experiment accel-chamber --sweep "$sweep" --out "$out" overwrite=true
 python "$here/devices.py" --boards "$out"

@@ -19,5 +19,5 @@ tcbench run -m task=sphere,rastrigin,schaffer,rosenbrock,ackley,griewank,schwefe
 tcbench run -m experiment=optim_suite_mo hydra.launcher.n_jobs="$jobs" \
   tracking.plots=false "tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep-mo"
 rm -rf leaderboards/optim-suite
-tcbench leaderboard --experiment optim-suite --sweep "$sweep" --out leaderboards/optim-suite --ecdf
+tcbench leaderboard --experiment optim-suite --sweep "$sweep" --out leaderboards/optim-suite --ecdf overwrite=true
 python "$here/summarise.py"

@@ -9,5 +9,5 @@ export MLFLOW_TRACKING_URI="sqlite:///$PWD/$here/mlflow.db"
 rm -f "$here/mlflow.db"
 sweep=paper-fa-ifa-$(date -u +%Y%m%dT%H%M%S)
 tcbench run -m experiment=paper_fa_ifa "tracking.sweep_id=$sweep" hydra.sweep.dir="multirun/$sweep"
-tcbench leaderboard --experiment paper-fa-ifa --sweep "$sweep" --out leaderboards/paper-fa-ifa
+tcbench leaderboard --experiment paper-fa-ifa --sweep "$sweep" --out leaderboards/paper-fa-ifa overwrite=true
 python "$here/analyse.py" --sweep "$sweep" --out "$here"

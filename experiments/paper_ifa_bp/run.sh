@@ -41,5 +41,5 @@ tcbench run -m task=msra_fulltemp learner=bp learner.training=gd learner.epochs=
   'learner.checkpoints=[1000,3000,10000,30000,100000]' optimiser=ifa 'seed=range(30)' \
   '+learner.label=IFA-BP-gd-300000ep' tracking.experiment=paper-ifa-bp "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
-tcbench leaderboard --experiment paper-ifa-bp --sweep "$sweep" --out "$out"
+tcbench leaderboard --experiment paper-ifa-bp --sweep "$sweep" --out "$out" overwrite=true
 python "$here/tables.py" --experiment paper-ifa-bp --sweep "$sweep" --out "$out"

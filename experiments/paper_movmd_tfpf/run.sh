@@ -52,6 +52,6 @@ run 12 "${low[@]}" "${serial[@]}" task.inputs=t learner=bp optimiser=none "seed=
 wait
 run 13 "${low[@]}" task.decomposition=emd task.denoise=wavelet learner=bp optimiser=sa 'seed=range(10)'
 rm -rf "$out" && mkdir -p "$out"
-tcbench leaderboard --experiment paper-movmd-tfpf --out "$out"
+tcbench leaderboard --experiment paper-movmd-tfpf --out "$out" overwrite=true
 python "$here/figures.py" --experiment paper-movmd-tfpf --out "$out"
 python "$here/wtd_levels.py" --out "$out"

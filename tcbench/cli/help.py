@@ -30,6 +30,8 @@ RUN_PARAMS = {
     "tracking.plots": "a figure per run (null: for single runs and compensation runs, not in optimisation sweeps)",
     "tracking.ioh_dir": "also write each run in IOHprofiler's format into this folder (null: no)",
 }
+OVERWRITE = ("replace files of the same name already in out= and say which (false: refuse, naming the first; "
+             "a link out of out= or a folder where a file goes is refused either way)")
 # keys of the shared schema that these commands accept and ignore (``tcbench run`` uses them)
 IGNORED = ("tracking.plots", "tracking.ioh_dir")
 HIDDEN = ("kind",)  # the job kind the primary config names, not a parameter
@@ -83,6 +85,7 @@ SPECS: dict[str, CommandHelp] = {
             "power_on": "null: the run's own power-on; N: replay run N's power-on with this run's noise (only the noise "
                         "differs: the replay tier)",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "format": "csv or parquet",
             "name": "file stem (null: <sensor>-<protocol>-dev<device_seed>-seed<seed>[-poweron<N>])",
             "protocol_params": "protocol_params.<keyword>=VALUE overrides a protocol keyword (duration_s=3600)",
@@ -107,6 +110,7 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "recording": "the recording (.csv or .parquet with its .json sidecar); also the first argument",
             "out": "output folder (null: <recording stem>_metrics next to the recording)",
+            "overwrite": OVERWRITE,
             "scale_factor_hz_per_g": "MSRA scale factor in Hz/g (null: the sidecar's, else the nominal one)",
             **TRACKING,
         },
@@ -144,6 +148,7 @@ SPECS: dict[str, CommandHelp] = {
                     "fields are their axes)",
             "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "name": "file stem (null: the CSV's)",
             "device_id": "device id for the sidecar (null: the CSV's stem)",
             "sample_rate_hz": "sample rate (null: one over the median interval of the time column)",
@@ -167,6 +172,7 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "recording": "the recording to diagnose",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "sensor": "the sensor kind (msra, gyro, accel), for a recording without a sidecar (null: from the sidecar)",
             "model": "model file of the effects already modelled (null: none)",
             **TRACKING,
@@ -189,6 +195,7 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
                               "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
             "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
@@ -232,6 +239,7 @@ SPECS: dict[str, CommandHelp] = {
             "experiments": "MLflow experiment whose runs are ranked; several: experiments=[a,b]",
             "sweep": "only the runs of this sweep id (null: every run of the experiment)",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "ecdf": "also write COCO-style ECDF plots per dimension",
             "tracking.uri": "MLflow store to read (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
             "tracking.enabled": "also file the board files as a run in the store (false: files only)",
@@ -263,6 +271,7 @@ SPECS: dict[str, CommandHelp] = {
         params={
             "calibrations": "the out= folders of tcbench calibrate (their calibration.json): one per axis and kind",
             "out": "output folder",
+            "overwrite": OVERWRITE,
             "formats": "px4, ardupilot, or both",
             "device_id": "PX4's TC_*_ID: the sensor's device id (CAL_GYROn_ID / CAL_ACCn_ID), one number or "
                          "{gyro: N, accel: M}; null: the id the PX4 log gave (required for px4 otherwise)",
@@ -304,7 +313,8 @@ SPECS: dict[str, CommandHelp] = {
             "diagnose_sensor": "msra or gyro: the simulated recording diagnosed",
             "diagnose_effect": "the effect hidden in it (an effect of tcbench.diagnose.concealed, e.g. hysteresis)",
             "diagnose_seed": "its draw",
-            "out": "output folder (leaderboard/, diagnosis/, recordings/)",
+            "out": "output folder (leaderboard/, diagnosis/, recordings/); a quickstart run again replaces the "
+                   "files the earlier one wrote there and says which",
             "tracking.uri": TRACKING["tracking.uri"],
             "tracking.experiment": "MLflow experiment the quickstart's runs are filed under",
             "tracking.sweep_id": "the quickstart's sweep id in MLflow (null: a new one)",

@@ -9,7 +9,9 @@
    does; the report and plots are written and logged as an MLflow run.
 
 Its parameters are :class:`tcbench.commands.schemas.QuickstartConfig` (``conf/quickstart.yaml``);
-the test suite runs it with two short trainings.
+the test suite runs it with two short trainings. Run again, it replaces the files an earlier
+quickstart wrote into ``out`` and says which (every file moved into place only when complete); a
+link out of ``out`` is refused, as by every command.
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ from __future__ import annotations
 import textwrap
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +44,9 @@ from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
   python experiments/diagnose-concealed/run.py --workers 2   every hidden effect and controls, 80 recordings
   tcbench run -m experiment=paper_fa_ifa   FA against IFA on the paper's benchmark functions
   tcbench --help                           every command; tcbench <command> --help for its parameters"""
+
+
+FOLDERS = ("diagnosis", "leaderboard", "recordings")  # the quickstart's, inside its out=
 
 
 def _rule(title: str) -> str:
@@ -83,9 +89,14 @@ def check(cfg: QuickstartConfig) -> None:
     if not str(cfg.tracking.experiment).strip():
         raise ConfigError("tracking.experiment: give the MLflow experiment a name")
     from tcbench.outputs import folder_problem
+    from tcbench.staging import OutputRefusedError, check_targets, refusal_line
 
     if problem := folder_problem(cfg.out):
         raise ConfigError(f"out={cfg.out}: {problem}")
+    try:
+        check_targets(cfg.out, [(folder, True) for folder in FOLDERS], overwrite=True)
+    except OutputRefusedError as exc:
+        raise ConfigError(refusal_line(exc)) from None
 
 
 def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int], cfg: QuickstartConfig) -> int:
@@ -147,6 +158,12 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
     runs = comp_board.load_runs(tracking.client(uri), [experiment], sweep)
     boards = comp_board.boards(runs, protocols())
     written: list[Path] = []
+    replaced: list[Path] = []
+    with _staged(out, replaced) as tmp:
+        for board in boards:
+            paths = comp_board.write(board, tmp, f"MLflow experiment {experiment}, sweep {sweep} (tcbench quickstart)")
+            written += [out / p.relative_to(tmp) for p in paths.values()]
+    _say_replaced(replaced)
     for board in boards:
         primary = comp_board.PRIMARY[board.protocol]
         s = comp_board.SHORT[primary]
@@ -167,9 +184,27 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
                 for r in t.itertuples(index=False)]
         _print_table(["rank", "method", "runs", "failed", "median (µg)", "95% CI (µg)", "x physical limit",
                       "gain over raw"], rows)
-        paths = comp_board.write(board, out, f"MLflow experiment {experiment}, sweep {sweep} (tcbench quickstart)")
-        written += list(paths.values())
     return written
+
+
+@contextmanager
+def _staged(out: Path, replaced: list[Path]) -> Iterator[Path]:
+    """:func:`tcbench.staging.staged_dir` into the quickstart's own folder: files of an earlier
+    quickstart replaced (listed in ``replaced``), a refusal one line."""
+    from tcbench.staging import OutputRefusedError, refusal_line, staged_dir
+
+    try:
+        with staged_dir(out, overwrite=True, replaced=replaced) as tmp:
+            yield tmp
+    except OutputRefusedError as exc:
+        raise ConfigError(refusal_line(exc)) from None
+
+
+def _say_replaced(replaced: list[Path]) -> None:
+    from tcbench.staging import replaced_line
+
+    if replaced:
+        print(replaced_line(replaced))
 
 
 def _where(where: dict[str, Any]) -> str:
@@ -202,12 +237,19 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
           f"effect hidden under the noise: {hidden.effect} ({', '.join(f'{k} {v:.4g}' for k, v in hidden.params.items())}). "
           "The diagnosis is not told which; it starts from the minimal model (bias and scale factor "
           "quadratic in the thermometer temperature, white noise) and tests the library's effects.")
-    (out.parent / "recordings").mkdir(parents=True, exist_ok=True)
-    path = write_recording(rec, out.parent / "recordings" / f"concealed-{hidden.sensor}-{hidden.effect}-{hidden.seed}.csv")
-    c = as_dict(OmegaConf.structured(DiagnoseConfig(recording=str(path), out=str(out))))
+    folder = out.parent / "recordings"
+    path = folder / f"concealed-{hidden.sensor}-{hidden.effect}-{hidden.seed}.csv"
+    replaced: list[Path] = []
+    with _staged(folder, replaced) as tmp:
+        write_recording(rec, tmp / path.name)
+    _say_replaced(replaced)
+    # the job tcbench diagnose runs (its report, and its run in MLflow), over an earlier quickstart's report
+    c = as_dict(OmegaConf.structured(DiagnoseConfig(recording=str(path), out=str(out), overwrite=True)))
     c["tracking"] |= {"uri": uri, "experiment": experiment, "sweep_id": sweep}
-    outcome = run_job(c)  # the job tcbench diagnose runs: its report, and its run in MLflow
+    outcome = run_job(c)
     if isinstance(outcome, JobFailure):
+        if outcome.user:
+            raise ConfigError(outcome.error)
         raise RuntimeError(f"the diagnosis failed: {outcome.error}")
     diag, written = outcome.diagnosis, outcome.written
     sigma = float(diag.noise["white_sigma"])

@@ -24,11 +24,21 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.commands.errors import CommandError, cannot_write, checked_store, read_recording_arg, writable_folder
+from tcbench.commands.errors import (
+    CommandError,
+    cannot_write,
+    checked_store,
+    free_outputs,
+    read_recording_arg,
+    refused_output,
+    say_replaced,
+    writable_folder,
+)
 from tcbench.commands.schemas import CalibrateConfig
-from tcbench.staging import InputOverwriteError, moved, staged_dir
+from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
 
 
+FILES = ("calibration.csv", "calibration.json", "calibration.md", "residuals.png")  # OUT/, checked before any work
 AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
 PLOT_POINTS = 4000  # points per line of the residual plot (a min/max envelope beyond)
 
@@ -90,6 +100,7 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, A
     if cfg.axis is not None and cfg.axis not in ("x", "y", "z"):
         raise CommandError(f"axis={cfg.axis}: the axes are x, y and z")
     writable_folder(cfg.out)
+    free_outputs(cfg.out, list(FILES), cfg.overwrite, folders=["diagnosis"] if "model" in cfg.methods else [])
     checked_store(cfg.tracking)
     rec, split = _split(cfg.recording, cfg)
     others = []
@@ -245,8 +256,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     about["training"] = _training(fitted)
     about["export"] = _export_fit(whole, cfg.screen)
     out = Path(cfg.out)
+    replaced: list[Path] = []
     try:
-        with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)]) as tmp:
+        with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)], cfg.overwrite, replaced) as tmp:
             written = _write(tmp, cfg, rec, split, residuals, table, summary, about, unit)
             if diagnosis is not None:
                 from tcbench.diagnose.report import write_report
@@ -256,9 +268,12 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     except InputOverwriteError as exc:
         raise CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out=") \
             from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc) from None
     except OSError as exc:
         raise cannot_write(out, exc, "the calibration") from None
     written = moved(written, tmp, out)
+    say_replaced(replaced)
     _print_summary(summary, about, unit, written)
     return CalibrationOutcome(table, written, str(rec.meta.sensor), summary, about)
 

@@ -17,12 +17,16 @@ from tcbench.commands.errors import (
     CommandError,
     cannot_write,
     checked_store,
+    free_outputs,
     overwrite_error,
     read_recording_arg,
+    refused_output,
+    say_replaced,
     writable_folder,
 )
 
 log = logging.getLogger(__name__)
+REPORT_FILES = ("report.json", "report.md")  # what every report holds, checked before any work
 
 
 @dataclass
@@ -44,6 +48,7 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     if cfg.sensor is not None and not kinds.known(cfg.sensor):
         raise CommandError(f"sensor must be one of {', '.join(kinds.names())}, got {cfg.sensor!r}")
     writable_folder(cfg.out)
+    free_outputs(cfg.out, list(REPORT_FILES), cfg.overwrite)
     checked_store(cfg.tracking)
     rec = read_recording_arg(cfg.recording)
     sensor = cfg.sensor or rec.meta.sensor
@@ -86,17 +91,23 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
 
 
 def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
-    """``writer(report, out, inputs)``, its failures as one line (never over an input)."""
+    """``writer(report, out, inputs, overwrite=, replaced=)``, its failures as one line (never over
+    an input, nor over a file without ``overwrite``); says what it replaced."""
     from tcbench.sensors.recording import sidecar_path
-    from tcbench.staging import InputOverwriteError
+    from tcbench.staging import InputOverwriteError, OutputRefusedError
 
     inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
+    replaced: list[Path] = []
     try:
-        return writer(report, cfg.out, inputs)
+        written = writer(report, cfg.out, inputs, overwrite=cfg.overwrite, replaced=replaced)
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc) from None
     except OSError as exc:
         raise cannot_write(cfg.out, exc, "the report") from None
+    say_replaced(replaced)
+    return dict(written)
 
 
 def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str) -> DiagnosisOutcome:

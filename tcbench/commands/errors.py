@@ -1,5 +1,5 @@
 """What the commands share: their one-line user error, reading a recording argument, and the
-checks of their output folder, file names and tracking store, made before any work."""
+checks of their output folder, file names, output files and tracking store, made before any work."""
 
 from __future__ import annotations
 
@@ -45,6 +45,38 @@ def overwrite_error(exc: Any) -> CommandError:
     """The one-line error for output that would replace one of the command's inputs."""
     return CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out= "
                         "or name=")
+
+
+def refused_output(exc: Any, hint: str = "out=") -> CommandError:
+    """The one-line error for output the staging refused (:class:`tcbench.staging.OutputRefusedError`):
+    a link out of ``out=``, a file where a folder is, or existing files without ``overwrite=true``
+    (``hint``: what else the user can change, ``out=`` or ``out= or name=``)."""
+    from tcbench.staging import refusal_line
+
+    return CommandError(refusal_line(exc, hint))
+
+
+def free_outputs(out: str | Path, names: list[str], overwrite: bool, hint: str = "out=",
+                 folders: list[str] | None = None) -> None:
+    """The files ``names`` (and folders ``folders``) a command will write into ``out``, checked
+    before any work as they will be when moved into place (:func:`tcbench.staging.check_targets`):
+    a :class:`CommandError` when one exists without ``overwrite``, is a link out of ``out`` or
+    is a folder where a file goes (or the reverse)."""
+    from tcbench.staging import OutputRefusedError, check_targets
+
+    entries = [(f, True) for f in folders or []] + [(n, False) for n in names]
+    try:
+        check_targets(out, sorted(entries), overwrite)
+    except OutputRefusedError as exc:
+        raise refused_output(exc, hint) from None
+
+
+def say_replaced(replaced: list[Path]) -> None:
+    """Print, in one line, the files an ``overwrite=true`` command replaced (none: nothing)."""
+    from tcbench.staging import replaced_line
+
+    if replaced:
+        print(replaced_line(replaced))
 
 
 def read_recording_arg(path: str | Path) -> Any:

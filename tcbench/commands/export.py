@@ -17,11 +17,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tcbench.commands.errors import CommandError, cannot_write, writable_folder
+from tcbench.commands.errors import CommandError, cannot_write, free_outputs, refused_output, say_replaced, writable_folder
 from tcbench.commands.schemas import ExportConfig
-from tcbench.staging import moved, staged_dir
+from tcbench.staging import OutputRefusedError, moved, staged_dir
 
 FORMATS = ("px4", "ardupilot")
+FILES = {"px4": "px4_tc_params.txt", "ardupilot": "ardupilot_tcal.parm"}  # the file of each format in OUT/
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,7 @@ def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
     if not 1 <= cfg.ardupilot_imu <= 3:
         raise CommandError(f"ardupilot_imu must be 1..3, got {cfg.ardupilot_imu}")
     writable_folder(cfg.out)
+    free_outputs(cfg.out, [FILES[f] for f in dict.fromkeys(cfg.formats)], cfg.overwrite)
     by_sensor: dict[str, dict[str, AxisCalibration]] = {}
     for folder in cfg.calibrations:
         cal = read_calibration(folder)
@@ -128,24 +130,28 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
             print(f"tcbench: {sensor}: the axes were fitted over different temperatures; all held to "
                   f"{first.tmin_c:.2f}..{first.tmax_c:.2f} degC, where every axis was fitted")
     out = Path(cfg.out)
+    replaced: list[Path] = []
     try:
-        with staged_dir(out, []) as tmp:
+        with staged_dir(out, [], cfg.overwrite, replaced) as tmp:
             written: dict[str, Path] = {}
             if "px4" in cfg.formats:
                 params: dict[str, float | int] = {}
                 for sensor, axes in polys.items():
                     params |= px4_parameters(axes, sensor, cfg.px4_instance, device_id(cfg, sensor, by_sensor[sensor]),
                                              to_px4_unit=to_si[sensor])
-                written["px4"] = write_parameters(params, tmp / "px4_tc_params.txt", list(polys))
+                written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys))
             if "ardupilot" in cfg.formats:
                 try:
                     ap = ardupilot_parameters(polys, cfg.ardupilot_imu, to_si)
                 except ValueError as exc:
                     raise CommandError(f"ardupilot: {exc}") from None
-                written["ardupilot"] = write_parm(ap, tmp / "ardupilot_tcal.parm")
+                written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"])
+    except OutputRefusedError as exc:
+        raise refused_output(exc) from None
     except OSError as exc:
         raise cannot_write(out, exc, "the parameter files") from None
     written = moved(written, tmp, out)
+    say_replaced(replaced)
     every = ", ".join(f"{s} {''.join(sorted(a))}" for s, a in polys.items())
     if "px4" in written:
         print(f"tcbench: wrote {written['px4']} (PX4 TC_* of {every}, instance {cfg.px4_instance}; "

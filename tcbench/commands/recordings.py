@@ -16,11 +16,14 @@ from tcbench.commands.errors import (
     cannot_write,
     checked_store,
     file_stem,
+    free_outputs,
     overwrite_error,
     read_recording_arg,
+    refused_output,
+    say_replaced,
     writable_folder,
 )
-from tcbench.staging import InputOverwriteError, moved, staged_dir
+from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
 
 
 @dataclass
@@ -108,7 +111,10 @@ def check_simulate(cfg: SimulateConfig) -> Any:
         raise CommandError("device_seed, seed and power_on must be non-negative integers")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    file_stem(simulation_stem(cfg))
+    stem = file_stem(simulation_stem(cfg))
+    metrics = [f"{stem}_metrics"] if cfg.metrics else []
+    free_outputs(cfg.out, [f"{stem}.{cfg.format}", f"{stem}.json", *[f"{m}/metrics.json" for m in metrics]],
+                 cfg.overwrite, "out= or name=", folders=metrics)
     return fitted
 
 
@@ -128,8 +134,9 @@ def simulate(cfg: SimulateConfig) -> RecordingOutcome:
     path = out / f"{stem}.{cfg.format}"
     inputs = [cfg.model] if cfg.model else []
     report = None
+    replaced: list[Path] = []
     try:
-        with staged_dir(out, inputs) as tmp:  # the recording and its metrics, all or nothing
+        with staged_dir(out, inputs, cfg.overwrite, replaced) as tmp:  # the recording and its metrics, all or nothing
             write_recording(rec, tmp / path.name)
             if cfg.metrics:
                 report = _analysed(path, rec, tmp / f"{stem}_metrics", None)
@@ -137,10 +144,13 @@ def simulate(cfg: SimulateConfig) -> RecordingOutcome:
         raise CommandError(str(exc)) from None
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc, "out= or name=") from None
     except OSError as exc:
         raise cannot_write(out, exc, "the recording and its metrics" if cfg.metrics else "the recording") from None
     print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
           f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
+    say_replaced(replaced)
     if report is not None:
         report.files = moved(report.files, tmp, out)
         show(path, rec, report)
@@ -163,6 +173,7 @@ def check_metrics(cfg: MetricsConfig) -> Any:
         raise CommandError(f"scale_factor_hz_per_g: must be a finite number > 0, got {scale:g}")
     rec = read_recording_arg(cfg.recording)
     writable_folder(metrics_folder(cfg))
+    free_outputs(metrics_folder(cfg), ["metrics.json"], cfg.overwrite)
     checked_store(cfg.tracking)
     return rec
 
@@ -173,15 +184,19 @@ def metrics(cfg: MetricsConfig) -> RecordingOutcome:
 
     rec = check_metrics(cfg)
     path, out = Path(cfg.recording), metrics_folder(cfg)
+    replaced: list[Path] = []
     try:
-        with staged_dir(out, [path, sidecar_path(path)]) as tmp:  # a failure leaves nothing behind
+        with staged_dir(out, [path, sidecar_path(path)], cfg.overwrite, replaced) as tmp:  # a failure leaves nothing behind
             report = _analysed(path, rec, tmp, cfg.scale_factor_hz_per_g)
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc) from None
     except OSError as exc:
         raise cannot_write(out, exc, "the metrics") from None
     report.files = moved(report.files, tmp, out)
     show(path, rec, report)
+    say_replaced(replaced)
     return RecordingOutcome(path, rec, report)
 
 
@@ -275,6 +290,7 @@ def check_import(cfg: ImportConfig) -> None:
     targets = [Path(cfg.out) / f"{stem}.{ext}" for stem in stems[1:] for ext in ("csv", "json")]
     if clash := overwritten_input(targets, [Path(cfg.csv)]):
         raise overwrite_error(InputOverwriteError(*clash))
+    free_outputs(cfg.out, [t.name for t in targets], cfg.overwrite, "out= or name=")
     checked_store(cfg.tracking)
 
 
@@ -301,12 +317,15 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
     recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else _table_recordings(cfg, drop)
+    replaced: list[Path] = []
     try:
-        paths = save_all(recs, cfg.out, inputs=[csv])
+        paths = save_all(recs, cfg.out, inputs=[csv], overwrite=cfg.overwrite, replaced=replaced)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
     except InputOverwriteError as exc:
         raise overwrite_error(exc) from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc, "out= or name=") from None
     except OSError as exc:
         raise cannot_write(cfg.out, exc) from None
     outcomes = [RecordingOutcome(path, rec) for path, rec in zip(paths, recs.values(), strict=True)]
@@ -318,6 +337,7 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
         print(f"tcbench: wrote {o.path} ({len(o.rec.data)} samples {kind}at {o.rec.meta.sample_rate_hz:g} Hz{dropped}) "
               f"and its sidecar {o.path.with_suffix('.json')}")
         print(f"  {column_summary(o.rec)}")
+    say_replaced(replaced)
     first, *rest = outcomes
     first.also = rest
     return first

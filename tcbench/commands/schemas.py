@@ -30,6 +30,7 @@ class SimulateConfig:
     out: str = "recordings"
     format: str = "csv"
     name: str | None = None
+    overwrite: bool = False  # replace files of the same name in out= (false: refuse them)
     protocol_params: dict[str, Any] = field(default_factory=dict)
     effects: dict[str, dict[str, Any]] = field(default_factory=dict)
     without: list[str] = field(default_factory=list)
@@ -45,6 +46,7 @@ class MetricsConfig:
     kind: str = "metrics"
     recording: str = ""
     out: str | None = None
+    overwrite: bool = False
     scale_factor_hz_per_g: float | None = None
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
 
@@ -78,6 +80,7 @@ class ImportConfig:
     drop: str | None = None
     out: str = ""
     name: str | None = None
+    overwrite: bool = False
     device_id: str | None = None
     sample_rate_hz: float | None = None
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
@@ -91,6 +94,7 @@ class DiagnoseConfig:
     kind: str = "diagnose"
     recording: str = ""
     out: str = "diagnosis"
+    overwrite: bool = False
     sensor: str | None = None
     model: str | None = None
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
@@ -106,6 +110,7 @@ class CalibrateConfig:
     kind: str = "calibrate"
     recording: str = ""
     out: str = "calibration"
+    overwrite: bool = False
     train_branches: list[int] | None = None
     methods: list[str] = field(default_factory=lambda: ["raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model"])
     seed: int = 0
@@ -127,6 +132,7 @@ class ExportConfig:
 
     calibrations: list[str] = field(default_factory=list)
     out: str = "export"
+    overwrite: bool = False
     formats: list[str] = field(default_factory=lambda: ["px4", "ardupilot"])
     device_id: Any = None  # PX4's TC_*_ID: a number, or {gyro: N, accel: M}; null: the log's
     px4_instance: int = 0
@@ -143,6 +149,7 @@ class LeaderboardConfig:
     experiments: Any = "tcbench"
     sweep: str | None = None
     out: str = "leaderboards"
+    overwrite: bool = False
     ecdf: bool = False
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(enabled=False, experiment="leaderboards"))
 

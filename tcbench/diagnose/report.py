@@ -38,11 +38,13 @@ def model_spec(diag: Diagnosis) -> ModelSpec:
 
 
 def write_report(diag: Diagnosis, out: str | Path, inputs: Sequence[str | Path] = (),
-                 with_plots: bool = True) -> dict[str, Path]:
+                 with_plots: bool = True, overwrite: bool = True, replaced: list[Path] | None = None) -> dict[str, Path]:
     """Write the report files into ``out`` (created if needed), none of them over one of
-    ``inputs``; returns name -> path. ``with_plots=False`` leaves out the figures."""
+    ``inputs``, nor over an existing file without ``overwrite`` (:func:`~tcbench.staging.staged_dir`:
+    the paths replaced are appended to ``replaced``); returns name -> path. ``with_plots=False``
+    leaves out the figures."""
     out = Path(out)
-    with staged_dir(out, inputs) as tmp:
+    with staged_dir(out, inputs, overwrite, replaced) as tmp:
         (tmp / "report.json").write_text(json.dumps(_plain(diag.to_json()), indent=2) + "\n")
         write_model(model_spec(diag), tmp / "model.yaml")
         plots = write_plots(diag, tmp) if with_plots else {}

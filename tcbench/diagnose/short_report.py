@@ -61,11 +61,13 @@ def render_short_markdown(report: ShortRecordReport) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_short_report(report: ShortRecordReport, out: str | Path, inputs: Sequence[str | Path] = ()) -> dict[str, Path]:
-    """Write ``report.json`` and ``report.md`` into ``out``, neither over one of ``inputs``; name -> path."""
+def write_short_report(report: ShortRecordReport, out: str | Path, inputs: Sequence[str | Path] = (),
+                       overwrite: bool = True, replaced: list[Path] | None = None) -> dict[str, Path]:
+    """Write ``report.json`` and ``report.md`` into ``out``, neither over one of ``inputs`` nor over
+    an existing file without ``overwrite`` (the paths replaced appended to ``replaced``); name -> path."""
     out = Path(out)
     doc: dict[str, Any] = _plain(report.to_json())
-    with staged_dir(out, inputs) as tmp:
+    with staged_dir(out, inputs, overwrite, replaced) as tmp:
         (tmp / "report.json").write_text(json.dumps(doc, indent=2) + "\n")
         (tmp / "report.md").write_text(render_short_markdown(report))
     return {name: out / name for name in ("report.json", "report.md")}

@@ -35,12 +35,15 @@ def check_leaderboard(experiment: Any, out: str, uri: str | None) -> str:
 
 
 def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | None,
-                      ecdf: bool = False) -> list[Path]:
+                      ecdf: bool = False, overwrite: bool = False) -> list[Path]:
     """Write and print the boards of the runs in ``experiment`` (optionally of one ``sweep``)
-    into ``out``; the files written. ConfigError (one line) when there is nothing to rank."""
+    into ``out``; the files written. Every board is written to a temporary folder and moved into
+    ``out`` at the end, files already there replaced only with ``overwrite`` (and said).
+    ConfigError (one line) when there is nothing to rank or an output is refused."""
     from tcbench.leaderboard import calibration as cal_board
     from tcbench.leaderboard import compensation as comp_board
     from tcbench.leaderboard import optimisation as leaderboard
+    from tcbench.staging import OutputRefusedError, refusal_line, replaced_line, staged_dir
     from tcbench.tasks.specs import protocols
     from tcbench.tracking import store as tracking
 
@@ -57,29 +60,40 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
         where = f", sweep {sweep}" if sweep else ""
         raise ConfigError(f"no tcbench runs in experiment {', '.join(experiments)}{where}")
     source = f"MLflow experiment {', '.join(experiments)}" + (f", sweep {sweep}" if sweep else "")
-    written: list[Path] = []
-    for board in leaderboard.boards(runs) if not runs.empty else []:
-        paths = leaderboard.write(board, Path(out), client, source)
-        print(f"\n## {board.task}  (target precision {board.target_precision:g})\n")
-        print(leaderboard.markdown_table(board.table))
-        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-        written += list(paths.values())
-    for cboard in comp_board.boards(comp, protocols()) if not comp.empty else []:
-        paths = comp_board.write(cboard, Path(out), source)
-        print(f"\n## {cboard.task}  (compensation)\n")
-        print(leaderboard.markdown_table(cboard.table))
-        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-        written += list(paths.values())
-    for calboard in cal_board.boards(cals) if not cals.empty else []:
-        paths = cal_board.write(calboard, Path(out), source)
-        print(f"\n## {calboard.recording}  (calibration, content {calboard.data_hash})\n")
-        print(leaderboard.markdown_table(calboard.table) if not calboard.table.empty else "no finished calibration")
-        print(f"\nwritten: {', '.join(str(p) for p in paths.values())}")
-        written += list(paths.values())
-    if ecdf and not runs.empty:
-        from tcbench.leaderboard.ecdf import write_ecdf_plots
+    sections: list[tuple[str, list[Path]]] = []  # each board's text and files, printed once they are in place
+    replaced: list[Path] = []
+    try:
+        with staged_dir(out, (), overwrite, replaced) as tmp:
+            for board in leaderboard.boards(runs) if not runs.empty else []:
+                paths = leaderboard.write(board, tmp, client, source)
+                sections.append((f"\n## {board.task}  (target precision {board.target_precision:g})\n\n"
+                                 + leaderboard.markdown_table(board.table), list(paths.values())))
+            for cboard in comp_board.boards(comp, protocols()) if not comp.empty else []:
+                paths = comp_board.write(cboard, tmp, source)
+                sections.append((f"\n## {cboard.task}  (compensation)\n\n" + leaderboard.markdown_table(cboard.table),
+                                 list(paths.values())))
+            for calboard in cal_board.boards(cals) if not cals.empty else []:
+                paths = cal_board.write(calboard, tmp, source)
+                table = leaderboard.markdown_table(calboard.table) if not calboard.table.empty else "no finished calibration"
+                sections.append((f"\n## {calboard.recording}  (calibration, content {calboard.data_hash})\n\n" + table,
+                                 list(paths.values())))
+            plots = None
+            if ecdf and not runs.empty:
+                from tcbench.leaderboard.ecdf import write_ecdf_plots
 
-        plots = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), Path(out))
-        print(f"\nECDF plots: {', '.join(map(str, plots)) or 'none (no single-objective runs)'}")
-        written += list(plots)
-    return [Path(p) for p in written]
+                plots = write_ecdf_plots(client, leaderboard.one_run_per_job(runs), tmp)
+    except OutputRefusedError as exc:
+        raise ConfigError(refusal_line(exc)) from None
+    written: list[Path] = []
+    for text, files in sections:
+        final = [Path(out) / Path(p).relative_to(tmp) for p in files]
+        print(text)
+        print(f"\nwritten: {', '.join(str(p) for p in final)}")
+        written += final
+    if plots is not None:
+        final = [Path(out) / Path(p).relative_to(tmp) for p in plots]
+        print(f"\nECDF plots: {', '.join(map(str, final)) or 'none (no single-objective runs)'}")
+        written += final
+    if replaced:
+        print(replaced_line(replaced))
+    return written

@@ -386,16 +386,20 @@ def _recording(raw: Mapping[str, np.ndarray], empty: np.ndarray, spec: Mapping[s
         raise _in_csv(err, name, rows, spec, table, sensor) from None
 
 
-def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path] = ()) -> Path:
+def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path] = (), overwrite: bool = True,
+         replaced: list[Path] | None = None) -> Path:
     """Write ``rec`` as ``out/<stem>.csv`` and its sidecar, all or nothing (``out`` is not even
     created when writing fails); neither may replace one of ``inputs``
-    (:class:`~tcbench.staging.InputOverwriteError`)."""
-    return save_all({stem: rec}, out, inputs)[0]
+    (:class:`~tcbench.staging.InputOverwriteError`), nor an existing file without ``overwrite``
+    (:func:`~tcbench.staging.staged_dir`)."""
+    return save_all({stem: rec}, out, inputs, overwrite, replaced)[0]
 
 
-def save_all(recs: Mapping[str, Recording], out: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
-    """Write each recording as ``out/<stem>.csv`` with its sidecar, all of them or none."""
-    with staged_dir(out, inputs) as tmp:
+def save_all(recs: Mapping[str, Recording], out: str | Path, inputs: Sequence[str | Path] = (), overwrite: bool = True,
+             replaced: list[Path] | None = None) -> list[Path]:
+    """Write each recording as ``out/<stem>.csv`` with its sidecar, all of them or none; files
+    already there are replaced only with ``overwrite`` (their paths appended to ``replaced``)."""
+    with staged_dir(out, inputs, overwrite, replaced) as tmp:
         for stem, rec in recs.items():
             write_recording(rec, tmp / f"{stem}.csv")
     return [Path(out) / f"{stem}.csv" for stem in recs]

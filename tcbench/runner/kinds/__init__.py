@@ -66,7 +66,7 @@ class JobKind:
 
     def plan_check(self, c: dict[str, Any]) -> None:
         """What a command checks of every job of a sweep before the first one starts."""
-        self.check(c)
+        self.check(planned(c))
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:
         """The files or folders the job writes outside MLflow: no two jobs of a sweep may share one."""
@@ -87,6 +87,17 @@ class JobKind:
     def summary(self, outcome: Any, c: dict[str, Any]) -> str:
         """One line for the log when the job ends."""
         return f"{self.names(c).run} done"
+
+
+def planned(c: dict[str, Any]) -> dict[str, Any]:
+    """``c`` as a sweep's plan checks it before the first job starts. With ``tracking.resume`` a
+    job that already finished is skipped and writes nothing, so its files being there is no reason
+    to refuse the sweep: a job that does run still refuses them when it moves its files into place
+    (:func:`tcbench.staging.staged_dir`), unless ``overwrite``."""
+    track = c.get("tracking") or {}
+    if "overwrite" in c and track.get("enabled") and track.get("resume"):
+        return {**c, "overwrite": True}
+    return c
 
 
 def announce(run: Any, c: dict[str, Any]) -> None:

@@ -35,7 +35,7 @@ class LeaderboardKind(JobKind):
 
     def execute(self, c: dict[str, Any]) -> list[Path]:
         cfg = self.config(c)
-        return make_leaderboards(cfg.experiments, cfg.sweep, cfg.out, cfg.tracking.uri, cfg.ecdf)
+        return make_leaderboards(cfg.experiments, cfg.sweep, cfg.out, cfg.tracking.uri, cfg.ecdf, cfg.overwrite)
 
     def record(self, run: Any, outcome: list[Path], c: dict[str, Any], where: Path) -> list[Path]:
         announce(run, c)
