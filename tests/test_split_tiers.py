@@ -114,3 +114,15 @@ def test_the_memoriser_loses_to_a_cubic_on_the_gyro_oven() -> None:
 
     assert drift("next_run", None, "memoriser") > 1.3 * drift("next_run", "poly")
     assert drift("replay", None, "memoriser") < 1.1 * drift("replay", None, "oracle")
+
+
+def test_a_task_that_cannot_pass_runs_refuses_per_run_offsets_up_front() -> None:
+    """The gyro task trains on one record through its pipeline: poly's per-run offsets are refused
+    before any work, naming the key; the static-input tasks accept them."""
+    from tcbench.errors import ConfigError
+    from tcbench.runner.compensation_config import validate_compensation
+
+    job = {"learner": {"name": "poly", "offsets": "per_run"}, "optimiser": {"name": "none"}, "budget": 10}
+    with pytest.raises(ConfigError, match="learner.offsets=per_run: task gyro_driftnoise"):
+        validate_compensation(job, {"name": "gyro_driftnoise", "decomposition": "none", "denoise": "none"})
+    validate_compensation(job, {"name": "msra_zerobias"})

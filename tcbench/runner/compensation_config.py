@@ -56,6 +56,9 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
         env.check_files()
     except TaskDataError as exc:
         raise _error(str(exc)) from None
+    if learner.get("offsets") == "per_run" and not getattr(env, "passes_runs", False):
+        raise _error(f"learner.offsets=per_run: task {task['name']} does not pass the runs of its training rows "
+                     "(msra_zerobias, msra_fulltemp and accel_chamber do)")
     known = getattr(env, "baselines", BASELINES)
     if name in BASELINES and name not in known:
         raise _error(f"learner {name} is not a baseline of task {task['name']} (its baselines: {', '.join(known)})")

@@ -81,6 +81,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     """
 
     metadata = {"render_modes": []}
+    passes_runs = True  # a learner with uses_runs gets the run of each training row (poly offsets=per_run)
 
     def __init__(
         self,
