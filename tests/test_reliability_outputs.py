@@ -165,26 +165,16 @@ def test_a_simulate_sweep_is_refused_before_its_first_job(workdir: Path, capsys:
 
 
 @pytest.mark.parametrize("command", WRITERS)
-def test_a_second_run_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
-                                 command: str) -> None:
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
-    args = command_args(command, tmp_path, capsys)
-    ok(capsys, *args)
-    line = refused(capsys, tmp_path, args, str(tmp_path / "out"), "overwrite=true")
-    if FILE_OF[command]:
-        assert str(tmp_path / "out" / FILE_OF[command]) in line or "already exists" in line
-
-
-@pytest.mark.parametrize("command", WRITERS)
-def test_overwrite_true_replaces_and_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                             monkeypatch: pytest.MonkeyPatch, command: str) -> None:
+def test_a_second_run_is_refused_unless_overwrite(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                  monkeypatch: pytest.MonkeyPatch, command: str) -> None:
+    """Refused in one line naming an existing file; with overwrite=true replaced, and said in one line."""
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
     args = command_args(command, tmp_path, capsys)
     assert "replaced" not in ok(capsys, *args)
     target = tmp_path / "out" / (FILE_OF[command] or first_file(tmp_path / "out").name)
     target.write_text("stale\n")
+    refused(capsys, tmp_path, args, str(tmp_path / "out" / ""), "already exists", "overwrite=true")
     out = ok(capsys, *args, "overwrite=true")
     said = [ln for ln in out.splitlines() if "replaced" in ln]
     assert len(said) == 1 and said[0].startswith("tcbench: overwrite=true: replaced ") and str(target) in said[0], out
@@ -198,8 +188,9 @@ def test_a_linked_file_pointing_outside_is_refused(tmp_path: Path, capsys: pytes
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
     args = command_args(command, tmp_path, capsys)
-    ok(capsys, *[a if not a.startswith("out=") else f"out={tmp_path / 'first'}" for a in args])
-    name = FILE_OF[command] or first_file(tmp_path / "first").name
+    if not (name := FILE_OF[command]):  # a board's name: from a first run elsewhere
+        ok(capsys, *[a if not a.startswith("out=") else f"out={tmp_path / 'first'}" for a in args])
+        name = first_file(tmp_path / "first").name
     (tmp_path / "outside").mkdir()
     (tmp_path / "outside" / "keep").write_text("mine\n")
     (tmp_path / "out").mkdir()
@@ -299,3 +290,13 @@ def test_a_resumed_command_sweep_skips_its_finished_jobs(workdir: Path, capsys: 
     ok(capsys, *sweep)
     ok(capsys, *sweep, "tracking.resume=true")
 
+
+
+@pytest.mark.slow
+def test_the_quickstart_runs_again_over_its_own_files(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The README's quickstart run twice in one folder: the second replaces the first's files and says so."""
+    small = ["quickstart", "seeds=2", "budget=60", "epochs=100"]
+    assert "replaced" not in ok(capsys, *small)
+    said = [ln for ln in ok(capsys, *small).splitlines() if ln.startswith("tcbench: overwrite=true: replaced ")]
+    assert len(said) == 3, said  # the board, the recording and the diagnosis report
+    assert any("tcbench-quickstart/diagnosis/report.json" in ln for ln in said), said
