@@ -35,6 +35,7 @@ with, and runs nothing; -m sweeps.
 
 
 from tcbench.cli.flags import (  # noqa: E402 - after the usage text
+    CFG_CHOICES,
     CONFIG_SOURCE_FLAGS,
     HELP_FLAGS,
     HYDRA_FLAGS,
@@ -215,6 +216,12 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         args = with_overrides(args, [f"tracking.sweep_id={uuid.uuid4().hex[:12]}"])
     checked: Plan | None = None
     if any(a in CONFIG_SOURCE_FLAGS for a in args):
+        from tcbench.cli.app import check_command_line_size
+
+        try:  # counted from the overrides alone: Hydra would list every job first
+            check_command_line_size(args)
+        except ConfigError as exc:
+            raise UserError(str(exc)) from None
         print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)
     elif not info:
         try:
@@ -301,6 +308,18 @@ def _failures_report(jobs: int) -> int:
     return 1
 
 
+def _check_cfg_value(args: list[str]) -> None:
+    """A UserError for ``--cfg`` (``-c``) without one of Hydra's values (job, hydra, all)."""
+    for i, a in enumerate(args):
+        flag, eq, value = a.partition("=")
+        if flag not in {"--cfg", "-c"}:
+            continue
+        given = value if eq else (args[i + 1] if i + 1 < len(args) else None)
+        if given not in CFG_CHOICES:
+            what = f"--cfg {given}" if given else "--cfg without a value"
+            raise UserError(f"{what}: expected {', '.join(CFG_CHOICES[:-1])} or {CFG_CHOICES[-1]}")
+
+
 def cmd_run(args: list[str]) -> int:
     after_value_flag, flags = False, []
     for a in args:
@@ -309,6 +328,7 @@ def cmd_run(args: list[str]) -> int:
                 raise _unknown_option("run", flag)
             flags.append(flag)
         after_value_flag = a in VALUE_FLAGS
+    _check_cfg_value(args)
     if HELP_FLAGS & set(flags) and not CONFIG_SOURCE_FLAGS & set(flags):  # configs from elsewhere: Hydra's help
         from tcbench.cli import help as cli_help
 
