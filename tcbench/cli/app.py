@@ -190,8 +190,8 @@ def check_override_values(overrides: list[str], config_name: str = CONFIG_NAME) 
             raise ConfigError(f"{given}: {problem}")
         if key == "out" and isinstance(value, str) and not value.strip():
             raise ConfigError(f"{given}: give a folder (out=. for the working directory)")
-        if _plain_type(_field_type(schema, key)) is bool and not isinstance(value, bool) and \
-                not (value is None and type(None) in typing.get_args(_field_type(schema, key))):
+        if _plain_type(_field_type(schema, key)) is bool and isinstance(value, int | float) and \
+                not isinstance(value, bool):  # OmegaConf would take 1 as true (a word it checks itself)
             raise ConfigError(f"{given}: expected true or false")
 
 
