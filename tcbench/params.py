@@ -28,7 +28,8 @@ def make_params(cls: type[Any], params: Any) -> Any:
 
 
 def coerce_param(owner: str, key: str, annotation: Any, value: Any) -> Any:
-    """Check a parameter value against a simple annotation (int, float, bool, str, optional)."""
+    """Check a parameter value against a simple annotation (int, float, bool, str, optional); a
+    float must be finite (no parameter of tcbench's takes ``inf`` or ``nan``)."""
     ann = str(annotation)
     optional = "None" in ann
     if value is None:
@@ -44,6 +45,8 @@ def coerce_param(owner: str, key: str, annotation: Any, value: Any) -> Any:
             return int(value)
     elif base == "float":
         if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
+            if not np.isfinite(float(value)):
+                raise ValueError(f"{owner}.{key} must be a finite number, got {value!r}")
             return float(value)
     elif base == "str":
         if isinstance(value, str):

@@ -8,26 +8,54 @@ import pandas as pd
 BOOTSTRAP_SEED = 20221  # fixed, so a leaderboard is reproducible from the same runs
 
 
+def with_failures(values: np.ndarray, failed: int = 0, higher_is_better: bool = False) -> np.ndarray:
+    """The finished runs' values (NaN left out) and one worst value per failed run: ``+inf``, or
+    ``-inf`` where higher is better. Every order statistic of a board is taken over these, so a
+    failed run ranks below every finished one instead of leaving the sample."""
+    x = np.asarray(values, dtype=float)
+    worst = -np.inf if higher_is_better else np.inf
+    return np.concatenate([x[~np.isnan(x)], np.full(int(failed), worst)])
+
+
+def percentiles(values: np.ndarray, q: list[float]) -> np.ndarray:
+    """``np.percentile`` (linear) of values that may hold ``±inf`` (failed runs): a percentile
+    that falls on, or between a finite value and, an infinite one is that infinity."""
+    x = np.asarray(values, dtype=float)
+    finite = x[np.isfinite(x)]
+    if finite.size == x.size:
+        return np.percentile(x, q)
+    if finite.size == 0:
+        return np.full(len(q), x[0])
+    lo, hi = float(finite.min()), float(finite.max())
+    pad = max(1.0, hi - lo)
+    stand_in = np.where(x == np.inf, hi + pad, np.where(x == -np.inf, lo - pad, x))
+    p = np.percentile(stand_in, q)
+    return np.where(p > hi, np.inf, np.where(p < lo, -np.inf, p))
+
+
 def bootstrap_median_ci(
     values: np.ndarray, level: float = 0.95, n_boot: int = 2000, seed: int = BOOTSTRAP_SEED
 ) -> tuple[float, float]:
-    """Percentile-bootstrap confidence interval of the median (NaN for fewer than 2 values); the
-    same for the same values in any order (runs come back from MLflow in the order they ran)."""
+    """Percentile-bootstrap confidence interval of the median (NaN for fewer than 2 values; NaN
+    values are left out, ``±inf`` — failed runs, :func:`with_failures` — kept, so an end of the
+    interval may be infinite); the same for the same values in any order (runs come back from
+    MLflow in the order they ran)."""
     x = np.sort(np.asarray(values, dtype=float))
-    x = x[np.isfinite(x)]
+    x = x[~np.isnan(x)]
     if x.size < 2:
         return float("nan"), float("nan")
     rng = np.random.default_rng(seed)
     medians = np.median(x[rng.integers(0, x.size, size=(n_boot, x.size))], axis=1)
     tail = 100.0 * (1.0 - level) / 2.0
-    low, high = np.percentile(medians, [tail, 100.0 - tail])
+    low, high = percentiles(medians, [tail, 100.0 - tail])
     return float(low), float(high)
 
 
-def median_counting_failures(values: np.ndarray, failed: int) -> float:
-    """Median of ``values`` with ``failed`` more runs counted as infinitely bad: a method that
-    crashed on most seeds cannot rank on the few it finished (NaN when there are no runs)."""
-    x = np.concatenate([np.asarray(values, dtype=float), np.full(int(failed), np.inf)])
+def median_counting_failures(values: np.ndarray, failed: int, higher_is_better: bool = False) -> float:
+    """Median of ``values`` with ``failed`` more runs counted as worse than any finished one
+    (:func:`with_failures`): a method that failed on half its runs or more has an infinite
+    median ("failed"), and cannot rank on the few it finished (NaN when there are no runs)."""
+    x = with_failures(values, failed, higher_is_better)
     return float(np.median(x)) if x.size else float("nan")
 
 

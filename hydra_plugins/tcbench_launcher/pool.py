@@ -144,7 +144,9 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
                             on_lost_run(index, run_id, f"WorkerDied: the worker process running the job {why}")
                     if pending:
                         start()
-    finally:
+    finally:  # on Ctrl-C too: the workers end, and are reaped, before the sweep marks their runs KILLED
         for proc, _, _ in busy.values():
             proc.terminate()
+        for proc, _, _ in busy.values():
+            proc.join(10)
     return [r if r is not None else (False, WorkerDied("the job never ran")) for r in results]

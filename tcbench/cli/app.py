@@ -7,9 +7,12 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import logging
+import math
 import os
 import re
 import shutil
+import typing
+from decimal import Decimal
 from pathlib import Path
 from dataclasses import dataclass
 from typing import Any
@@ -17,6 +20,7 @@ from typing import Any
 import hydra
 from hydra import compose, initialize_config_module
 from hydra.core.override_parser.overrides_parser import OverridesParser
+from hydra.core.override_parser.types import ChoiceSweep, Override, RangeSweep
 from hydra.errors import HydraException, MissingConfigException
 from omegaconf import DictConfig
 from omegaconf.errors import ConfigAttributeError, ConfigKeyError, OmegaConfBaseException
@@ -29,6 +33,10 @@ from tcbench.runner.schema import as_dict, register_schema
 
 SLURM_LAUNCHER = "hydra_plugins.hydra_submitit_launcher.submitit_launcher.SlurmLauncher"
 SLURM_COMMANDS = ("sbatch", "srun")  # submitit submits with sbatch, and refuses to start without srun
+GROUPED_LAUNCHER = "hydra_plugins.tcbench_launcher.launcher.GroupedLauncher"
+JOBLIB_LAUNCHER = "hydra_plugins.hydra_joblib_launcher.joblib_launcher.JoblibLauncher"
+MAX_JOBS = 100_000  # the most jobs one command line may sweep, unless $TCBENCH_MAX_JOBS says otherwise
+MAX_JOBS_ENV = "TCBENCH_MAX_JOBS"
 log = logging.getLogger(__name__)
 
 register_schema()
@@ -123,13 +131,103 @@ def _explain(exc: Exception, config_name: str = CONFIG_NAME) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def _schema(config_name: str) -> type | None:
+    """The structured schema of a primary config (``config``: ``tcbench run``'s job)."""
+    from tcbench.runner.schema import JobConfig
+
+    return JobConfig if config_name == CONFIG_NAME else command_schemas.SCHEMAS.get(config_name)
+
+
+def _plain_type(annotation: Any) -> Any:
+    """``X`` of ``X | None``; the annotation itself otherwise."""
+    args = [a for a in typing.get_args(annotation) if a is not type(None)]
+    return args[0] if len(args) == 1 and type(None) in typing.get_args(annotation) else annotation
+
+
+def _field_type(schema: type | None, key: str) -> Any:
+    """The annotation of the dotted ``key`` in a dataclass schema (``tracking.resume``: bool), or
+    None where the key is not a field of a dataclass (a free-form dict's, or unknown)."""
+    for part in key.split("."):
+        if schema is None or not dataclasses.is_dataclass(schema):
+            return None
+        hints = typing.get_type_hints(schema)
+        if part not in hints:
+            return None
+        annotation = hints[part]
+        schema = _plain_type(annotation)
+    return annotation
+
+
+def _searchpath_problem(value: Any) -> str | None:
+    """Why a ``hydra.searchpath`` value names a folder that is not there, or None."""
+    for entry in value if isinstance(value, list) else [value]:
+        entry = str(entry)
+        if "${" in entry:
+            continue
+        path = entry[len("file://"):] if entry.startswith("file://") else None if "://" in entry else entry
+        if path is not None and not Path(path).is_dir():
+            return f"no folder {path!r} (the entry {entry!r})"
+    return None
+
+
+def check_override_values(overrides: list[str], config_name: str = CONFIG_NAME) -> None:
+    """ConfigError naming the key and value of an override the composition would take but should
+    not: a number for a true/false key (``tracking.resume=1``), a ``hydra.searchpath`` folder
+    that is not there, an empty ``out=``. What does not parse is left to the composition."""
+    try:
+        parsed = OverridesParser.create().parse_overrides(overrides)
+    except HydraException:
+        return
+    schema = _schema(config_name)
+    for o in parsed:
+        if o.is_delete() or o.is_sweep_override():
+            continue
+        key, value = o.key_or_group, o.value()
+        given = o.input_line.lstrip("+")
+        if isinstance(value, str) and "${" in value:
+            continue  # an interpolation: resolved, and its value checked, with the config
+        if key == "hydra.searchpath" and (problem := _searchpath_problem(value)):
+            raise ConfigError(f"{given}: {problem}")
+        if key == "out" and isinstance(value, str) and not value.strip():
+            raise ConfigError(f"{given}: give a folder (out=. for the working directory)")
+        if _plain_type(_field_type(schema, key)) is bool and isinstance(value, int | float) and \
+                not isinstance(value, bool):  # OmegaConf would take 1 as true (a word it checks itself)
+            raise ConfigError(f"{given}: expected true or false")
+
+
+def _unknown_key(cfg: DictConfig, schema: type, prefix: str = "") -> str | None:
+    """The first key of a composed config its dataclass schema does not have (``+unknown_key=1``
+    adds one), searched into the fields that are dataclasses themselves; None if all are known."""
+    hints = typing.get_type_hints(schema)
+    for key in cfg:
+        name = str(key)
+        if not prefix and name == "hydra":
+            continue
+        if name not in hints:
+            return prefix + name
+        sub = _plain_type(hints[name])
+        node = cfg._get_node(name)
+        if dataclasses.is_dataclass(sub) and isinstance(node, DictConfig) and not node._is_none():
+            if found := _unknown_key(node, sub, f"{prefix}{name}."):
+                return found
+    return None
+
+
 def compose_job(overrides: list[str], config_name: str = CONFIG_NAME, hydra_cfg: bool = False) -> DictConfig:
     """The composed config of one job (call inside ``initialize_config_module``); ConfigError
-    with one line when it does not compose."""
+    with one line when it does not compose, an override's value would be taken wrongly
+    (:func:`check_override_values`), or it adds a key the schema does not have."""
+    check_override_values(overrides, config_name)
     try:
-        return compose(config_name, overrides=overrides, return_hydra_config=hydra_cfg)
+        cfg = compose(config_name, overrides=overrides, return_hydra_config=hydra_cfg)
     except (HydraException, OmegaConfBaseException, ValueError) as exc:
         raise ConfigError(_explain(exc, config_name)) from None
+    schema = _schema(config_name)
+    if schema is not None and (unknown := _unknown_key(cfg, schema)):
+        parent = unknown.rpartition(".")[0]
+        known = list(typing.get_type_hints(_plain_type(_field_type(schema, parent)) if parent else schema))
+        raise ConfigError(_no_such_key(unknown, known))
+    return cfg
 
 
 def _override_positions(args: list[str]) -> list[int]:
@@ -178,8 +276,18 @@ def check_job(cfg: DictConfig | dict[str, Any], written: dict[Path, int] | None 
 
 def check_launcher(launcher: Any) -> None:
     """A ConfigError when the sweep's launcher (``hydra.launcher`` of the composed config) cannot
-    run here: submitit's SLURM launcher on a machine without SLURM's commands."""
-    if launcher is None or launcher.get("_target_") != SLURM_LAUNCHER:
+    run here: no worker process (``n_jobs`` below 1), or submitit's SLURM launcher on a machine
+    without SLURM's commands."""
+    if launcher is None:
+        return
+    target, n_jobs = launcher.get("_target_"), launcher.get("n_jobs")
+    if target == GROUPED_LAUNCHER and n_jobs is not None and (isinstance(n_jobs, bool) or not isinstance(n_jobs, int)
+                                                             or n_jobs < 1):
+        raise ConfigError(f"hydra.launcher.n_jobs={n_jobs}: must be a positive whole number of worker processes "
+                          "(1 runs the jobs in this process)")
+    if target == JOBLIB_LAUNCHER and n_jobs == 0:
+        raise ConfigError("hydra.launcher.n_jobs=0: joblib needs a number of processes (-1: one per core)")
+    if target != SLURM_LAUNCHER:
         return
     if missing := [c for c in SLURM_COMMANDS if shutil.which(c) is None]:
         raise ConfigError(f"hydra/launcher=submitit_slurm needs SLURM, but {' and '.join(missing)} "
@@ -188,32 +296,96 @@ def check_launcher(launcher: Any) -> None:
                           "tcbench's launcher (hydra.launcher.n_jobs=2)")
 
 
+def max_jobs() -> int:
+    """The most jobs one command line may sweep: ``$TCBENCH_MAX_JOBS``, else :data:`MAX_JOBS`."""
+    given = os.environ.get(MAX_JOBS_ENV, "").strip()
+    if not given:
+        return MAX_JOBS
+    if not given.isdigit() or int(given) < 1:
+        raise ConfigError(f"${MAX_JOBS_ENV} must be a positive whole number of jobs, got {given!r}")
+    return int(given)
+
+
+def sweep_length(override: Override) -> int:
+    """How many values a sweep override gives, counted without listing them (a ``range()``'s
+    length is computed); a ConfigError for a range of step 0 or a sweep of no value."""
+    value = override.value()
+    if isinstance(value, RangeSweep):
+        if not value.step:
+            raise ConfigError(f"{override.input_line}: a range's step must not be 0")
+        values = value.range()
+        if isinstance(values, range):
+            n = len(values)
+        else:  # Hydra's float range: start, start + step, ... while short of stop
+            n = max(0, math.ceil((Decimal(values.stop) - Decimal(values.start)) / Decimal(values.step)))
+    elif isinstance(value, ChoiceSweep):
+        n = len(value.list)
+    elif isinstance(value, list):
+        n = len(value)
+    else:
+        try:
+            n = sum(1 for _ in override.sweep_string_iterator())
+        except HydraException as exc:
+            raise ConfigError(f"{override.input_line}: {str(exc).strip().splitlines()[0]}") from None
+    if n == 0:
+        raise ConfigError(f"{override.input_line}: the sweep has no value; give at least one")
+    return n
+
+
+def check_sweep_size(lengths: dict[str, int]) -> int:
+    """The number of jobs of a sweep, the product of its keys' numbers of values; a ConfigError
+    with the count when it is more than :func:`max_jobs`."""
+    jobs = math.prod(lengths.values())
+    limit = max_jobs()
+    if jobs > limit:
+        parts = " × ".join(f"{n} {key}" for key, n in lengths.items())
+        raise ConfigError(f"a sweep of {jobs} jobs ({parts}) is more than the {limit} one command line may run; "
+                          f"split it into smaller sweeps (or set ${MAX_JOBS_ENV})")
+    return jobs
+
+
+def _parsed(args: list[str]) -> list[Override]:
+    try:
+        return OverridesParser.create().parse_overrides(overrides_of(args))
+    except HydraException as exc:
+        raise ConfigError(_explain(exc)) from None
+
+
+def check_command_line_size(args: list[str]) -> int:
+    """The number of jobs the sweeps of a command line give, counted from its overrides alone
+    (no config composed); a ConfigError for an empty sweep or one over :func:`max_jobs`."""
+    return check_sweep_size({o.get_key_element(): sweep_length(o) for o in _parsed(args) if o.is_sweep_override()})
+
+
 def _sweep(args: list[str], config_name: str) -> tuple[list[str], dict[str, list[str]], Any]:
     """The fixed overrides of a command line, its swept keys with their values (the config's
     own ``hydra.sweeper.params`` included, the command line winning) and, with ``-m``, the
-    ``hydra.launcher`` config that will run them; call inside ``initialize_config_module``."""
+    ``hydra.launcher`` config that will run them; call inside ``initialize_config_module``. The
+    jobs are counted before any value is listed (:func:`check_sweep_size`)."""
     multirun = "-m" in args or "--multirun" in args
     parser = OverridesParser.create()
-    try:
-        parsed = parser.parse_overrides(overrides_of(args))
-    except HydraException as exc:
-        raise ConfigError(_explain(exc)) from None
+    parsed = _parsed(args)
     fixed = [o.input_line for o in parsed if not o.is_sweep_override()]
-    sweeps = {o.get_key_element(): list(o.sweep_string_iterator()) for o in parsed if o.is_sweep_override()}
-    if sweeps and not multirun:
-        key = next(iter(sweeps))
+    swept = {o.get_key_element(): o for o in parsed if o.is_sweep_override()}
+    if swept and not multirun:
+        key = next(iter(swept))
         raise ConfigError(f"{key} has several values; add -m (--multirun) to sweep over them")
+    lengths = {key: sweep_length(o) for key, o in swept.items()}
+    check_sweep_size(lengths)
     launcher = None
     if multirun:
-        first = [f"{k}={v[0]}" for k, v in sweeps.items()]
+        first = [f"{k}={next(iter(o.sweep_string_iterator()))}" for k, o in swept.items()]
         base = compose_job(fixed + first, config_name, hydra_cfg=True)
         given = {o.get_key_element() for o in parsed}  # the command line wins over the config's params
         for key, value in (base.hydra.sweeper.get("params") or {}).items():
             if key not in given:
                 (o,) = parser.parse_overrides([f"{key}={value}"])
-                vals = list(o.sweep_string_iterator()) if o.is_sweep_override() else [o.value()]
-                sweeps[key] = [str(v) for v in vals]
+                swept[key] = o
+                lengths[key] = sweep_length(o) if o.is_sweep_override() else 1
+        check_sweep_size(lengths)
         launcher = base.hydra.get("launcher")
+    sweeps = {key: [str(v) for v in o.sweep_string_iterator()] if o.is_sweep_override() else [str(o.value())]
+              for key, o in swept.items()}
     return fixed, sweeps, launcher
 
 

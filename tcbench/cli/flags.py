@@ -14,3 +14,4 @@ HELP_FLAGS = {"-h", "--help"}
 # skip its up-front check (each job still validates its own config).
 VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
 CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
+CFG_CHOICES = ("job", "hydra", "all")  # the values of Hydra's --cfg

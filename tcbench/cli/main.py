@@ -35,6 +35,7 @@ with, and runs nothing; -m sweeps.
 
 
 from tcbench.cli.flags import (  # noqa: E402 - after the usage text
+    CFG_CHOICES,
     CONFIG_SOURCE_FLAGS,
     HELP_FLAGS,
     HYDRA_FLAGS,
@@ -215,6 +216,12 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         args = with_overrides(args, [f"tracking.sweep_id={uuid.uuid4().hex[:12]}"])
     checked: Plan | None = None
     if any(a in CONFIG_SOURCE_FLAGS for a in args):
+        from tcbench.cli.app import check_command_line_size
+
+        try:  # counted from the overrides alone: Hydra would list every job first
+            check_command_line_size(args)
+        except ConfigError as exc:
+            raise UserError(str(exc)) from None
         print("tcbench: configs from elsewhere: each job validates its own config", file=sys.stderr)
     elif not info:
         try:
@@ -225,8 +232,12 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
             from tcbench.tracking import store as tracking
 
             _prepare_store(checked.tracking_uri, checked.experiment)
-            if checked.resume and (dead := tracking.mark_dead_runs(checked.tracking_uri, checked.experiment,
-                                                                   checked.sweep_id)):
+            try:
+                dead = tracking.mark_dead_runs(checked.tracking_uri, checked.experiment,
+                                               checked.sweep_id) if checked.resume else 0
+            except tracking.StoreError as exc:
+                raise UserError(str(exc)) from None
+            if dead:
                 print(f"tcbench: {dead} run{'s' * (dead != 1)} of sweep {checked.sweep_id} left RUNNING by a "
                       "process that is gone marked KILLED; their jobs run again", file=sys.stderr)
         n = checked.jobs
@@ -236,6 +247,10 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     os.environ["HYDRA_FULL_ERROR"] = "1"  # Hydra's errors reach us whole instead of as its traceback
     try:
         hydra_app(config_name)()
+    except KeyboardInterrupt:
+        if checked is not None and checked.tracking_enabled:
+            _mark_interrupted(checked)
+        raise
     except OSError as exc:  # a job folder or Hydra's own files cannot be written (a full disk)
         where = f" {exc.filename}" if exc.filename else ""
         raise UserError(f"cannot write{where} ({exc.strerror or exc}); nothing more was run") from None
@@ -250,15 +265,40 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     return checked
 
 
+def _mark_interrupted(checked: Plan) -> None:
+    """After Ctrl-C: every run of the sweep left RUNNING by this process or its ended workers is
+    marked KILLED (a store that cannot be written is said in one line)."""
+    from tcbench.tracking import store as tracking
+
+    try:
+        n = tracking.mark_dead_runs(checked.tracking_uri, checked.experiment, checked.sweep_id,
+                                    frozenset({os.getpid()}), reason=tracking.INTERRUPTED)
+    except Exception as exc:  # noqa: BLE001 - the store cannot be written or read: said, then the interrupt
+        print(f"tcbench: error: {_first_line(str(exc))}", file=sys.stderr)
+        return
+    if n:
+        print(f"tcbench: {n} run{'s' * (n != 1)} of sweep {checked.sweep_id} marked KILLED", file=sys.stderr)
+
+
 def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | None = None) -> int:
     """Print how the jobs of a sweep ended (the latest run of each job: a resumed sweep's re-run
-    replaces the attempt it repeats); 1 if any job's latest run did not finish or, when
-    ``expected`` is given, if fewer jobs than planned left a run."""
+    replaces the attempt it repeats); 1 if any job's latest run did not finish, when ``expected``
+    is given if fewer jobs than planned left a run, or if the store could not be written (said
+    in one line)."""
     from tcbench.leaderboard import optimisation as leaderboard
     from tcbench.tracking import store as tracking
 
-    tracking.mark_dead_runs(uri, experiment, sweep, frozenset({os.getpid()}))
-    runs = leaderboard.sweep_runs(tracking.client(uri), [experiment], sweep)
+    unwritable = None
+    try:
+        tracking.mark_dead_runs(uri, experiment, sweep, frozenset({os.getpid()}))
+    except tracking.StoreError as exc:
+        unwritable = str(exc)
+    try:
+        runs = leaderboard.sweep_runs(tracking.client(uri), [experiment], sweep)
+    except Exception as exc:  # noqa: BLE001 - a store that cannot be read either
+        unread = f"tracking store {tracking.tracking_uri(uri)} cannot be read ({tracking.first_line(exc)})"
+        print(f"tcbench: error: {unwritable or unread}", file=sys.stderr)
+        return 1
     latest = leaderboard.one_run_per_job(runs)
     failed = latest[latest["status"] != "FINISHED"]
     running = int((failed["status"] == "RUNNING").sum())
@@ -267,7 +307,7 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
         f"tcbench: {len(latest)} job{'s' if len(latest) != 1 else ''} recorded in {tracking.tracking_uri(uri)} "
         f"(experiment {experiment!r}, sweep {sweep}): {len(latest) - len(failed)} finished, "
         f"{len(failed)} failed" + (f" ({running} still RUNNING in another live process or on another host)"
-                                   if running else "")
+                                   if running and not unwritable else "")
         + (f"; {repeated} earlier attempt{'s' * (repeated != 1)} replaced by a re-run" if repeated else ""),
     )
     for r in failed.itertuples():
@@ -280,7 +320,9 @@ def _sweep_report(sweep: str, experiment: str, uri: str | None, expected: int | 
               f"(skipped by resume, or the tracking store failed: see the job logs)")
         for error in dict.fromkeys(_first_line(f.error) for f in FAILURES):
             print(f"  a job's error: {error}")
-    return 1 if len(failed) or missing > 0 else 0
+    if unwritable:
+        print(f"tcbench: error: {unwritable}", file=sys.stderr)
+    return 1 if len(failed) or missing > 0 or unwritable else 0
 
 
 def _first_line(text: str) -> str:
@@ -301,6 +343,18 @@ def _failures_report(jobs: int) -> int:
     return 1
 
 
+def _check_cfg_value(args: list[str]) -> None:
+    """A UserError for ``--cfg`` (``-c``) without one of Hydra's values (job, hydra, all)."""
+    for i, a in enumerate(args):
+        flag, eq, value = a.partition("=")
+        if flag not in {"--cfg", "-c"}:
+            continue
+        given = value if eq else (args[i + 1] if i + 1 < len(args) else None)
+        if given not in CFG_CHOICES:
+            what = f"--cfg {given}" if given else "--cfg without a value"
+            raise UserError(f"{what}: expected {', '.join(CFG_CHOICES[:-1])} or {CFG_CHOICES[-1]}")
+
+
 def cmd_run(args: list[str]) -> int:
     after_value_flag, flags = False, []
     for a in args:
@@ -309,6 +363,7 @@ def cmd_run(args: list[str]) -> int:
                 raise _unknown_option("run", flag)
             flags.append(flag)
         after_value_flag = a in VALUE_FLAGS
+    _check_cfg_value(args)
     if HELP_FLAGS & set(flags) and not CONFIG_SOURCE_FLAGS & set(flags):  # configs from elsewhere: Hydra's help
         from tcbench.cli import help as cli_help
 

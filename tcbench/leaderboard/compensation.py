@@ -4,8 +4,10 @@ Per method: runs (one per seed), failed runs, for each metric the median over re
 bootstrap 95 % interval, the value of the run with the smallest training RMSE ("best of N by
 training RMSE", the paper's selection) and the improvement over the raw output (raw / median).
 Rows are ordered by the median of the task's primary metric (bias variation for full
-temperature, zero-start stability for zero bias) with a failed run counted as infinitely bad, so a
-method cannot rank on the few restarts it finished; raw and the oracle are deterministic, one run.
+temperature, zero-start stability for zero bias). Every median and interval counts a failed run as
+worse than any finished one (:func:`tcbench.stats.with_failures`; "failed" where it falls on
+them), so a method cannot rank, nor show a tight interval, on the few restarts it finished; raw
+and the oracle are deterministic, one run.
 ``p_vs_next``: Wilcoxon signed-rank p-value of the primary metric against the next row, paired
 by seed (NaN below 6 shared seeds). ``note`` flags a method whose median is below the oracle's,
 the physical limit: it cannot be compensating the sensor better than its own noise allows.
@@ -28,6 +30,8 @@ import numpy as np
 import pandas as pd
 
 from tcbench.leaderboard.files import (
+    FAILED_RULE,
+    failed_as_text,
     failed_lines,
     one_run_per_job,
     search_runs,
@@ -36,7 +40,7 @@ from tcbench.leaderboard.files import (
 from tcbench.tables import markdown_table
 from tcbench.compensation.data import DEFAULT_TIER
 from tcbench.compensation.scoring import FLAGS, METRIC_NAMES, PRIMARY, TRAIN_RMSE
-from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
+from tcbench.stats import bootstrap_median_ci, paired_p_value, with_failures
 
 METRICS = METRIC_NAMES
 SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
@@ -46,6 +50,7 @@ SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_er
          "temp_slope_ug_per_c": "slope_ug_per_c"}
 FLAG_SHORT = {"allan_min_interior": "bi_is_floor"}  # the share of runs (mean over their test records)
 NO_GAIN = ("halfg_error_ug", "bandwidth_hz")  # no raw value (probe), or not a figure to improve
+HIGHER_IS_BETTER = ("bandwidth_hz",)  # a failed run counts as the lowest value here, the highest elsewhere
 
 
 @dataclass
@@ -98,26 +103,28 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     rows, values = [], {}
     for method, g in runs.groupby("method", sort=True):
         ok = g[g["status"] == "FINISHED"]
-        row: dict[str, object] = {"method": method, "runs": len(g), "failed": int(len(g) - len(ok))}
+        failed = int(len(g) - len(ok))
+        row: dict[str, object] = {"method": method, "runs": len(g), "failed": failed}
         train = TRAIN_RMSE[protocol]
         best = ok.loc[ok[train].idxmin()] if train in ok and ok[train].notna().any() else None
         for m in metrics:
-            x = ok[m].to_numpy(float) if m in ok else np.array([])
+            x = with_failures(ok[m].to_numpy(float) if m in ok else np.array([]), failed, m in HIGHER_IS_BETTER)
             low, high = bootstrap_median_ci(x)
             s = SHORT[m]
-            row[f"median_{s}"] = float(np.median(x)) if x.size else np.nan
-            row[f"ci95_{s}"] = f"{low:.3g}–{high:.3g}" if np.isfinite(low) else "–"
+            median = row[f"median_{s}"] = float(np.median(x)) if x.size else np.nan
+            row[f"ci95_{s}"] = f"{_shown(low)}–{_shown(high)}" if not np.isnan(low) else "–"
             if m == primary:
                 row["ci_high_primary"], row["ci_low_primary"] = high, low
             row[f"best_by_train_{s}"] = float(best[m]) if best is not None else np.nan
             raw = ok[f"raw_{m}"].to_numpy(float) if f"raw_{m}" in ok else np.array([])
             if m not in NO_GAIN:
-                row[f"gain_{s}"] = float(np.median(raw) / row[f"median_{s}"]) if raw.size and row[f"median_{s}"] else np.nan
+                row[f"gain_{s}"] = float(np.median(raw) / median) if raw.size and median and np.isfinite(median) \
+                    else np.nan
         for flag in FLAGS.get(protocol, ()):
             row[FLAG_SHORT[flag]] = float(ok[flag].mean()) if flag in ok else np.nan
-        row[f"median_{train}"] = float(ok[train].median()) if train in ok else np.nan
-        row["_rank"] = median_counting_failures(ok[primary].to_numpy(float) if primary in ok else np.array([]),
-                                                int(row["failed"]))  # type: ignore[arg-type]
+        trained = with_failures(ok[train].to_numpy(float), failed) if train in ok else np.array([])
+        row[f"median_{train}"] = float(np.median(trained)) if trained.size else np.nan
+        row["_rank"] = row[f"median_{SHORT[primary]}"]
         rows.append(row)
         values[method] = pd.Series(ok[primary].to_numpy(float), index=ok["seed"].to_numpy()) if primary in ok else pd.Series(dtype=float)
     table = pd.DataFrame(rows)
@@ -135,6 +142,11 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
 
 
 LIMITS = {"x_oracle": "oracle", "x_thermo": "oracle_thermometer"}  # ratio column -> the limit row it divides by
+
+
+def _shown(value: float) -> str:
+    """An end of an interval as the board shows it: "failed" where it falls on failed runs."""
+    return "failed" if np.isinf(value) else f"{value:.3g}"
 
 
 def _ratio_to(table: pd.DataFrame, protocol: str, limit: str) -> np.ndarray:
@@ -440,8 +452,8 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
         f"Source: {source}. Metrics are means over the test recordings; {conv}.",
         f"Rows are ordered by the median of {primary} over restarts (seeds); ci95 = bootstrap 95 % "
         "interval of that median; best_by_train = the run with the smallest training RMSE (the paper's "
-        "\"best of 30\" selection); gain = raw / median. " + KEYS.get(board.protocol, MSRA_KEY), "",
-        markdown_table(board.table), "", f"![{primary} per restart]({paths['png'].name})", "",
+        "\"best of 30\" selection); gain = raw / median. " + FAILED_RULE + " " + KEYS.get(board.protocol, MSRA_KEY), "",
+        markdown_table(failed_as_text(board.table)), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
     write_board_files(lines + failed_lines(failed), board.table, paths)
     return paths

@@ -1,6 +1,6 @@
 """What every leaderboard shares, optimisation (:mod:`tcbench.leaderboard.optimisation`) and compensation
 (:mod:`tcbench.leaderboard.compensation`): the MLflow runs of a kind, one run per job and the board
-files (markdown tables: :mod:`tcbench.tables`). A leaf module (pandas only)."""
+files (markdown tables: :mod:`tcbench.tables`). A leaf module (numpy and pandas only)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,14 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
+
+# How every board counts failed runs in its statistics (:func:`tcbench.stats.with_failures`), said in its key
+FAILED_RULE = ("Every median, quartile and ci95 counts a failed run as worse than any finished one: "
+               "\"failed\" where the statistic falls on failed runs (a method that failed half its runs or "
+               "more has median \"failed\"); p_vs_next pairs finished runs only.")
+STAT_PREFIXES = ("median_", "ci95_", "iqr_", "x_")  # the columns a failed run can make "failed"
 
 
 def search_runs(client, experiments: list[str], kind: str | None, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
@@ -41,6 +48,17 @@ def one_run_per_job(runs: pd.DataFrame, keys: tuple[str, ...] = ("task", "method
     order = runs.assign(_ok=runs["status"] == "FINISHED").sort_values(["_ok", "start_time"])
     keys = list(keys)
     return order.drop_duplicates(keys, keep="last").drop(columns="_ok").sort_index()
+
+
+def failed_as_text(table: pd.DataFrame) -> pd.DataFrame:
+    """The board's table as shown: an infinite median, quartile, interval end or ratio to a limit
+    (one that falls on failed runs) reads "failed"; the CSV keeps the number (``inf``)."""
+    shown = table.copy()
+    for column in [c for c in table.columns if str(c).startswith(STAT_PREFIXES)]:
+        values = pd.to_numeric(table[column], errors="coerce")
+        if np.isinf(values).any():
+            shown[column] = table[column].astype(object).where(~np.isinf(values), "failed")
+    return shown
 
 
 def failed_lines(failed: pd.DataFrame) -> list[str]:

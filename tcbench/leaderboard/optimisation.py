@@ -5,10 +5,12 @@ the final error (best - optimum),
 success rate at the task's target precision, expected running time (ERT) to that target, and a
 rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
 and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
-Rank orders methods by success rate (higher first), then ERT, then median final error with a
-failed run counted as infinitely bad (a failed run is a failure to reach the target: it counts
-in the success rate, in ERT at its full budget, and in the rank; ``median_error`` and its
-interval are over the finished runs, ``failed`` says how many did not finish).
+Rank orders methods by success rate (higher first), then ERT, then median final error. A failed
+run is a failure to reach the target: it counts in the success rate, in ERT at its full budget,
+and in every median, quartile and interval as worse than any finished run (:func:`tcbench.stats.with_failures`:
+``+inf``, shown "failed"; ``-inf`` for the hypervolume), so a method that failed on half its runs
+or more has median "failed", and one that failed on a few has its interval widened by them;
+``failed`` says how many did not finish.
 ``ci95_low``/``ci95_high``: percentile-bootstrap 95 % interval of the median error over seeds;
 ``p_vs_next``: two-sided Wilcoxon signed-rank p-value of the final errors of this method and
 the next-ranked one, paired by seed (and BBOB instance; finished runs both have; NaN below 6
@@ -24,13 +26,15 @@ import numpy as np
 import pandas as pd
 
 from tcbench.leaderboard.files import (
+    FAILED_RULE,
+    failed_as_text,
     failed_lines,
     one_run_per_job,
     search_runs,
     write_board_files,
 )
 from tcbench.tables import markdown_table
-from tcbench.stats import bootstrap_median_ci, median_counting_failures, paired_p_value
+from tcbench.stats import bootstrap_median_ci, paired_p_value, percentiles, with_failures
 
 COLUMNS = [
     "rank", "method", "seeds", "failed", "median_best", "median_error", "ci95_low", "ci95_high",
@@ -109,28 +113,31 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
     rows, errors = [], {}
     for method, g in runs.groupby("method", sort=True):
         ok = g["status"] == "FINISHED"
+        n_failed = int((~ok).sum())
         err = g.loc[ok, "final_error"].to_numpy(float)
         pairs = g.loc[ok, ["instance", "seed"]] if "instance" in g else g.loc[ok, ["seed"]]
         errors[method] = pd.Series(err, index=pd.MultiIndex.from_frame(pairs))
         hit = (g["target_hit"] & ok).to_numpy(bool)
         evals = np.where(ok, g["evaluations"].fillna(0), g["budget"]).astype(float)
-        q25, q50, q75 = np.percentile(err, [25, 50, 75]) if err.size else (np.nan,) * 3
-        low, high = bootstrap_median_ci(err)
+        scored = with_failures(err, n_failed)
+        q25, q50, q75 = percentiles(scored, [25, 50, 75]) if scored.size else (np.nan,) * 3
+        low, high = bootstrap_median_ci(scored)
         rows.append({
             "method": method,
             "seeds": len(g),
-            "failed": int((~ok).sum()),
-            "median_best": float(np.median(g.loc[ok, "final_best"])) if ok.any() else np.nan,
+            "failed": n_failed,
+            "median_best": _median(g.loc[ok, "final_best"], n_failed),
             "median_error": q50,
             "ci95_low": low,
             "ci95_high": high,
-            "iqr_error": q75 - q25,
+            "iqr_error": q75 - q25 if np.isfinite(q75) else np.inf,
             "success_rate": hit.mean(),
             "ert_evals": expected_running_time(evals, g["evals_to_target"].to_numpy(float), hit),
             "median_evals": float(np.median(evals)),
-            "median_hv": float(np.median(g.loc[ok, "hypervolume"])) if "hypervolume" in g and ok.any() else np.nan,
-            "median_igd": float(np.median(g.loc[ok, "igd"])) if "igd" in g and ok.any() else np.nan,
-            "_rank_error": median_counting_failures(err, int((~ok).sum())),
+            "median_hv": _median(g.loc[ok, "hypervolume"], n_failed, higher_is_better=True) if "hypervolume" in g
+            else np.nan,
+            "median_igd": _median(g.loc[ok, "igd"], n_failed) if "igd" in g else np.nan,
+            "_rank_error": q50,
         })
     table = pd.DataFrame(rows)
     columns = MO_COLUMNS if is_multiobjective(runs) else COLUMNS
@@ -146,6 +153,13 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
         paired_p_value(errors[m], errors[n]) for m, n in zip(methods, methods[1:], strict=False)
     ] + [np.nan]
     return table[columns]
+
+
+def _median(finished: pd.Series, failed: int, higher_is_better: bool = False) -> float:
+    """Median of the finished runs' values with the failed runs counted as the worst (NaN without
+    any value)."""
+    x = with_failures(finished.to_numpy(float), failed, higher_is_better)
+    return float(np.median(x)) if x.size else np.nan
 
 
 def is_multiobjective(runs: pd.DataFrame) -> bool:
@@ -243,9 +257,9 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
         "error. ci95 = bootstrap 95 % interval of the median error; IQR = inter-quartile range of "
         "the final error over seeds; p_vs_next = Wilcoxon signed-rank p-value against the next "
         "row, paired by seed (p ≥ 0.05: the two are not told apart by these seeds). Failed runs "
-        "count as unsuccessful runs that used their whole budget.",
+        f"count as unsuccessful runs that used their whole budget. {FAILED_RULE}",
         "",
-        markdown_table(board.table),
+        markdown_table(failed_as_text(board.table)),
         "",
     ]
     if curves:

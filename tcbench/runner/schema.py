@@ -33,10 +33,18 @@ def register_schema() -> None:
 
 
 def as_dict(cfg: Any) -> dict[str, Any]:
-    """Plain, resolved dict of a (sub)config."""
+    """Plain, resolved dict of a (sub)config; a ConfigError naming the key whose interpolation
+    does not resolve (``${oc.env:NOPE}`` of a variable that is not set)."""
     if not isinstance(cfg, dict):
         from omegaconf import DictConfig, OmegaConf
+        from omegaconf.errors import OmegaConfBaseException
 
         if isinstance(cfg, DictConfig):
-            return OmegaConf.to_container(cfg, resolve=True)  # type: ignore[return-value]
+            try:
+                return OmegaConf.to_container(cfg, resolve=True)  # type: ignore[return-value]
+            except OmegaConfBaseException as exc:
+                from tcbench.errors import ConfigError, error_line
+
+                key = getattr(exc, "full_key", None) or "config"
+                raise ConfigError(f"{key}: {error_line(str(exc))}") from None
     return dict(cfg)

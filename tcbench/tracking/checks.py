@@ -70,7 +70,8 @@ def _http_problem(uri: str, timeout_s: float) -> str | None:
 def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str:
     """The resolved store URI if the store can be used, checked once and quickly; else a
     :class:`StoreError` with one line. ``create=False`` (reading, e.g. a leaderboard) refuses a
-    local store that does not exist instead of making an empty one."""
+    local store that does not exist instead of making an empty one; ``create=True`` refuses one
+    whose folder does not exist (no folder is made for a store)."""
     resolved = tracking_uri(uri)
     db = sqlite_path(resolved)
     if db is not None:
@@ -81,6 +82,9 @@ def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str
                              "(MLFLOW_TRACKING_URI, tracking.uri=, --tracking-uri)")
         from tcbench.outputs import folder_problem
 
+        if create and not db.parent.exists() and not db.parent.is_symlink():
+            raise StoreError(f"tracking store {db}: its folder {db.parent} does not exist; make it first "
+                             "(a store's folder is never made for it)")
         if create and (problem := folder_problem(db.parent)):
             raise StoreError(f"tracking store {db}: its folder {db.parent} {problem}")
         return resolved

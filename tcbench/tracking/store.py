@@ -171,6 +171,11 @@ class JobRun:
         self._params: list[Param] = []
         self._metrics: list[Metric] = []
         self._tags: list[RunTag] = []
+        self.announcements: list[str] = []  # printed once the run is recorded FINISHED
+
+    def announce(self, line: str) -> None:
+        """Print ``line`` (where the run is logged) once the run is recorded FINISHED, never before."""
+        self.announcements.append(line)
 
     def log_params(self, params: Mapping[str, str]) -> None:
         self._params += [Param(k, str(v)[:6000]) for k, v in params.items()]
@@ -225,25 +230,55 @@ def process_alive(pid: int) -> bool:
     return True
 
 
-def mark_failed(c: MlflowClient, run_id: str, error: str, status: str = "FAILED") -> bool:
-    """Mark a run ended with ``status`` and ``error`` as its ``tcbench.error`` tag; False (and one
-    logged line) if the store cannot be written."""
+INTERRUPTED = "interrupted (Ctrl-C)"
+
+
+def end_run(c: MlflowClient, run_id: str, error: str, status: str = "FAILED") -> str | None:
+    """Mark a run ended with ``status`` and ``error`` as its ``tcbench.error`` tag; None, or why
+    the store could not be written (one line)."""
     try:
         c.set_tag(run_id, f"{TAG_PREFIX}error", error[:4900])
         c.set_terminated(run_id, status=status)
-    except Exception as exc:  # noqa: BLE001 - a full disk or a dead server: say so, do not mask the job's error
-        log.error("run %s could not be marked %s in %s: %s", run_id, status, c.tracking_uri, first_line(exc))
+    except Exception as exc:  # noqa: BLE001 - a full disk or a dead server: said by the caller
+        return first_line(exc)
+    return None
+
+
+def mark_failed(c: MlflowClient, run_id: str, error: str, status: str = "FAILED") -> bool:
+    """Mark a run ended with ``status`` and ``error`` as its ``tcbench.error`` tag; False (and one
+    logged line) if the store cannot be written."""
+    if (problem := end_run(c, run_id, error, status)) is not None:
+        log.error("run %s could not be marked %s in %s: %s", run_id, status, c.tracking_uri, problem)
         return False
     return True
+
+
+def ended_by(exc: BaseException) -> tuple[str, str]:
+    """The status and error a job's run ends with when ``exc`` ends it: KILLED for Ctrl-C,
+    FAILED for anything else (a store that cannot be written included)."""
+    if isinstance(exc, KeyboardInterrupt):
+        return "KILLED", INTERRUPTED
+    return "FAILED", f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+
+
+def unwritable(uri: str, why: str, runs: str, sweep_id: str | None = None) -> StoreError:
+    """The one-line error of a store that cannot be written, with the runs it leaves RUNNING and,
+    given the sweep, how to mark them once it can be written."""
+    advice = (f"; a resume (tracking.resume=true tracking.sweep_id={sweep_id}) marks them KILLED once the store "
+              "can be written") if sweep_id else ""
+    return StoreError(f"tracking store {uri} cannot be written ({why}): {runs} left RUNNING{advice}")
 
 
 @contextmanager
 def job_run(
     cfg: Mapping[str, Any], run_name: str, tags: Mapping[str, str]
 ) -> Iterator[JobRun]:
-    """Open a run for one job; mark it FAILED (with the error as a tag) if the body, or sending
-    what it logged, raises. The run carries the host and process id that ran it, so a run left
-    RUNNING by a killed process can be told from one still running (:func:`mark_dead_runs`)."""
+    """Open a run for one job; mark it FAILED (with the error as a tag) if the body, sending what
+    it logged or ending it FINISHED raises, KILLED on Ctrl-C; a :class:`StoreError` saying the run
+    is left RUNNING when the store cannot be written at all. What the job announced
+    (:meth:`JobRun.announce`) is printed once the run is FINISHED. The run carries the host and
+    process id that ran it, so a run left RUNNING by a killed process can be told from one still
+    running (:func:`mark_dead_runs`)."""
     track = cfg["tracking"]
     uri = tracking_uri(track.get("uri"))
     c = client(uri)
@@ -265,27 +300,34 @@ def job_run(
     try:
         yield handle
         handle.flush()
+        c.set_terminated(run_id, status="FINISHED")
     except BaseException as exc:
-        error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+        status, error = ended_by(exc)
         try:
             handle.flush()
-        except Exception:  # noqa: BLE001 - what the job logged is lost; its failure is still recorded below
+        except Exception:  # noqa: BLE001 - what the job logged is lost; its end is still recorded below
             log.debug("params and metrics of run %s could not be sent", run_id)
-        mark_failed(c, run_id, error)
+        problem = end_run(c, run_id, error, status)
+        if problem is not None and not isinstance(exc, KeyboardInterrupt):
+            raise unwritable(uri, problem, f"run {run_id}") from exc
         raise
-    c.set_terminated(run_id, status="FINISHED")
+    for line in handle.announcements:
+        print(line)
 
 
-def mark_dead_runs(uri: str | None, experiment: str, sweep_id: str, ended_pids: frozenset[int] = frozenset()) -> int:
+def mark_dead_runs(uri: str | None, experiment: str, sweep_id: str, ended_pids: frozenset[int] = frozenset(),
+                   reason: str | None = None) -> int:
     """Mark ``KILLED`` every RUNNING run of a sweep whose process is gone: it ran on this host and
     its process no longer exists, or is one of ``ended_pids`` (this process, after its jobs
-    ended). Runs of other hosts, or of live processes, are left alone. The number marked."""
+    ended); ``reason`` is their error (default: which process ended). Runs of other hosts, or of
+    live processes, are left alone. The number marked; a :class:`StoreError` naming how many are
+    left RUNNING when the store cannot be written."""
     c = client(uri)
     exp = c.get_experiment_by_name(experiment)
     if exp is None:
         return 0
     query = f"tags.`{TAG_PREFIX}sweep_id` = '{sweep_id}' and attributes.status = 'RUNNING'"
-    host, marked = _host(), 0
+    host, marked, problems = _host(), 0, []
     for run in c.search_runs([exp.experiment_id], filter_string=query, max_results=10000):
         tags = run.data.tags
         pid = tags.get(f"{TAG_PREFIX}pid", "")
@@ -293,6 +335,11 @@ def mark_dead_runs(uri: str | None, experiment: str, sweep_id: str, ended_pids: 
             continue
         if int(pid) in ended_pids or not process_alive(int(pid)):
             how = "ended without marking it" if int(pid) in ended_pids else "killed"
-            marked += mark_failed(c, run.info.run_id, f"process {pid} on {host} {how} (found RUNNING)",
-                                  status="KILLED")
+            problem = end_run(c, run.info.run_id, reason or f"process {pid} on {host} {how} (found RUNNING)",
+                              status="KILLED")
+            marked += problem is None
+            problems += [problem] if problem is not None else []
+    if problems:
+        n = len(problems)
+        raise unwritable(tracking_uri(uri), problems[0], f"{n} run{'s' * (n != 1)} of sweep {sweep_id}", sweep_id)
     return marked

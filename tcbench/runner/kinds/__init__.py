@@ -101,12 +101,13 @@ def planned(c: dict[str, Any]) -> dict[str, Any]:
 
 
 def announce(run: Any, c: dict[str, Any]) -> None:
-    """Print where a command's run is logged (the recording commands, whose output is the user's)."""
+    """Say where a command's run is logged (the recording commands, whose output is the user's):
+    printed once the run is recorded FINISHED (:meth:`tcbench.tracking.store.JobRun.announce`)."""
     from tcbench.tracking import store as tracking
 
     track = c["tracking"]
-    print(f"logged to MLflow run {run.run_id} in {tracking.tracking_uri(track.get('uri'))} "
-          f"(experiment {track['experiment']!r})")
+    run.announce(f"logged to MLflow run {run.run_id} in {tracking.tracking_uri(track.get('uri'))} "
+                 f"(experiment {track['experiment']!r})")
 
 
 def kind_name(c: dict[str, Any]) -> str:
