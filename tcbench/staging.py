@@ -9,7 +9,7 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from tcbench.outputs import overwritten_input
+from tcbench.outputs import overwritten_input, short_name
 
 
 class InputOverwriteError(ValueError):
@@ -31,7 +31,7 @@ def staged_dir(out: str | Path, inputs: Iterable[str | Path] = ()) -> Iterator[P
     made = _make_parents(out.parent)
     moved_any = False
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=f".{short_name(out.name)}.", dir=out.parent))
         try:
             yield tmp
             staged = [out / p.relative_to(tmp) for p in tmp.rglob("*") if not p.is_dir()]

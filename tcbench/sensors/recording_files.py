@@ -26,6 +26,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
+from tcbench.outputs import temp_name
 from tcbench.sensors.recording_schema import FORMATS, NUMERIC_COLUMNS, RecordingError, _check_columns, _normalise
 
 MAX_HEADER_BYTES = 64 * 1024  # a longer first line is no header
@@ -357,7 +358,7 @@ def _atomic_write(writers: dict[Path, Callable[[BinaryIO], None]]) -> None:
     temps: dict[Path, Path] = {}
     try:
         for target, write in writers.items():
-            temp = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
+            temp = target.with_name(temp_name(target.name, secrets.token_hex(6)))
             temps[target] = temp
             with open(os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), "wb") as f:
                 write(f)
