@@ -30,6 +30,10 @@ from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
 AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
+FIT_COEFFICIENTS = 5  # the largest linear fit, poly3_rate: the cubic's four and the rate term
+ROWS_PER_COEFFICIENT = 5  # as the networks' LM asks per weight (tcbench.compensation.training)
+MIN_FIT_ROWS = FIT_COEFFICIENTS * ROWS_PER_COEFFICIENT
+CUBIC_TEMPERATURES = 4  # distinct thermometer readings a cubic in the temperature needs
 PLOT_POINTS = 4000  # points per line of the residual plot (a min/max envelope beyond)
 
 
@@ -114,6 +118,7 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
     from tcbench.signal.branches import temperature_branches, time_blocks
 
     rec = read_recording_arg(path)
+    _check_record(path, rec, cfg, own)
     if cfg.true_input is not None:
         rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
     blocks = cfg.blocks
@@ -139,7 +144,48 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
         raise CommandError(f"train_branches={list(cfg.train_branches or [])}: the recording has {len(parts)} "
                            f"{noun}{'es' * (noun.endswith('branch') and len(parts) != 1)}"
                            f"{'s' * (noun.endswith('block') and len(parts) != 1)} (0..{len(parts) - 1}; {how})")
-    return rec, Split(parts, train, noun, how)
+    split = Split(parts, train, noun, how)
+    rows = np.concatenate([np.arange(parts[k].start, parts[k].stop) for k in train])
+    fittable(rec.temperature_c[rows], f"{path}: the fitted parts ({split.describe(train)})")
+    return rec, split
+
+
+def _check_record(path: str, rec: Any, cfg: CalibrateConfig, own: bool) -> None:
+    """What a calibration needs of a recording before it is cut: its sidecar (the sensor kind
+    and units), the rows of the fitted parts (:data:`MIN_FIT_ROWS`; a test recording: two, to
+    be cut) and a duration that holds one drift window (``drift_window_s``)."""
+    from tcbench.sensors.recording import sidecar_path
+
+    where = path if own else f"test_recordings: {path}"
+    if rec.meta.sensor is None:
+        raise CommandError(f"{'' if own else 'test_recordings: '}{sidecar_path(path)}: no such file; calibrate reads "
+                           "the sensor kind and units from the recording's sidecar (tcbench import writes one)")
+    rows = rec.time_s.size
+    if rows < (MIN_FIT_ROWS if own else 2):
+        need = (f"its fitted parts need at least {MIN_FIT_ROWS} rows ({ROWS_PER_COEFFICIENT} for each of the "
+                f"{FIT_COEFFICIENTS} coefficients of poly3_rate: a cubic in the temperature and a rate term)"
+                if own else "a recording scored part by part needs at least 2")
+        raise CommandError(f"{where}: {rows} row{'s' * (rows != 1)}; {need}")
+    duration_s = float(rec.time_s[-1] - rec.time_s[0])
+    if not cfg.drift_window_s <= duration_s:
+        raise CommandError(f"drift_window_s={cfg.drift_window_s:g} is longer than {where} ({duration_s:.6g} s): the "
+                           f"drift is a running mean over that window, which must fit in the record; give "
+                           f"drift_window_s={duration_s:.6g} or less")
+
+
+def fittable(temp_c: np.ndarray, where: str) -> None:
+    """A :class:`CommandError` unless the samples ``temp_c`` can be fitted: at least
+    :data:`MIN_FIT_ROWS` of them, at :data:`CUBIC_TEMPERATURES` distinct temperatures."""
+    if temp_c.size < MIN_FIT_ROWS:
+        raise CommandError(f"{where} hold {temp_c.size} rows; a calibration fits up to {FIT_COEFFICIENTS} "
+                           f"coefficients (poly3_rate) and needs at least {MIN_FIT_ROWS} rows there "
+                           f"({ROWS_PER_COEFFICIENT} per coefficient): fit on more parts (train_branches=)")
+    distinct = np.unique(temp_c).size
+    if distinct < CUBIC_TEMPERATURES:
+        span = float(np.ptp(temp_c))
+        raise CommandError(f"{where} read {distinct} distinct temperature{'s' * (distinct != 1)} ({span:g} degC "
+                           f"apart); a cubic in the temperature needs at least {CUBIC_TEMPERATURES}: calibrate a "
+                           "record over a temperature range")
 
 
 def true_input(spec: object, input_unit: str) -> float:
@@ -193,6 +239,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
     screening = screened_all(train, cfg.screen)
     print(screening.describe() if cfg.screen else "not screened (screen=false): " + screening.describe(), flush=True)
+    if cfg.screen:
+        fittable(np.concatenate([p.temp_c for p in screening.pieces] or [np.array([])]),
+                 "the fitted parts left by screening (screen=false fits every sample)")
     jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
     fitted: dict[str, list[Any]] = {m: [] for m in methods}
     diagnosis = None
