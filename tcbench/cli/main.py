@@ -116,26 +116,28 @@ def _literal_path(arg: str, command: str, multirun: bool) -> str:
     """A file argument of ``command`` (``recording=``, ``csv=``, ``model=``, ``test_recordings=``)
     quoted and escaped so that Hydra and OmegaConf pass its text on as it is: a name holding ``$``,
     ``${...}``, commas or brackets is the file's name, never an interpolation or a sweep. One job
-    takes the whole text as the path (a list key: its items, in Hydra's list syntax); with ``-m``
-    Hydra's grammar still separates the values (``recording=a.csv,b.csv``), each then literal."""
+    takes the whole text as the path (unquoted when it is quoted; a list key: its items, in Hydra's
+    list syntax); with ``-m`` Hydra's grammar still separates the values (``recording=a.csv,b.csv``),
+    each then literal. ``null`` stays null."""
     import dataclasses
 
     from tcbench.commands.inputs import INPUT_KEYS
     from tcbench.commands.schemas import SCHEMAS
 
     key, eq, value = arg.partition("=")
-    if not eq or key not in INPUT_KEYS.get(command, ()):
+    if not eq or key not in INPUT_KEYS.get(command, ()) or value == "null":
         return arg
-    from tcbench.cli.app import hydra_string
-    from tcbench.commands.schemas import literal
-
-    listed = any(f.name == key and str(f.type).startswith("list") for f in dataclasses.fields(SCHEMAS[command]))
-    if not multirun and not listed:
-        return f"{key}={hydra_string(literal(value))}"
     from hydra.core.override_parser.overrides_parser import OverridesParser
     from hydra.core.override_parser.types import ChoiceSweep
     from hydra.errors import HydraException
 
+    from tcbench.cli.app import hydra_string
+    from tcbench.commands.schemas import literal
+
+    listed = any(f.name == key and str(f.type).startswith("list") for f in dataclasses.fields(SCHEMAS[command]))
+    quoted = len(value) > 1 and value[0] == value[-1] and value[0] in "'\""
+    if not multirun and not listed and not quoted:
+        return f"{key}={hydra_string(literal(value))}"
     try:
         (override,) = OverridesParser.create().parse_overrides([arg])
     except HydraException:
