@@ -220,9 +220,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     name = Path(cfg.recording).name
     methods = list(dict.fromkeys(cfg.methods))
-    if "model" in methods and (short := _too_short_to_diagnose(rec, split)):
+    if "model" in methods and (why := _too_short_to_diagnose(rec, split) or _too_long_to_diagnose(split)):
         methods.remove("model")
-        print(f"tcbench: model left out: {short}", file=sys.stderr)
+        print(f"tcbench: model left out: {why}", file=sys.stderr)
     scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
     if cfg.test_recordings:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
@@ -520,6 +520,19 @@ def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
         return None
     return (f"the fitted parts last {fitted_s / 60:.1f} min and a diagnosis needs {need_s / 60:.0f} min "
             "(tcbench diagnose reports what a short record can tell)")
+
+
+def _too_long_to_diagnose(split: Split) -> str | None:
+    """Why the fitted parts hold too many rows for the ``model`` method's diagnosis (more than
+    ``tcbench diagnose`` takes by default, :data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS`), or None."""
+    from tcbench.commands import schemas
+    from tcbench.diagnose.cost import duration_text, estimated_s
+
+    rows = sum(split.parts[k].stop - split.parts[k].start for k in split.train)
+    if rows <= schemas.DIAGNOSE_MAX_ROWS:
+        return None
+    return (f"the fitted parts hold {rows} rows, whose diagnosis would take about {duration_text(estimated_s(rows))} "
+            f"(tcbench diagnose takes at most max_rows={schemas.DIAGNOSE_MAX_ROWS} unless told otherwise)")
 
 
 def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | None = None) -> tuple[Any, Any]:

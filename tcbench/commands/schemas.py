@@ -84,16 +84,22 @@ class ImportConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
 
 
+# the most rows tcbench diagnose takes by default: about 8 min of one core and 3 GB (tcbench.diagnose.cost)
+DIAGNOSE_MAX_ROWS = 1_000_000
+
+
 @dataclass
 class DiagnoseConfig:
     """``tcbench diagnose``: the recording, the output directory, the sensor kind for a recording
-    without a sidecar, and the model file of effects already modelled."""
+    without a sidecar, the model file of effects already modelled, and the most rows diagnosed
+    (:mod:`tcbench.diagnose.cost`)."""
 
     kind: str = "diagnose"
     recording: str = ""
     out: str = "diagnosis"
     sensor: str | None = None
     model: str | None = None
+    max_rows: int | None = DIAGNOSE_MAX_ROWS  # null: no limit
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
 
 

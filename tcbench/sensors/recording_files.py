@@ -43,6 +43,26 @@ def _format(path: Path) -> str:
     return fmt
 
 
+def table_rows(path: str | Path) -> int | None:
+    """The data rows of a recording's table, known without parsing it: a CSV file's lines after
+    the header (counted in pieces of :data:`CHUNK_BYTES`), a Parquet file's row count from its
+    footer. None when the file cannot tell (no table of a known format, unreadable, binary): its
+    reader then says why."""
+    path = Path(path)
+    try:
+        if _format(path) == ".parquet":
+            return int(pq.ParquetFile(path).metadata.num_rows) if path.is_file() else None
+        lines, last = 0, b"\n"
+        with path.open("rb") as f:
+            while piece := f.read(CHUNK_BYTES):
+                if b"\0" in piece:
+                    return None
+                lines, last = lines + piece.count(b"\n"), piece[-1:]
+    except (RecordingError, OSError, pa.ArrowException):
+        return None
+    return max(lines + (last != b"\n") - 1, 0)
+
+
 def _load_json(path: Path) -> Any:
     """Parsed JSON of a sidecar."""
     size = path.stat().st_size
