@@ -146,22 +146,28 @@ def test_calibrate_refuses_a_drift_window_longer_than_a_test_recording(workdir: 
 
 # -- 3. the least a calibration fits, and sidecars ----------------------------------------------
 
-@pytest.mark.parametrize(("rows", "words"), [(1, "1 row;"), (10, "10 rows;")])
-def test_calibrate_refuses_too_few_rows(workdir: Path, capsys: pytest.CaptureFixture[str], rows: int,
-                                        words: str) -> None:
-    """One row crashed calibrate (ValueError, exit 1); ten were calibrated (exit 0)."""
-    gyro(workdir / "rec.csv", rows=rows)
-    refused(capsys, workdir, ["calibrate", "recording=rec.csv", "out=c", FAST, OFF], "rec.csv", words,
-            "at least 25 rows")
+@pytest.mark.parametrize(("rows", "step_s", "words"), [
+    (1, 1.0, "rec.csv: 1 row; its fitted parts need at least 6 rows"),
+    (5, 100.0, "rec.csv: 5 rows; its fitted parts need at least 6 rows"),
+    (10, 1.0, "drift_window_s=60 is longer than rec.csv (9 s)"),
+])
+def test_calibrate_refuses_too_little(workdir: Path, capsys: pytest.CaptureFixture[str], rows: int, step_s: float,
+                                      words: str) -> None:
+    """One row crashed calibrate (ValueError, exit 1); ten rows at 1 Hz were calibrated (exit 0),
+    though they hold no drift window: no more rows than poly3_rate has coefficients, and a record
+    shorter than one drift window, are one line each."""
+    gyro(workdir / "rec.csv", rows=rows, step_s=step_s)
+    refused(capsys, workdir, ["calibrate", "recording=rec.csv", "out=c", FAST, OFF], words)
 
 
 def test_calibrate_refuses_fitted_parts_too_small_for_the_cubic(workdir: Path,
                                                                 capsys: pytest.CaptureFixture[str]) -> None:
     """Enough rows, but fitted on one short block: too few rows there; a constant thermometer:
     too few temperatures for a cubic."""
-    gyro(workdir / "rec.csv", rows=100)
+    gyro(workdir / "rec.csv", rows=50)
     refused(capsys, workdir, ["calibrate", "recording=rec.csv", "out=c", "blocks=10", "train_branches=[0]",
-                              "drift_window_s=5", FAST, OFF], "the fitted parts (time block 0", "hold 10 rows")
+                              "drift_window_s=5", FAST, OFF], "the fitted parts (time block 0", "hold 5 rows",
+            "at least 6")
     gyro(workdir / "flat.csv", span_c=0.0)
     refused(capsys, workdir, ["calibrate", "recording=flat.csv", "out=c", FAST, OFF],
             "flat.csv: the fitted parts", "1 distinct temperature", "needs at least 4")

@@ -31,8 +31,7 @@ from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
 FIT_COEFFICIENTS = 5  # the largest linear fit, poly3_rate: the cubic's four and the rate term
-ROWS_PER_COEFFICIENT = 5  # as the networks' LM asks per weight (tcbench.compensation.training)
-MIN_FIT_ROWS = FIT_COEFFICIENTS * ROWS_PER_COEFFICIENT
+MIN_FIT_ROWS = FIT_COEFFICIENTS + 1  # more rows than coefficients: a residual is left to score
 CUBIC_TEMPERATURES = 4  # distinct thermometer readings a cubic in the temperature needs
 PLOT_POINTS = 4000  # points per line of the residual plot (a min/max envelope beyond)
 
@@ -162,8 +161,8 @@ def _check_record(path: str, rec: Any, cfg: CalibrateConfig, own: bool) -> None:
                            "the sensor kind and units from the recording's sidecar (tcbench import writes one)")
     rows = rec.time_s.size
     if rows < (MIN_FIT_ROWS if own else 2):
-        need = (f"its fitted parts need at least {MIN_FIT_ROWS} rows ({ROWS_PER_COEFFICIENT} for each of the "
-                f"{FIT_COEFFICIENTS} coefficients of poly3_rate: a cubic in the temperature and a rate term)"
+        need = (f"its fitted parts need at least {MIN_FIT_ROWS} rows, more than the {FIT_COEFFICIENTS} coefficients "
+                "of poly3_rate (a cubic in the temperature and a rate term)"
                 if own else "a recording scored part by part needs at least 2")
         raise CommandError(f"{where}: {rows} row{'s' * (rows != 1)}; {need}")
     duration_s = float(rec.time_s[-1] - rec.time_s[0])
@@ -178,8 +177,8 @@ def fittable(temp_c: np.ndarray, where: str) -> None:
     :data:`MIN_FIT_ROWS` of them, at :data:`CUBIC_TEMPERATURES` distinct temperatures."""
     if temp_c.size < MIN_FIT_ROWS:
         raise CommandError(f"{where} hold {temp_c.size} rows; a calibration fits up to {FIT_COEFFICIENTS} "
-                           f"coefficients (poly3_rate) and needs at least {MIN_FIT_ROWS} rows there "
-                           f"({ROWS_PER_COEFFICIENT} per coefficient): fit on more parts (train_branches=)")
+                           f"coefficients (poly3_rate) and needs at least {MIN_FIT_ROWS} rows there: fit on more "
+                           "parts (train_branches=)")
     distinct = np.unique(temp_c).size
     if distinct < CUBIC_TEMPERATURES:
         span = float(np.ptp(temp_c))
