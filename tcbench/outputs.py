@@ -21,10 +21,13 @@ def folder_problem(path: str | Path) -> str | None:
     the superuser. Nothing is left behind."""
     target = Path(path)
     probe_in = target
-    while not probe_in.exists():
-        if probe_in.parent == probe_in:
-            return "no part of the path exists"
-        probe_in = probe_in.parent
+    try:
+        while not probe_in.exists():
+            if probe_in.parent == probe_in:
+                return "no part of the path exists"
+            probe_in = probe_in.parent
+    except OSError as exc:  # a name longer than the file system takes
+        return f"cannot be made ({exc.strerror or type(exc).__name__})"
     if not probe_in.is_dir():
         return "is not a folder" if probe_in == target else f"cannot be made: {probe_in} is not a folder"
     try:
@@ -37,11 +40,19 @@ def folder_problem(path: str | Path) -> str | None:
     return None
 
 
-def name_problem(name: str) -> str | None:
+NAME_MAX_BYTES = 255  # the longest file name of the common file systems (ext4, xfs, btrfs, tmpfs, APFS)
+TEMP_NAME_BYTES = 64  # what a temporary name keeps of the name it stands for
+
+
+def name_problem(name: str, suffix: str = "") -> str | None:
     """Why ``name`` cannot be the stem of files written inside an output folder, or None if it
-    can: it must be a plain file name, so that every write stays inside the folder."""
+    can: it must be a plain file name, so that every write stays inside the folder, and with
+    ``suffix`` (the longest ending the command adds: ``.json``) no longer than a file name may be."""
     if not name:
         return "is empty"
+    if (size := len(f"{name}{suffix}".encode(errors="surrogateescape"))) > NAME_MAX_BYTES:
+        return (f"makes a file name of {size} bytes ({'NAME' + suffix if suffix else 'NAME'}), longer than the "
+                f"{NAME_MAX_BYTES} a file name may have; give a shorter one")
     if "\0" in name:
         return "holds a NUL character"
     if "/" in name or "\\" in name or (os.altsep and os.altsep in name):
@@ -76,3 +87,14 @@ def write_problem(exc: OSError) -> str:
     if exc.errno:
         return os.strerror(exc.errno)
     return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+
+
+def short_name(name: str) -> str:
+    """At most :data:`TEMP_NAME_BYTES` of ``name`` (whole characters): what a temporary name
+    keeps of the name it stands for, so that it fits wherever ``name`` fits."""
+    return name.encode(errors="surrogateescape")[:TEMP_NAME_BYTES].decode(errors="ignore")
+
+
+def temp_name(name: str, tag: str) -> str:
+    """A hidden temporary name beside the file ``name``: ``.<short name>.<tag>.tmp``."""
+    return f".{short_name(name)}.{tag}.tmp"

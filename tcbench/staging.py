@@ -13,7 +13,7 @@ from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path, PurePath
 
-from tcbench.outputs import overwritten_input
+from tcbench.outputs import overwritten_input, short_name
 
 
 class InputOverwriteError(ValueError):
@@ -113,7 +113,7 @@ def staged_dir(out: str | Path, inputs: Iterable[str | Path] = (), overwrite: bo
     made = _make_parents(out.parent)
     moved_any = False
     try:
-        tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+        tmp = Path(tempfile.mkdtemp(prefix=f".{short_name(out.name)}.", dir=out.parent))
         try:
             yield tmp
             entries = sorted((p.relative_to(tmp), p.is_dir()) for p in tmp.rglob("*"))

@@ -125,7 +125,7 @@ def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytes
     assert code == 0, err
     for a in AXES:
         code, _, err = run(capsys, "calibrate", f"recording=rec/log-sensor_gyro-0-{a}.csv", f"out=cal/{a}",
-                           "methods=[poly3]", "train_branches=[0]", "tracking.enabled=false")
+                           "methods=[poly3]", "train_branches=[0]", "drift_window_s=5", "tracking.enabled=false")
         assert code == 0, err
     code, _, err = run(capsys, "export", "calibrations=[cal/x,cal/y,cal/z]", "out=params")
     assert code == 0, err

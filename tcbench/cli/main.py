@@ -94,6 +94,65 @@ def _open_key(arg: str, command: str) -> str:
     return f"++{arg}" if arg.split("=", 1)[0].split(".", 1)[0] in open_dicts and "." in arg.split("=", 1)[0] else arg
 
 
+def _first_input_key(command: str) -> str:
+    """The first file argument of ``command`` (``recording``, ``csv``), or ``recording``."""
+    from tcbench.commands.inputs import INPUT_KEYS
+
+    return next(iter(INPUT_KEYS.get(command, ())), "recording")
+
+
+def _file_not_key(arg: str, command: str) -> bool:
+    """True when ``arg`` is no ``key=value`` of ``command`` (its key is none of the schema's) but
+    the name of a file: ``tcbench metrics a=b.csv`` means the file ``a=b.csv``."""
+    import dataclasses
+
+    from tcbench.commands.schemas import SCHEMAS
+
+    head = arg.partition("=")[0].lstrip("+~").split(".", 1)[0]
+    known = {f.name for f in dataclasses.fields(SCHEMAS[command])} | {"hydra"}
+    return head not in known and os.path.lexists(arg)
+
+
+def _literal_path(arg: str, command: str, multirun: bool) -> str:
+    """A file argument of ``command`` (``recording=``, ``csv=``, ``model=``, ``test_recordings=``)
+    quoted and escaped so that Hydra and OmegaConf pass its text on as it is: a name holding ``$``,
+    ``${...}``, commas or brackets is the file's name, never an interpolation or a sweep. One job
+    takes the whole text as the path (unquoted when it is quoted; a list key: its items, in Hydra's
+    list syntax); with ``-m`` Hydra's grammar still separates the values (``recording=a.csv,b.csv``),
+    each then literal. ``null`` stays null."""
+    import dataclasses
+
+    from tcbench.commands.inputs import INPUT_KEYS
+    from tcbench.commands.schemas import SCHEMAS
+
+    key, eq, value = arg.partition("=")
+    if not eq or key not in INPUT_KEYS.get(command, ()) or value == "null":
+        return arg
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import ChoiceSweep
+    from hydra.errors import HydraException
+
+    from tcbench.cli.app import hydra_string
+    from tcbench.commands.schemas import literal
+
+    listed = any(f.name == key and str(f.type).startswith("list") for f in dataclasses.fields(SCHEMAS[command]))
+    quoted = len(value) > 1 and value[0] == value[-1] and value[0] in "'\""
+    if not multirun and not listed and not quoted:
+        return f"{key}={hydra_string(literal(value))}"
+    try:
+        (override,) = OverridesParser.create().parse_overrides([arg])
+    except HydraException:
+        return arg  # Hydra's own line names the problem
+    parsed = override.value()
+    items = parsed.list if isinstance(parsed, ChoiceSweep) else parsed if isinstance(parsed, list) else [parsed]
+    if not all(isinstance(v, str) for v in items):
+        return arg
+    quoted = [hydra_string(literal(v)) for v in items]
+    if isinstance(parsed, list) and not isinstance(parsed, ChoiceSweep):
+        return f"{key}=[{','.join(quoted)}]"
+    return f"{key}={','.join(quoted)}"
+
+
 @contextlib.contextmanager
 def _quiet_job_log() -> Iterator[None]:
     """The runner's own failure log line off: one job's command reports its error itself."""
@@ -137,9 +196,14 @@ def _app_command(command: str, argv: list[str]) -> int:
         args = [f"{positional}={args[0]}", *args[1:]]
     if bad := [a for a in args if "=" not in a or a.startswith("=")]:
         raise UserError(f"expected key=value, got {bad[0]!r}")
+    if named := [a for a in args if _file_not_key(a, command)]:
+        key, _, _ = named[0].partition("=")
+        given = positional or _first_input_key(command)
+        raise UserError(f"{named[0]}: {key!r} is no key of tcbench {command}, and {named[0]} is a file; to read it, "
+                        f"give {given}={named[0]}")
     if nul := [a for a in args if "\0" in a]:
         raise UserError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
-    args = [_open_key(a, command) for a in args]
+    args = [_literal_path(_open_key(a, command), command, multirun) for a in args]
     if multirun and cfg is None and command in IN_TURN:
         return _in_turn(command, args)
     if multirun and cfg is None:

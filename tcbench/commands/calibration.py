@@ -40,6 +40,9 @@ from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, stag
 
 FILES = ("calibration.csv", "calibration.json", "calibration.md", "residuals.png")  # OUT/, checked before any work
 AUTO_BLOCKS = 5  # a record of one temperature branch: five time blocks, the even ones fitted
+FIT_COEFFICIENTS = 5  # the largest linear fit, poly3_rate: the cubic's four and the rate term
+MIN_FIT_ROWS = FIT_COEFFICIENTS + 1  # more rows than coefficients: a residual is left to score
+CUBIC_TEMPERATURES = 4  # distinct thermometer readings a cubic in the temperature needs
 PLOT_POINTS = 4000  # points per line of the residual plot (a min/max envelope beyond)
 
 
@@ -125,6 +128,7 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
     from tcbench.signal.branches import temperature_branches, time_blocks
 
     rec = read_recording_arg(path)
+    _check_record(path, rec, cfg, own)
     if cfg.true_input is not None:
         rec.data["input"] = true_input(cfg.true_input, rec.meta.units.get("input", ""))
     blocks = cfg.blocks
@@ -150,7 +154,48 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
         raise CommandError(f"train_branches={list(cfg.train_branches or [])}: the recording has {len(parts)} "
                            f"{noun}{'es' * (noun.endswith('branch') and len(parts) != 1)}"
                            f"{'s' * (noun.endswith('block') and len(parts) != 1)} (0..{len(parts) - 1}; {how})")
-    return rec, Split(parts, train, noun, how)
+    split = Split(parts, train, noun, how)
+    rows = np.concatenate([np.arange(parts[k].start, parts[k].stop) for k in train])
+    fittable(rec.temperature_c[rows], f"{path}: the fitted parts ({split.describe(train)})")
+    return rec, split
+
+
+def _check_record(path: str, rec: Any, cfg: CalibrateConfig, own: bool) -> None:
+    """What a calibration needs of a recording before it is cut: its sidecar (the sensor kind
+    and units), the rows of the fitted parts (:data:`MIN_FIT_ROWS`; a test recording: two, to
+    be cut) and a duration that holds one drift window (``drift_window_s``)."""
+    from tcbench.sensors.recording import sidecar_path
+
+    where = path if own else f"test_recordings: {path}"
+    if rec.meta.sensor is None:
+        raise CommandError(f"{'' if own else 'test_recordings: '}{sidecar_path(path)}: no such file; calibrate reads "
+                           "the sensor kind and units from the recording's sidecar (tcbench import writes one)")
+    rows = rec.time_s.size
+    if rows < (MIN_FIT_ROWS if own else 2):
+        need = (f"its fitted parts need at least {MIN_FIT_ROWS} rows, more than the {FIT_COEFFICIENTS} coefficients "
+                "of poly3_rate (a cubic in the temperature and a rate term)"
+                if own else "a recording scored part by part needs at least 2")
+        raise CommandError(f"{where}: {rows} row{'s' * (rows != 1)}; {need}")
+    duration_s = float(rec.time_s[-1] - rec.time_s[0])
+    if not cfg.drift_window_s <= duration_s:
+        raise CommandError(f"drift_window_s={cfg.drift_window_s:g} is longer than {where} ({duration_s:.6g} s): the "
+                           f"drift is a running mean over that window, which must fit in the record; give "
+                           f"drift_window_s={duration_s:.6g} or less")
+
+
+def fittable(temp_c: np.ndarray, where: str) -> None:
+    """A :class:`CommandError` unless the samples ``temp_c`` can be fitted: at least
+    :data:`MIN_FIT_ROWS` of them, at :data:`CUBIC_TEMPERATURES` distinct temperatures."""
+    if temp_c.size < MIN_FIT_ROWS:
+        raise CommandError(f"{where} hold {temp_c.size} rows; a calibration fits up to {FIT_COEFFICIENTS} "
+                           f"coefficients (poly3_rate) and needs at least {MIN_FIT_ROWS} rows there: fit on more "
+                           "parts (train_branches=)")
+    distinct = np.unique(temp_c).size
+    if distinct < CUBIC_TEMPERATURES:
+        span = float(np.ptp(temp_c))
+        raise CommandError(f"{where} read {distinct} distinct temperature{'s' * (distinct != 1)} ({span:g} degC "
+                           f"apart); a cubic in the temperature needs at least {CUBIC_TEMPERATURES}: calibrate a "
+                           "record over a temperature range")
 
 
 def true_input(spec: object, input_unit: str) -> float:
@@ -185,9 +230,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     name = Path(cfg.recording).name
     methods = list(dict.fromkeys(cfg.methods))
-    if "model" in methods and (short := _too_short_to_diagnose(rec, split)):
+    if "model" in methods and (why := _too_short_to_diagnose(rec, split) or _too_long_to_diagnose(split)):
         methods.remove("model")
-        print(f"tcbench: model left out: {short}", file=sys.stderr)
+        print(f"tcbench: model left out: {why}", file=sys.stderr)
     scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
     if cfg.test_recordings:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
@@ -204,6 +249,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
     screening = screened_all(train, cfg.screen)
     print(screening.describe() if cfg.screen else "not screened (screen=false): " + screening.describe(), flush=True)
+    if cfg.screen:
+        fittable(np.concatenate([p.temp_c for p in screening.pieces] or [np.array([])]),
+                 "the fitted parts left by screening (screen=false fits every sample)")
     jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
     fitted: dict[str, list[Any]] = {m: [] for m in methods}
     diagnosis = None
@@ -486,6 +534,19 @@ def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
         return None
     return (f"the fitted parts last {fitted_s / 60:.1f} min and a diagnosis needs {need_s / 60:.0f} min "
             "(tcbench diagnose reports what a short record can tell)")
+
+
+def _too_long_to_diagnose(split: Split) -> str | None:
+    """Why the fitted parts hold too many rows for the ``model`` method's diagnosis (more than
+    ``tcbench diagnose`` takes by default, :data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS`), or None."""
+    from tcbench.commands import schemas
+    from tcbench.diagnose.cost import duration_text, estimated_s
+
+    rows = sum(split.parts[k].stop - split.parts[k].start for k in split.train)
+    if rows <= schemas.DIAGNOSE_MAX_ROWS:
+        return None
+    return (f"the fitted parts hold {rows} rows, whose diagnosis would take about {duration_text(estimated_s(rows))} "
+            f"(tcbench diagnose takes at most max_rows={schemas.DIAGNOSE_MAX_ROWS} unless told otherwise)")
 
 
 def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | None = None) -> tuple[Any, Any]:

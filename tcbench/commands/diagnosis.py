@@ -6,7 +6,12 @@ through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import math
+import sys
+import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -27,6 +32,7 @@ from tcbench.commands.errors import (
 
 log = logging.getLogger(__name__)
 REPORT_FILES = ("report.json", "report.md")  # what every report holds, checked before any work
+PROGRESS_AFTER_S = 30.0  # a diagnosis estimated to take longer says so before it starts
 
 
 @dataclass
@@ -47,9 +53,12 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
         raise CommandError("recording=PATH is required")
     if cfg.sensor is not None and not kinds.known(cfg.sensor):
         raise CommandError(f"sensor must be one of {', '.join(kinds.names())}, got {cfg.sensor!r}")
+    if cfg.max_rows is not None and cfg.max_rows < 1:
+        raise CommandError(f"max_rows must be a number of rows >= 1 (null: no limit), got {cfg.max_rows}")
     writable_folder(cfg.out)
     free_outputs(cfg.out, list(REPORT_FILES), cfg.overwrite)
     checked_store(cfg.tracking)
+    check_size(cfg.recording, cfg.max_rows)
     rec = read_recording_arg(cfg.recording)
     sensor = cfg.sensor or rec.meta.sensor
     if sensor is None:
@@ -68,6 +77,60 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     return rec, sensor, declared
 
 
+def check_size(path: str, max_rows: int | None) -> None:
+    """A record of more than ``max_rows`` rows refused from its row count, before it is read: one
+    line with the rows, the time they are estimated to take (:mod:`tcbench.diagnose.cost`) and
+    what to do."""
+    from tcbench.diagnose.cost import duration_text, estimated_bytes, estimated_s, size_text
+    from tcbench.sensors.recording_files import table_rows
+
+    rows = table_rows(path)
+    if rows is None or max_rows is None or rows <= max_rows:
+        return
+    raise CommandError(f"{path}: {rows} rows would take about {duration_text(estimated_s(rows))} and "
+                       f"{size_text(estimated_bytes(rows))} to diagnose (one core, estimated from the rows; "
+                       f"max_rows={max_rows}: about {duration_text(estimated_s(max_rows))}): average it into at most "
+                       f"{max_rows} rows (means of {math.ceil(rows / max_rows)} samples) or cut it into shorter "
+                       f"recordings, or give max_rows={rows} to diagnose it anyway")
+
+
+@contextlib.contextmanager
+def progress(name: str, rows: int) -> Iterator[None]:
+    """Around the diagnosis of ``rows`` rows: when it is estimated to take longer than
+    :data:`PROGRESS_AFTER_S`, one line on stderr with the rows and the estimate before it starts,
+    and on a terminal a bar of the time spent against the estimate, updated every second."""
+    from tcbench.diagnose.cost import duration_text, estimated_s
+
+    estimate = estimated_s(rows)
+    if estimate < PROGRESS_AFTER_S:
+        yield
+        return
+    print(f"tcbench: diagnosing {name}: {rows} rows, about {duration_text(estimate)} (one core, estimated from the "
+          "rows)", file=sys.stderr, flush=True)
+    if not sys.stderr.isatty():
+        yield
+        return
+    from tqdm import tqdm
+
+    done = threading.Event()
+    with tqdm(total=math.ceil(estimate), desc="diagnosing", unit="s", leave=False, file=sys.stderr,
+              bar_format=f"{{desc}} {{bar}} {{elapsed}} of about {duration_text(estimate)}") as bar:
+        def tick() -> None:
+            while not done.wait(1.0):
+                if bar.n < bar.total - 1:
+                    bar.update(1)
+                else:
+                    bar.refresh()
+
+        ticker = threading.Thread(target=tick, daemon=True)
+        ticker.start()
+        try:
+            yield
+        finally:
+            done.set()
+            ticker.join()
+
+
 def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     """Diagnose the recording, write its report and print the verdict."""
     from tcbench.diagnose.diagnosis import diagnose
@@ -79,7 +142,8 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s():
         return _short_record(cfg, rec, sensor)
     try:
-        diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
+        with progress(Path(cfg.recording).name, rec.time_s.size):
+            diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
     written = _written(write_report, diag, cfg)

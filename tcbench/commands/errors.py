@@ -32,11 +32,12 @@ def cannot_write(out: str | Path, exc: OSError, what: str = "the recording") -> 
     return CommandError(f"out={out}: cannot write {what} ({write_problem(exc)})")
 
 
-def file_stem(name: str, key: str = "name") -> str:
-    """``name`` (the ``key=`` argument) checked as the stem of files written inside ``out=``."""
+def file_stem(name: str, key: str = "name", suffix: str = "") -> str:
+    """``name`` (the ``key=`` argument) checked as the stem of files written inside ``out=``,
+    ``suffix`` the longest ending they get."""
     from tcbench.outputs import name_problem
 
-    if problem := name_problem(name):
+    if problem := name_problem(name, suffix):
         raise CommandError(f"{key}={name!r}: {problem}")
     return name
 

@@ -111,7 +111,7 @@ def check_simulate(cfg: SimulateConfig) -> Any:
         raise CommandError("device_seed, seed and power_on must be non-negative integers")
     writable_folder(cfg.out)
     checked_store(cfg.tracking)
-    stem = file_stem(simulation_stem(cfg))
+    stem = file_stem(simulation_stem(cfg), suffix=max((f".{cfg.format}", ".json", "_metrics" * cfg.metrics), key=len))
     metrics = [f"{stem}_metrics"] if cfg.metrics else []
     free_outputs(cfg.out, [f"{stem}.{cfg.format}", f"{stem}.json", *[f"{m}/metrics.json" for m in metrics]],
                  cfg.overwrite, "out= or name=", folders=metrics)
@@ -172,7 +172,12 @@ def check_metrics(cfg: MetricsConfig) -> Any:
     if scale is not None and not (math.isfinite(scale) and scale > 0):
         raise CommandError(f"scale_factor_hz_per_g: must be a finite number > 0, got {scale:g}")
     rec = read_recording_arg(cfg.recording)
-    writable_folder(metrics_folder(cfg))
+    try:
+        writable_folder(metrics_folder(cfg))
+    except CommandError as exc:
+        if cfg.out:
+            raise
+        raise CommandError(f"{exc} (the default folder beside the recording; give out=DIR)") from None
     free_outputs(metrics_folder(cfg), ["metrics.json"], cfg.overwrite)
     checked_store(cfg.tracking)
     return rec
@@ -280,12 +285,12 @@ def check_import(cfg: ImportConfig) -> None:
     import_units(cfg)
     if is_ulog(cfg):
         _ulog_axes(cfg)
-        file_stem(import_stem(cfg))
+        file_stem(import_stem(cfg), suffix=".json")
         writable_folder(cfg.out)
         checked_store(cfg.tracking)
         return
     import_axis_list(cfg, import_axes(cfg))
-    stems = [file_stem(import_stem(cfg))] + [file_stem(s, "output") for s in import_stems(cfg)]
+    stems = [file_stem(import_stem(cfg), suffix=".json")] + [file_stem(s, "output", ".json") for s in import_stems(cfg)]
     writable_folder(cfg.out)
     targets = [Path(cfg.out) / f"{stem}.{ext}" for stem in stems[1:] for ext in ("csv", "json")]
     if clash := overwritten_input(targets, [Path(cfg.csv)]):
@@ -403,7 +408,7 @@ def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
                  "px4_device_id": inst.device_id}
         for output, axis in outputs:
             field_name = output.rsplit(":", 1)[0] if ":" in output else output
-            stem = file_stem(f"{import_stem(cfg)}-{inst.topic}-{inst.instance}-{field_name}", "output")
+            stem = file_stem(f"{import_stem(cfg)}-{inst.topic}-{inst.instance}-{field_name}", "output", ".json")
             try:
                 recs[stem] = import_table(
                     inst.fields, cfg.sensor, {**columns, "output": output}, units=units, axis=axis, drop=drop,

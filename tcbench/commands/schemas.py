@@ -6,6 +6,7 @@ ConfigStore as ``<command>_schema`` so types and known keys are checked at compo
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -86,10 +87,15 @@ class ImportConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
 
 
+# the most rows tcbench diagnose takes by default: about 8 min of one core and 3 GB (tcbench.diagnose.cost)
+DIAGNOSE_MAX_ROWS = 1_000_000
+
+
 @dataclass
 class DiagnoseConfig:
     """``tcbench diagnose``: the recording, the output directory, the sensor kind for a recording
-    without a sidecar, and the model file of effects already modelled."""
+    without a sidecar, the model file of effects already modelled, and the most rows diagnosed
+    (:mod:`tcbench.diagnose.cost`)."""
 
     kind: str = "diagnose"
     recording: str = ""
@@ -97,6 +103,7 @@ class DiagnoseConfig:
     overwrite: bool = False
     sensor: str | None = None
     model: str | None = None
+    max_rows: int | None = DIAGNOSE_MAX_ROWS  # null: no limit
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
 
 
@@ -208,8 +215,27 @@ def register() -> None:
         OmegaConf.register_new_resolver("stem", lambda key, _root_: PurePath(str(OmegaConf.select(_root_, key))).stem)
 
 
+def literal(text: str) -> str:
+    """``text`` escaped so that OmegaConf reads it as it is: every ``${`` is part of the text,
+    never an interpolation (``\\${``; the backslashes before one are doubled)."""
+    return re.sub(r"(\\*)\$\{", lambda m: m.group(1) * 2 + "\\${", text)
+
+
+def _literal_values(value: Any) -> Any:
+    """Every string inside ``value`` (dicts and lists) as :func:`literal` text."""
+    if isinstance(value, str):
+        return literal(value)
+    if isinstance(value, dict):
+        return {k: _literal_values(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_literal_values(v) for v in value]
+    return value
+
+
 def as_schema(c: dict[str, Any], schema: type) -> Any:
-    """A composed config (plain dict) as the schema's dataclass, types checked."""
+    """A composed config (plain dict, already resolved) as the schema's dataclass, types checked.
+    Its values are taken as they are: a ``${...}`` left in one after the composition resolved the
+    config is text (a file named ``${HOME}.csv``), not resolved a second time."""
     from omegaconf import OmegaConf
 
-    return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(schema), c))
+    return OmegaConf.to_object(OmegaConf.merge(OmegaConf.structured(schema), _literal_values(c)))

@@ -46,6 +46,7 @@ from typing import Any
 
 import yaml
 
+from tcbench.outputs import temp_name
 from tcbench.sensors import effects as fx
 from tcbench.sensors import kinds
 from tcbench.sensors.fitted import PolynomialModel
@@ -239,7 +240,7 @@ def write_model(spec: ModelSpec, path: str | Path) -> Path:
     parse_model(data, str(path))
     text = ("# tcbench fitted model; format: tcbench/diagnose/model_file.py\n"
             + yaml.safe_dump(data, sort_keys=False, default_flow_style=None))
-    temp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
+    temp = path.with_name(temp_name(path.name, secrets.token_hex(6)))
     try:
         with open(os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), "w", encoding="utf-8") as f:
             f.write(text)

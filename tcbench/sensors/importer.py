@@ -41,6 +41,7 @@ from tcbench.sensors.recording import (
     check_sensor,
     make_recording,
     sidecar_path,
+    sidecar_present,
     standard_units,
     write_recording,
 )
@@ -100,9 +101,9 @@ def sidecar_units(path: Path, given: Mapping[str, str] | None = None) -> StatedU
     beside it (``<stem>.json`` holding a schema-v1 sidecar), by column name."""
     side = sidecar_path(path)
     stated = StatedUnits(dict(given or {}))
-    if side == path or not side.is_file():
-        return stated
     try:
+        if side == path or not sidecar_present(side):
+            return stated
         meta = _meta_from_dict(_load_json(side))
     except (RecordingError, OSError) as exc:
         problem = exc.problem if isinstance(exc, RecordingError) else (exc.strerror or str(exc))

@@ -1,9 +1,9 @@
 """Sensor recordings, schema v1: a CSV or Parquet table plus a JSON sidecar, validated on I/O.
 
-Table columns: ``time_s`` (strictly increasing), ``temperature_c`` (the sensor's thermometer),
-``input`` (applied acceleration in g, or applied rate in deg/s), ``output`` (in the kind's unit:
-an MSRA's frequency difference in Hz, a gyro's rate in deg/s, an accelerometer's g) and, for
-accelerometer kinds, an optional ``position`` (``+0g``, ``+1g``, ``-0g``, ``-1g``, or empty outside
+Table columns: ``time_s`` (strictly increasing, counted from the power-on: never negative),
+``temperature_c`` (the sensor's thermometer), ``input`` (applied acceleration in g, or applied
+rate in deg/s), ``output`` (in the kind's unit: an MSRA's frequency difference in Hz, a gyro's
+rate in deg/s, an accelerometer's g) and, for accelerometer kinds, an optional ``position`` (``+0g``, ``+1g``, ``-0g``, ``-1g``, or empty outside
 a four-position test). Other columns are rejected. The kinds are :mod:`tcbench.sensors.kinds`.
 The sidecar ``<stem>.json`` holds the sensor kind, units, sample rate, device id and a free-form
 ``extra`` object; it is optional when reading and always written. One key of ``extra`` has a
@@ -22,6 +22,7 @@ public names.
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -176,6 +177,20 @@ def sidecar_path(path: str | Path) -> Path:
     return Path(path).with_suffix(".json")
 
 
+def sidecar_present(side: Path) -> bool:
+    """True when the sidecar ``side`` is there to be read, False when there is none (it is
+    optional); a :class:`RecordingError` when something else is in its place (a folder, a
+    broken link, a device): a sidecar the user may think is read."""
+    if side.is_file():
+        return True
+    if not os.path.lexists(side):
+        return False
+    what = "a directory" if side.is_dir() else "a broken link" if side.is_symlink() and not side.exists() else \
+        "not a regular file"
+    raise RecordingError(f"is {what}, not a sidecar (the recording's sidecar is optional: remove it, or put the "
+                         "sidecar there)")
+
+
 def write_recording(rec: Recording, path: str | Path) -> Path:
     """Validate ``rec`` and write it to ``path`` (``.csv`` or ``.parquet``) plus its sidecar.
 
@@ -214,8 +229,8 @@ def read_recording(path: str | Path) -> Recording:
         _check_table(data)
     side = sidecar_path(path)
     meta = RecordingMeta()
-    if side.is_file():
-        with _in_file(str(side)):
+    with _in_file(str(side)):
+        if sidecar_present(side):
             meta = _meta_from_dict(_load_json(side))
     _check_consistency(data, meta, name, str(side))
     return Recording(data, meta)

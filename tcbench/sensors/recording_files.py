@@ -26,6 +26,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 import pyarrow.parquet as pq
 
+from tcbench.outputs import temp_name
 from tcbench.sensors.recording_schema import FORMATS, NUMERIC_COLUMNS, RecordingError, _check_columns, _normalise
 
 MAX_HEADER_BYTES = 64 * 1024  # a longer first line is no header
@@ -40,6 +41,26 @@ def _format(path: Path) -> str:
     if fmt not in FORMATS:
         raise RecordingError(f"unsupported format {path.suffix or '(no suffix)'!r}; expected .csv or .parquet")
     return fmt
+
+
+def table_rows(path: str | Path) -> int | None:
+    """The data rows of a recording's table, known without parsing it: a CSV file's lines after
+    the header (counted in pieces of :data:`CHUNK_BYTES`), a Parquet file's row count from its
+    footer. None when the file cannot tell (no table of a known format, unreadable, binary): its
+    reader then says why."""
+    path = Path(path)
+    try:
+        if _format(path) == ".parquet":
+            return int(pq.ParquetFile(path).metadata.num_rows) if path.is_file() else None
+        lines, last = 0, b"\n"
+        with path.open("rb") as f:
+            while piece := f.read(CHUNK_BYTES):
+                if b"\0" in piece:
+                    return None
+                lines, last = lines + piece.count(b"\n"), piece[-1:]
+    except (RecordingError, OSError, pa.ArrowException):
+        return None
+    return max(lines + (last != b"\n") - 1, 0)
 
 
 def _load_json(path: Path) -> Any:
@@ -357,7 +378,7 @@ def _atomic_write(writers: dict[Path, Callable[[BinaryIO], None]]) -> None:
     temps: dict[Path, Path] = {}
     try:
         for target, write in writers.items():
-            temp = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
+            temp = target.with_name(temp_name(target.name, secrets.token_hex(6)))
             temps[target] = temp
             with open(os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), "wb") as f:
                 write(f)

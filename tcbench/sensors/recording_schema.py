@@ -139,7 +139,7 @@ def _check_table(data: pd.DataFrame) -> None:
 
 def _check_clock(t_s: np.ndarray) -> None:
     """An increasing clock that a sample rate can describe: every time within
-    :data:`TIME_LIMIT_S`, and no gap longer than :data:`GAP_LIMIT` times the time the samples
+    :data:`TIME_LIMIT_S` and none negative (the clock counts from the power-on), and no gap longer than :data:`GAP_LIMIT` times the time the samples
     cover at the median step (``n * step``). A logger's bursts pass: their gaps are minutes
     between seconds of data, not years after a minute; a uniform grid over the clock then stays
     within ``GAP_LIMIT`` times the samples per gap."""
@@ -148,6 +148,10 @@ def _check_clock(t_s: np.ndarray) -> None:
         i = int(np.argmax(far))
         raise RecordingError(f"{t_s[i]:g} s is not a plausible time (beyond ±{TIME_LIMIT_S:g} s, 317 years; "
                              "ms or µs given as s?)", row=i + 1, column="time_s")
+    if t_s.size and t_s[0] < 0.0:  # the clock increases: the first time is the earliest
+        raise RecordingError(f"{t_s[0]:g} s is before the power-on: time_s counts from it (the warm-up and "
+                             "ageing of a sensor model are functions of it), so no time may be negative; "
+                             "shift the clock to start at 0 or later", row=1, column="time_s")
     if t_s.size < 3:
         return
     dt = np.diff(t_s)
