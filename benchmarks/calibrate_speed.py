@@ -150,7 +150,7 @@ def drift(seeds: int, bins: list[float]) -> list[dict[str, Any]]:
     """Held-out drift of bp and elman on the tofupilot gyro axes, on samples and on bins of each
     width in ``bins``."""
     from tcbench.compensation.calibration import LEARNERS, fit, record, residual, scores
-    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.datasets.real import tofupilot_gyro
     from tcbench.signal.branches import temperature_branches
 
     rows = []

@@ -71,7 +71,7 @@ def main() -> None:
     worst = max(r["diagnose_s"] + r["report_s"] for r in results.values())
     print(f"\nSlowest {HOURS:g} h diagnosis with its report: **{worst:.1f} s** (target < 60 s): "
           f"**{'met' if worst < 60 else 'not met'}**.\n")
-    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.datasets.real import tofupilot_gyro
 
     print("| tofupilot gyro axis | samples | diagnose (s) | found |\n|---|---:|---:|---|")
     for axis in ("x", "y", "z"):

@@ -20,7 +20,7 @@ threadpool_limits(1)  # where a plugin loaded numpy before this file
 # The real recordings the tests read, from the repository's data/real/ (tcbench.data_paths),
 # always there (tests/test_repository_data.py); imported here, after BLAS is set to one thread.
 from tcbench.data_paths import REAL_DATA  # noqa: E402
-from tcbench.diagnose.real_records import TOFUPILOT_CSV  # noqa: E402
+from tcbench.datasets.real import TOFUPILOT_CSV  # noqa: E402
 
 PAN_CSV = REAL_DATA / "pan_lsm6dsm_tvac_cooling" / "pan_lsm6dsm_tvac_cooling.csv"
 PX4_LOG = REAL_DATA / "px4_ulog_samples" / "sample_log_small.ulg"

@@ -126,7 +126,7 @@ def test_a_px4_log_imports_every_accelerometer(workdir: Path, capsys: pytest.Cap
 
 
 def test_the_tofupilot_accelerometer_imports(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from tcbench.diagnose.real_records import TOFUPILOT_CSV
+    from tcbench.datasets.real import TOFUPILOT_CSV
 
     axes = ",".join(f"imu.acc.{a}:m/s^2" for a in "xyz")
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=accel", "time=timestamp:us",
@@ -236,7 +236,7 @@ def test_the_accelerometer_is_diagnosed_and_calibrated(workdir: Path, capsys: py
 def test_true_input_of_an_axis_along_gravity(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The tofupilot z axis reads about -1 g at rest: ``true_input=-1:g`` (or the same in m/s^2)
     makes the raw row its bias, not gravity; a bad value is one line and writes nothing."""
-    from tcbench.diagnose.real_records import TOFUPILOT_CSV
+    from tcbench.datasets.real import TOFUPILOT_CSV
 
     code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=accel", "time=timestamp:us",
                        "temperature=imu.temperature:degC", "output=imu.acc.z:m/s^2", f"out={tmp_path / 'rec'}",

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 from conftest import PAN_CSV
 
-from tcbench.diagnose.real_records import tofupilot_gyro
+from tcbench.datasets.real import tofupilot_gyro
 from tcbench.signal.branches import temperature_branches
 
 

@@ -13,7 +13,7 @@ import pytest
 from conftest import PAN_CSV
 
 from tcbench.cli import main
-from tcbench.diagnose.real_records import TOFUPILOT_CSV
+from tcbench.datasets.real import TOFUPILOT_CSV
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[str]]:
@@ -171,7 +171,7 @@ def test_fitted_on_one_recording_scored_on_another(workdir: Path, capsys: pytest
     """The tofupilot gyro y cut in two recordings: fitted on the first (its cooling), scored on every
     part of the second; the cubic's scores there are those of the cubic fitted by hand."""
     from tcbench.compensation.calibration import fit, record, residual, scores
-    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.datasets.real import tofupilot_gyro
     from tcbench.sensors.recording import make_recording, write_recording
     from tcbench.signal.branches import temperature_branches
 
@@ -215,7 +215,7 @@ def test_a_short_record_is_calibrated_without_the_diagnosed_model(workdir: Path,
     """12 minutes of the tofupilot gyro: the default methods run, the model is left out with one
     line saying why (blocks 0, 2, 4 of five: 7.2 min; a diagnosis needs 20 min), and the rest are ranked
     on the held-out parts."""
-    from tcbench.diagnose.real_records import tofupilot_gyro
+    from tcbench.datasets.real import tofupilot_gyro
     from tcbench.sensors.recording import make_recording, write_recording
 
     full = tofupilot_gyro("x")

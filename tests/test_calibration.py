@@ -11,7 +11,7 @@ from tcbench.compensation.fitted_model import deterministic_output, dropped_term
 from tcbench.sensors import effects as fx
 from tcbench.sensors.fitted import PolynomialModel
 from tcbench.sensors.simulate import simulate_recording
-from tcbench.diagnose.real_records import tofupilot_gyro
+from tcbench.datasets.real import tofupilot_gyro
 from tcbench.signal.branches import temperature_branches
 
 

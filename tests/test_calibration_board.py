@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from tcbench.cli import main
-from tcbench.diagnose.real_records import TOFUPILOT_CSV
+from tcbench.datasets.real import TOFUPILOT_CSV
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[str]]:

@@ -14,7 +14,7 @@ from conftest import PAN_CSV
 from tcbench.cli import main
 from tcbench.compensation.calibration import Record, fit, record, residual, scores
 from tcbench.compensation.screening import screen
-from tcbench.diagnose.real_records import tofupilot_gyro
+from tcbench.datasets.real import tofupilot_gyro
 
 BURST = -4.4  # rad/s: the board picked up and turned at the end of the run
 

@@ -10,9 +10,9 @@ import json
 
 import pytest
 
+from tcbench.datasets.real import tofupilot_gyro
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.plan import SURROGATE
-from tcbench.diagnose.real_records import tofupilot_gyro
 from tcbench.diagnose.report import write_report
 
 TEMPERATURE_EFFECTS = {"thermal_lag", "hysteresis", "temperature_cubic", "temperature_rate"}

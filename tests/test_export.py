@@ -14,7 +14,7 @@ from conftest import PX4_LOG
 from tcbench.cli import main
 from tcbench.compensation.ardupilot import ardupilot_correction, ardupilot_parameters
 from tcbench.compensation.px4 import OffsetPolynomial, common_range, fit_offset, px4_offset, reexpanded
-from tcbench.diagnose.real_records import TOFUPILOT_CSV
+from tcbench.datasets.real import TOFUPILOT_CSV
 from tcbench.sensors.recording import read_recording
 
 AXES = "xyz"

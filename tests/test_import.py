@@ -124,7 +124,7 @@ def test_any_unit_pint_knows(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 def test_the_tofupilot_chamber_cycle_imports_as_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The real tab-separated IMU log, byte for byte as upstream (PROVENANCE.md: a microsecond
     clock, rad/s): imported with one command, the values tcbench's own reader of it gives."""
-    from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
+    from tcbench.datasets.real import TOFUPILOT_CSV, tofupilot_gyro
 
     code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
                          "temperature=imu.temperature:degC", "output=imu.gyro.y:rad/s", f"out={tmp_path / 'rec'}",
@@ -144,7 +144,7 @@ def test_several_axes_in_one_command(workdir: Path, capsys: pytest.CaptureFixtur
     recording per axis sharing the clock and temperature, one MLflow run naming them all."""
     import mlflow
 
-    from tcbench.diagnose.real_records import TOFUPILOT_CSV
+    from tcbench.datasets.real import TOFUPILOT_CSV
 
     axes = ",".join(f"imu.gyro.{a}:rad/s" for a in "xyz")
     code, out, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset, px4_offset, px4_parameters, write_parameters
-from tcbench.diagnose.real_records import tofupilot_gyro
+from tcbench.datasets.real import tofupilot_gyro
 
 
 @pytest.fixture(scope="module")

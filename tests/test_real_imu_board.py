@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from tcbench.cli import main
-from tcbench.diagnose.real_records import TOFUPILOT_CSV
+from tcbench.datasets.real import TOFUPILOT_CSV
 
 SUMMARISE = Path(__file__).resolve().parents[1] / "experiments" / "real-imu" / "summarise.py"
 

@@ -10,7 +10,7 @@ import pytest
 from conftest import REAL_FILES
 
 from tcbench.data_paths import REAL_DATA, real_file
-from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
+from tcbench.datasets.real import TOFUPILOT_CSV, tofupilot_gyro
 from tcbench.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]

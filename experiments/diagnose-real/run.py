@@ -3,7 +3,7 @@ physics-agnostic reference (issue 23, item 6), in one command.
 
 Records (PROVENANCE.md beside each under the repository's ``data/real/``):
 - ``tofupilot``: the 70.7-min chamber cycle, -17.6 -> 74 -> 35 degC at about 2 Hz
-  (:func:`tcbench.diagnose.real_records.tofupilot_gyro`);
+  (:func:`tcbench.datasets.real.tofupilot_gyro`);
 - ``pan_lsm6dsm``: the 2-h thermal-vacuum cooling run, 25 bursts of 5 s at about 50 Hz
   (``pan_lsm6dsm.convert``).
 
@@ -27,9 +27,9 @@ from pathlib import Path
 from pan_lsm6dsm import DATA as PAN_DATA
 from pan_lsm6dsm import convert as pan_gyro
 
+from tcbench.datasets.real import TOFUPILOT_CSV, tofupilot_gyro
 from tcbench.diagnose.diagnosis import REFERENCE_RATIO, Diagnosis, diagnose
 from tcbench.diagnose.markdown import format_where
-from tcbench.diagnose.real_records import TOFUPILOT_CSV, tofupilot_gyro
 from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording
 

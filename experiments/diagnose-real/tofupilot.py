@@ -2,7 +2,7 @@
 
 ``data/real/tofupilot_imu_chamber/imu_raw_data.csv`` (PROVENANCE.md there): a static
 IMU cooled to -17.6 degC, heated to 74 degC and cooled to 35 degC in 70.7 min at about 2 Hz.
-Each axis is converted by :func:`tcbench.diagnose.real_records.tofupilot_gyro` (tab-separated,
+Each axis is converted by :func:`tcbench.datasets.real.tofupilot_gyro` (tab-separated,
 us to s, rad/s to deg/s, first sample dropped), diagnosed, and its report written to
 ``--out/tofupilot/{x,y,z}/``; the per-axis rows of ``run.py``'s summary are printed. ``run.py``
 runs this record and PAN LSM6DSM in one command.
