@@ -10,7 +10,7 @@ import mlflow
 import pytest
 
 from tcbench.cli import main
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.sensors.recording import write_recording
 
 SHORT_GYRO = ["sensor=gyro", "protocol=static", "protocol_params.duration_s=600", "metrics=false"]

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tcbench.cli import main
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.crossval import block_folds, fit_cv
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.signals import (

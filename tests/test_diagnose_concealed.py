@@ -1,4 +1,4 @@
-"""Recordings with one effect hidden under the noise (tcbench.diagnose.concealed)."""
+"""Recordings with one effect hidden under the noise (tcbench.datasets.concealed)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tcbench.diagnose.concealed import (
+from tcbench.datasets.concealed import (
     EFFECTS_BY_SENSOR,
     Concealed,
     _build,

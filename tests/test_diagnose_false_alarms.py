@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tcbench.datasets.controls import Form, bursts_for, control_recording
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.forms import Form, bursts_for, control_recording
 from tcbench.diagnose.signals import DiagnosisDataError, fitted_window_s, savgol
 
 DEV_SEED = 44_900_000  # the development base of experiments/diagnose-concealed/false_alarms.py

@@ -21,8 +21,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.attribute import CONFUSABLE
-from tcbench.diagnose.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import Diagnosis, Series, diagnose
 from tcbench.diagnose.explain import explain
 from tcbench.diagnose.findings import SHAPES, check_finding

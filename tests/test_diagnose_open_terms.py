@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tcbench.diagnose.concealed import concealed_recording, minimal_columns, unexplained
+from tcbench.datasets.concealed import concealed_recording, minimal_columns, unexplained
 from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.discover import _testable

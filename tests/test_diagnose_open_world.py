@@ -1,4 +1,5 @@
-"""Open-world recordings (tcbench.diagnose.open_world): truth, sizing and the scoring rules."""
+"""Open-world recordings (tcbench.datasets.open_world): truth, sizing and the scoring rules
+(tcbench.datasets.open_world_scoring)."""
 
 from __future__ import annotations
 
@@ -7,16 +8,14 @@ import pandas as pd
 import pytest
 from scipy.signal import lfilter
 
-from tcbench.diagnose.open_world import (
+from tcbench.datasets.open_world import (
     ADDITIVE,
     KINDS,
     SHAPE,
     OpenWorld,
     open_world_recording,
-    score,
-    time_tolerance_s,
-    where_matches,
 )
+from tcbench.datasets.open_world_scoring import score, time_tolerance_s, where_matches
 from tcbench.sensors.recording import Recording
 
 SEED = 40_900_123  # development seeds (see experiments/diagnose-concealed/README.md)

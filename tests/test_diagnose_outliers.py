@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tcbench.diagnose.concealed import concealed_profile, concealed_recording
+from tcbench.datasets.concealed import concealed_profile, concealed_recording
 from tcbench.diagnose import diagnosis as dg
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.markdown import render_markdown

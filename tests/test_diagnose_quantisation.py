@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from tcbench.cli import main
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose import nonmean as nm
-from tcbench.diagnose.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model
 from tcbench.diagnose.quantisation import (

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
 from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.plots import plot_allan, plot_evidence, write_plots

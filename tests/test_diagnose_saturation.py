@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, to_sensor_model
 from tcbench.diagnose.report import write_report

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from tcbench.cli import main
-from tcbench.diagnose.concealed import concealed_recording
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.crossval import block_folds
 from tcbench.diagnose.design import Designer
 from tcbench.diagnose.detectors import why_no_bumps, why_no_lines, why_no_steps

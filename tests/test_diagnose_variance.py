@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tcbench.diagnose.concealed import concealed_profile, concealed_recording
+from tcbench.datasets.concealed import concealed_profile, concealed_recording
 from tcbench.diagnose.design import Designer, Model
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, read_model, to_sensor_model

@@ -16,8 +16,8 @@ import time
 import numpy as np
 from joblib import Parallel, delayed
 
+from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.attribute import DETECTION_THRESHOLD, WALD_THRESHOLD
-from tcbench.diagnose.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 
 

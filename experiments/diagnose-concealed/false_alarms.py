@@ -1,10 +1,10 @@
 """False alarms of ``tcbench diagnose`` on controls of every form: minutes to days, 0.5-100 Hz,
 continuous and in bursts.
 
-Each control is the minimal model plus white noise (:func:`tcbench.diagnose.forms.control_recording`:
+Each control is the minimal model plus white noise (:func:`tcbench.datasets.controls.control_recording`:
 the open-world controls' staircase, device and thermometer, sized to the record's length and
 sampled at its rate), so any finding in ``report.json`` ``effects`` is a false alarm (the rule of
-:func:`tcbench.diagnose.open_world.score` for a control). A diagnosis that raises is a crash,
+:func:`tcbench.datasets.open_world_scoring.score` for a control). A diagnosis that raises is a crash,
 except the documented refusal (``DiagnosisDataError``) of a record shorter than the diagnosis's
 minimum (30 min, 200 samples), which is counted as ``refused``. Writes ``false_alarms.md`` and
 ``false_alarms.csv``.
@@ -26,8 +26,8 @@ from typing import Any
 import pandas as pd
 from joblib import Parallel, delayed
 
+from tcbench.datasets.controls import Form, bursts_for, control_recording
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.forms import Form, bursts_for, control_recording
 from tcbench.diagnose.signals import DiagnosisDataError
 
 PROOF_SEED = 45_300_000  # 45 000 000 + i was the first proof run (README), before the thermometer window rule
@@ -118,7 +118,7 @@ def summary(df: pd.DataFrame, wall_s: float, seeds: str, proof: bool, workers: i
     lines = [
         "# tcbench diagnose: false alarms on controls of every form",
         "",
-        f"Controls with nothing hidden (minimal model + white noise; `tcbench.diagnose.forms`), "
+        f"Controls with nothing hidden (minimal model + white noise; `tcbench.datasets.controls`), "
         f"{len(df)} records, seeds {seeds} ({'proof seeds, never used while tuning' if proof else 'development seeds'}); "
         f"wall time {wall_s / 60:.1f} min on {workers} worker(s). A control is a false alarm when `report.json` names "
         f"any effect (the open-world rule). Records shorter than the diagnosis's 30-min minimum are refused "

@@ -1,12 +1,12 @@
 """Proof, open world: can ``tcbench diagnose`` characterise a mismatch outside the effect library?
 
-Generates recordings (``tcbench.diagnose.open_world``) in which one structure no library effect
+Generates recordings (``tcbench.datasets.open_world``) in which one structure no library effect
 makes (a step, a gap with a restart, a spectral line, a slow oscillation, a compressor switching
 in the cold, a transient, a bump in temperature, a second thermal node, noise growing with
 temperature, saturation, quantisation of the output or of the thermometer, spikes) is hidden so that what the minimal model cannot absorb
 is 0.5-1 of the per-sample noise, plus controls with nothing hidden; diagnoses each with
 ``tcbench.diagnose.diagnosis.diagnose`` and scores ``Diagnosis.to_json()["effects"]`` against the
-truth by fixed rules (``tcbench.diagnose.open_world.score``, README.md). Writes, to ``--out``:
+truth by fixed rules (``tcbench.datasets.open_world_scoring.score``, README.md). Writes, to ``--out``:
 ``open_world.csv`` (one row per recording), ``open_world.md`` (targets, per kind, worst cases)
 and ``open_world.png`` (kind x shapes stated); ``--quick`` writes ``open_world_quick.*`` instead.
 
@@ -35,9 +35,10 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
+from tcbench.datasets.open_world import KINDS, SENSORS, SHAPE, open_world_recording
+from tcbench.datasets.open_world_scoring import score
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import SHAPES
-from tcbench.diagnose.open_world import KINDS, SENSORS, SHAPE, open_world_recording, score
 
 FIRST_SEED = 44_000_000  # the proof's base: 41 000 000 was the first proof, 43 000 000 the second, before duty_cycle (README)
 QUICK_SEED = 40_900_000

@@ -1,6 +1,6 @@
 """Proof on concealed effects: can ``tcbench diagnose`` name an effect hidden under the noise?
 
-Generates recordings (``tcbench.diagnose.concealed``) in which one effect of the library, with
+Generates recordings (``tcbench.datasets.concealed``) in which one effect of the library, with
 random parameters, is hidden so that what the minimal model cannot absorb is 0.3-0.7 of the
 per-sample noise, plus controls with nothing hidden; diagnoses each and writes, to ``--out``:
 ``results.csv`` (one row per recording), ``confusion.md`` / ``confusion.png`` (truth x named),
@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 from joblib import Parallel, delayed
 
-from tcbench.diagnose.concealed import EFFECTS_BY_SENSOR, concealed_recording
+from tcbench.datasets.concealed import EFFECTS_BY_SENSOR, concealed_recording
 from tcbench.diagnose.design import DETERMINISTIC
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.report import write_report

@@ -316,7 +316,7 @@ SPECS: dict[str, CommandHelp] = {
             "budget": "evaluations of IFA's weight search per training (the paper's search: 510)",
             "epochs": "BP gradient-descent epochs per training",
             "diagnose_sensor": "msra or gyro: the simulated recording diagnosed",
-            "diagnose_effect": "the effect hidden in it (an effect of tcbench.diagnose.concealed, e.g. hysteresis)",
+            "diagnose_effect": "the effect hidden in it (an effect of tcbench.datasets.concealed, e.g. hysteresis)",
             "diagnose_seed": "its draw",
             "out": "output folder (leaderboard/, diagnosis/, recordings/); a quickstart run again replaces the "
                    "files the earlier one wrote there and says which",

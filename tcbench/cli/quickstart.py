@@ -5,7 +5,7 @@
    (pooled and within runs), the lag-aware polynomial and the oracle (the physical limit) — every job through the normal runner, one MLflow run each —
    then a small leaderboard.
 2. Diagnosis: a simulated MSRA recording with one effect hidden under the noise
-   (:func:`~tcbench.diagnose.concealed.concealed_recording`), diagnosed as ``tcbench diagnose``
+   (:func:`~tcbench.datasets.concealed.concealed_recording`), diagnosed as ``tcbench diagnose``
    does; the report and plots are written and logged as an MLflow run.
 
 Its parameters are :class:`tcbench.commands.schemas.QuickstartConfig` (``conf/quickstart.yaml``);
@@ -74,7 +74,7 @@ def _print_table(header: list[str], rows: list[list[Any]]) -> None:
 def check(cfg: QuickstartConfig) -> None:
     """The quickstart's own parameters, checked before anything runs (the compensation sweep's
     are checked by ``tcbench run``): ConfigError with one line."""
-    from tcbench.diagnose.concealed import EFFECTS_BY_SENSOR
+    from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
 
     for key in ("seeds", "budget", "epochs"):
         if getattr(cfg, key) < 1:
@@ -227,7 +227,7 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
     from tcbench.tracking import store as tracking
     from tcbench.commands.schemas import DiagnoseConfig
     from tcbench.runner.config import as_dict
-    from tcbench.diagnose.concealed import concealed_recording
+    from tcbench.datasets.concealed import concealed_recording
     from tcbench.runner.job import JobFailure, run_job
     from tcbench.sensors.recording import write_recording
 

@@ -1,9 +1,9 @@
 """Control recordings (nothing hidden) of any form: length, rate, continuous or in bursts.
 
-The open-world controls (:func:`tcbench.diagnose.open_world.open_world_recording` with no kind)
+The open-world controls (:func:`tcbench.datasets.open_world.open_world_recording` with no kind)
 are 8-12 h at 1 Hz. :func:`control_recording` draws the same kind of control at another form:
-the heat-and-cool staircase of :func:`~tcbench.diagnose.concealed.concealed_profile` sized to
-the length (:meth:`~tcbench.diagnose.concealed.Sizing.for_duration`), sampled at ``rate_hz``;
+the heat-and-cool staircase of :func:`~tcbench.datasets.concealed.concealed_profile` sized to
+the length (:meth:`~tcbench.datasets.concealed.Sizing.for_duration`), sampled at ``rate_hz``;
 the device with every effect removed, its white noise density times a log-uniform factor 1-3
 (so the per-sample sigma grows as sqrt(rate)); the thermometer as in the concealed set. In
 bursts, only ``burst_s`` of every ``period_s`` is kept (the logger sleeps the rest), starting
@@ -17,14 +17,14 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from tcbench.diagnose.concealed import (
+from tcbench.datasets.concealed import (
     NOISE_FACTOR,
     THERMOMETER_NOISE_C,
     THERMOMETER_STEP_C,
     Sizing,
     concealed_profile,
 )
-from tcbench.diagnose.open_world.recordings import device_without_effects
+from tcbench.datasets.open_world import device_without_effects
 from tcbench.sensors import noise
 from tcbench.sensors.recording import Recording, make_recording
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.open_world.recordings import OpenWorld
+from tcbench.datasets.open_world import OpenWorld
 
 TIME_TOLERANCE_S = 600.0
 TIME_TOLERANCE_SPAN = 0.02

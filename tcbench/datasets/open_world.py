@@ -1,6 +1,6 @@
 """Recordings with a mismatch hidden that lies outside the effect library (open world).
 
-Each recording is a concealed recording (:mod:`tcbench.diagnose.concealed`: the same 1 Hz,
+Each recording is a concealed recording (:mod:`tcbench.datasets.concealed`: the same 1 Hz,
 8-12 h heat-and-cool staircase, the same device with every effect removed, so that without
 the hidden mismatch it *is* the minimal model plus white noise) with one structure of
 PHYSICS.md §8 that no library effect makes. The kinds (:data:`KINDS`), with the ``shape`` and
@@ -30,7 +30,7 @@ PHYSICS.md §8 that no library effect makes. The kinds (:data:`KINDS`), with the
 Sizing, "what the starting model cannot absorb is 0.5-1 sigma per sample":
 
 - additive kinds (:data:`ADDITIVE`): the noise-free contribution ``d`` is projected out of the
-  minimal model's columns (:func:`~tcbench.diagnose.concealed.minimal_columns` of the package
+  minimal model's columns (:func:`~tcbench.datasets.concealed.minimal_columns` of the package
   temperature and the acceleration, on the samples kept), and its amplitude is set so that the
   RMS of what is left is ``rho * sigma``, ``rho ~ U(0.5, 1)``, with the white sigma the device's
   own times a log-uniform factor in 1-3 (as for the concealed set's free-amplitude effects);
@@ -62,7 +62,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.concealed import (
+from tcbench.datasets.concealed import (
     NOISE_FACTOR,
     SAMPLE_RATE_HZ,
     THERMOMETER_NOISE_C,
