@@ -73,9 +73,9 @@ from tcbench.datasets.concealed import (
 )
 from tcbench.sensors import noise
 from tcbench.sensors.devices import unit
+from tcbench.sensors.effects import BiasStep, Effect, Periodic, SecondNode, Signals, TemperatureBump, Transient
 from tcbench.sensors.models import MSRA, SensorModel
 from tcbench.sensors.recording import Recording, make_recording
-from tcbench.sensors.thermal import first_order_lag
 
 SHAPE: dict[str, str] = {
     "step": "step",
@@ -188,17 +188,27 @@ def _at(t_s: np.ndarray, frac: tuple[float, float], rng: np.random.Generator) ->
     return int(np.searchsorted(t_s, target))
 
 
+def _term(effect: Effect, draw: _Draw, rng: np.random.Generator) -> np.ndarray:
+    """The output term of a library effect (:mod:`tcbench.sensors.effects`) on the draw's clock,
+    with the package temperature as the die's."""
+    zeros = np.zeros_like(draw.t_s)
+    s = Signals(t_s=draw.t_s, dt_s=1.0 / SAMPLE_RATE_HZ, temp_meas_c=draw.temp_c, temp_die_c=draw.temp_c,
+                temp_rate_c_per_s=zeros, accel_g=zeros, cross_g=zeros, rate_dps=zeros)
+    return effect.term(s, rng)
+
+
 def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarray, str, float]:
     """Unit-amplitude contribution of an additive ``kind`` (sign included), the name of its
     amplitude parameter and the sign; fills ``draw.params``, ``draw.where`` and (for a gap)
-    ``draw.keep``."""
+    ``draw.keep``. Every kind but ``compressor_cycling`` (gated by the temperature) is the term
+    of the library effect of the same form."""
     t, temp = draw.t_s, draw.temp_c
     sign = float(rng.choice([-1.0, 1.0]))
     p, w = draw.params, draw.where
     if kind == "step":
         t0 = float(t[_at(t, STEP_AT, rng)])
         p["time_s"], w["time_s"] = t0, t0
-        return sign * (t >= t0), "jump", sign
+        return _term(BiasStep(time_s=t0, size=sign), draw, rng), "jump", sign
     if kind == "restart_after_gap":
         start = float(t[_at(t, GAP_AT, rng)])
         gap_s = float(np.round(rng.uniform(*GAP_S)))
@@ -206,13 +216,13 @@ def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarr
         after = float(t[np.searchsorted(t, start + gap_s)])
         p |= {"gap_start_s": start, "gap_s": gap_s, "time_s": after}
         w["time_s"] = after
-        return sign * (t >= after), "jump", sign
+        return _term(BiasStep(time_s=after, size=sign), draw, rng), "jump", sign
     if kind in ("periodic", "slow_oscillation"):
         period = float(rng.uniform(*(PERIOD_S if kind == "periodic" else SLOW_PERIOD_S)))
         phase = float(rng.uniform(0.0, 2.0 * np.pi))
         p |= {"period_s": period, "phase_rad": phase}
         w["period_s"] = period
-        return sign * np.sin(2.0 * np.pi * t / period + phase), "amplitude", sign
+        return _term(Periodic(period_s=period, amplitude=sign, phase_rad=phase), draw, rng), "amplitude", sign
     if kind == "compressor_cycling":
         period = float(rng.uniform(*PERIOD_S))
         duty = float(rng.uniform(*DUTY))
@@ -227,18 +237,18 @@ def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarr
         tau = float(rng.uniform(*TRANSIENT_TAU_S))
         p |= {"time_s": t0, "tau_s": tau}
         w["time_s"] = t0
-        return sign * np.where(t >= t0, np.exp(-np.maximum(t - t0, 0.0) / tau), 0.0), "jump", sign
+        return _term(Transient(time_s=t0, tau_s=tau, amplitude=sign), draw, rng), "jump", sign
     if kind == "temperature_bump":
         width = float(rng.uniform(*BUMP_WIDTH_C))
         lo, hi = float(temp.min()), float(temp.max())
         centre = float(rng.uniform(lo + width, hi - width))
         p |= {"centre_c": centre, "width_c": width}
         w["temperature_c"] = [centre - 2.0 * width, centre + 2.0 * width]
-        return sign * np.exp(-0.5 * ((temp - centre) / width) ** 2), "amplitude", sign
+        return _term(TemperatureBump(centre_c=centre, width_c=width, amplitude=sign), draw, rng), "amplitude", sign
     if kind == "second_node":
         tau = float(rng.uniform(*SECOND_NODE_TAU_S))
         p["tau_s"] = tau
-        return sign * (first_order_lag(temp, 1.0 / SAMPLE_RATE_HZ, tau) - temp), "coef_per_c", sign
+        return _term(SecondNode(tau_s=tau, coef_per_c=sign), draw, rng), "coef_per_c", sign
     raise ValueError(f"not an additive kind: {kind!r}")  # pragma: no cover
 
 
