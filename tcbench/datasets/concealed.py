@@ -118,6 +118,19 @@ def _check_sensor(sensor: str) -> None:
         raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(EFFECTS_BY_SENSOR)}")
 
 
+def device_without_effects(sensor: str, device_seed: int, rate_hz: float = SAMPLE_RATE_HZ,
+                           ) -> tuple[SensorModel, float]:
+    """The unit with every effect removed (MSRA misalignment zero) and its white sigma per
+    sample at ``rate_hz`` (density times sqrt(rate))."""
+    device = unit(sensor, device_seed).model
+    white_fx = device.effect("white_noise")
+    sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(rate_hz)
+    model = dataclasses.replace(device, effects=())
+    if isinstance(model, MSRA):
+        model = dataclasses.replace(model, misalignment_rad=0.0)
+    return model, float(sigma)
+
+
 @dataclass(frozen=True)
 class Sizing:
     """The time and temperature scales of a staircase programme (defaults: the 8-12 h, 1 Hz set).
@@ -264,17 +277,12 @@ def _build(sensor: str, effect: str | None, seed: int) -> _Parts:
         np.random.default_rng(s) for s in streams)
     profile = concealed_profile(sensor, r_profile)
     device_seed = int(r_device.integers(0, 10_000))
-    device = unit(sensor, device_seed).model
-    white_fx = device.effect("white_noise")
-    default_sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(SAMPLE_RATE_HZ)
-    model = dataclasses.replace(device, effects=())
-    if isinstance(model, MSRA):
-        model = dataclasses.replace(model, misalignment_rad=0.0)
+    model, default_sigma = device_without_effects(sensor, device_seed)
     base = model.simulate(profile, r_effect)
     n = profile.t_s.size
     if effect is None:
         params: dict[str, float] = {}
-        ratio, sigma, hidden = 0.0, float(default_sigma), np.zeros(n)
+        ratio, sigma, hidden = 0.0, default_sigma, np.zeros(n)
     else:
         params = _shape_params(effect, r_params)
         hidden = model.with_effects({effect: params}).simulate(profile, r_effect) - base
@@ -283,7 +291,7 @@ def _build(sensor: str, effect: str | None, seed: int) -> _Parts:
         ratio = float(r_scale.uniform(*RATIO))
         if effect in _AMPLITUDE:
             factor = float(np.exp(r_scale.uniform(*np.log(NOISE_FACTOR))))
-            sigma = float(default_sigma) * factor
+            sigma = default_sigma * factor
             scale = ratio * sigma / left
             params[_AMPLITUDE[effect]] *= scale
             hidden = hidden * scale

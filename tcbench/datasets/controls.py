@@ -23,8 +23,8 @@ from tcbench.datasets.concealed import (
     THERMOMETER_STEP_C,
     Sizing,
     concealed_profile,
+    device_without_effects,
 )
-from tcbench.datasets.open_world import device_without_effects
 from tcbench.sensors import noise
 from tcbench.sensors.recording import Recording, make_recording
 

@@ -68,13 +68,20 @@ from tcbench.datasets.concealed import (
     THERMOMETER_NOISE_C,
     THERMOMETER_STEP_C,
     concealed_profile,
+    device_without_effects,
     minimal_columns,
     unexplained,
 )
 from tcbench.sensors import noise
-from tcbench.sensors.devices import unit
-from tcbench.sensors.effects import BiasStep, Effect, Periodic, SecondNode, Signals, TemperatureBump, Transient
-from tcbench.sensors.models import MSRA, SensorModel
+from tcbench.sensors.effects import (
+    BiasStep,
+    Effect,
+    Periodic,
+    SecondNode,
+    Signals,
+    TemperatureBump,
+    Transient,
+)
 from tcbench.sensors.recording import Recording, make_recording
 
 SHAPE: dict[str, str] = {
@@ -158,19 +165,6 @@ class _Draw:
 
 def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x * x)))
-
-
-def device_without_effects(sensor: str, device_seed: int, rate_hz: float = SAMPLE_RATE_HZ,
-                           ) -> tuple[SensorModel, float]:
-    """The unit with every effect removed (MSRA misalignment zero) and its white sigma per
-    sample at ``rate_hz`` (density times sqrt(rate))."""
-    device = unit(sensor, device_seed).model
-    white_fx = device.effect("white_noise")
-    sigma = (white_fx.params()["density"] if white_fx else 0.0) * np.sqrt(rate_hz)
-    model = dataclasses.replace(device, effects=())
-    if isinstance(model, MSRA):
-        model = dataclasses.replace(model, misalignment_rad=0.0)
-    return model, float(sigma)
 
 
 def _left(d: np.ndarray, draw: _Draw, temp_c: np.ndarray | None = None) -> float:
