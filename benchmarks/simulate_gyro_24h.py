@@ -80,7 +80,7 @@ from common import (
 )
 
 from tcbench.sensors import noise
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import profile_input, unit
 from tcbench.sensors.protocols import gyro_static
 from tcbench.sensors.recording import make_recording
 from tcbench.sensors.simulate import (
@@ -183,7 +183,7 @@ def run_recording(cfg: Config, state: tuple[Any, np.ndarray]) -> Any:
     reading += profile.temp_c
     device = unit("gyro", DEVICE_SEED)
     return make_recording(
-        profile.t_s, noise.quantise(reading, THERMOMETER_STEP_C, in_place=True), profile.input, output,
+        profile.t_s, noise.quantise(reading, THERMOMETER_STEP_C, in_place=True), profile_input(profile), output,
         sensor="gyro", sample_rate_hz=profile.sample_rate_hz, device_id=device.device_id,
         position=profile.position, extra={"device_draws": device.draws},
     )

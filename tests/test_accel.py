@@ -16,7 +16,7 @@ from conftest import PX4_LOG
 from tcbench.cli import main
 from tcbench.metrics.report import analyse
 from tcbench.sensors import kinds
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import unit
 from tcbench.sensors.recording import read_recording, write_recording
 from tcbench.sensors.simulate import simulate_recording
 

@@ -15,7 +15,7 @@ from tcbench.datasets.concealed import (
     concealed_profile,
     concealed_recording,
 )
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import profile_input, unit
 from tcbench.sensors.recording import standard_units
 from tcbench.sensors.thermal import Segment, segment_index
 
@@ -128,7 +128,7 @@ def test_control_has_no_effect(sensor: str) -> None:
     assert _left_rms(rec.output - parts.base, parts.profile.temp_c, accel) == pytest.approx(truth.white_sigma, rel=0.03)
     assert rec.meta.sensor == sensor and rec.meta.units == standard_units(sensor)
     assert rec.meta.sample_rate_hz == 1.0 and rec.meta.device_id == f"concealed-{sensor}-9"
-    assert np.array_equal(rec.input, parts.profile.input)
+    assert np.array_equal(rec.input, profile_input(parts.profile))
 
 
 @pytest.mark.parametrize(

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tcbench.sensors.runs import Placement, placement, power_on
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import unit
 from tcbench.sensors.simulate import simulate_recording
 from tcbench.sensors.timing import Timing, running
 from tcbench.sensors.truth import simulate_truth

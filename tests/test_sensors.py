@@ -6,8 +6,11 @@ import numpy as np
 import pytest
 
 from tcbench.sensors import effects as fx
-from tcbench.sensors import protocols as P
-from tcbench.sensors.devices import gyro_unit, msra_unit, unit
+from tcbench.sensors.kinds import gyro as G
+from tcbench.sensors.kinds import msra as M
+from tcbench.sensors.kinds import unit
+from tcbench.sensors.kinds.gyro import gyro_unit
+from tcbench.sensors.kinds.msra import msra_unit
 from tcbench.sensors.models import DPH, MSRA, Gyro
 from tcbench.sensors.thermal import Segment, first_order_lag, segment_index, setpoint
 
@@ -29,7 +32,7 @@ def test_setpoint_ramps_at_the_rate_limit() -> None:
 
 
 def test_fulltemp_protocol_shape() -> None:
-    prof = P.msra_fulltemp()
+    prof = M.msra_fulltemp()
     labels = prof.position
     assert set(labels) == {"", "+0g", "+1g", "-0g", "-1g"}
     assert np.count_nonzero(labels == "+1g") == 6 * 40
@@ -43,7 +46,7 @@ def test_fulltemp_protocol_shape() -> None:
 
 
 def test_gyro_oven_protocol_follows_seed_001() -> None:
-    prof = P.gyro_oven()
+    prof = G.gyro_oven()
     hours = prof.t_s / 3600
     assert prof.sample_rate_hz == 10.0
     assert prof.temp_c[hours < 1].max() == pytest.approx(25.0, abs=0.01)
@@ -53,7 +56,7 @@ def test_gyro_oven_protocol_follows_seed_001() -> None:
 
 
 def test_thermal_lag_delays_the_die() -> None:
-    prof = P.gyro_oven()
+    prof = G.gyro_oven()
     s = fx.Signals(prof.t_s, prof.dt_s, prof.temp_c, prof.temp_c, np.gradient(prof.temp_c, prof.dt_s),
                    prof.accel_g, prof.cross_g, prof.rate_dps)
     die = fx.ThermalLag(480.0).die_temperature(s)
@@ -132,7 +135,7 @@ def test_devices_differ_and_repeat() -> None:
 
 def test_simulation_is_seeded() -> None:
     model = gyro_unit(0).model
-    prof = P.gyro_static(duration_s=600.0, sample_rate_hz=10.0)
+    prof = G.gyro_static(duration_s=600.0, sample_rate_hz=10.0)
     a = model.simulate(prof, np.random.default_rng(4))
     b = model.simulate(prof, np.random.default_rng(4))
     c = model.simulate(prof, np.random.default_rng(5))
@@ -142,13 +145,13 @@ def test_simulation_is_seeded() -> None:
 
 def test_wrong_protocol_for_sensor() -> None:
     with pytest.raises(ValueError, match="is for a gyro, not a msra"):
-        msra_unit(0).model.simulate(P.gyro_static(60.0, sample_rate_hz=1.0), np.random.default_rng(0))
+        msra_unit(0).model.simulate(G.gyro_static(60.0, sample_rate_hz=1.0), np.random.default_rng(0))
 
 
 def test_removing_effects() -> None:
     model = gyro_unit(0).model
     quiet = model.without("white_noise", "bias_instability", "quantisation")
     assert quiet.effect("white_noise") is None and quiet.effect("thermal_lag") is not None
-    prof = P.gyro_static(duration_s=100.0, sample_rate_hz=10.0)
+    prof = G.gyro_static(duration_s=100.0, sample_rate_hz=10.0)
     y = quiet.simulate(prof, np.random.default_rng(0))
     assert np.ptp(y) == pytest.approx(0.0, abs=1e-12)  # constant temperature, no noise

@@ -7,7 +7,7 @@ import pytest
 
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.metrics import accelerometer as acc
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import unit
 from tcbench.sensors.noise import FLICKER_SIGMA_PER_B
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.simulate import simulate_recording

@@ -21,8 +21,10 @@ from tcbench.metrics import gyro
 from tcbench.metrics.report import analyse
 from tcbench.plots import recording_overview
 from tcbench.sensors import runs, timing
-from tcbench.sensors.devices import AGEING_DAYS, MSRA_SLOPE_REPEAT, unit
-from tcbench.sensors.protocols import gyro_oven
+from tcbench.sensors.devices import AGEING_DAYS
+from tcbench.sensors.kinds import unit
+from tcbench.sensors.kinds.msra import SLOPE_REPEAT as MSRA_SLOPE_REPEAT
+from tcbench.sensors.kinds.gyro import gyro_oven
 from tcbench.sensors.simulate import simulate_recording
 
 HERE = Path(__file__).resolve().parent
@@ -218,7 +220,7 @@ first being the run in the table above, so no two devices share a run seed). The
 runs the same seeds with `power_on=d`: every run replays the first run's power-on, and only the
 sensor noise and the room's ambient wander (drawn with the profile) differ.
 
-What a power-on draws (`runs.power_on`, `devices.msra_power_on`, `timing.draw_timing`):
+What a power-on draws (`runs.power_on`, `kinds.msra.msra_power_on`, `timing.draw_timing`):
 
 - **turn-on** (MSRA): bias 100 µg (std; resonator 1's frequency moved), scale factor 50 ppm (std), the
   bias temperature slope {slope:.1%} (relative std), and ageing of 2 µg per day (std of the rate) over a

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors import noise
-from tcbench.sensors.devices import unit
+from tcbench.sensors.kinds import profile_input, unit
 from tcbench.sensors.models import MSRA, SensorModel
 from tcbench.sensors.protocols import Chamber, Profile, _from_segments
 from tcbench.sensors.recording import Recording, make_recording
@@ -319,7 +319,7 @@ def concealed_recording(sensor: str, effect: str | None, seed: int) -> tuple[Rec
         "profile": dict(profile.info),
     }
     rec = make_recording(
-        profile.t_s, parts.thermometer_c, profile.input, parts.base + parts.hidden + parts.white,
+        profile.t_s, parts.thermometer_c, profile_input(profile), parts.base + parts.hidden + parts.white,
         sensor=sensor, sample_rate_hz=SAMPLE_RATE_HZ, device_id=f"concealed-{sensor}-{truth.seed}",
         extra=extra,
     )

@@ -27,6 +27,7 @@ from tcbench.datasets.concealed import (
 )
 from tcbench.sensors import noise
 from tcbench.sensors.recording import Recording, make_recording
+from tcbench.sensors.kinds import profile_input
 
 
 @dataclass(frozen=True)
@@ -85,6 +86,6 @@ def control_recording(sensor: str, form: Form, seed: int) -> tuple[Recording, di
     truth = {"white_sigma": float(sigma), "span_s": float(t_kept[-1] - t_kept[0]), "seed": float(seed),
              "samples": float(keep.sum())}
     extra = {"form": asdict(form), "control": truth, "device_seed": device_seed, "profile": dict(profile.info)}
-    rec = make_recording(t_kept, thermometer[keep], profile.input[keep], output[keep], sensor=sensor,
+    rec = make_recording(t_kept, thermometer[keep], profile_input(profile)[keep], output[keep], sensor=sensor,
                          sample_rate_hz=form.rate_hz, device_id=f"form-control-{sensor}-{seed}", extra=extra)
     return rec, truth

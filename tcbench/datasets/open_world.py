@@ -83,6 +83,7 @@ from tcbench.sensors.effects import (
     Transient,
 )
 from tcbench.sensors.recording import Recording, make_recording
+from tcbench.sensors.kinds import profile_input
 
 SHAPE: dict[str, str] = {
     "step": "step",
@@ -388,7 +389,7 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
                       {key: float(v) for key, v in draw.params.items()}, ratio, float(white_sigma),
                       float(t_kept[-1] - t_kept[0]), int(seed))
     extra = {"open_world": dataclasses.asdict(truth), "device_seed": device_seed, "profile": dict(profile.info)}
-    rec = make_recording(t_kept, thermometer[kept], profile.input[kept], output[kept], sensor=sensor,
+    rec = make_recording(t_kept, thermometer[kept], profile_input(profile)[kept], output[kept], sensor=sensor,
                          sample_rate_hz=SAMPLE_RATE_HZ, device_id=f"open-world-{sensor}-{seed}", extra=extra)
     return rec, truth
 

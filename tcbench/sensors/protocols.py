@@ -6,13 +6,8 @@ set-point follows the protocol's segments at a limited ramp rate; the chamber ai
 package follow it with first-order lags (the die's own lag behind the thermometer is the
 sensor's ``thermal_lag`` effect).
 
-- ``msra_roomtemp``: seed 000 zero-bias test — 1.5 h at 1 Hz, 0 g, power-on self-heating and
-  slow ambient wander.
-- ``msra_fulltemp``: seed 000 full-temperature test — nodes -40..60 degC every 20 degC, 1 h
-  soak, then +0 g, +1 g, -0 g, -1 g for 40 s each (10 s turntable moves between) at 1 Hz.
-- ``gyro_oven``: seed 001 §4.1 — 1 h at room temperature, 60 degC for 1 h, then down in
-  10 degC steps held 1 h each to -40 degC, at rest.
-- ``gyro_static``: a long run at constant temperature, at rest (Allan variance).
+Each sensor kind's protocols are in its module of :mod:`tcbench.sensors.kinds`; this module holds
+what they are built from.
 """
 
 from __future__ import annotations
@@ -23,8 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tcbench.sensors import kinds
-from tcbench.sensors.thermal import Segment, first_order_lag, gauss_markov, segment_index, setpoint
+from tcbench.sensors.thermal import Segment, first_order_lag, segment_index, setpoint
 from tcbench.sensors.timing import MIN_SOAK_S, Timing, current_timing
 
 MAX_LEVELS = 1000  # temperature levels of an oven run
@@ -56,11 +50,6 @@ class Profile:
     def dt_s(self) -> float:
         return 1.0 / self.sample_rate_hz
 
-    @property
-    def input(self) -> np.ndarray:
-        """The recorded ``input`` column: the applied input its sensor kind measures
-        (acceleration in g, or rate in deg/s)."""
-        return getattr(self, kinds.get(self.sensor).input_field)
 
 
 @dataclass(frozen=True)
@@ -166,81 +155,3 @@ def four_position_nodes(
             segments.append(Segment(node, move_s, "", accel, cross))
             segments.append(Segment(node, position_s, label, accel, cross))
     return _from_segments(name, sensor, segments, start_c, sample_rate_hz, chamber)
-
-
-def msra_fulltemp(
-    nodes_c: tuple[float, ...] = (-40.0, -20.0, 0.0, 20.0, 40.0, 60.0),
-    soak_s: float = 3600.0,
-    position_s: float = 40.0,
-    move_s: float = 10.0,
-    start_c: float = 25.0,
-    sample_rate_hz: float = 1.0,
-    chamber: Chamber = Chamber(),
-) -> Profile:
-    """Seed 000 full-temperature test: soak at each node, then the four positions."""
-    return four_position_nodes("fulltemp", "msra", nodes_c, soak_s, position_s, move_s, start_c, sample_rate_hz,
-                               chamber)
-
-
-def msra_roomtemp(
-    rng: np.random.Generator,
-    duration_s: float = 5400.0,
-    ambient_c: float = 23.0,
-    self_heating_c: float = 1.1,
-    self_heating_tau_s: float = 2400.0,
-    wander_c: float = 0.05,
-    wander_tau_s: float = 1800.0,
-    sample_rate_hz: float = 1.0,
-) -> Profile:
-    """Seed 000 zero-bias test at room temperature: 0 g, power-on at t = 0.
-
-    The package warms by ``self_heating_c`` with time constant ``self_heating_tau_s`` after
-    power-on, on top of an ambient that wanders (Gauss-Markov, std ``wander_c``).
-    """
-    check_length(duration_s, sample_rate_hz)
-    timing = current_timing()
-    ambient_c += timing.ambient_offset_c
-    self_heating_c *= timing.self_heating_scale
-    t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
-    thermal_dt = max(1.0 / sample_rate_hz, 1.0)
-    coarse_t = np.arange(0.0, duration_s + thermal_dt, thermal_dt)
-    wander = gauss_markov(coarse_t.size, thermal_dt, wander_tau_s, wander_c, rng)
-    temp = ambient_c + self_heating_c * (1.0 - np.exp(-t / self_heating_tau_s))
-    temp = temp + np.interp(t, coarse_t, wander)
-    zeros = np.zeros_like(t)
-    return Profile(
-        "roomtemp", "msra", sample_rate_hz, t, temp, zeros, np.ones_like(t), zeros.copy(),
-        np.full(t.size, "+0g"), {"self_heating_c": self_heating_c, "wander_c": wander_c},
-    )
-
-
-def gyro_oven(
-    room_c: float = 25.0,
-    room_s: float = 3600.0,
-    hot_c: float = 60.0,
-    cold_c: float = -40.0,
-    step_c: float = 10.0,
-    hold_s: float = 3600.0,
-    sample_rate_hz: float = 10.0,
-    chamber: Chamber = Chamber(ramp_c_per_min=1.0),
-) -> Profile:
-    """Seed 001 §4.1 oven run: room temperature, 60 degC, then 10 degC steps down to -40 degC."""
-    if (hot_c - cold_c) / step_c > MAX_LEVELS:
-        raise ValueError(f"protocol_params.step_c: {step_c:g} degC makes more than {MAX_LEVELS} levels from "
-                         f"{hot_c:g} to {cold_c:g} degC")
-    levels = np.arange(hot_c, cold_c - 1e-9, -step_c)
-    segments = [Segment(room_c, room_s, cross_g=0.0)]
-    segments += [Segment(float(level), hold_s, cross_g=0.0) for level in levels]
-    return _from_segments("oven", "gyro", segments, room_c, sample_rate_hz, chamber)
-
-
-def gyro_static(
-    duration_s: float = 86400.0, temp_c: float = 25.0, sample_rate_hz: float = 100.0
-) -> Profile:
-    """A long run at rest and constant temperature (for Allan variance). The constant columns
-    are read-only broadcast views, so a 24 h run at 100 Hz holds one full-length array (time)."""
-    check_length(duration_s, sample_rate_hz)
-    temp_c += current_timing().start_offset_c
-    t = np.arange(0.0, duration_s, 1.0 / sample_rate_hz)
-    zeros = np.broadcast_to(np.float64(0.0), t.shape)
-    return Profile("static", "gyro", sample_rate_hz, t, np.broadcast_to(np.float64(temp_c), t.shape), zeros, zeros, zeros)

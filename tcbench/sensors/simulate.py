@@ -15,7 +15,6 @@ import numpy as np
 
 from tcbench.sensors import effects as fx
 from tcbench.sensors import kinds
-from tcbench.sensors.devices import unit
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.noise import quantise
 from tcbench.sensors.protocols import Profile
@@ -112,7 +111,7 @@ def prepare_run(
     """The run :func:`simulate_recording` draws (its arguments); :func:`~tcbench.sensors.truth.simulate_truth`
     rebuilds the same one."""
     if model is None:
-        device = unit(sensor, device_seed)
+        device = kinds.unit(sensor, device_seed)
         device_placement = placement(sensor, device_seed)
     else:
         if model.kind != sensor:
@@ -182,7 +181,7 @@ def simulate_recording(
         **profile.info,
     }
     return make_recording(
-        profile.t_s, thermometer_reading(profile, model, run.thermometer_rng, run.power_on.placement), profile.input,
+        profile.t_s, thermometer_reading(profile, model, run.thermometer_rng, run.power_on.placement), kinds.profile_input(profile),
         output, sensor=sensor, sample_rate_hz=profile.sample_rate_hz, device_id=run.device.device_id,
         position=profile.position, extra=_plain(extra),
     )

@@ -105,6 +105,6 @@ def simulate_truth(
         temp_die_c=np.asarray(temp_die_c, dtype=np.float64),
         output_det=_deterministic(det, profile),
         sensitivity_per_input=(plus - minus) / (2.0 * step),
-        input=profile.input.copy(),
+        input=kinds.profile_input(profile).copy(),
         output_det_thermometer=_deterministic(run.nominal.without(*STOCHASTIC_EFFECTS), read_profile),
     )

@@ -142,3 +142,14 @@ def get(name: str) -> SensorKind:
     if name not in kinds:
         raise ValueError(f"unknown sensor {name!r} (known: {', '.join(kinds)})")
     return kinds[name]
+
+
+def unit(sensor: str, device_seed: int) -> Any:
+    """The unit ``device_seed`` of sensor kind ``sensor`` (a :class:`~tcbench.sensors.models.Unit`)."""
+    return get(sensor).device(device_seed)
+
+
+def profile_input(profile: Any) -> Any:
+    """The recorded ``input`` column of a :class:`~tcbench.sensors.protocols.Profile`: the applied
+    input its sensor kind measures (acceleration in g, or rate in deg/s)."""
+    return getattr(profile, get(profile.sensor).input_field)
