@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from tcbench.config_dir import conf_dir
+from tcbench.commands.registry import SPECS, CommandSpec
 from tcbench.errors import ConfigError
 from tcbench.runner import kinds
 from tcbench.runner.job import FAILURES, JobFailure, run_job
@@ -25,7 +26,7 @@ def test_every_task_config_has_a_spec_and_every_spec_a_registered_env() -> None:
     names = {yaml.safe_load(p.read_text())["name"] for p in (conf_dir() / "task").glob("*.yaml")}
     assert names == set(TASKS)
     for spec in TASKS.values():
-        assert spec.gym_id in gym.registry and spec.job_kind in kinds.KIND_MODULES
+        assert spec.gym_id in gym.registry and spec.job_kind in SPECS["run"].kinds
         assert "name" in spec.schema.__dataclass_fields__
         assert spec.is_compensation == (spec.protocol is not None)
     with pytest.raises(KeyError, match="unknown task 'nope'; known: accel_chamber, ackley"):
@@ -47,8 +48,6 @@ def test_an_unknown_kind_is_one_line() -> None:
 class EchoKind(kinds.JobKind):
     """A kind in a dozen lines: says its message, or raises it."""
 
-    name = "echo"
-
     def names(self, c: dict[str, Any]) -> kinds.JobNames:
         return kinds.JobNames(f"echo-{c['message']}", "echo-task", "echo", int(c["seed"]))
 
@@ -65,10 +64,12 @@ class EchoKind(kinds.JobKind):
 
 @pytest.fixture
 def echo(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A command ``echo`` with its kind: one spec in the registry, and its module."""
     module = types.ModuleType("echo_kind")
-    module.KINDS = {"echo": EchoKind()}  # type: ignore[attr-defined]
+    module.EchoKind = EchoKind  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "echo_kind", module)
-    monkeypatch.setitem(kinds.KIND_MODULES, "echo", "echo_kind")
+    monkeypatch.setitem(SPECS, "echo", CommandSpec(name="echo", summary="say a message", schema="echo_kind:Echo",
+                                                    kinds={"echo": "echo_kind:EchoKind"}))
 
 
 def test_a_new_kind_runs_through_the_one_runner(echo: None, workdir: Path) -> None:
