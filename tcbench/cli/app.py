@@ -1,5 +1,5 @@
-"""The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``,
-``tcbench simulate|metrics|import|diagnose|leaderboard|list|quickstart`` on ``conf/<command>.yaml``)
+"""The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``, the
+others on ``conf/<command>.yaml``: each spec's ``config`` in :mod:`tcbench.commands.registry`)
 and the checks made before any job starts. Every job of every command runs through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
