@@ -11,6 +11,7 @@ import yaml
 
 from tcbench.cli import help as cli_help
 from tcbench.cli import COMMANDS, main
+from tcbench.commands.registry import SPECS
 
 KEYVALUE = ["simulate", "metrics", "import", "diagnose", "calibrate", "export", "leaderboard", "list", "quickstart"]
 # what the help of the other commands must name: their parameters or settings
@@ -44,7 +45,7 @@ def test_help_exits_0_and_names_the_parameters(command: str, flag: str, capsys: 
     out = capsys.readouterr().out
     if command in KEYVALUE:
         assert out.startswith(f"usage: tcbench {command} ")
-        for key, _ in cli_help.parameters(cli_help.SPECS[command].schema()):
+        for key, _ in cli_help.parameters(SPECS[command].schema_class()):
             if key not in cli_help.IGNORED + cli_help.HIDDEN:
                 assert f"  {key}=" in out, key
         assert "--cfg job" in out and "examples:" in out and "output:" in out
@@ -70,8 +71,8 @@ def test_help_shows_the_defaults_the_command_parses() -> None:
 
 @pytest.mark.parametrize("command", KEYVALUE)
 def test_every_parameter_has_a_meaning(command: str) -> None:
-    spec = cli_help.SPECS[command]
-    keys = {k for k, _ in cli_help.parameters(spec.schema())} - set(cli_help.IGNORED + cli_help.HIDDEN)
+    spec = SPECS[command]
+    keys = {k for k, _ in cli_help.parameters(spec.schema_class())} - set(cli_help.IGNORED + cli_help.HIDDEN)
     assert keys == set(spec.params)
     assert set(spec.required) <= keys
 
@@ -113,7 +114,7 @@ def test_cfg_job_prints_the_composed_config_and_writes_nothing(args: list[str], 
             assert {k: cfg[key][k] for k in value} == value
         else:
             assert cfg[key] == value, key
-    defaults = dict(cli_help.parameters(cli_help.SPECS[args[0]].schema()))
+    defaults = dict(cli_help.parameters(SPECS[args[0]].schema_class()))
     assert set(cfg) == {k.split(".")[0] for k in defaults}  # the whole config, defaults included
     assert list(tmp_path.iterdir()) == []  # no output folder, no recording, no MLflow store
 

@@ -14,6 +14,7 @@ import mlflow
 import pytest
 import yaml
 
+from tcbench.commands.registry import SPECS, CommandSpec
 from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
 from tcbench.runner import kinds
@@ -25,7 +26,7 @@ def test_every_task_config_has_a_spec_and_every_spec_a_registered_env() -> None:
     names = {yaml.safe_load(p.read_text())["name"] for p in (conf_dir() / "task").glob("*.yaml")}
     assert names == set(TASKS)
     for spec in TASKS.values():
-        assert spec.gym_id in gym.registry and spec.job_kind in kinds.KIND_MODULES
+        assert spec.gym_id in gym.registry and spec.job_kind in SPECS["run"].kinds
         assert "name" in spec.schema.__dataclass_fields__
         assert spec.is_compensation == (spec.protocol is not None)
     with pytest.raises(KeyError, match="unknown task 'nope'; known: accel_chamber, ackley"):
@@ -47,8 +48,6 @@ def test_an_unknown_kind_is_one_line() -> None:
 class EchoKind(kinds.JobKind):
     """A kind in a dozen lines: says its message, or raises it."""
 
-    name = "echo"
-
     def names(self, c: dict[str, Any]) -> kinds.JobNames:
         return kinds.JobNames(f"echo-{c['message']}", "echo-task", "echo", int(c["seed"]))
 
@@ -65,10 +64,12 @@ class EchoKind(kinds.JobKind):
 
 @pytest.fixture
 def echo(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A command ``echo`` with its kind: one spec in the registry, and its module."""
     module = types.ModuleType("echo_kind")
-    module.KINDS = {"echo": EchoKind()}  # type: ignore[attr-defined]
+    module.EchoKind = EchoKind  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "echo_kind", module)
-    monkeypatch.setitem(kinds.KIND_MODULES, "echo", "echo_kind")
+    monkeypatch.setitem(SPECS, "echo", CommandSpec(name="echo", summary="say a message", schema="echo_kind:Echo",
+                                                    kinds={"echo": "echo_kind:EchoKind"}))
 
 
 def test_a_new_kind_runs_through_the_one_runner(echo: None, workdir: Path) -> None:
@@ -99,3 +100,31 @@ def test_untracked_jobs_of_a_new_kind_fail_into_the_list(echo: None) -> None:
     assert run_job({"kind": "echo", "message": "hi", "seed": 0, "tracking": track}) == "hi"
     assert isinstance(run_job({"kind": "echo", "message": "boom", "seed": 0, "tracking": track}), JobFailure)
     assert [f.name for f in FAILURES] == ["echo-boom"]
+
+
+def test_the_default_learner_is_read_once_and_each_job_gets_its_own_copy(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A compensation job without a learner (config.yaml's ``learner: null``) gets the default
+    learner's option file, read once per process however many jobs are planned and run."""
+    from tcbench.config_dir import group_options
+    from tcbench.runner import compensation_config
+
+    top = yaml.safe_load((conf_dir() / "config.yaml").read_text())
+    assert {"learner": None} in top["defaults"] and compensation_config.DEFAULT_LEARNER in group_options("learner")
+    default = f"{compensation_config.DEFAULT_LEARNER}.yaml"
+    expected = yaml.safe_load((conf_dir() / "learner" / default).read_text())
+    reads: list[Path] = []
+    read_text = Path.read_text
+
+    def counted(self: Path, *args: Any, **kwargs: Any) -> str:
+        reads.extend([self] if self.name == default else [])
+        return read_text(self, *args, **kwargs)
+
+    compensation_config._default_learner.cache_clear()
+    monkeypatch.setattr(Path, "read_text", counted)
+    kind = kinds.kind_of({"kind": "compensation"})
+    first = kind.prepare({"learner": None, "seed": 0})["learner"]
+    assert first == expected and first["name"] == compensation_config.DEFAULT_LEARNER
+    first["hidden"] = -1  # one job's copy
+    assert [compensation_config.learner_of({}) for _ in range(5)] == [expected] * 5
+    assert len(reads) == 1
+    assert compensation_config.learner_of({"learner": {"name": "elman"}}) == {"name": "elman"}

@@ -1,7 +1,6 @@
-"""The command line: every command (:mod:`.main`), its --help (:mod:`.help`), the Hydra apps and
-the checks made before any job starts (:mod:`.app`), the quickstart, the work of the recording
-commands (:mod:`.recordings`), their config schemas (:mod:`.schemas`) and one-line errors
-(:mod:`.errors`).
+"""The command line: the usage and dispatch of every command (:mod:`.main`), its --help
+(:mod:`.help`), the Hydra apps and the checks made before any job starts (:mod:`.app`) and the
+quickstart. The commands themselves are the specs of :mod:`tcbench.commands.registry`.
 
 Kept light: ``tcbench --help`` imports none of the scientific libraries. ``tcbench.cli:main`` is
 the console script. The name ``main`` here is the function; the module is

@@ -1,5 +1,5 @@
-"""The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``,
-``tcbench simulate|metrics|import|diagnose|leaderboard|list|quickstart`` on ``conf/<command>.yaml``)
+"""The Hydra applications behind tcbench's commands (``tcbench run`` on ``conf/config.yaml``, the
+others on ``conf/<command>.yaml``: each spec's ``config`` in :mod:`tcbench.commands.registry`)
 and the checks made before any job starts. Every job of every command runs through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from omegaconf.errors import ConfigAttributeError, ConfigKeyError, OmegaConfBase
 
 from tcbench.cli.flags import VALUE_FLAGS
 from tcbench.commands import schemas as command_schemas
+from tcbench.commands.registry import by_config
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
 from tcbench.errors import ConfigError, did_you_mean
 from tcbench.runner.schema import as_dict, register_schema
@@ -102,9 +103,7 @@ def _no_such_key(key: str, known: Any) -> str:
 
 def _schema_keys(config_name: str) -> list[str]:
     """The top-level keys of a primary config's schema."""
-    from tcbench.runner.schema import JobConfig
-
-    schema = JobConfig if config_name == CONFIG_NAME else command_schemas.SCHEMAS.get(config_name)
+    schema = _schema(config_name)
     return [f.name for f in dataclasses.fields(schema)] if schema is not None else []
 
 
@@ -132,10 +131,10 @@ def _explain(exc: Exception, config_name: str = CONFIG_NAME) -> str:
 
 
 def _schema(config_name: str) -> type | None:
-    """The structured schema of a primary config (``config``: ``tcbench run``'s job)."""
-    from tcbench.runner.schema import JobConfig
-
-    return JobConfig if config_name == CONFIG_NAME else command_schemas.SCHEMAS.get(config_name)
+    """The structured schema of a primary config (``config``: ``tcbench run``'s job), or None
+    for a config no command runs."""
+    spec = by_config(config_name)
+    return spec.schema_class() if spec is not None else None
 
 
 def _plain_type(annotation: Any) -> Any:

@@ -1,339 +1,23 @@
-"""Usage text of tcbench's commands, generated from the schema of each command's primary config
-(:mod:`tcbench.commands.schemas`; ``tcbench run``'s :mod:`tcbench.runner.schema` with its config
-groups), so the parameters and defaults shown are the ones the command uses. Built without Hydra,
-OmegaConf or the tasks' libraries: ``--help`` answers at once."""
+"""Usage text of tcbench's commands, generated from each command's spec
+(:mod:`tcbench.commands.registry`) and the schema of its primary config (``tcbench run``'s with
+its config groups), so the parameters and defaults shown are the ones the command uses. Built
+without Hydra, OmegaConf or the tasks' libraries: ``--help`` answers at once."""
 
 from __future__ import annotations
 
 import dataclasses
 import textwrap
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
-TRACKING = {
-    "tracking.enabled": "log the results to MLflow (false: files only)",
-    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
-    "tracking.experiment": "MLflow experiment the run is filed under",
-    "tracking.sweep_id": "the sweep's id in MLflow (null: a new one per command)",
-    "tracking.resume": "skip a job whose config already FINISHED in the experiment (re-run a killed sweep)",
-}
-RUN_PARAMS = {
-    "task": "the task, an option of the group task (task.<key>=VALUE sets one of its keys)",
-    "optimiser": "the optimiser, an option of the group optimiser (optimiser.<key>=VALUE sets one of its keys)",
-    "learner": "compensation tasks: the learner, an option of the group learner (null: bp)",
-    "experiment": "a whole study in one file, an option of the group experiment (experiment=paper_fa_ifa)",
-    "seed": "run seed: the task instance and the optimiser's streams derive from it",
-    "budget": "objective evaluations per run, initial population included",
-    "progress": "a progress bar per run",
-    **TRACKING,
-    "tracking.plots": "a figure per run (null: for single runs and compensation runs, not in optimisation sweeps)",
-    "tracking.ioh_dir": "also write each run in IOHprofiler's format into this folder (null: no)",
-}
-OVERWRITE = ("replace files of the same name already in out= and say which (false: refuse, naming the first; "
-             "a link out of out= or a folder where a file goes is refused either way)")
+from tcbench.commands.registry import SPECS, by_config
+
 # keys of the shared schema that these commands accept and ignore (``tcbench run`` uses them)
 IGNORED = ("tracking.plots", "tracking.ioh_dir")
 HIDDEN = ("kind",)  # the job kind the primary config names, not a parameter
-
-
-@dataclass(frozen=True)
-class CommandHelp:
-    """What ``tcbench <name> --help`` says: ``params`` gives the meaning of every key of the
-    command's schema (dotted for nested dataclasses; a dict-valued key is one entry)."""
-
-    name: str
-    summary: str
-    schema: Callable[[], type]
-    params: dict[str, str]
-    examples: tuple[str, ...]
-    output: str
-    positional: str | None = None  # ``tcbench metrics PATH`` means ``recording=PATH``
-    required: tuple[str, ...] = ()
-    options: tuple[str, ...] = ()  # further lines of the options section (flags kept as aliases)
-    sweep: str = ("the jobs run on tcbench run's launcher (hydra.launcher.n_jobs=2 for two workers) and "
-                  "the sweep is reported at the end")
-
-
-def _schema(command: str) -> Callable[[], type]:
-    """The schema of ``command``'s primary config, imported when the help is shown."""
-
-    def schema() -> type:
-        from tcbench.commands.schemas import SCHEMAS
-
-        return SCHEMAS[command]
-
-    return schema
-
-
+# what -m does, by where a command's jobs run (its spec's ``kinds`` or ``runs_here``)
+ON_LAUNCHER = ("the jobs run on tcbench run's launcher (hydra.launcher.n_jobs=2 for two workers) and "
+               "the sweep is reported at the end")
 IN_TURN = "the jobs run one after another in this process"
-
-
-SPECS: dict[str, CommandHelp] = {
-    "simulate": CommandHelp(
-        name="simulate",
-        summary="Simulate a recording of one device under a test protocol, then compute its metrics.",
-        schema=_schema("simulate"),
-        params={
-            "sensor": "msra (resonant accelerometer), gyro or accel (capacitive accelerometer); `tcbench list what=sensors` "
-                      "(null: msra, or the model file's)",
-            "protocol": "test protocol: msra roomtemp|fulltemp, gyro oven|static, accel chamber|multipos|static "
-                        "(null: the sensor's default, msra fulltemp, gyro oven, accel chamber)",
-            "device_seed": "which unit of the device population (integer >= 0)",
-            "seed": "which run of the device (integer >= 0): a new power-on (turn-on bias and scale factor, hysteresis "
-                    "state, chamber timing within tolerance, the thermometer's offset and gradient) and new noise",
-            "power_on": "null: the run's own power-on; N: replay run N's power-on with this run's noise (only the noise "
-                        "differs: the replay tier)",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "format": "csv or parquet",
-            "name": "file stem (null: <sensor>-<protocol>-dev<device_seed>-seed<seed>[-poweron<N>])",
-            "protocol_params": "protocol_params.<keyword>=VALUE overrides a protocol keyword (duration_s=3600)",
-            "effects": "effects.<effect>.<param>=VALUE changes or adds an effect (effects.hysteresis.amplitude=0.02)",
-            "without": "effects to drop, e.g. 'without=[white_noise]'",
-            "metrics": "also compute the metrics, plots and tables",
-            **TRACKING,
-            "model": "simulate a fitted-model file (model.yaml of tcbench diagnose) instead of a device",
-        },
-        examples=(
-            "tcbench simulate sensor=msra protocol=fulltemp device_seed=0 out=recordings",
-            "tcbench simulate sensor=gyro protocol=oven seed=1 format=parquet tracking.enabled=false",
-            "tcbench simulate -m device_seed='range(100)' out=population   (a population, one job per device)",
-        ),
-        output="OUT/NAME.csv (or .parquet) with its sidecar OUT/NAME.json, and with metrics=true "
-               "OUT/NAME_metrics/ (metrics.json, plots); MLflow experiment 'simulations' when tracking is on",
-    ),
-    "metrics": CommandHelp(
-        name="metrics",
-        summary="Validate a recording and compute the papers' metrics, with plots.",
-        schema=_schema("metrics"),
-        params={
-            "recording": "the recording (.csv or .parquet with its .json sidecar); also the first argument",
-            "out": "output folder (null: <recording stem>_metrics next to the recording)",
-            "overwrite": OVERWRITE,
-            "scale_factor_hz_per_g": "MSRA scale factor in Hz/g (null: the sidecar's, else the nominal one)",
-            **TRACKING,
-        },
-        examples=(
-            "tcbench metrics recordings/msra-fulltemp-dev0-seed0.csv",
-            "tcbench metrics recording=run.csv out=run_metrics tracking.enabled=false",
-        ),
-        output="OUT/ (metrics.json, overview and Allan deviation plots, nodes.csv for a four-position "
-               "test); MLflow experiment 'recordings' when tracking is on",
-        positional="recording",
-        required=("recording",),
-    ),
-    "import": CommandHelp(
-        name="import",
-        summary="Import your own CSV file as a tcbench recording (validated, with its sidecar).",
-        schema=_schema("import"),
-        params={
-            "csv": "the table to import (fields separated by commas, tabs or semicolons), or a PX4 log (.ulg: "
-                   "every instance and axis of the sensor's topic, sensor_gyro for a gyro, sensor_accel for accel); also the first argument",
-            "sensor": "msra, gyro or accel (any kind `tcbench list what=sensors` shows)",
-            "time": "time column, COL:unit (any time unit pint knows: s, ms, us, ns, min, h)",
-            "temperature": "temperature column, COL:unit (degC, K, degF)",
-            "output": "sensor output column, COL:unit (gyro: deg/s, rad/s, mrad/s, mdps ...; accel: g, mg, m/s^2 ...; "
-                      "msra: Hz, kHz ...); "
-                      "several axes: COL:unit,COL:unit,... (one recording each, NAME-COL)",
-            "input": "optional true-input column, COL:unit",
-            "units.time": "the unit of time= when it names its column without one (units={time:us,output:rad/s} "
-                          "sets several): a unit is never assumed; say it after the column's colon, here, or import "
-                          "a tcbench recording whose sidecar states it",
-            "units.temperature": "the unit of temperature= when it names its column without one",
-            "units.output": "the unit of every output= column named without one (units.output=m/s^2)",
-            "units.input": "the unit of input= when it names its column without one",
-            "axes": "the sensor axis of each output column, x, y or z (axes=y, or axes=x,y,z for three), written to "
-                    "the sidecar's extra.axis; null: not recorded (never guessed from a name; a PX4 log's x, y, z "
-                    "fields are their axes)",
-            "drop": "drop rows where these columns are nonzero (drop=flag or drop=a,b)",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "name": "file stem (null: the CSV's)",
-            "device_id": "device id for the sidecar (null: the CSV's stem)",
-            "sample_rate_hz": "sample rate (null: one over the median interval of the time column)",
-            **TRACKING,
-        },
-        examples=(
-            "tcbench import csv=log.csv sensor=gyro time=time_s:s temperature=temp_c:degC "
-            "output=gyro_x_dps:deg/s axes=x out=recordings",
-            "tcbench import csv=flight.ulg sensor=gyro out=recordings   (NAME-sensor_gyro-<instance>-<axis>.csv)",
-            "tcbench import csv=imu.tsv sensor=accel time=t temperature=temp output=ax,ay,az "
-            "units={time:us,temperature:degC} units.output=m/s^2 axes=x,y,z out=recordings",
-        ),
-        output="OUT/NAME.csv and its sidecar OUT/NAME.json; MLflow experiment 'recordings' when tracking is on",
-        positional="csv",
-        required=("csv", "sensor", "time", "temperature", "output", "out"),
-    ),
-    "diagnose": CommandHelp(
-        name="diagnose",
-        summary="Find the physics a model leaves out of a recording: a report, plots and a model file.",
-        schema=_schema("diagnose"),
-        params={
-            "recording": "the recording to diagnose",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "sensor": "the sensor kind (msra, gyro, accel), for a recording without a sidecar (null: from the sidecar)",
-            "model": "model file of the effects already modelled (null: none)",
-            "max_rows": "the most rows diagnosed (null: no limit). Measured on one core (benchmarks/"
-                        "diagnose_scaling.py), a diagnosis takes about 49 s and 550 MB at 100 000 rows, 8 min and "
-                        "3.2 GB at the default 1 000 000, 1.2 h and 30 GB at 10^7: a longer record is refused before "
-                        "it is read, with its estimate; one estimated over 30 s says so when it starts and shows the "
-                        "time spent on a terminal",
-            **TRACKING,
-        },
-        examples=(
-            "tcbench diagnose recording=recordings/msra-fulltemp-dev0-seed0.csv out=diagnosis",
-            "tcbench diagnose recording=run.csv out=diag2 model=diagnosis/model.yaml",
-            "tcbench diagnose -m recording=a.csv,b.csv 'out=diagnoses/${stem:recording}' hydra.launcher.n_jobs=2",
-        ),
-        output="OUT/report.json, OUT/report.md, plots and OUT/model.yaml; MLflow experiment 'diagnoses' "
-               "(effects found, held-out RMSEs, the report) when tracking is on",
-        required=("recording",),
-    ),
-    "calibrate": CommandHelp(
-        name="calibrate",
-        summary="Calibrate a static recording on its own temperature branches: each offset model (raw, PX4's "
-                "cubic in the thermometer, the cubic with a temperature-rate term, BP and Elman networks, the diagnosed "
-                "model) fitted on some parts and ranked on the others, held out, with a block-bootstrap interval.",
-        schema=_schema("calibrate"),
-        params={
-            "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
-                              "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
-            "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
-                      "(a record that only cools: train_branches=[0,2,4] blocks=5)",
-            "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp (trained by "
-                       "Levenberg-Marquardt when the rows allow), bp_gd (gradient descent, 1000 epochs), elman (Adam) "
-                       "(the seed papers' networks on [T, dT/dt]), model (the diagnosed physics without its "
-                       "clock-keyed terms)",
-            "seed": "the networks' initial weights",
-            "restarts": "networks per learner method, seeds seed, seed+1, ...: the board gives the median of their "
-                        "scores (the plot shows the first)",
-            "min_swing_c": "a turning point of the temperature stands out by at least this (degC)",
-            "drift_window_s": "the drift score's running mean (s)",
-            "screen": "drop the training parts' handling bursts, spikes and thermometer glitches before any model is "
-                      "fitted (reported); false: fit every sample",
-            "axis": "x, y or z: the recording's axis when its sidecar does not say (tcbench import axes= records it)",
-            "test_recordings": "other recordings of the same kind and unit to score the fitted models on, every "
-                               "part of them held out: train on one record, test on others",
-            "true_input": "the static record's true input, VALUE[:unit] (an accelerometer axis along gravity: "
-                          "-1:g); null: the recording's input column",
-            **TRACKING,
-        },
-        examples=(
-            "tcbench calibrate recording=recordings/tofupilot/imu-imu.gyro.y.csv out=cal/gyro-y",
-            "tcbench calibrate recording=run.csv 'train_branches=[0,1]' 'methods=[poly3]'",
-            "tcbench calibrate -m recording=a.csv,b.csv 'out=cal/${stem:recording}'",
-            "tcbench calibrate recording=recordings/tofupilot/imu-imu.acc.z.csv true_input=-1:g out=cal/acc-z",
-        ),
-        output="the held-out ranking (printed); OUT/calibration.md and .csv (one row per method and part: drift and "
-               "RMS), OUT/residuals.png, OUT/calibration.json (the ranking and the cubic for tcbench export); MLflow "
-               "experiment 'calibrations' when tracking is on",
-        positional="recording",
-        required=("recording",),
-    ),
-    "leaderboard": CommandHelp(
-        name="leaderboard",
-        summary="Aggregate the finished runs of MLflow experiments into leaderboards (optimisation and "
-                "compensation): tables, convergence plots, ECDFs.",
-        schema=_schema("leaderboard"),
-        params={
-            "experiments": "MLflow experiment whose runs are ranked; several: experiments=[a,b]",
-            "sweep": "only the runs of this sweep id (null: every run of the experiment)",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "ecdf": "also write COCO-style ECDF plots per dimension",
-            "tracking.uri": "MLflow store to read (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
-            "tracking.enabled": "also file the board files as a run in the store (false: files only)",
-            "tracking.experiment": "experiment that run is filed under",
-            "tracking.sweep_id": TRACKING["tracking.sweep_id"],
-            "tracking.resume": TRACKING["tracking.resume"],
-        },
-        examples=(
-            "tcbench leaderboard                                         all runs of experiment tcbench",
-            "tcbench leaderboard experiments=quickstart sweep=SWEEP_ID out=lb ecdf=true",
-            "tcbench leaderboard --experiment quickstart --sweep SWEEP_ID --out lb --ecdf   (the same)",
-            "tcbench leaderboard -m experiments=paper-fa-ifa,paper-ifa-bp 'out=lb/${experiments}'   (a board per experiment)",
-        ),
-        output="OUT/<task>.md, OUT/<task>.csv and OUT/<task>_convergence.png per task (compensation tasks too), "
-               "the tables also printed; ecdf=true adds OUT/ecdf_<d>d.png. Reads the MLflow store and writes "
-               "nothing to it unless tracking.enabled=true",
-        options=("  --experiment NAME   experiments=NAME (repeatable: experiments=[a,b])",
-                 "  --sweep ID          sweep=ID",
-                 "  --out DIR           out=DIR",
-                 "  --tracking-uri URI  tracking.uri=URI",
-                 "  --ecdf              ecdf=true"),
-    ),
-    "export": CommandHelp(
-        name="export",
-        summary="Write the thermal-calibration parameters of one IMU for PX4 (TC_G*/TC_A*, a param-set "
-                "script) and ArduPilot (INS_TCALn_*, a .parm file) from tcbench calibrate's outputs, one per axis "
-                "and sensor kind, every axis in its slot (the axis from the recording's sidecar or calibrate axis=).",
-        schema=_schema("export"),
-        params={
-            "calibrations": "the out= folders of tcbench calibrate (their calibration.json): one per axis and kind",
-            "out": "output folder",
-            "overwrite": OVERWRITE,
-            "formats": "px4, ardupilot, or both",
-            "device_id": "PX4's TC_*_ID: the sensor's device id (CAL_GYROn_ID / CAL_ACCn_ID), one number or "
-                         "{gyro: N, accel: M}; null: the id the PX4 log gave (required for px4 otherwise)",
-            "px4_instance": "the TC_G<i> / TC_A<i> instance (0..3)",
-            "ardupilot_imu": "the INS_TCAL<n> IMU (1..3)",
-        },
-        examples=(
-            "tcbench export 'calibrations=[cal/x,cal/y,cal/z]' device_id=2293768 out=params",
-            "tcbench export 'calibrations=[cal/gx,cal/gy,cal/gz,cal/ax,cal/ay,cal/az]' formats=[ardupilot] out=params",
-        ),
-        output="OUT/px4_tc_params.txt and OUT/ardupilot_tcal.parm",
-        required=("calibrations",),
-        sweep=f"{IN_TURN}",
-    ),
-    "list": CommandHelp(
-        name="list",
-        summary="Print the registered tasks (their gymnasium env id and task= name), optimisers (with the "
-                "package that provides them: tcbench or a plugin), learners and broken plugins.",
-        schema=_schema("list"),
-        params={"what": "which list: all, tasks, optimisers, learners or sensors"},
-        examples=("tcbench list", "tcbench list what=optimisers", "tcbench list -m what=tasks,learners"),
-        output="stdout only",
-        sweep=f"{IN_TURN}, each list printed in turn",
-    ),
-    "quickstart": CommandHelp(
-        name="quickstart",
-        summary="The main job in about a minute (2 cores), at demonstration sizes, not the paper's: "
-                "1. compensation: the paper's IFA-BP on the simulated MSRA zero-bias task (`tcbench run -m "
-                "experiment=quickstart`, conf/experiment/quickstart.yaml: seed: range(5), budget: 510), beside "
-                "raw, poly and the oracle (the physical limit), then a small leaderboard; 2. diagnosis: a "
-                "simulated recording with one hidden effect (thermal_lag by default), what the diagnosis finds, "
-                "where, and the held-out RMSE before and after in noise sigmas. Deterministic: same "
-                "parameters, same numbers.",
-        schema=_schema("quickstart"),
-        params={
-            "seeds": "IFA-BP trainings (seeds 0..seeds-1; the paper: 30)",
-            "budget": "evaluations of IFA's weight search per training (the paper's search: 510)",
-            "epochs": "BP gradient-descent epochs per training",
-            "diagnose_sensor": "msra or gyro: the simulated recording diagnosed",
-            "diagnose_effect": "the effect hidden in it (an effect of tcbench.datasets.concealed, e.g. hysteresis)",
-            "diagnose_seed": "its draw",
-            "out": "output folder (leaderboard/, diagnosis/, recordings/); a quickstart run again replaces the "
-                   "files the earlier one wrote there and says which",
-            "tracking.uri": TRACKING["tracking.uri"],
-            "tracking.experiment": "MLflow experiment the quickstart's runs are filed under",
-            "tracking.sweep_id": "the quickstart's sweep id in MLflow (null: a new one)",
-        },
-        examples=("tcbench quickstart",
-                  "tcbench quickstart seeds=30             the paper's 30 trainings (about 5 min)",
-                  "tcbench quickstart -m diagnose_effect=thermal_lag,hysteresis 'out=qs/${diagnose_effect}'",
-                  "tcbench run -m experiment=quickstart 'seed=range(30)' learner.epochs=3000   the sweep alone"),
-        output="runs in MLflow (./mlflow.db, experiment quickstart: one per compensation job and one for the "
-               "diagnosis), the leaderboard in OUT/leaderboard/, the diagnosis report and plots in "
-               "OUT/diagnosis/, Hydra job logs and resolved configs in multirun/",
-        sweep=f"{IN_TURN} (each quickstart runs its own sweeps on tcbench run's launcher)",
-    ),
-}
 
 
 def _shown(value: Any) -> str:
@@ -365,16 +49,22 @@ def parameters(schema: type) -> list[tuple[str, Any]]:
 
 def usage(name: str) -> str:
     """The ``--help`` text of command ``name``."""
+    from tcbench.config_dir import CONFIG_NAME
+
     spec = SPECS[name]
+    if spec.config == CONFIG_NAME:
+        return run_usage()
+    schema = spec.schema_class()
+    sweep = (IN_TURN if spec.runs_here else ON_LAUNCHER) + spec.sweep
     first = f" [{spec.positional.upper()}]" if spec.positional else ""
     lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "",
-             textwrap.fill(spec.summary, width=100), "",
+             textwrap.fill(spec.description, width=100), "",
              "parameters (key=value, default after =):"]
     rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", spec.params.get(key, ""))
-            for key, default in parameters(spec.schema()) if key not in IGNORED + HIDDEN]
+            for key, default in parameters(schema) if key not in IGNORED + HIDDEN]
     width = max(len(left) for left, _ in rows) + 2
     lines += [f"  {left:{width}s}{meaning}" for left, meaning in rows]
-    if ignored := [k for k, _ in parameters(spec.schema()) if k in IGNORED]:
+    if ignored := [k for k, _ in parameters(schema) if k in IGNORED]:
         lines.append(f"  (also accepted, unused here: {', '.join(ignored)})")
     lines += ["", "options:",
               "  -h, --help   show this help and exit",
@@ -382,7 +72,7 @@ def usage(name: str) -> str:
               "and exit without running",
               *textwrap.wrap("sweep (--multirun): one job per combination of comma-separated values or "
                              "range(...), in Hydra's override grammar (quote a path holding , ( ) [ ] { } or "
-                             f"quotes: \"recording='run (1).csv'\"); {spec.sweep}", width=98,
+                             f"quotes: \"recording='run (1).csv'\"); {sweep}", width=98,
                              initial_indent="  -m           ", subsequent_indent=" " * 15),
               *spec.options,
               "", "examples:", *(f"  {e}" for e in spec.examples),
@@ -404,27 +94,29 @@ def run_usage() -> str:
     import yaml
 
     from tcbench.config_dir import CONFIG_NAME, conf_dir, group_options
-    from tcbench.runner.schema import JobConfig
 
+    spec = by_config(CONFIG_NAME)
+    assert spec is not None, "no command runs conf/config.yaml"
+    schema, meanings = spec.schema_class(), spec.params
     root = conf_dir()
     top = yaml.safe_load((root / f"{CONFIG_NAME}.yaml").read_text(encoding="utf-8"))
     text = top["hydra"]["help"]
     groups = _group_defaults(top)
     options = {group: group_options(group) for group in sorted(groups)}
     rows: list[tuple[str, str]] = []
-    for key, default in parameters(JobConfig):
+    for key, default in parameters(schema):
         if key in groups:
             choice = groups[key]
-            rows.append((f"{key}={_shown(choice)}", RUN_PARAMS[key]))
+            rows.append((f"{key}={_shown(choice)}", meanings[key]))
             if choice is not None:
                 values = yaml.safe_load((root / key / f"{choice}.yaml").read_text(encoding="utf-8")) or {}
                 rows += [(f"  {key}.{k}={_shown(v)}", "") for k, v in values.items() if k not in {"name", "defaults"}]
         else:
             value = top.get(key, default) if "." not in key else \
                 (top.get(key.split(".")[0]) or {}).get(key.split(".", 1)[1], default)
-            rows.append((f"{key}={_shown(value)}", RUN_PARAMS.get(key, "")))
-    keys = dict(parameters(JobConfig))
-    rows += [(f"{g}={_shown(choice)}", RUN_PARAMS.get(g, "")) for g, choice in groups.items() if g not in keys]
+            rows.append((f"{key}={_shown(value)}", meanings.get(key, "")))
+    keys = dict(parameters(schema))
+    rows += [(f"{g}={_shown(choice)}", meanings.get(g, "")) for g, choice in groups.items() if g not in keys]
     width = max(len(left) for left, meaning in rows if meaning) + 2
     lines = [text["header"].rstrip(), "", "== Configuration groups ==",
              "Compose your configuration from those groups (group=option)", "",

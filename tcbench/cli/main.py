@@ -1,40 +1,19 @@
-"""``tcbench`` command line: run, leaderboard, quickstart, list, simulate, import, metrics, diagnose."""
+"""``tcbench`` command line: the commands of :mod:`tcbench.commands.registry`, their usage and
+their dispatch."""
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
 import sys
 import uuid
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:
-    from tcbench.cli.app import Plan
-
-USAGE = """usage: tcbench <command> [args]
-
-commands:
-  run          one job, or a Hydra sweep with -m (e.g. tcbench run -m optimiser=fa,ifa seed='range(30)')
-  leaderboard  aggregate finished runs into leaderboards/<task>.md/.csv/.png (experiments=NAME out=DIR)
-  quickstart   the main job in a minute: compensate a simulated MSRA, diagnose a recording
-  list         registered tasks, optimisers and learners (what=all|tasks|optimisers|learners)
-  simulate     simulate a recording (sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR) and its metrics
-  import       your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL:unit ... out=DIR)
-  metrics      validate a recording and compute the papers' metrics, with plots (tcbench metrics PATH)
-  diagnose     find the physics a model leaves out of a recording: report, plots, model.yaml
-  calibrate    fit offset models on some temperature branches of a static recording, score them on the others
-  export       PX4 and ArduPilot thermal-calibration parameters of calibrations (calibrations=[DIR,...])
-
-Every command is a Hydra app: `tcbench <command> --help` (or -h) shows its parameters, their
-defaults, examples and where its output goes; `--cfg job` prints the config a command would run
-with, and runs nothing; -m sweeps.
-"""
-
-
-from tcbench.cli.flags import (  # noqa: E402 - after the usage text
+from tcbench.cli.flags import (
     CFG_CHOICES,
     CONFIG_SOURCE_FLAGS,
     HELP_FLAGS,
@@ -42,6 +21,24 @@ from tcbench.cli.flags import (  # noqa: E402 - after the usage text
     HYDRA_INFO_FLAGS,
     VALUE_FLAGS,
 )
+from tcbench.commands.registry import SPECS, CommandSpec, load
+
+if TYPE_CHECKING:
+    from tcbench.cli.app import Plan
+
+
+def _usage() -> str:
+    """``tcbench --help``: every registered command with its summary."""
+    width = max(len(name) for name in SPECS) + 2
+    return "\n".join([
+        "usage: tcbench <command> [args]", "", "commands:",
+        *(f"  {name:{width}s}{spec.summary}" for name, spec in SPECS.items()), "",
+        "Every command is a Hydra app: `tcbench <command> --help` (or -h) shows its parameters, their",
+        "defaults, examples and where its output goes; `--cfg job` prints the config a command would run",
+        "with, and runs nothing; -m sweeps.", ""])
+
+
+USAGE = _usage()
 
 
 class UserError(Exception):
@@ -86,19 +83,15 @@ def _open_key(arg: str, command: str) -> str:
     free-form dict of the schema (``protocol_params``, ``effects``) is added or replaced."""
     import dataclasses
 
-    from tcbench.commands.schemas import SCHEMAS
-
     if arg.startswith(("+", "~")):
         return arg
-    open_dicts = {f.name for f in dataclasses.fields(SCHEMAS[command]) if str(f.type).startswith("dict")}
+    open_dicts = {f.name for f in dataclasses.fields(SPECS[command].schema_class()) if str(f.type).startswith("dict")}
     return f"++{arg}" if arg.split("=", 1)[0].split(".", 1)[0] in open_dicts and "." in arg.split("=", 1)[0] else arg
 
 
 def _first_input_key(command: str) -> str:
     """The first file argument of ``command`` (``recording``, ``csv``), or ``recording``."""
-    from tcbench.commands.inputs import INPUT_KEYS
-
-    return next(iter(INPUT_KEYS.get(command, ())), "recording")
+    return next(iter(SPECS[command].inputs), "recording")
 
 
 def _file_not_key(arg: str, command: str) -> bool:
@@ -106,10 +99,8 @@ def _file_not_key(arg: str, command: str) -> bool:
     the name of a file: ``tcbench metrics a=b.csv`` means the file ``a=b.csv``."""
     import dataclasses
 
-    from tcbench.commands.schemas import SCHEMAS
-
     head = arg.partition("=")[0].lstrip("+~").split(".", 1)[0]
-    known = {f.name for f in dataclasses.fields(SCHEMAS[command])} | {"hydra"}
+    known = {f.name for f in dataclasses.fields(SPECS[command].schema_class())} | {"hydra"}
     return head not in known and os.path.lexists(arg)
 
 
@@ -122,11 +113,8 @@ def _literal_path(arg: str, command: str, multirun: bool) -> str:
     each then literal. ``null`` stays null."""
     import dataclasses
 
-    from tcbench.commands.inputs import INPUT_KEYS
-    from tcbench.commands.schemas import SCHEMAS
-
     key, eq, value = arg.partition("=")
-    if not eq or key not in INPUT_KEYS.get(command, ()) or value == "null":
+    if not eq or key not in SPECS[command].inputs or value == "null":
         return arg
     from hydra.core.override_parser.overrides_parser import OverridesParser
     from hydra.core.override_parser.types import ChoiceSweep
@@ -135,7 +123,8 @@ def _literal_path(arg: str, command: str, multirun: bool) -> str:
     from tcbench.cli.app import hydra_string
     from tcbench.commands.schemas import literal
 
-    listed = any(f.name == key and str(f.type).startswith("list") for f in dataclasses.fields(SCHEMAS[command]))
+    listed = any(f.name == key and str(f.type).startswith("list")
+                 for f in dataclasses.fields(SPECS[command].schema_class()))
     quoted = len(value) > 1 and value[0] == value[-1] and value[0] in "'\""
     if not multirun and not listed and not quoted:
         return f"{key}={hydra_string(literal(value))}"
@@ -165,10 +154,10 @@ def _quiet_job_log() -> Iterator[None]:
 
 
 def _app_command(command: str, argv: list[str]) -> int:
-    """``tcbench simulate|metrics|import|diagnose|leaderboard|list|quickstart``: a Hydra app on
-    ``conf/<command>.yaml``. One job runs here (no Hydra output folder); ``-m`` sweeps run through
-    Hydra's launcher like ``tcbench run``'s, but those of :data:`IN_TURN` one after another here.
-    Every job is checked before the first starts."""
+    """A key=value command: a Hydra app on its primary config ``conf/<command>.yaml``. One job runs
+    here (no Hydra output folder); ``-m`` sweeps run through Hydra's launcher like ``tcbench run``'s,
+    but those of a command whose spec has ``runs_here`` one after another here. Every job is checked
+    before the first starts."""
     from tcbench.cli import help as cli_help
 
     if any(a in HELP_FLAGS for a in argv):  # the help of the schema: nothing else imported
@@ -191,7 +180,8 @@ def _app_command(command: str, argv: list[str]) -> int:
             multirun = True
         else:
             raise _unknown_option(command, flag)
-    positional = cli_help.SPECS[command].positional
+    spec = SPECS[command]
+    positional = spec.positional
     if positional and args and "=" not in args[0]:
         args = [f"{positional}={args[0]}", *args[1:]]
     if bad := [a for a in args if "=" not in a or a.startswith("=")]:
@@ -204,10 +194,10 @@ def _app_command(command: str, argv: list[str]) -> int:
     if nul := [a for a in args if "\0" in a]:
         raise UserError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
     args = [_literal_path(_open_key(a, command), command, multirun) for a in args]
-    if multirun and cfg is None and command in IN_TURN:
+    if multirun and cfg is None and spec.runs_here:
         return _in_turn(command, args)
     if multirun and cfg is None:
-        checked = _run_sweep(["-m", *args], command)
+        checked = _run_sweep(["-m", *args], spec.config)
         assert checked is not None
         if not checked.tracking_enabled:
             return _failures_report(checked.jobs)
@@ -224,7 +214,7 @@ def _app_command(command: str, argv: list[str]) -> int:
 
     try:
         with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
-            composed = compose_job(args, command)
+            composed = compose_job(args, spec.config)
         if cfg is not None:
             from omegaconf import OmegaConf
 
@@ -234,8 +224,8 @@ def _app_command(command: str, argv: list[str]) -> int:
         check_inputs_exist(c)  # but a missing input file is named before its readers are imported
     except ConfigError as exc:
         raise UserError(str(exc)) from None
-    if command in IN_TURN:
-        check, work = IN_TURN[command]
+    if spec.runs_here:
+        check, work = _runs_here(spec)
         try:
             check(c)
             return work(c)
@@ -446,14 +436,15 @@ def cmd_run(args: list[str]) -> int:
 
 
 def _in_turn(command: str, args: list[str]) -> int:
-    """A ``-m`` sweep of a command of :data:`IN_TURN`: every job checked, then each run here in
+    """A ``-m`` sweep of a command whose jobs run here: every job checked, then each run here in
     turn; the worst exit code."""
     from tcbench.cli.app import claim_outputs, expand
     from tcbench.errors import ConfigError
 
-    check, work = IN_TURN[command]
+    spec = SPECS[command]
+    check, work = _runs_here(spec)
     try:
-        jobs = expand(["-m", *args], command)
+        jobs = expand(["-m", *args], spec.config)
         written: dict[Path, int] = {}
         for i, (_, c) in enumerate(jobs):
             check(c)
@@ -470,100 +461,17 @@ def _in_turn(command: str, args: list[str]) -> int:
     return status
 
 
-def _check_list(c: dict[str, object]) -> None:
-    from tcbench.commands.schemas import LISTS
-    from tcbench.errors import ConfigError
+def _runs_here(spec: CommandSpec) -> tuple[Callable[[dict[str, Any]], None], Callable[[dict[str, Any]], int]]:
+    """The check and the work of a command whose jobs run in this process (the ``check`` and
+    ``work`` of its spec's ``runs_here`` module), each taking a composed job config."""
+    import importlib
 
-    if c.get("what") not in LISTS:
-        raise ConfigError(f"what={c.get('what')}: expected one of {', '.join(LISTS)}")
+    from tcbench.commands.schemas import as_schema
 
+    assert spec.runs_here is not None
+    module, schema = importlib.import_module(spec.runs_here), spec.schema_class()
+    return (lambda c: module.check(as_schema(c, schema))), (lambda c: int(module.work(as_schema(c, schema))))
 
-def _list(c: dict[str, object]) -> int:
-    """Print the registered tasks, optimisers, learners and sensor kinds (``what``: one of them, or all)."""
-    what = c.get("what", "all")
-    if what in {"all", "tasks"}:
-        from tcbench.tasks import TASKS
-
-        for family in dict.fromkeys(spec.family for spec in TASKS.values()):
-            print(f"tasks ({family}):")
-            for spec in (s for s in TASKS.values() if s.family == family):
-                print(f"  {spec.gym_id:26s} task={spec.name:{14 if spec.is_compensation else 11}s} {spec.summary}")
-    if what in {"all", "optimisers"}:
-        from tcbench.optimisers import registry
-
-        print("optimisers:")
-        for name, entry in registry.available().items():
-            kinds = "+".join(k for k, ok in (("single", entry.cls.single_objective),
-                                             ("multi", entry.cls.multi_objective)) if ok)
-            print(f"  {name:10s} {entry.cls.__module__}.{entry.cls.__name__}  (from {entry.package}; {kinds}-objective)")
-        for name, err in registry.broken().items():
-            print(f"  {name:10s} BROKEN: {err}")
-    if what in {"all", "learners"}:
-        from tcbench.learners import registry as learners
-
-        print("learners:")
-        for name, lentry in learners.available().items():
-            kind = "initial weights searchable" if lentry.cls.searchable else "closed form"
-            print(f"  {name:10s} {lentry.cls.__module__}.{lentry.cls.__name__}  (from {lentry.package}; {kind})")
-        for name, err in learners.broken().items():
-            print(f"  {name:10s} BROKEN: {err}")
-        print("  raw, memoriser, oracle, oracle_thermometer, lagpoly, model  baselines: no compensation; the training "
-              "runs' mean output at the same time (no physics); the simulator's truth (the physical limit); its model "
-              "fed the thermometer (the limit of what a compensator reads); the lag-aware polynomial; the model "
-              "tcbench diagnose fits (accel_chamber)")
-    if what in {"all", "sensors"}:
-        from tcbench.sensors import kinds as sensor_kinds
-
-        print("sensors:")
-        for kind in sensor_kinds.registry().values():
-            units = f"{kind.input_unit} in, {kind.output_unit} out"
-            print(f"  {kind.name:10s} {kind.title}; {units}; protocols: {', '.join(kind.protocols)}"
-                  + (f"; PX4 {kind.ulog_topic}" if kind.ulog_topic else ""))
-    return 0
-
-
-def _quickstart_config(c: dict[str, object]) -> object:
-    from tcbench.commands.schemas import QuickstartConfig, as_schema
-
-    return as_schema(c, QuickstartConfig)
-
-
-def _check_quickstart(c: dict[str, object]) -> None:
-    from tcbench.cli import quickstart
-
-    quickstart.check(_quickstart_config(c))  # type: ignore[arg-type]
-
-
-def _quickstart(c: dict[str, object]) -> int:
-    from tcbench.cli import quickstart
-
-    return quickstart.run(_run_sweep, _sweep_report, _quickstart_config(c))  # type: ignore[arg-type]
-
-
-def _export_config(c: dict[str, object]) -> object:
-    from tcbench.commands.schemas import ExportConfig, as_schema
-
-    return as_schema(c, ExportConfig)
-
-
-def _check_export(c: dict[str, object]) -> None:
-    from tcbench.commands.export import check_export
-
-    check_export(_export_config(c))  # type: ignore[arg-type]
-
-
-def _export(c: dict[str, object]) -> int:
-    from tcbench.commands.export import export
-
-    export(_export_config(c))  # type: ignore[arg-type]
-    return 0
-
-
-# commands whose jobs run here, not on the launcher: a listing is instant, an export writes two
-# small files, and each quickstart runs sweeps of its own on the launcher; name -> (check before
-# any job, the job)
-IN_TURN = {"list": (_check_list, _list), "quickstart": (_check_quickstart, _quickstart),
-           "export": (_check_export, _export)}
 
 # ``tcbench leaderboard``'s flags, kept as aliases of its keys
 LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--out": "out", "--tracking-uri": "tracking.uri"}
@@ -605,43 +513,16 @@ def cmd_leaderboard(argv: list[str]) -> int:
     return _app_command("leaderboard", args)
 
 
-def cmd_quickstart(argv: list[str]) -> int:
-    return _app_command("quickstart", argv)
+def _handler(spec: CommandSpec) -> Callable[[list[str]], int]:
+    """What runs ``tcbench NAME ARGS...``: the spec's own argument parser, imported when called,
+    else the key=value app on its primary config."""
+    if spec.parser is None:
+        return functools.partial(_app_command, spec.name)
+    parser = spec.parser
+    return lambda argv: int(load(parser)(argv))
 
 
-def cmd_list(argv: list[str]) -> int:
-    return _app_command("list", argv)
-
-
-def cmd_simulate(argv: list[str]) -> int:
-    return _app_command("simulate", argv)
-
-
-def cmd_import(argv: list[str]) -> int:
-    return _app_command("import", argv)
-
-
-def cmd_metrics(argv: list[str]) -> int:
-    return _app_command("metrics", argv)
-
-
-def cmd_diagnose(argv: list[str]) -> int:
-    return _app_command("diagnose", argv)
-
-
-def cmd_calibrate(argv: list[str]) -> int:
-    return _app_command("calibrate", argv)
-
-
-def cmd_export(argv: list[str]) -> int:
-    return _app_command("export", argv)
-
-
-COMMANDS = {
-    "run": cmd_run, "leaderboard": cmd_leaderboard, "quickstart": cmd_quickstart, "list": cmd_list,
-    "simulate": cmd_simulate, "import": cmd_import, "metrics": cmd_metrics, "diagnose": cmd_diagnose,
-    "calibrate": cmd_calibrate, "export": cmd_export,
-}
+COMMANDS: dict[str, Callable[[list[str]], int]] = {name: _handler(spec) for name, spec in SPECS.items()}
 
 
 def main(argv: list[str] | None = None) -> int:

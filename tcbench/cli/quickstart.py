@@ -99,10 +99,18 @@ def check(cfg: QuickstartConfig) -> None:
         raise ConfigError(refusal_line(exc)) from None
 
 
+def work(cfg: QuickstartConfig) -> int:
+    """``tcbench quickstart`` (:attr:`~tcbench.commands.registry.CommandSpec.runs_here`): :func:`run`
+    on the command line's sweep launcher and end-of-sweep report."""
+    from tcbench.cli.main import _run_sweep, _sweep_report
+
+    return run(_run_sweep, _sweep_report, cfg)
+
+
 def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int], cfg: QuickstartConfig) -> int:
     """Run the quickstart ``cfg`` from the working directory with the command line's sweep
-    launcher ``run_sweep`` and end-of-sweep report ``sweep_report`` (passed in, so this module does
-    not import the command line that calls it); 0 if every job finished."""
+    launcher ``run_sweep`` and end-of-sweep report ``sweep_report`` (:func:`work` passes the command
+    line's); 0 if every job finished."""
     check(cfg)
     started = time.monotonic()
     sweep = cfg.tracking.sweep_id or uuid.uuid4().hex[:12]

@@ -160,3 +160,15 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
         print(f"tcbench: wrote {written['ardupilot']} (ArduPilot INS_TCAL{cfg.ardupilot_imu}_* of {every}; "
               "load it in the ground station)")
     return written
+
+
+# tcbench export runs in the command line's process (CommandSpec.runs_here): its check and its work
+def check(cfg: ExportConfig) -> None:
+    """Every argument of an export, before any export of a sweep is written."""
+    check_export(cfg)
+
+
+def work(cfg: ExportConfig) -> int:
+    """Write the parameter files of ``cfg``; exit code 0."""
+    export(cfg)
+    return 0

@@ -1,8 +1,8 @@
-"""Config schemas of the key=value commands (``tcbench simulate|metrics|import|diagnose|leaderboard|
-list|quickstart``; ``tcbench run``'s is :mod:`tcbench.runner.config`): each
-is the structured base of its primary config ``conf/<command>.yaml``, registered with Hydra's
-ConfigStore as ``<command>_schema`` so types and known keys are checked at composition.
-``kind`` names the job kind that runs it (:mod:`tcbench.runner.kinds`)."""
+"""Config schemas of the key=value commands (``tcbench run``'s is :mod:`tcbench.runner.schema`):
+each is the structured base of its primary config ``conf/<command>.yaml``, named by the command's
+spec (:mod:`tcbench.commands.registry`) and registered with Hydra's ConfigStore as
+``<command>_schema`` so types and known keys are checked at composition. ``kind`` names the job
+kind that runs it (:mod:`tcbench.runner.kinds`)."""
 
 from __future__ import annotations
 
@@ -195,22 +195,14 @@ class QuickstartConfig:
     tracking: QuickstartTracking = field(default_factory=QuickstartTracking)
 
 
-SCHEMAS: dict[str, type] = {"simulate": SimulateConfig, "metrics": MetricsConfig, "import": ImportConfig,
-                            "diagnose": DiagnoseConfig, "calibrate": CalibrateConfig, "export": ExportConfig, "leaderboard": LeaderboardConfig, "list": ListConfig,
-                            "quickstart": QuickstartConfig}
-
-
 def register() -> None:
-    """Make the schemas available to Hydra as ``<command>_schema``, and the resolver ``stem``:
-    ``${stem:KEY}`` is the file stem of the path at config key ``KEY`` (``out=diagnoses/${stem:recording}``:
-    a folder per recording of a sweep)."""
+    """Register the resolver ``stem``: ``${stem:KEY}`` is the file stem of the path at config key
+    ``KEY`` (``out=diagnoses/${stem:recording}``: a folder per recording of a sweep). The schemas
+    are registered by :func:`tcbench.runner.schema.register_schema`."""
     from pathlib import PurePath
 
-    from hydra.core.config_store import ConfigStore
     from omegaconf import OmegaConf
 
-    for name, schema in SCHEMAS.items():
-        ConfigStore.instance().store(name=f"{name}_schema", node=schema)
     if not OmegaConf.has_resolver("stem"):
         OmegaConf.register_new_resolver("stem", lambda key, _root_: PurePath(str(OmegaConf.select(_root_, key))).stem)
 

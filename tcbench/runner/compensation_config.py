@@ -3,6 +3,8 @@ compensation, gyro and task layers it checks, below the config and job modules t
 
 from __future__ import annotations
 
+import copy
+import functools
 from typing import Any
 
 import gymnasium as gym
@@ -23,11 +25,22 @@ def _error(message: str) -> Exception:
     return ConfigError(message)
 
 
+# a compensation job's learner when its config gives none (config.yaml's defaults list has
+# ``learner: null``: optimisation jobs take no learner)
+DEFAULT_LEARNER = "bp"
+
+
+@functools.cache
+def _default_learner() -> dict[str, Any]:
+    """The option :data:`DEFAULT_LEARNER` of the config group ``learner``, read once."""
+    return dict(yaml.safe_load((conf_dir() / "learner" / f"{DEFAULT_LEARNER}.yaml").read_text(encoding="utf-8")))
+
+
 def learner_of(c: dict[str, Any]) -> dict[str, Any]:
-    """The job's learner config; ``conf/learner/bp.yaml`` when none is given."""
+    """The job's learner config, a copy; the default learner's when none is given."""
     if c.get("learner"):
         return dict(c["learner"])
-    return dict(yaml.safe_load((conf_dir() / "learner" / "bp.yaml").read_text()))
+    return copy.deepcopy(_default_learner())
 
 
 def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:

@@ -26,10 +26,15 @@ class JobConfig:
 
 
 def register_schema() -> None:
-    """Make the structured schema available to Hydra as ``base_config``."""
+    """Make the schema of every command available to Hydra under the name its primary config's
+    defaults list gives it (:attr:`~tcbench.commands.registry.CommandSpec.schema_node`:
+    ``base_config`` for this one, ``simulate_schema`` ...)."""
     from hydra.core.config_store import ConfigStore
 
-    ConfigStore.instance().store(name="base_config", node=JobConfig)
+    from tcbench.commands.registry import SPECS
+
+    for spec in SPECS.values():
+        ConfigStore.instance().store(name=spec.schema_node, node=spec.schema_class())
 
 
 def as_dict(cfg: Any) -> dict[str, Any]:

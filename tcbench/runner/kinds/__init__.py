@@ -6,29 +6,18 @@ way for every kind: the memory limit, resume, the run's tags and params, the con
 the FAILED path. A job's kind is its config's ``kind`` key (``simulate``, ``metrics``,
 ``import``, ``diagnose``, ``leaderboard``: the primary configs ``conf/<command>.yaml``) or, for ``tcbench run``,
 the job kind of its task's spec (:mod:`tcbench.tasks.specs`). A new kind is one module here
-and one entry in :data:`KIND_MODULES`.
+and one entry in the ``kinds`` of its command's spec (:mod:`tcbench.commands.registry`).
 """
 
 from __future__ import annotations
 
-import importlib
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tcbench.commands.registry import job_kinds, load
 from tcbench.errors import ConfigError
-
-# kind name -> module whose ``KINDS`` dict holds it (imported when a job of that kind runs)
-KIND_MODULES = {
-    "optimisation": "tcbench.runner.kinds.optimisation",
-    "compensation": "tcbench.runner.kinds.compensation",
-    "simulate": "tcbench.runner.kinds.recordings",
-    "metrics": "tcbench.runner.kinds.recordings",
-    "import": "tcbench.runner.kinds.recordings",
-    "diagnose": "tcbench.runner.kinds.diagnosis",
-    "leaderboard": "tcbench.runner.kinds.leaderboards",
-    "calibrate": "tcbench.runner.kinds.calibration",
-}
 
 
 @dataclass(frozen=True)
@@ -43,9 +32,8 @@ class JobNames:
 
 
 class JobKind:
-    """One kind of job; subclasses override what differs."""
+    """One kind of job, named by its command's spec; subclasses override what differs."""
 
-    name = ""
     tag = ""  # ``tcbench.kind`` of its MLflow runs (the leaderboards select by it); default: name
     plots_in_sweeps = True  # ``tracking.plots: null`` in a sweep draws the figures
     # True: the MLflow run opens when the work is done (a user error, such as a malformed input
@@ -53,8 +41,9 @@ class JobKind:
     # first and shows RUNNING while the job works (the long jobs of ``tcbench run``)
     opens_run_after_work = False
 
-    def __init__(self) -> None:
-        self.tag = self.tag or self.name
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.tag = self.tag or name
 
     def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
         """The config as it will run and be logged (defaults made explicit); nothing is run."""
@@ -122,10 +111,16 @@ def kind_name(c: dict[str, Any]) -> str:
         raise ConfigError(f"task: {exc}") from None
 
 
+@functools.cache
+def _kind(name: str, path: str) -> JobKind:
+    """The one instance of the JobKind class at ``path`` (imported now) running kind ``name``."""
+    return load(path)(name)  # type: ignore[no-any-return]
+
+
 def kind_of(c: dict[str, Any]) -> JobKind:
     """The :class:`JobKind` that runs config ``c``; ConfigError for an unknown kind."""
     name = kind_name(c)
-    if name not in KIND_MODULES:
-        raise ConfigError(f"kind: unknown job kind {name!r}; known: {', '.join(KIND_MODULES)}")
-    kinds = importlib.import_module(KIND_MODULES[name]).KINDS
-    return kinds[name]
+    paths = job_kinds()
+    if name not in paths:
+        raise ConfigError(f"kind: unknown job kind {name!r}; known: {', '.join(paths)}")
+    return _kind(name, paths[name])

@@ -19,7 +19,7 @@ from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 class CalibrateKind(JobKind):
-    name, tag = "calibrate", "calibration"
+    tag = "calibration"
     opens_run_after_work = True  # a recording it cannot calibrate leaves no run, as it leaves no file
 
     def config(self, c: dict[str, Any]) -> CalibrateConfig:
@@ -71,6 +71,3 @@ class CalibrateKind(JobKind):
 
     def summary(self, outcome: CalibrationOutcome, c: dict[str, Any]) -> str:
         return f"calibrated {c.get('recording')}"
-
-
-KINDS = {"calibrate": CalibrateKind()}

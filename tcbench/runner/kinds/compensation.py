@@ -145,8 +145,6 @@ def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:
 
 
 class CompensationKind(JobKind):
-    name = "compensation"
-
     def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
         return {**c, "learner": learner_of(c)}  # the default learner made explicit: logged and hashed
 
@@ -208,6 +206,3 @@ class CompensationKind(JobKind):
         s, primary = result.score.summary(), PRIMARY[result.score.protocol]
         return (f"{self.names(c).run}: {primary} {s[primary]:.4g} (raw {s[f'raw_{primary}']:.4g}), "
                 f"{result.score.train_key} {s[result.score.train_key]:.3g}")
-
-
-KINDS = {"compensation": CompensationKind()}

@@ -27,7 +27,7 @@ def diagnosis_metrics(diag: Any) -> dict[str, float]:
 
 
 class DiagnoseKind(JobKind):
-    name, tag = "diagnose", "diagnosis"
+    tag = "diagnosis"
     opens_run_after_work = True  # a recording it cannot diagnose leaves no run, as it leaves no report
 
     def config(self, c: dict[str, Any]) -> DiagnoseConfig:
@@ -66,6 +66,3 @@ class DiagnoseKind(JobKind):
 
     def summary(self, outcome: DiagnosisOutcome, c: dict[str, Any]) -> str:
         return f"diagnosed {c.get('recording')}: {outcome.diagnosis.verdict}"
-
-
-KINDS = {"diagnose": DiagnoseKind()}

@@ -14,7 +14,6 @@ from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 class LeaderboardKind(JobKind):
-    name = "leaderboard"
     opens_run_after_work = True  # nothing to rank leaves no run, as it leaves no file
 
     def config(self, c: dict[str, Any]) -> LeaderboardConfig:
@@ -43,6 +42,3 @@ class LeaderboardKind(JobKind):
 
     def summary(self, outcome: list[Path], c: dict[str, Any]) -> str:
         return f"leaderboard of {c.get('experiments')}: {len(outcome)} files in {c.get('out')}"
-
-
-KINDS = {"leaderboard": LeaderboardKind()}

@@ -55,7 +55,6 @@ def ioh_folder(c: dict[str, Any]) -> Path | None:
 
 
 class OptimisationKind(JobKind):
-    name = "optimisation"
     plots_in_sweeps = False  # a convergence PNG per run costs more than the run; the leaderboard draws them
 
     def plan_check(self, c: dict[str, Any]) -> None:
@@ -102,6 +101,3 @@ class OptimisationKind(JobKind):
         n = self.names(c)
         return (f"{n.method} on {n.task} seed {c['seed']}: best {result.best_f:.6g} (error {result.error:.3g}) "
                 f"after {result.evaluations} evaluations")
-
-
-KINDS = {"optimisation": OptimisationKind()}

@@ -50,7 +50,7 @@ class RecordingKind(JobKind):
 
 
 class SimulateKind(RecordingKind):
-    name, tag, schema = "simulate", "simulation", SimulateConfig
+    tag, schema = "simulation", SimulateConfig
 
     def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
         return {**c, "protocol": recordings.simulated_protocol(self.config(c))}  # the kind's default made explicit
@@ -75,7 +75,7 @@ class SimulateKind(RecordingKind):
 
 
 class MetricsKind(RecordingKind):
-    name, schema = "metrics", MetricsConfig
+    schema = MetricsConfig
 
     def check(self, c: dict[str, Any]) -> None:
         recordings.check_metrics(self.config(c))
@@ -95,7 +95,7 @@ class MetricsKind(RecordingKind):
 
 
 class ImportKind(RecordingKind):
-    name, schema = "import", ImportConfig
+    schema = ImportConfig
 
     def check(self, c: dict[str, Any]) -> None:
         recordings.check_import(self.config(c))
@@ -115,6 +115,3 @@ class ImportKind(RecordingKind):
 
     def summary(self, outcome: recordings.RecordingOutcome, c: dict[str, Any]) -> str:
         return f"imported {outcome.path}"
-
-
-KINDS = {"simulate": SimulateKind(), "metrics": MetricsKind(), "import": ImportKind()}
