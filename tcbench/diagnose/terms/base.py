@@ -61,14 +61,16 @@ def signals(data: DiagnosisData, temp_c: np.ndarray, ref_c: float = 0.0) -> Sign
 class Term(ABC):
     """One effect of the library in the diagnosis.
 
-    ``id`` and ``effect`` (its class in the effect library), ``shape`` (PHYSICS.md §8),
-    ``param`` and ``grid`` (the nonlinear parameter searched on a grid, or None),
-    ``deterministic`` (False: noise, judged from the residual's Allan deviation, not searched
-    as a model term), ``confirm_with``
-    (the measurement that would confirm it), ``confusable`` (``{other term id: the test that
-    would tell the two apart}``, declared on one side of each pair), ``flicker_mimics`` (a
-    slow random excursion of the bias can look like it) and ``cached`` (its column is costly:
-    the designer keeps it per value and model temperature).
+    - ``id``, ``effect``: its id and its class in the effect library (the same id);
+    - ``shape``: the shape its signature takes in a residual (PHYSICS.md §8);
+    - ``param``, ``grid``: the nonlinear parameter searched and its grid (None: none);
+    - ``deterministic``: a model term of the forward selection (False: noise, judged from the
+      residual's Allan deviation);
+    - ``confirm_with``: the measurement that would confirm it;
+    - ``confusable``: ``{other id: the test that would tell the two apart}``, declared on one
+      side of each pair (:meth:`partners` gives both);
+    - ``flicker_mimics``: a slow random excursion of the bias can look like it;
+    - ``cached``: its column is costly; the designer keeps it per value and model temperature.
     """
 
     id: ClassVar[str] = ""
