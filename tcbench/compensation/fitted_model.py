@@ -34,12 +34,13 @@ import dataclasses
 import numpy as np
 
 from tcbench.sensors import kinds
+from tcbench.sensors.effects import EFFECTS
 from tcbench.sensors.fitted import PolynomialModel
 from tcbench.sensors.protocols import MAX_SAMPLES, Profile
 from tcbench.sensors.segments import within_rate_hz
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 
-RIG_EFFECTS = ("periodic", "gated_periodic", "duty_cycle")
+RIG_EFFECTS = tuple(cls.id for cls in EFFECTS.values() if cls.rig)  # the rig's lines, not the sensor
 CLOCK_EFFECTS = ("bias_step", "transient", "warmup", "aging_drift")  # keyed to the calibration run's clock
 
 

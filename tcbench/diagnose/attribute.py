@@ -43,6 +43,7 @@ from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_signifi
 from tcbench.diagnose.open_terms import is_open, term_threshold
 from tcbench.diagnose.plan import ROBUST_WALD, SURROGATE, StatsPlan, plan_for
 from tcbench.diagnose.surrogate import LEVEL, surrogate_test
+from tcbench.diagnose.terms import confusable_pairs, term
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
 
@@ -50,21 +51,7 @@ PENALTY_PER_PARAM = 2.0
 WALD_THRESHOLD = 25.0  # cluster-robust Wald statistic; same calibration
 MOST_OF_EXCESS = 0.5  # an effect removing this share of the held-out error above noise is never dropped by the Wald test alone
 SURROGATE_SEED = 20240611  # the surrogate test's generator: same recording, same diagnosis
-CONFUSABLE: dict[frozenset[str], str] = {
-    frozenset({"thermal_lag", "temperature_rate"}): (
-        "soaks of at least five die time constants after fast ramps: a lagging die keeps drifting "
-        "into the soak, a thermal-gradient term stops with the ramp"),
-    frozenset({"hysteresis", "thermal_lag"}): (
-        "soaks at one temperature approached from above and from below, each long enough to settle: "
-        "a lag dies out during the soak, hysteresis persists"),
-    frozenset({"hysteresis", "temperature_rate"}): (
-        "soaks at one temperature approached from above and from below: a gradient term is zero "
-        "during a soak, hysteresis is not"),
-    frozenset({"warmup", "aging_drift"}): (
-        "a longer run or a power cycle: warm-up settles within the hour after power-on, ageing keeps going"),
-    frozenset({"aging_drift", "temperature_cubic"}): (
-        "a profile that revisits the same temperatures hours apart: ageing follows time, a cubic follows temperature"),
-}
+CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}
 
 
 @dataclass
@@ -165,8 +152,8 @@ class _Scorer:
         if values[i] is None:
             return gains[i], None
         lo, hi = np.log(values[max(i - 1, 0)]), np.log(values[min(i + 1, len(values) - 1)])  # type: ignore[arg-type]
-        if i == len(values) - 1 and effect == "hysteresis":  # best at the grid's edge: search on, to half the span
-            hi = max(hi, float(np.log(0.5 * np.ptp(self.designer.data.temp_c))))
+        if i == len(values) - 1 and (top := term(effect).past_grid(self.designer.data)) is not None:
+            hi = max(hi, float(np.log(top)))  # best at the grid's edge: search on, as far as the term allows
         res = minimize_scalar(lambda z: -self.gain(base, base.with_effect(effect, float(np.exp(z)))),
                               bounds=(lo, hi), method="bounded", options={"xatol": 0.02})
         if -res.fun > gains[i]:

@@ -3,8 +3,9 @@
 The minimal model (DESIGN.md "Diagnosis") is ``b(T) + input * k(T)``, with ``b`` and ``k``
 quadratic in ``u = (T - centre_c) / half_range_c``; the ``input * k(T)`` columns are dropped
 when the input never varies. ``T`` is the smoothed thermometer reading, or the die temperature
-``lag(T, tau_s)`` once ``thermal_lag`` is part of the model. Every other effect adds columns
-(PHYSICS.md §3); its nonlinear parameter (a time constant, a width) is searched on a grid:
+``lag(T, tau_s)`` once ``thermal_lag`` is part of the model. Every other effect adds the
+column(s) of its term (:mod:`tcbench.diagnose.terms`, PHYSICS.md §3); its nonlinear parameter
+(a time constant, a width) is searched on the term's grid:
 
 =====================  ===============================  =====================
 effect                 column(s)                        searched
@@ -31,19 +32,11 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.open_terms import kind_of, term_columns
-from tcbench.diagnose.signals import DiagnosisData, hysteresis_state, lagged
+from tcbench.diagnose.signals import DiagnosisData, lagged
+from tcbench.diagnose.terms import term, terms
 
-DETERMINISTIC = (
-    "thermal_lag", "temperature_rate", "hysteresis", "warmup", "aging_drift", "temperature_cubic",
-    "accel_nonlinearity",
-)
-ALL_EFFECTS = (*DETERMINISTIC, "bias_instability")
-GRIDS: dict[str, np.ndarray] = {  # the nonlinear parameter's search grid
-    "thermal_lag": np.geomspace(20.0, 3600.0, 16),
-    "hysteresis": np.geomspace(0.2, 8.0, 12),
-    "warmup": np.geomspace(120.0, 7200.0, 14),
-}
-PARAM_NAME = {"thermal_lag": "tau_s", "hysteresis": "width_c", "warmup": "tau_s"}
+DETERMINISTIC = tuple(t.id for t in terms() if t.deterministic)  # the forward selection's candidates, in order
+ALL_EFFECTS = tuple(t.id for t in terms())
 
 
 @dataclass(frozen=True)
@@ -83,7 +76,7 @@ class Designer:
 
     data: DiagnosisData
     _lag_cache: dict[float, np.ndarray] = field(default_factory=dict)
-    _hyst_cache: dict[tuple[float, float | None], np.ndarray] = field(default_factory=dict)
+    _term_cache: dict[tuple[str, float | None, float | None], np.ndarray] = field(default_factory=dict)
     _open_cache: dict[tuple[str, Any, float | None], np.ndarray] = field(default_factory=dict)
 
     @cached_property
@@ -119,24 +112,14 @@ class Designer:
         return np.column_stack(cols)
 
     def column(self, effect: str, value: float | None, temp_c: np.ndarray, lag_tau_s: float | None) -> np.ndarray:
-        """The regressor of ``effect`` with nonlinear parameter ``value``."""
-        d = self.data
-        if effect == "temperature_rate":
-            return d.rate_c_per_s
-        if effect == "hysteresis":
-            key = (float(value), lag_tau_s)  # type: ignore[arg-type]
-            if key not in self._hyst_cache:
-                self._hyst_cache[key] = hysteresis_state(d.t_s, temp_c, float(value))  # type: ignore[arg-type]
-            return self._hyst_cache[key]
-        if effect == "warmup":
-            return np.exp(-d.t_s / float(value))  # type: ignore[arg-type]
-        if effect == "aging_drift":
-            return d.t_s / 3600.0
-        if effect == "temperature_cubic":
-            return ((temp_c - self.centre_c) / self.half_range_c) ** 3
-        if effect == "accel_nonlinearity":
-            return d.input**2
-        raise ValueError(f"effect {effect!r} has no regressor")
+        """The regressor of ``effect`` with nonlinear parameter ``value`` (its term's column)."""
+        t = term(effect)
+        if not t.cached:
+            return t.column(self.data, value, temp_c, self.centre_c, self.half_range_c)
+        key = (effect, float(value) if value is not None else None, lag_tau_s)
+        if key not in self._term_cache:
+            self._term_cache[key] = t.column(self.data, value, temp_c, self.centre_c, self.half_range_c)
+        return self._term_cache[key]
 
     def columns(self, effect: str, value: Any, lag_tau_s: float | None) -> np.ndarray:
         """The column(s) (n, m) of ``effect`` at ``value`` on the model temperature of ``lag_tau_s``."""
@@ -155,21 +138,10 @@ class Designer:
         return np.hstack(cols)
 
     def why_not_identifiable(self, effect: str) -> str | None:
-        """Why this recording cannot show ``effect`` at all, or None."""
-        d = self.data
-        rising = d.rate_c_per_s > 0.05 / 60.0
-        falling = d.rate_c_per_s < -0.05 / 60.0
-        if effect == "accel_nonlinearity" and d.input_levels < 3:
-            return (f"the input takes {d.input_levels} value(s); a square term needs at least three "
-                    "(e.g. +1 g, 0 g, -1 g)")
-        if effect == "hysteresis" and not (rising.any() and falling.any()):
-            return "the temperature only moves one way; hysteresis needs the same temperatures reached heating and cooling"
-        if effect in ("temperature_rate", "thermal_lag") and not (rising | falling).any():
-            return "the temperature never changes faster than 0.05 degC/min"
-        return None
+        """Why this recording cannot show ``effect`` at all (its term's ``skip``), or None."""
+        return term(effect).skip(self.data)
 
 
 def grid_values(effect: str) -> list[float | None]:
     """Values of the nonlinear parameter searched for ``effect`` (``[None]`` if it has none)."""
-    return list(GRIDS[effect]) if effect in GRIDS else [None]
-
+    return term(effect).grid_values()

@@ -20,7 +20,7 @@ from tcbench.diagnose.attribute import (
     attribute,
     recheck_with_flicker,
 )
-from tcbench.diagnose.design import DETERMINISTIC, PARAM_NAME, Designer, Model
+from tcbench.diagnose.design import DETERMINISTIC, Designer, Model
 from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.open_terms import TERMS, is_open, kind_of, open_finding
@@ -31,13 +31,14 @@ from tcbench.diagnose.plan import SURROGATE, min_full_duration_s
 from tcbench.diagnose.reference import Reference, reference_fit
 from tcbench.diagnose.surrogate import LEVEL
 from tcbench.diagnose.signals import DiagnosisData, prepare
+from tcbench.diagnose.terms import term, terms
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
 log = logging.getLogger(__name__)
 FALSE_ALARM = 0.01  # of the mismatch scan and of the flicker test
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
-TIME_EFFECTS = ("warmup", "aging_drift")  # what a slow random excursion of the bias can mimic
+TIME_EFFECTS = tuple(t.id for t in terms() if t.flicker_mimics)  # what a slow random excursion of the bias can mimic
 REFERENCE_RATIO = 1.25  # final / reference held-out RMSE above which deterministic structure remains
 FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every power-on and ageing keeps "
                 "its sign, a flicker excursion does neither")
@@ -134,8 +135,8 @@ def _evidence_json(e: Evidence) -> dict[str, Any]:
     if np.isfinite(e.gain):
         out |= {"gain_sigma2": round(float(e.gain), 2), "threshold_sigma2": float(e.threshold)}
     out |= _test_json(e)
-    if e.value is not None and e.effect in PARAM_NAME:
-        out[PARAM_NAME[e.effect]] = float(e.value)
+    if e.value is not None and e.effect in DETERMINISTIC and (name := term(e.effect).param):
+        out[name] = float(e.value)
     return out
 
 
@@ -162,19 +163,9 @@ def base_model(effects: dict[str, dict[str, float]]) -> Model:
     for effect, params in effects.items():
         if effect not in DETERMINISTIC:
             continue
-        name = PARAM_NAME.get(effect)
+        name = term(effect).param
         model = model.with_effect(effect, float(params[name]) if name else None)
     return model
-
-
-def _effect_params(effect: str, coef: float, value: float | None, half_range_c: float) -> dict[str, float]:
-    """An effect term's fitted coefficient (and searched value) as the effect library's parameters."""
-    if effect in ("hysteresis", "warmup"):
-        return {"amplitude": coef, PARAM_NAME[effect]: float(value)}  # type: ignore[arg-type]
-    if effect == "temperature_cubic":
-        return {"c3_per_c3": coef / half_range_c**3}  # the column is u^3, u = (T - centre) / half range
-    name = {"temperature_rate": "coef_per_c_per_s", "aging_drift": "rate_per_h", "accel_nonlinearity": "k2_per_g2"}
-    return {name[effect]: coef}
 
 
 def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, float]]]:
@@ -195,7 +186,7 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
         coef, i = beta[i:i + m], i + m
         effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
-                           else _effect_params(effect, float(coef[0]), value, d.half_range_c))
+                           else term(effect).params(float(coef[0]), value, d.half_range_c))
     return core, effects
 
 

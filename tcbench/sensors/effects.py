@@ -47,10 +47,15 @@ class Signals:
 
 @dataclass(frozen=True)
 class Effect:
-    """Base of all effects; subclasses set ``id`` and ``stage`` and implement one method."""
+    """Base of all effects; subclasses set ``id`` and ``stage`` and implement one method.
+    ``stochastic``: part of the recorded noise (drawn, or the quantisation of what was drawn),
+    left out of the deterministic truth; ``rig``: what the test rig does to the output (a
+    compressor's, a fan's or a supply's line), not the sensor."""
 
     id: ClassVar[str] = ""
     stage: ClassVar[str] = "output"
+    stochastic: ClassVar[bool] = False
+    rig: ClassVar[bool] = False
 
     def die_temperature(self, s: Signals) -> np.ndarray:
         """Stage ``die``: the die temperature after this effect."""
@@ -183,6 +188,7 @@ class BiasInstability(Effect):
     """Flicker bias noise with Allan floor ``0.664 b`` (``b`` in output units)."""
 
     id: ClassVar[str] = "bias_instability"
+    stochastic: ClassVar[bool] = True
     b: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
@@ -195,6 +201,7 @@ class WhiteNoise(Effect):
     velocity random walk); per sample its standard deviation is ``density * sqrt(fs)``."""
 
     id: ClassVar[str] = "white_noise"
+    stochastic: ClassVar[bool] = True
     density: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
@@ -206,6 +213,7 @@ class RandomWalk(Effect):
     """Rate random walk, ``k`` in output unit per sqrt(s)."""
 
     id: ClassVar[str] = "random_walk"
+    stochastic: ClassVar[bool] = True
     k_per_sqrt_s: float = 0.0
 
     def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
@@ -218,6 +226,7 @@ class Quantisation(Effect):
 
     id: ClassVar[str] = "quantisation"
     stage: ClassVar[str] = "final"
+    stochastic: ClassVar[bool] = True
     step: float = 0.0
 
     def transform(self, y: np.ndarray) -> np.ndarray:
@@ -241,6 +250,7 @@ class Periodic(Effect):
     """``amplitude * sin(2 pi t / period_s + phase_rad)``: environmental cycling (PHYSICS.md §8)."""
 
     id: ClassVar[str] = "periodic"
+    rig: ClassVar[bool] = True
     period_s: float = 1800.0
     amplitude: float = 0.0
     phase_rad: float = 0.0
@@ -257,6 +267,7 @@ class GatedPeriodic(Effect):
     cycle, not a sinusoid); ``amplitude`` (the fundamental's) is informative."""
 
     id: ClassVar[str] = "gated_periodic"
+    rig: ClassVar[bool] = True
     period_s: float = 1800.0
     start_s: float = 0.0
     end_s: float = 0.0
@@ -287,6 +298,7 @@ class DutyCycle(Effect):
     while the load is on (a compressor or heater on a thermostat)."""
 
     id: ClassVar[str] = "duty_cycle"
+    rig: ClassVar[bool] = True
     period_s: float = 1800.0
     on_s: float = 0.0
     duty: float = 0.5
@@ -389,6 +401,7 @@ class NoiseTemperature(Effect):
     per sqrt(Hz) at ``ref_c``; ``growth_per_c`` the relative growth of sigma per degC)."""
 
     id: ClassVar[str] = "noise_temperature"
+    stochastic: ClassVar[bool] = True
     density: float = 0.0
     growth_per_c: float = 0.0
     ref_c: float = 25.0
@@ -411,6 +424,7 @@ class NoiseTime(Effect):
     sigma per hour). A reference inside the record keeps the level finite on an epoch clock."""
 
     id: ClassVar[str] = "noise_time"
+    stochastic: ClassVar[bool] = True
     density: float = 0.0
     growth_per_h: float = 0.0
     ref_s: float = 0.0

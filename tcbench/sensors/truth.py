@@ -35,7 +35,7 @@ from tcbench.sensors.models import SensorModel, _signals
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.simulate import prepare_run, thermometer_reading
 
-STOCHASTIC_EFFECTS = ("white_noise", "bias_instability", "random_walk", "quantisation", "noise_temperature", "noise_time")
+STOCHASTIC_EFFECTS = tuple(cls.id for cls in fx.EFFECTS.values() if cls.stochastic)  # the noise a recording adds
 # The thermometer-limited oracle's smoothing of the reading: a centred mean over a minute averages
 # 60-600 samples of thermometer noise while the package temperature, behind the chamber's air by
 # minutes, moves by at most 1 degC/min x 60 s at the fastest ramp (its curvature, not its slope,

@@ -1,0 +1,175 @@
+"""The base of a library term: one effect of :mod:`tcbench.sensors.effects` as the diagnosis
+models, reports and explains it, and the registry that finds a term by its id.
+
+A subclass sets the class attributes (``id``, ``shape``, ``effect``, ``confirm_with``, ...) and
+implements :meth:`Term.explanation` and :meth:`Term.params`; a regressor (every term but
+``bias_instability``, which is judged from the residual's Allan deviation, and ``thermal_lag``,
+which moves the whole model to the die temperature) also implements :meth:`Term.column`.
+Defining the subclass registers it: :func:`term` finds it by id, :func:`terms` lists them all
+in the order they were defined.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from tcbench.diagnose.signals import DiagnosisData
+from tcbench.sensors.effects import Effect, Signals
+
+_REGISTRY: dict[str, Term] = {}
+_NO_DRAW = np.random.default_rng(0)  # the deterministic effects a column comes from never draw from it
+
+
+def g3(x: float) -> str:
+    """A number in an explanation: three significant digits."""
+    return f"{x:.3g}"
+
+
+@dataclass(frozen=True)
+class Extent:
+    """What a library finding needs from the recording: its time span (s), its temperature
+    band (degC, smoothed thermometer) and the output unit."""
+
+    t_start_s: float
+    t_end_s: float
+    temp_low_c: float
+    temp_high_c: float
+    unit: str
+
+    @classmethod
+    def of(cls, data: DiagnosisData) -> Extent:
+        """The extent of prepared ``data``."""
+        return cls(float(data.t_s[0]), float(data.t_s[-1]), float(np.min(data.temp_c)), float(np.max(data.temp_c)),
+                   data.unit)
+
+
+def signals(data: DiagnosisData, temp_c: np.ndarray, ref_c: float = 0.0) -> Signals:
+    """What an effect of the library sees on ``data``: its clock, ``temp_c`` as both the
+    thermometer and the die temperature, the thermometer's slope, the input (as the
+    acceleration and as the rate) and the mean sample interval."""
+    dt_s = float(data.t_s[-1] - data.t_s[0]) / (data.t_s.size - 1) if data.t_s.size > 1 else 1.0
+    return Signals(t_s=data.t_s, dt_s=dt_s, temp_meas_c=temp_c, temp_die_c=temp_c,
+                   temp_rate_c_per_s=data.rate_c_per_s, accel_g=data.input, cross_g=np.zeros_like(data.input),
+                   rate_dps=data.input, ref_c=ref_c)
+
+
+class Term(ABC):
+    """One effect of the library in the diagnosis.
+
+    - ``id``, ``effect``: its id and its class in the effect library (the same id);
+    - ``shape``: the shape its signature takes in a residual (PHYSICS.md §8);
+    - ``param``, ``grid``: the nonlinear parameter searched and its grid (None: none);
+    - ``deterministic``: a model term of the forward selection (False: noise, judged from the
+      residual's Allan deviation);
+    - ``confirm_with``: the measurement that would confirm it;
+    - ``confusable``: ``{other id: the test that would tell the two apart}``, declared on one
+      side of each pair (:meth:`partners` gives both);
+    - ``flicker_mimics``: a slow random excursion of the bias can look like it;
+    - ``cached``: its column is costly; the designer keeps it per value and model temperature.
+    """
+
+    id: ClassVar[str] = ""
+    effect: ClassVar[type[Effect]]
+    shape: ClassVar[str] = ""
+    param: ClassVar[str | None] = None
+    grid: ClassVar[np.ndarray | None] = None
+    deterministic: ClassVar[bool] = True
+    confirm_with: ClassVar[str] = ""
+    confusable: ClassVar[Mapping[str, str]] = {}
+    flicker_mimics: ClassVar[bool] = False
+    cached: ClassVar[bool] = False
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        if not cls.id:
+            return  # an intermediate base
+        if cls.id in _REGISTRY:
+            raise ValueError(f"term {cls.id!r} is registered twice")
+        if cls.id != cls.effect.id:
+            raise ValueError(f"term {cls.id!r} models effect {cls.effect.id!r}: the ids must match")
+        _REGISTRY[cls.id] = cls()
+
+    def grid_values(self) -> list[float | None]:
+        """Values of the nonlinear parameter searched (``[None]`` if it has none)."""
+        return [None] if self.grid is None else list(self.grid)
+
+    def column(self, data: DiagnosisData, value: float | None, temp_c: np.ndarray, centre_c: float,
+               half_range_c: float) -> np.ndarray:
+        """The regressor at nonlinear parameter ``value`` on the model temperature ``temp_c``
+        (``centre_c`` and ``half_range_c`` scale the temperature as the minimal model does)."""
+        raise ValueError(f"effect {self.id!r} has no regressor")
+
+    def past_grid(self, data: DiagnosisData) -> float | None:
+        """How far the search may go past the grid's top when the best value is there, or None."""
+        return None
+
+    def skip(self, data: DiagnosisData) -> str | None:
+        """Why ``data`` cannot show this effect at all, or None."""
+        return None
+
+    def where(self, extent: Extent) -> dict[str, Any]:
+        """Where the effect shows in a recording of ``extent`` (report contract ``where``)."""
+        if self.shape.startswith("temperature_"):
+            return {"temperature_c": [round(extent.temp_low_c, 3), round(extent.temp_high_c, 3)]}
+        return {}
+
+    @abstractmethod
+    def explanation(self, params: Mapping[str, float], unit: str) -> str:
+        """What the data showed and what physics does that, with the fitted ``params``."""
+
+    @abstractmethod
+    def params(self, coef: float, value: float | None, half_range_c: float) -> dict[str, float]:
+        """The fitted coefficient ``coef`` of the column (and searched ``value``) as the effect
+        library's parameters."""
+
+    def unit_effect(self, value: float | None = None) -> Effect:
+        """The library effect with a unit coefficient (and ``value`` as its nonlinear parameter):
+        its output term is the column, where the design uses the simulator's formula."""
+        raise NotImplementedError(f"term {self.id!r} does not build its column from its effect")
+
+    def effect_column(self, data: DiagnosisData, value: float | None, temp_c: np.ndarray) -> np.ndarray:
+        """The output term of :meth:`unit_effect` on ``data`` with ``temp_c`` as the temperature."""
+        return self.unit_effect(value).term(signals(data, temp_c), _NO_DRAW)
+
+    def partners(self) -> dict[str, str]:
+        """``{other term id: test that tells the two apart}`` for every pair this term is in."""
+        out = dict(self.confusable)
+        for other in _REGISTRY.values():
+            if self.id in other.confusable:
+                out[other.id] = other.confusable[self.id]
+        return out
+
+
+def term(term_id: str) -> Term:
+    """The registered term ``term_id``; ``KeyError`` naming the known ones otherwise."""
+    try:
+        return _REGISTRY[term_id]
+    except KeyError:
+        raise KeyError(f"no term {term_id!r}; known: {', '.join(_REGISTRY)}") from None
+
+
+def terms() -> tuple[Term, ...]:
+    """Every registered term, in the order defined."""
+    return tuple(_REGISTRY.values())
+
+
+def is_term(term_id: str) -> bool:
+    """Whether ``term_id`` is a registered term."""
+    return term_id in _REGISTRY
+
+
+def confusable_pairs() -> dict[frozenset[str], str]:
+    """``{pair of term ids: the test that would tell them apart}``, in the order declared."""
+    out: dict[frozenset[str], str] = {}
+    for t in _REGISTRY.values():
+        for other, test in t.confusable.items():
+            pair = frozenset({t.id, other})
+            if pair in out:
+                raise ValueError(f"confusable pair {sorted(pair)} is declared twice")
+            out[pair] = test
+    return out
