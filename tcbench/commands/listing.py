@@ -1,7 +1,9 @@
-"""``tcbench list``: the registered tasks, optimisers, learners and sensor kinds. Its jobs run in
+"""``tcbench list``: the registered tasks, optimisers, learners, sensor kinds and diagnosis terms. Its jobs run in
 the command line's process (:attr:`~tcbench.commands.registry.CommandSpec.runs_here`)."""
 
 from __future__ import annotations
+
+import re
 
 from tcbench.commands.schemas import LISTS, ListConfig
 from tcbench.errors import ConfigError
@@ -14,7 +16,7 @@ def check(cfg: ListConfig) -> None:
 
 
 def work(cfg: ListConfig) -> int:
-    """Print the registered tasks, optimisers, learners and sensor kinds (``what``: one of them, or all)."""
+    """Print the registered tasks, optimisers, learners, sensor kinds and terms (``what``: one of them, or all)."""
     what = cfg.what
     if what in {"all", "tasks"}:
         from tcbench.tasks import TASKS
@@ -54,4 +56,23 @@ def work(cfg: ListConfig) -> int:
             units = f"{kind.input_unit} in, {kind.output_unit} out"
             print(f"  {kind.name:10s} {kind.title}; {units}; protocols: {', '.join(kind.protocols)}"
                   + (f"; PX4 {kind.ulog_topic}" if kind.ulog_topic else ""))
+    if what in {"all", "terms"}:
+        _list_terms()
     return 0
+
+
+def _list_terms() -> None:
+    """The diagnosis's terms (built-in and installed) with their shape and a line each, then the
+    broken term and effect plugins with their error."""
+    from tcbench.diagnose.terms import broken_terms, term_source, terms
+    from tcbench.sensors.effects import PLUGINS as EFFECT_PLUGINS
+
+    print("terms:")
+    for t in terms():
+        doc = " ".join((type(t).__doc__ or "").strip().split("\n\n")[0].split())
+        doc = re.sub(r" \(:\w+:`[^`]*`\)", "", doc.split(". ")[0].rstrip(".")).replace("``", "")
+        print(f"  {t.id:24s} {t.shape:22s} {doc}  (from {term_source(t.id)})")
+    for name, err in broken_terms().items():
+        print(f"  {name:24s} BROKEN: {err}")
+    for name, err in EFFECT_PLUGINS.broken().items():
+        print(f"  {name:24s} BROKEN effect: {err}")

@@ -176,12 +176,12 @@ SPECS: dict[str, CommandSpec] = {
     ),
     "list": CommandSpec(
         name="list",
-        summary="registered tasks, optimisers and learners (what=all|tasks|optimisers|learners)",
+        summary="registered tasks, optimisers, learners, sensors and terms (what=all|tasks|optimisers|learners|sensors|terms)",
         description="Print the registered tasks (their gymnasium env id and task= name), optimisers (with the "
                     "package that provides them: tcbench or a plugin), learners and broken plugins.",
         schema="tcbench.commands.schemas:ListConfig",
         runs_here="tcbench.commands.listing",
-        params={"what": "which list: all, tasks, optimisers, learners or sensors"},
+        params={"what": "which list: all, tasks, optimisers, learners, sensors or terms"},
         examples=("tcbench list", "tcbench list what=optimisers", "tcbench list -m what=tasks,learners"),
         output="stdout only",
         sweep=", each list printed in turn",

@@ -161,7 +161,7 @@ class LeaderboardConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(enabled=False, experiment="leaderboards"))
 
 
-LISTS = ("all", "tasks", "optimisers", "learners", "sensors")
+LISTS = ("all", "tasks", "optimisers", "learners", "sensors", "terms")
 
 
 @dataclass

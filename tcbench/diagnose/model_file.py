@@ -115,7 +115,7 @@ def _effects(value: Any, where: str) -> dict[str, dict[str, float]]:
     for effect_id, params in value.items():
         cls = fx.effect_class(effect_id)
         if cls is None:
-            raise ModelFileError(f"{where}: unknown effect {effect_id!r}; known: {', '.join(sorted(fx.EFFECTS))}")
+            raise ModelFileError(f"{where}: unknown effect {effect_id!r}; known: {', '.join(fx.known_effects())}")
         params = {} if params is None else params
         if not isinstance(params, dict):
             raise ModelFileError(f"{where}: effect {effect_id!r} needs a mapping of parameters, got {params!r}")

@@ -22,6 +22,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from tcbench.plugins import PluginRegistry
 from tcbench.sensors import noise
 from tcbench.sensors.thermal import first_order_lag
 
@@ -450,18 +451,55 @@ EFFECTS: dict[str, type[Effect]] = {
 }
 
 
+EFFECTS_GROUP = "tcbench.effects"
+
+
+class _EffectPlugins(PluginRegistry[Effect]):
+    """Effects of installed packages (entry-point group ``tcbench.effects``, ``my_effect =
+    "pkg.module:MyEffect"``): the entry point's name is the effect's id, and no built-in id."""
+
+    def check_class(self, name: str, cls: Any) -> None:
+        super().check_class(name, cls)
+        if cls.id != name:
+            raise TypeError(f"entry point {name!r} names effect {cls.id!r}: the name must be the effect's id")
+        if name in EFFECTS:
+            raise ValueError(f"effect {name!r} is a built-in effect")
+        if cls.stage not in STAGES:
+            raise ValueError(f"effect {name!r}: stage {cls.stage!r} is none of {', '.join(STAGES)}")
+
+
+STAGES = ("die", "output", "final", "thermometer")
+PLUGINS: PluginRegistry[Effect] = _EffectPlugins(EFFECTS_GROUP, Effect, "effect")
+
+
+def plugin_effects() -> dict[str, type[Effect]]:
+    """The installed plugin effects by id (imports them all; a broken one is in ``PLUGINS.broken()``)."""
+    return {name: entry.cls for name, entry in PLUGINS.available().items()}
+
+
+def known_effects() -> list[str]:
+    """Every effect id, built-in and installed (without importing any plugin)."""
+    return sorted({*EFFECTS, *(n for n in PLUGINS.names() if n not in EFFECTS)})
+
+
 REPEATABLE = ("bias_step", "periodic", "gated_periodic", "duty_cycle", "transient", "temperature_bump", "second_node")
 MAX_REPEATS = 3  # instances of one repeatable effect in a model: ``bias_step``, ``bias_step_2``, ``bias_step_3``
 
 
 def effect_class(effect_id: str) -> type[Effect] | None:
-    """The effect class of ``effect_id``: an id of :data:`EFFECTS`, or a further instance of a
-    :data:`REPEATABLE` one (``bias_step_2``: a second step); None for an unknown id."""
+    """The effect class of ``effect_id``: an id of :data:`EFFECTS`, a further instance of a
+    :data:`REPEATABLE` one (``bias_step_2``: a second step) or an installed plugin effect
+    (imported on first use); None for an unknown id or a broken plugin."""
     if effect_id in EFFECTS:
         return EFFECTS[effect_id]
     base, _, k = effect_id.rpartition("_")
     if base in REPEATABLE and k.isdigit() and 2 <= int(k) <= MAX_REPEATS:
         return EFFECTS[base]
+    if effect_id in PLUGINS.names():
+        try:
+            return PLUGINS.get(effect_id)
+        except KeyError:
+            return None
     return None
 
 
@@ -469,7 +507,10 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
     """Build an effect by id; unknown ids or parameters raise ``ValueError`` naming the known ones."""
     cls = effect_class(effect_id)
     if cls is None:
-        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(sorted(EFFECTS))} "
+        broken = PLUGINS.broken().get(effect_id) if effect_id in PLUGINS.names() else None
+        if broken:
+            raise ValueError(f"effect {effect_id!r}: plugin failed to load: {broken}")
+        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(known_effects())} "
                          f"(and {REPEATABLE[0]}_2 ... _{MAX_REPEATS} for further instances of {', '.join(REPEATABLE)})")
     known = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(params) - known)

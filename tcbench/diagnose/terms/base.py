@@ -6,7 +6,12 @@ implements :meth:`Term.explanation` and :meth:`Term.params`; a regressor (every 
 ``bias_instability``, which is judged from the residual's Allan deviation, and ``thermal_lag``,
 which moves the whole model to the die temperature) also implements :meth:`Term.column`.
 Defining the subclass registers it: :func:`term` finds it by id, :func:`terms` lists them all
-in the order they were defined.
+in the order they were defined. Installed packages add terms under the entry-point group
+``tcbench.terms`` (``my_effect = "pkg.module:MyEffectTerm"``, the name being the term's id); they
+are imported once, on the first look-up, and come after the built-in ones. The term's effect must
+be known to the effect library (a built-in, or an entry point of ``tcbench.effects``). A plugin
+that fails to import, names no :class:`Term`, clashes with a built-in id or models an unknown
+effect is skipped and listed by :func:`broken_terms`.
 """
 
 from __future__ import annotations
@@ -19,8 +24,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.sensors.effects import Effect, Signals
+from tcbench.plugins import PluginRegistry
+from tcbench.sensors.effects import Effect, Signals, effect_class
 
+TERMS_GROUP = "tcbench.terms"
 _REGISTRY: dict[str, Term] = {}
 _NO_DRAW = np.random.default_rng(0)  # the deterministic effects a column comes from never draw from it
 
@@ -89,7 +96,7 @@ class Term(ABC):
         if not cls.id:
             return  # an intermediate base
         if cls.id in _REGISTRY:
-            raise ValueError(f"term {cls.id!r} is registered twice")
+            raise ValueError(f"term {cls.id!r} is registered twice (there is a term of that id already)")
         if cls.id != cls.effect.id:
             raise ValueError(f"term {cls.id!r} models effect {cls.effect.id!r}: the ids must match")
         _REGISTRY[cls.id] = cls()
@@ -139,34 +146,85 @@ class Term(ABC):
     def partners(self) -> dict[str, str]:
         """``{other term id: test that tells the two apart}`` for every pair this term is in."""
         out = dict(self.confusable)
-        for other in _REGISTRY.values():
+        for other in _registry().values():
             if self.id in other.confusable:
                 out[other.id] = other.confusable[self.id]
         return out
 
 
+class _TermPlugins(PluginRegistry[Term]):
+    """The entry points of ``tcbench.terms``; importing one defines (and so registers) its term,
+    which is taken back out of the registry if the checks fail."""
+
+    def check_class(self, name: str, cls: Any) -> None:
+        super().check_class(name, cls)
+        if cls.id != name:
+            raise TypeError(f"entry point {name!r} names term {cls.id!r}: the name must be the term's id")
+        if type(_REGISTRY.get(name)) is not cls:
+            raise ValueError(f"term {name!r} did not register")
+        if effect_class(name) is not cls.effect:
+            raise ValueError(f"term {name!r} models effect {cls.effect.__module__}.{cls.effect.__name__}, which the "
+                             f"effect library does not know as {name!r}: declare it under the entry-point group "
+                             "tcbench.effects")
+
+    def _load_one(self, name: str) -> Any:
+        before = set(_REGISTRY)
+        entry = super()._load_one(name)
+        if entry is None:
+            for added in set(_REGISTRY) - before:
+                del _REGISTRY[added]
+        return entry
+
+
+_PLUGINS = _TermPlugins(TERMS_GROUP, Term, "term")
+_loaded = False
+
+
+def _registry() -> dict[str, Term]:
+    """The registry, with the installed terms imported on the first call."""
+    global _loaded
+    if not _loaded:
+        _loaded = True
+        _PLUGINS.available()
+    return _REGISTRY
+
+
+def broken_terms() -> dict[str, str]:
+    """Installed terms that failed to load, with their error."""
+    _registry()
+    return _PLUGINS.broken()
+
+
+def term_source(term_id: str) -> str:
+    """Where term ``term_id`` comes from: ``tcbench`` or the distribution that installed it."""
+    if type(term(term_id)).__module__.startswith(f"{__package__}."):
+        return "tcbench"
+    entry = _PLUGINS.available().get(term_id)
+    return entry.package if entry is not None else "__main__"
+
+
 def term(term_id: str) -> Term:
     """The registered term ``term_id``; ``KeyError`` naming the known ones otherwise."""
     try:
-        return _REGISTRY[term_id]
+        return _registry()[term_id]
     except KeyError:
         raise KeyError(f"no term {term_id!r}; known: {', '.join(_REGISTRY)}") from None
 
 
 def terms() -> tuple[Term, ...]:
-    """Every registered term, in the order defined."""
-    return tuple(_REGISTRY.values())
+    """Every registered term: the built-in ones in the order defined, then the installed ones."""
+    return tuple(_registry().values())
 
 
 def is_term(term_id: str) -> bool:
     """Whether ``term_id`` is a registered term."""
-    return term_id in _REGISTRY
+    return term_id in _registry()
 
 
 def confusable_pairs() -> dict[frozenset[str], str]:
     """``{pair of term ids: the test that would tell them apart}``, in the order declared."""
     out: dict[frozenset[str], str] = {}
-    for t in _REGISTRY.values():
+    for t in _registry().values():
         for other, test in t.confusable.items():
             pair = frozenset({t.id, other})
             if pair in out:

@@ -1,0 +1,142 @@
+"""Diagnosis terms from other packages: the example plugin-term package end to end, and broken ones."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "plugin-term"
+TERM = "temperature_rate_squared"
+OTHERS = "without=[bias_instability,temperature_cubic,temperature_rate]"
+
+
+def tcbench(*args: str, cwd: Path, path: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(path), "MLFLOW_DISABLE_TELEMETRY": "true", "MPLBACKEND": "Agg"}
+    env.pop("MLFLOW_TRACKING_URI", None)
+    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory) -> Path:
+    """The example plugin installed (not editable) into a directory put on PYTHONPATH."""
+    target = tmp_path_factory.mktemp("site")
+    src = tmp_path_factory.mktemp("example") / EXAMPLE.name
+    shutil.copytree(EXAMPLE, src, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
+         "--target", str(target), str(src)],
+        check=True, capture_output=True, text=True, timeout=300,
+    )
+    return target
+
+
+def _fake_distribution(site: Path, name: str, entry_points: str, module: str = "", code: str = "") -> None:
+    info = site / f"{name}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(entry_points)
+    if module:
+        (site / f"{module}.py").write_text(code)
+
+
+def _simulate(coef: float, name: str, cwd: Path, site: Path) -> Path:
+    run = tcbench("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "seed=2",
+                  f"effects.{TERM}.coef_per_c2_per_min2={coef}", OTHERS, "protocol_params.sample_rate_hz=1",
+                  "out=rec", f"name={name}", "metrics=false", "tracking.enabled=false", cwd=cwd, path=site)
+    assert run.returncode == 0, run.stderr
+    return cwd / "rec" / f"{name}.csv"
+
+
+def _diagnose(recording: Path, out: str, cwd: Path, site: Path) -> dict:
+    run = tcbench("diagnose", f"recording={recording}", f"out={out}", "tracking.enabled=false", cwd=cwd, path=site)
+    assert run.returncode == 0, run.stderr
+    return json.loads((cwd / out / "report.json").read_text())
+
+
+def test_listed_with_its_shape(site: Path, tmp_path: Path) -> None:
+    listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
+    assert listed.returncode == 0, listed.stderr
+    line = next(x for x in listed.stdout.splitlines() if x.split()[:1] == [TERM])
+    assert "temperature_dynamics" in line and "(from tcbench-rate2)" in line
+    assert "thermal_lag" in listed.stdout and "BROKEN" not in listed.stdout
+
+
+def test_diagnose_names_the_plugin_effect_only_where_it_is(site: Path, tmp_path: Path) -> None:
+    report = _diagnose(_simulate(0.05, "with", tmp_path, site), "with", tmp_path, site)
+    found = {e["id"]: e for e in report["effects"]}
+    assert TERM in found and found[TERM]["library"] is True
+    assert found[TERM]["params"]["coef_per_c2_per_min2"] == pytest.approx(0.05, rel=0.2)
+    assert "(degC/min)^2" in found[TERM]["explanation"]
+    without = _diagnose(_simulate(0.0, "without", tmp_path, site), "without", tmp_path, site)
+    assert TERM not in {e["id"] for e in without["effects"]}
+    assert TERM in {c["id"] for c in without["candidates"]}  # tried like a library term, rejected
+    # the fitted model simulates with the plugin's effect, and without the plugin says what is missing
+    again = tcbench("simulate", "model=with/model.yaml", "protocol=oven", "out=again", "metrics=false",
+                    "tracking.enabled=false", cwd=tmp_path, path=site)
+    assert again.returncode == 0, again.stderr
+    bare = tcbench("simulate", "model=with/model.yaml", "protocol=oven", "out=bare", "metrics=false",
+                   "tracking.enabled=false", cwd=tmp_path, path=tmp_path / "nothing")
+    assert bare.returncode != 0 and f"unknown effect {TERM!r}" in bare.stderr
+
+
+@pytest.mark.parametrize(("entry", "error"), [
+    ("no_such_module_xyz:Nope", "ModuleNotFoundError: No module named 'no_such_module_xyz'"),
+    ("tcbench.sensors.effects:ThermalLag", "does not name a tcbench.diagnose.terms.base.Term subclass"),
+])
+def test_broken_term_plugin_is_listed_and_harmless(tmp_path: Path, entry: str, error: str) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    _fake_distribution(site, "broken_terms", f"[tcbench.terms]\nbroken_term = {entry}\n")
+    listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
+    assert listed.returncode == 0, listed.stderr
+    assert "broken_term              BROKEN: " in listed.stdout and error in listed.stdout
+    assert "bias_instability" in listed.stdout
+    assert tcbench("list", "what=sensors", cwd=tmp_path, path=site).returncode == 0
+
+
+def test_a_term_clashing_with_a_builtin_or_without_its_effect_is_broken(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    code = (
+        "from dataclasses import dataclass\n"
+        "from typing import ClassVar\n"
+        "from tcbench.diagnose.terms import Term\n"
+        "from tcbench.sensors.effects import Effect, Hysteresis\n"
+        "class Clash(Term):\n"
+        "    id = 'hysteresis'\n"
+        "    effect = Hysteresis\n"
+        "    def explanation(self, params, unit): return ''\n"
+        "    def params(self, coef, value, half_range_c): return {}\n"
+        "@dataclass(frozen=True)\n"
+        "class Orphan(Effect):\n"
+        "    id: ClassVar[str] = 'orphan'\n"
+        "class OrphanTerm(Term):\n"
+        "    id = 'orphan'\n"
+        "    effect = Orphan\n"
+        "    def explanation(self, params, unit): return ''\n"
+        "    def params(self, coef, value, half_range_c): return {}\n"
+    )
+    code_clash, code_orphan = code.split("@dataclass")[0], "from tcbench.sensors.effects import Effect\n" + (
+        "from dataclasses import dataclass\nfrom typing import ClassVar\nfrom tcbench.diagnose.terms import Term\n"
+        "@dataclass" + code.split("@dataclass")[1])
+    _fake_distribution(site, "clash", "[tcbench.terms]\nhysteresis = clash_mod:Clash\n", "clash_mod", code_clash)
+    _fake_distribution(site, "orphan", "[tcbench.terms]\norphan = orphan_mod:OrphanTerm\n", "orphan_mod", code_orphan)
+    listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
+    assert listed.returncode == 0, listed.stderr
+    assert "ValueError: term 'hysteresis' is registered twice" in listed.stdout
+    assert "ValueError: term 'orphan' models effect orphan_mod.Orphan, which the effect library does not know" \
+        in listed.stdout
+    terms = [x.split()[0] for x in listed.stdout.splitlines()[1:] if "BROKEN" not in x]
+    assert terms.count("hysteresis") == 1 and "orphan" not in terms
+    code = ("from tcbench.diagnose.terms import terms, term_source\n"
+            "print([t.id for t in terms()][-1], term_source('hysteresis'))")
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["bias_instability", "tcbench"]
