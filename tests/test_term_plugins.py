@@ -86,6 +86,13 @@ def test_diagnose_names_the_plugin_effect_only_where_it_is(site: Path, tmp_path:
     assert bare.returncode != 0 and f"unknown effect {TERM!r}" in bare.stderr
 
 
+def test_example_plugin_own_tests(site: Path) -> None:
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(EXAMPLE / "tests")],
+                         env=env, capture_output=True, text=True, timeout=300, cwd=site)
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
 @pytest.mark.parametrize(("entry", "error"), [
     ("no_such_module_xyz:Nope", "ModuleNotFoundError: No module named 'no_such_module_xyz'"),
     ("tcbench.sensors.effects:ThermalLag", "does not name a tcbench.diagnose.terms.base.Term subclass"),
@@ -140,3 +147,20 @@ def test_a_term_clashing_with_a_builtin_or_without_its_effect_is_broken(tmp_path
     env = {**os.environ, "PYTHONPATH": str(site)}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["bias_instability", "tcbench"]
+
+
+def test_broken_effect_plugin_is_listed_and_harmless(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    _fake_distribution(site, "bad_effects", "[tcbench.effects]\nhysteresis = tcbench.sensors.effects:Hysteresis\n"
+                       "gone = no_such_module_xyz:Gone\n")
+    listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
+    assert listed.returncode == 0, listed.stderr
+    assert "hysteresis               BROKEN effect: ValueError: effect 'hysteresis' is a built-in effect" in listed.stdout
+    assert "gone                     BROKEN effect: ModuleNotFoundError" in listed.stdout
+    code = ("from tcbench.sensors.effects import Hysteresis, effect_class, make_effect\n"
+            "assert effect_class('hysteresis') is Hysteresis\n"
+            "try:\n    make_effect('gone')\nexcept ValueError as exc:\n    print(exc)\n")
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.startswith("effect 'gone': plugin failed to load: ModuleNotFoundError")
