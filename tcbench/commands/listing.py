@@ -70,7 +70,7 @@ def _list_terms() -> None:
     print("terms:")
     for t in terms():
         doc = " ".join((type(t).__doc__ or "").strip().split("\n\n")[0].split())
-        doc = re.sub(r" \(:\w+:`[^`]*`\)", "", doc.split(". ")[0].rstrip(".")).replace("``", "")
+        doc = re.sub(r" \(:\w+:`[^)]*\)", "", doc.split(". ")[0].rstrip(".")).replace("``", "")
         print(f"  {t.id:24s} {t.shape:22s} {doc}  (from {term_source(t.id)})")
     for name, err in broken_terms().items():
         print(f"  {name:24s} BROKEN: {err}")
