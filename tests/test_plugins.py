@@ -3,47 +3,21 @@
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from plugin_site import fake_distribution, install_example, tcbench
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "plugin-optimiser"
 
 
-def tcbench(*args: str, cwd: Path, path: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(path)}
-    env.pop("MLFLOW_TRACKING_URI", None)
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=300)
-
-
 @pytest.fixture(scope="module")
-def site(tmp_path_factory) -> Path:
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The example plugin installed (not editable) into a directory put on PYTHONPATH."""
-    target = tmp_path_factory.mktemp("site")
-    # built from a copy: the build's build/ and *.egg-info stay out of the clone, and test
-    # workers that each install it (pytest -n) do not build in the same folder at once
-    src = tmp_path_factory.mktemp("example") / EXAMPLE.name
-    shutil.copytree(EXAMPLE, src, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
-    subprocess.run(
-        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
-         "--target", str(target), str(src)],
-        check=True, capture_output=True, text=True, timeout=300,
-    )
-    return target
-
-
-def _fake_distribution(site: Path, name: str, entry_points: str, module: str = "", code: str = "") -> None:
-    info = site / f"{name}-0.1.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(entry_points)
-    if module:
-        (site / f"{module}.py").write_text(code)
+    return install_example("plugin-optimiser", tmp_path_factory)
 
 
 def test_example_plugin_on_a_leaderboard(site: Path, tmp_path: Path) -> None:
@@ -69,7 +43,7 @@ def test_example_plugin_own_tests(site: Path) -> None:
 def test_broken_plugin_is_reported_and_skipped(tmp_path: Path) -> None:
     site = tmp_path / "site"
     site.mkdir()
-    _fake_distribution(site, "broken_plugin", "[tcbench.optimisers]\nbroken = no_such_module:Nope\n")
+    fake_distribution(site, "broken_plugin", "[tcbench.optimisers]\nbroken = no_such_module:Nope\n")
     listed = tcbench("list", cwd=tmp_path, path=site)
     assert listed.returncode == 0
     assert "broken     BROKEN: ModuleNotFoundError: No module named 'no_such_module'" in listed.stdout
@@ -89,7 +63,7 @@ def test_protocol_breaking_plugin_is_stopped_and_named(tmp_path: Path) -> None:
         "    def ask(self):\n"
         "        return super().ask() * 1000.0\n"
     )
-    _fake_distribution(site, "rogue_plugin", "[tcbench.optimisers]\nrogue = rogue_mod:Rogue\n", "rogue_mod", code)
+    fake_distribution(site, "rogue_plugin", "[tcbench.optimisers]\nrogue = rogue_mod:Rogue\n", "rogue_mod", code)
     run = tcbench("run", "-m", "task=sphere", "optimiser=fa", "optimiser.name=rogue,fa", "budget=50",
                   cwd=tmp_path, path=site)
     assert run.returncode == 1

@@ -4,46 +4,22 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from plugin_site import fake_distribution, install_example, tcbench
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "plugin-term"
 TERM = "temperature_rate_squared"
 OTHERS = "without=[bias_instability,temperature_cubic,temperature_rate]"
 
 
-def tcbench(*args: str, cwd: Path, path: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(path), "MLFLOW_DISABLE_TELEMETRY": "true", "MPLBACKEND": "Agg"}
-    env.pop("MLFLOW_TRACKING_URI", None)
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=600)
-
-
 @pytest.fixture(scope="module")
-def site(tmp_path_factory) -> Path:
+def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The example plugin installed (not editable) into a directory put on PYTHONPATH."""
-    target = tmp_path_factory.mktemp("site")
-    src = tmp_path_factory.mktemp("example") / EXAMPLE.name
-    shutil.copytree(EXAMPLE, src, ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
-    subprocess.run(
-        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--no-build-isolation",
-         "--target", str(target), str(src)],
-        check=True, capture_output=True, text=True, timeout=300,
-    )
-    return target
-
-
-def _fake_distribution(site: Path, name: str, entry_points: str, module: str = "", code: str = "") -> None:
-    info = site / f"{name}-0.1.dist-info"
-    info.mkdir()
-    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(entry_points)
-    if module:
-        (site / f"{module}.py").write_text(code)
+    return install_example("plugin-term", tmp_path_factory)
 
 
 def _simulate(coef: float, name: str, cwd: Path, site: Path) -> Path:
@@ -100,7 +76,7 @@ def test_example_plugin_own_tests(site: Path) -> None:
 def test_broken_term_plugin_is_listed_and_harmless(tmp_path: Path, entry: str, error: str) -> None:
     site = tmp_path / "site"
     site.mkdir()
-    _fake_distribution(site, "broken_terms", f"[tcbench.terms]\nbroken_term = {entry}\n")
+    fake_distribution(site, "broken_terms", f"[tcbench.terms]\nbroken_term = {entry}\n")
     listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
     assert listed.returncode == 0, listed.stderr
     assert "broken_term              BROKEN: " in listed.stdout and error in listed.stdout
@@ -133,8 +109,8 @@ def test_a_term_clashing_with_a_builtin_or_without_its_effect_is_broken(tmp_path
     code_clash, code_orphan = code.split("@dataclass")[0], "from tcbench.sensors.effects import Effect\n" + (
         "from dataclasses import dataclass\nfrom typing import ClassVar\nfrom tcbench.diagnose.terms import Term\n"
         "@dataclass" + code.split("@dataclass")[1])
-    _fake_distribution(site, "clash", "[tcbench.terms]\nhysteresis = clash_mod:Clash\n", "clash_mod", code_clash)
-    _fake_distribution(site, "orphan", "[tcbench.terms]\norphan = orphan_mod:OrphanTerm\n", "orphan_mod", code_orphan)
+    fake_distribution(site, "clash", "[tcbench.terms]\nhysteresis = clash_mod:Clash\n", "clash_mod", code_clash)
+    fake_distribution(site, "orphan", "[tcbench.terms]\norphan = orphan_mod:OrphanTerm\n", "orphan_mod", code_orphan)
     listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
     assert listed.returncode == 0, listed.stderr
     assert "ValueError: term 'hysteresis' is registered twice" in listed.stdout
@@ -152,7 +128,7 @@ def test_a_term_clashing_with_a_builtin_or_without_its_effect_is_broken(tmp_path
 def test_broken_effect_plugin_is_listed_and_harmless(tmp_path: Path) -> None:
     site = tmp_path / "site"
     site.mkdir()
-    _fake_distribution(site, "bad_effects", "[tcbench.effects]\nhysteresis = tcbench.sensors.effects:Hysteresis\n"
+    fake_distribution(site, "bad_effects", "[tcbench.effects]\nhysteresis = tcbench.sensors.effects:Hysteresis\n"
                        "gone = no_such_module_xyz:Gone\n")
     listed = tcbench("list", "what=terms", cwd=tmp_path, path=site)
     assert listed.returncode == 0, listed.stderr
