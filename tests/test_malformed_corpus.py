@@ -7,9 +7,7 @@ Every case is made inside the test (sparse files for the big ones), none is stor
 from __future__ import annotations
 
 import errno
-import hashlib
 import json
-import logging
 import os
 import subprocess
 import sys
@@ -18,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_refusals import fresh_logging, refused, snapshot  # noqa: F401 (fresh_logging: autouse)
 
 from tcbench.cli import main
 from tcbench.sensors.recording import make_recording, write_recording
@@ -25,37 +24,6 @@ from tcbench.sensors.recording import make_recording, write_recording
 SIM = ["simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=100",
        "protocol_params.sample_rate_hz=1", "tracking.enabled=false"]
 IMPORT = ["import", "sensor=gyro", "time=t:ms", "temperature=temp:degC", "output=rate:mdps"]
-
-
-@pytest.fixture(autouse=True)
-def _fresh_logging(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Logging as in a fresh ``tcbench`` process: earlier tests (Hydra runs) can leave handlers
-    on streams pytest has since closed, which would add lines to the captured stderr."""
-    root = logging.getLogger()
-    monkeypatch.setattr(root, "handlers", [])
-    monkeypatch.setattr(root, "level", logging.WARNING)
-
-
-def snapshot(root: Path) -> dict[str, str]:
-    """Every file and folder under ``root`` with a digest of its content."""
-    return {str(p.relative_to(root)): "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*"))}
-
-
-def refused(capsys: pytest.CaptureFixture[str], root: Path, args: list[str], *names: str) -> str:
-    """Run ``tcbench <args>``; assert exit 2, one ``tcbench: error:`` line naming each of
-    ``names``, no traceback and nothing changed under ``root``; the line."""
-    before = snapshot(root)
-    code = main(args)
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert code == 2, (code, captured.err)
-    assert len(lines) == 1 and lines[0].startswith("tcbench: error: "), captured.err
-    assert "Traceback" not in captured.err + captured.out
-    for name in names:
-        assert name in lines[0], (name, lines[0])
-    assert snapshot(root) == before
-    return lines[0]
 
 
 def log_csv(path: Path, t_ms: np.ndarray | None = None) -> Path:

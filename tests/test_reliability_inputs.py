@@ -10,49 +10,17 @@ count, before it is read.
 
 from __future__ import annotations
 
-import hashlib
-import logging
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_refusals import fresh_logging, refused, snapshot  # noqa: F401 (fresh_logging: autouse)
 
 from tcbench.cli import main
 from tcbench.sensors.recording import make_recording, write_recording
 
 OFF = "tracking.enabled=false"
 FAST = "methods=[raw,poly3]"  # a calibration refused before any fit is refused whatever it fits
-
-
-@pytest.fixture(autouse=True)
-def _fresh_logging(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Logging as in a fresh ``tcbench`` process (earlier Hydra runs can leave handlers on
-    streams pytest has closed, which would add lines to the captured stderr)."""
-    root = logging.getLogger()
-    monkeypatch.setattr(root, "handlers", [])
-    monkeypatch.setattr(root, "level", logging.WARNING)
-
-
-def snapshot(root: Path) -> dict[str, str]:
-    """Every file and folder under ``root`` with a digest of its content."""
-    return {str(p.relative_to(root)): "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*"))}
-
-
-def refused(capsys: pytest.CaptureFixture[str], root: Path, args: list[str], *words: str) -> str:
-    """Run ``tcbench <args>``: exit 2, one ``tcbench: error:`` line holding each of ``words``, no
-    traceback, nothing changed under ``root``; the line."""
-    before = snapshot(root)
-    code = main(args)
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert code == 2, (code, captured.err)
-    assert len(lines) == 1 and lines[0].startswith("tcbench: error: "), captured.err
-    assert "Traceback" not in captured.err + captured.out
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-    assert snapshot(root) == before
-    return lines[0]
 
 
 def ran(capsys: pytest.CaptureFixture[str], args: list[str]) -> tuple[str, str]:
