@@ -9,7 +9,7 @@ Each round tries every effect not yet in the model at every value of its grid, s
 output noise plus the thermometer's noise carried through the model; the ``2`` per parameter is
 Akaike's penalty). The effect with the largest gain is kept when its gain exceeds ``threshold``
 and it is significant against the residual's slow noise, by the strongest test the recording
-supports:
+supports (the :class:`~tcbench.diagnose.significance.SignificanceTest` its plan holds):
 
 - with enough clusters, a Wald statistic with a variance robust to slow noise (cluster scores
   with Bartlett-weighted neighbours, never above the known-noise Wald) above
@@ -41,8 +41,9 @@ from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
 from tcbench.diagnose.discover import OPEN_THRESHOLD, best_open
 from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_significant
 from tcbench.diagnose.open_terms import is_open, term_threshold
-from tcbench.diagnose.plan import ROBUST_WALD, SURROGATE, StatsPlan, plan_for
-from tcbench.diagnose.surrogate import LEVEL, surrogate_test
+from tcbench.diagnose.plan import StatsPlan, plan_for
+from tcbench.diagnose.significance import SURROGATE, SignificanceTest
+from tcbench.diagnose.surrogate import surrogate_test
 from tcbench.diagnose.terms import confusable_pairs, term
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
@@ -133,16 +134,12 @@ class _Scorer:
         drop = self.fit(base).sse_heldout - self.fit(model).sse_heldout
         return excess > 0 and drop >= MOST_OF_EXCESS * excess
 
-    def significant(self, base: Model, effect: str, value: Any, test: str, wald_threshold: float,
+    def significant(self, base: Model, effect: str, value: Any, test: SignificanceTest, wald_threshold: float,
                     searched: list[Any] | None = None) -> tuple[bool, float, float, str]:
-        """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise:
-        ``(passed, robust Wald, surrogate p-value, test that decided)`` (see module doc)."""
-        model = base.with_effect(effect, value)
-        wald = self.wald(base, model)
-        if test == ROBUST_WALD and (wald > wald_threshold or not self.removes_most(base, model)):
-            return wald > wald_threshold, wald, float("nan"), ROBUST_WALD
-        p = self.surrogate_p(base, effect, value, searched)
-        return p <= LEVEL, wald, p, SURROGATE
+        """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise by
+        ``test``: ``(passed, robust Wald, surrogate p-value, name of the test that decided)``."""
+        wald = self.wald(base, base.with_effect(effect, value))
+        return test.judge(self, base, effect, value, wald, wald_threshold, searched)
 
     def best(self, base: Model, effect: str) -> tuple[float, float | None]:
         """Best gain of adding ``effect`` to ``base`` over its grid, then refined."""
@@ -226,7 +223,7 @@ def attribute(
         value = _value(model, effect)
         searched = [value] if is_open(effect) else None
         ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
-                             if cost > (term_threshold(effect, open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test))
+                             if cost > (term_threshold(effect, open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test.name))
         if not ok:
             model = reduced
             evidence[effect].status = "rejected"

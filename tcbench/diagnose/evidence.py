@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from tcbench.diagnose.surrogate import LEVEL
-from tcbench.diagnose.plan import SURROGATE
+from tcbench.diagnose.significance import named
 
 DETECTION_THRESHOLD = 10.0  # gain in units of sigma^2; see experiments/diagnose-concealed/calibrate.py
 
@@ -30,8 +29,6 @@ class Evidence:
 
 
 def not_significant(test: str, p: float) -> str:
-    """Why an effect with a gain above the threshold was rejected by ``test`` (p-value ``p``)."""
-    if test == SURROGATE:
-        return (f"not significant against the residual's slow noise (surrogate test p = {p:.3g} above "
-                f"{LEVEL:g})")
-    return "not significant against the residual's slow noise (robust Wald below the threshold)"
+    """Why an effect with a gain above the threshold was rejected by the test named ``test``
+    (p-value ``p``)."""
+    return named(test).why_not(p)

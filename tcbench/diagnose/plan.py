@@ -10,11 +10,11 @@ slow noise. Both need time spans that fit the recording:
   five of 15 min, so leaving one fold out never removes a whole branch of the temperature cycle.
 - **Clusters** of the robust Wald test: ``cluster_s`` a 32nd of the recording, within
   2.5 smoothing windows and 15 min.
-- **The significance test**: the cluster-robust Wald statistic needs many clusters to estimate
-  the variance of slow noise; with fewer than :data:`MIN_CLUSTERS` the recording cannot support
-  it and the diagnosis uses a surrogate test instead
-  (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric bootstrap under a noise
-  model with the spectrum of the candidate model's own residual.
+- **The significance test** (an object of :mod:`tcbench.diagnose.significance`): the
+  cluster-robust Wald statistic needs many clusters to estimate the variance of slow noise; with
+  fewer than :data:`MIN_CLUSTERS` the recording cannot support it and the diagnosis uses a
+  surrogate test instead (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric
+  bootstrap under a noise model with the spectrum of the candidate model's own residual.
 - **The shortest record** (:func:`min_full_duration_s`): five folds of one block each, a block
   two smoothing windows long: 20 min at the default 120 s window. Shorter, a fold holds less
   than one whole block, or none, and its held-out samples are predicted by the smoothed
@@ -28,8 +28,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
-from tcbench.diagnose.signals import DiagnosisData
+from tcbench.diagnose.significance import (
+    ROBUST_WALD,
+    ROBUST_WALD_TEST,
+    SURROGATE,
+    SURROGATE_TEST,
+    SignificanceTest,
+)
+from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, DiagnosisData
 
 FOLDS = 5
 BLOCK_WINDOWS = 2.0  # a CV block spans at least this many thermometer-smoothing windows
@@ -37,25 +43,24 @@ MAX_BLOCK_S = 900.0
 BLOCKS_PER_RECORD = 24
 CLUSTERS_PER_RECORD = 32
 MIN_CLUSTERS = 24
-ROBUST_WALD = "cluster-robust Wald"
-SURROGATE = "spectral surrogate (parametric bootstrap)"
+__all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan_for"]
 
 
 @dataclass(frozen=True)
 class StatsPlan:
     """Block length (s) and fold count of the cross-validation, cluster length (s) and count of
-    the robust test, and which significance test the recording supports (:data:`ROBUST_WALD`
-    or :data:`SURROGATE`)."""
+    the robust test, and the significance test the recording supports (the robust Wald test or
+    the surrogate test, :mod:`tcbench.diagnose.significance`)."""
 
     block_s: float
     k: int
     cluster_s: float
     n_clusters: int
-    test: str
+    test: SignificanceTest
 
     def to_json(self) -> dict[str, float | int | str]:
         return {"cv_block_s": self.block_s, "folds": self.k, "cluster_s": self.cluster_s,
-                "clusters": self.n_clusters, "significance_test": self.test}
+                "clusters": self.n_clusters, "significance_test": self.test.name}
 
 
 def plan_for(data: DiagnosisData) -> StatsPlan:
@@ -64,7 +69,7 @@ def plan_for(data: DiagnosisData) -> StatsPlan:
     block_s = float(np.clip(span / BLOCKS_PER_RECORD, min(BLOCK_WINDOWS * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
     cluster_s = float(np.clip(span / CLUSTERS_PER_RECORD, min(2.5 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
     n_clusters = int(np.floor(span / cluster_s)) + 1
-    test = ROBUST_WALD if n_clusters >= MIN_CLUSTERS else SURROGATE
+    test = ROBUST_WALD_TEST if n_clusters >= MIN_CLUSTERS else SURROGATE_TEST
     return StatsPlan(block_s, FOLDS, cluster_s, n_clusters, test)
 
 

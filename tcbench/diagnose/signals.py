@@ -22,6 +22,7 @@ from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 
 MAD_TO_SIGMA = 1.4826
+DEFAULT_SMOOTH_S = 120.0  # the thermometer smoothing window (s) of a record without a coarse staircase
 GRID_S = 1.0  # clock of the lag filter and the play operator
 MAX_GRID_SAMPLES = 5_000_000  # that clock over the recording: 58 days at 1 s
 
