@@ -103,7 +103,7 @@ def method_step(method: str, rec: Any, branches: list[Any], train: int,
 def _diagnosed(rec: Any, b: Any) -> Any:
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.model_file import to_sensor_model
-    from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
+    from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
     from tcbench.diagnose.plan import FOLDS
     from tcbench.diagnose.report import model_spec
     from tcbench.sensors.recording import make_recording

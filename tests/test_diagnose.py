@@ -34,22 +34,22 @@ def test_names_the_hidden_effect(sensor: str, effect: str | None, seed: int) -> 
     rec, truth = concealed_recording(sensor, effect, seed)
     d = diagnose(rec)
     assert d.effect_ids == ([effect] if effect else [])
-    assert d.final["rmse_heldout"] <= 1.15 * truth.white_sigma
-    assert d.final["rmse_heldout"] <= d.baseline["rmse_heldout"]
+    assert d.final.rmse_heldout <= 1.15 * truth.white_sigma
+    assert d.final.rmse_heldout <= d.baseline.rmse_heldout
 
 
 def test_fitted_parameters_close_to_truth() -> None:
     rec, truth = concealed_recording("gyro", "thermal_lag", 2)
     found = diagnose(rec).effects[0]
-    assert found["params"]["tau_s"] == pytest.approx(truth.params["tau_s"], rel=0.25)
-    assert "lag" in found["explanation"]
+    assert found.params["tau_s"] == pytest.approx(truth.params["tau_s"], rel=0.25)
+    assert "lag" in found.explanation
 
 
 def test_declared_effect_is_not_found_again() -> None:
     rec, truth = concealed_recording("gyro", "warmup", 3)
     d = diagnose(rec, declared={"warmup": {"tau_s": truth.params["tau_s"]}})
     assert d.effect_ids == []
-    assert d.baseline["model"] == ["minimal", "warmup"]
+    assert d.baseline.model == ["minimal", "warmup"]
 
 
 def test_cross_validation_is_honest_about_overfitting() -> None:
@@ -165,6 +165,6 @@ def test_one_way_steps_without_soak_cannot_separate_lag_from_rate() -> None:
     assert d.effect_ids == ["thermal_lag"]
     # 2.6 h: the CV blocks are sized to the recording (390 s, not 15 min); with them the held-out
     # error separates the lag from a rate term, but not from hysteresis, which also needs soaks
-    pairs = {tuple(c["effects"]): c["test"] for c in d.confusable}
+    pairs = {c.effects: c.test for c in d.confusable}
     assert pairs and all(a == "thermal_lag" and "soak" in test for (a, _), test in pairs.items())
     assert "thermal_lag cannot be told from" in d.verdict

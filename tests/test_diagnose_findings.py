@@ -25,7 +25,7 @@ from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.attribute import CONFUSABLE
 from tcbench.diagnose.diagnosis import Diagnosis, Series, diagnose
 from tcbench.diagnose.explain import explain
-from tcbench.diagnose.findings import SHAPES, check_finding
+from tcbench.diagnose.findings import SHAPES, Finding, check_finding
 from tcbench.diagnose.library_findings import SHAPE, Extent, library_finding
 from tcbench.diagnose.markdown import format_where, render_markdown
 from tcbench.diagnose.plots import mark_bands, mark_levels, mark_times, residual_spectrum, write_plots
@@ -123,6 +123,14 @@ def test_report_md_shows_where_explanation_and_confirm_with(written: tuple[dict[
     assert "| thermal_lag | temperature_dynamics | yes |" in md and "| outliers | outliers | no |" in md
 
 
+def test_every_finding_reads_back_from_its_report_entry(written: tuple[dict[str, Any], str, Path],
+                                                        several: Diagnosis) -> None:
+    report, _, _ = written
+    assert [f.id for f in several.effects] == [e["id"] for e in report["effects"]]
+    for entry in report["effects"]:
+        assert Finding.from_json(entry).to_json() == entry
+
+
 def _open_world() -> list[dict[str, Any]]:
     """Findings of shapes outside the library, as the open-world detectors write them."""
     base = {"library": False, "evidence": {"gain_sigma2": 40.0, "threshold_sigma2": 10.0, "test": "permutation"},
@@ -142,7 +150,7 @@ def test_markdown_renders_open_world_findings_without_knowing_their_ids(several:
     findings = _open_world()
     for f in findings:
         check_finding(f)
-    md = render_markdown(replace(several, effects=findings), {})
+    md = render_markdown(replace(several, effects=[Finding.from_json(f) for f in findings]), {})
     for f in findings:
         assert f"### {f['id']} ({f['shape']}, not a library effect)" in md
     t0 = float(several.series.t_s[0])
@@ -164,7 +172,7 @@ def test_plots_mark_every_located_finding(several: Diagnosis, tmp_path: Path) ->
     s = several.series
     series = _WithOutput(s.t_s, s.temp_c, s.residual_before, s.residual_after, s.allan_before, s.allan_after,
                          output=np.asarray(s.residual_before) + 0.1)
-    d = replace(several, effects=[*several.effects, *_open_world()], series=series)
+    d = replace(several, effects=[*several.effects, *map(Finding.from_json, _open_world())], series=series)
     t0, t1 = float(s.t_s[0]), float(s.t_s[-1])
     fig, ax = plt.subplots()
     # warm-up at 0, two outliers, the step at 7200 s
@@ -209,6 +217,6 @@ def test_instants_outside_the_record_are_not_drawn(several: Diagnosis) -> None:
     t0, t1 = float(several.series.t_s[0]), float(several.series.t_s[-1])
     finding = _open_world()[0] | {"where": {"time_s": [t0 - 10.0 * (t1 - t0), 0.5 * (t0 + t1), t1 + 1e9]}}
     fig, ax = plt.subplots()
-    assert mark_times(ax, replace(several, effects=[finding]), t0, t1) == 1
+    assert mark_times(ax, replace(several, effects=[Finding.from_json(finding)]), t0, t1) == 1
     assert float(ax.lines[0].get_xdata()[0]) == pytest.approx(0.5 * (t1 - t0) / 3600.0)
     plt.close(fig)

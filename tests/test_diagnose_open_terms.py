@@ -123,7 +123,7 @@ def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_p
         check_finding(entry)
     steps = [e for e in report["effects"] if e["shape"] == "step"]
     assert steps and abs(steps[0]["where"]["time_s"] - t0) < 600.0
-    assert d.final["rmse_heldout"] / sigma < 1.05 < d.baseline["rmse_heldout"] / sigma
+    assert d.final.rmse_heldout / sigma < 1.05 < d.baseline.rmse_heldout / sigma
     assert "beyond the library: bias_step (step)" in d.verdict
     spec = parse_model(d.model, "model.yaml")
     step = next(e for e in to_sensor_model(spec).effects if e.id == "bias_step")
@@ -164,7 +164,7 @@ def test_two_steps_are_two_instances_of_the_term_and_simulate_back(tmp_path) -> 
     span = float(rec.time_s[-1])
     assert len(steps) == 2 and abs(steps[0] - 0.3 * span) < 600.0 and abs(steps[1] - 0.7 * span) < 600.0
     assert {"bias_step", "bias_step_2"} <= {e["id"] for e in report["effects"]}
-    assert d.final["rmse_heldout"] / sigma < 1.05
+    assert d.final.rmse_heldout / sigma < 1.05
     effects = to_sensor_model(parse_model(d.model, "model.yaml")).effects
     assert sorted(e.time_s for e in effects if e.id == "bias_step") == pytest.approx(steps)
 

@@ -25,6 +25,7 @@ from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.model_file import read_model, to_sensor_model
 from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
 from tcbench.diagnose.report import write_report
+from tcbench.diagnose.screens import outliers as outlier_screen
 from tcbench.sensors.recording import Recording
 
 def _with_spikes(rec: Recording, index: list[int], sizes: list[float]) -> Recording:
@@ -76,12 +77,12 @@ def test_spike_at_the_last_sample(clean: tuple[Recording, float], k: float) -> N
     assert finding["evidence"]["robust_z"][0] > 0.9 * k > finding["evidence"]["bound_z"]
     assert "glitch" in finding["explanation"] and finding["confirm_with"]
     # it no longer dominates: held-out RMSE as the clean record's, near 1 sigma; no effect named for it
-    assert d_spiked.final["rmse_heldout"] == pytest.approx(d_clean.final["rmse_heldout"], rel=1e-3)
-    assert d_spiked.final["rmse_heldout"] < 1.1 * sigma
-    assert d_spiked.baseline["rmse_heldout"] < 1.1 * sigma
+    assert d_spiked.final.rmse_heldout == pytest.approx(d_clean.final.rmse_heldout, rel=1e-3)
+    assert d_spiked.final.rmse_heldout < 1.1 * sigma
+    assert d_spiked.baseline.rmse_heldout < 1.1 * sigma
     assert [e for e in d_spiked.effect_ids if e != "outliers"] == []
     assert "bias_instability" not in d_spiked.effect_ids
-    assert d_spiked.noise["samples"] == n - 1
+    assert d_spiked.noise.samples == n - 1
     assert "zero weight" in d_spiked.verdict
     md = render_markdown(d_spiked, {})
     assert "### outliers" in md and f"{rec.time_s[-1]:.8g}" in md
@@ -90,9 +91,9 @@ def test_spike_at_the_last_sample(clean: tuple[Recording, float], k: float) -> N
 def test_without_exclusion_the_spike_dominates(clean: tuple[Recording, float], monkeypatch: pytest.MonkeyPatch) -> None:
     # the same 300-sigma spike, detector switched off: the behaviour this module removes
     rec, sigma = clean
-    monkeypatch.setattr(dg, "find_outliers", lambda t, r, w, **_: Outliers(*(np.zeros(0),) * 4, w, 5.0))
+    monkeypatch.setattr(outlier_screen, "find_outliers", lambda t, r, w, **_: Outliers(*(np.zeros(0),) * 4, w, 5.0))
     d = dg.diagnose(_with_spikes(rec, [rec.time_s.size - 1], [300.0 * sigma]))
-    assert d.final["rmse_heldout"] > 1.7 * sigma
+    assert d.final.rmse_heldout > 1.7 * sigma
     assert "bias_instability" in d.effect_ids
 
 
@@ -108,7 +109,7 @@ def test_spike_in_the_middle_of_a_soak(clean: tuple[Recording, float]) -> None:
     assert finding["where"]["time_s"] == [pytest.approx(float(rec.time_s[i])), pytest.approx(float(rec.time_s[i + 1]))]
     assert finding["params"]["size"] == [pytest.approx(-30.0 * sigma, rel=0.1), pytest.approx(-25.0 * sigma, rel=0.1)]
     assert [e for e in d.effect_ids if e != "outliers"] == []
-    assert d.final["rmse_heldout"] < 1.1 * sigma
+    assert d.final.rmse_heldout < 1.1 * sigma
 
 
 def test_a_long_run_is_not_a_spike() -> None:

@@ -15,7 +15,6 @@ import pytest
 
 from tcbench.cli import main
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.diagnose import nonmean as nm
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model
 from tcbench.diagnose.quantisation import (
@@ -25,6 +24,8 @@ from tcbench.diagnose.quantisation import (
     thermometer_steps,
 )
 from tcbench.diagnose.report import write_report
+from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens, smoothing
+from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
 from tcbench.sensors.recording import Recording, read_recording
 from tcbench.sensors.simulate import simulate_recording
 
@@ -55,8 +56,8 @@ def test_a_lattice_far_below_the_noise_is_not_reported() -> None:
     found = find_output_quantisation(np.round(rng.standard_normal(5000) / 0.5) * 0.5, 1.0)
     assert found is not None and found.step == pytest.approx(0.5)
     finding = found.finding("Hz")
-    assert finding["shape"] == "quantisation" and finding["where"] == {"level": pytest.approx(0.5)}
-    assert finding["params"] == {"step": pytest.approx(0.5)} and "converter" in finding["explanation"]
+    assert finding.shape == "quantisation" and finding.where == {"level": pytest.approx(0.5)}
+    assert finding.params == {"step": pytest.approx(0.5)} and "converter" in finding.explanation
 
 
 def test_thermometer_staircase_worked_by_hand() -> None:
@@ -70,8 +71,8 @@ def test_thermometer_staircase_worked_by_hand() -> None:
     assert steps.step_c == 1.0 and steps.rate_c_per_s == pytest.approx(rate, rel=0.05)
     assert steps.smooth_s == pytest.approx(PERIODS * 600.0, rel=0.05)
     finding = steps.finding()
-    assert finding["id"] == "thermometer_quantisation" and finding["shape"] == "quantisation"
-    assert finding["where"] == {"level": 1.0} and "whole degrees" in finding["explanation"]
+    assert finding.id == "thermometer_quantisation" and finding.shape == "quantisation"
+    assert finding.where == {"level": 1.0} and "whole degrees" in finding.explanation
     # dithered by noise of a third of a step (the concealed thermometer: 1/16 degC, 0.02 degC
     # noise) or of half a step (tcbench simulate's: 0.01 degC, 0.005 degC): nothing to report
     fine = np.round((true + 0.02 * rng.standard_normal(t.size)) * 16.0) / 16.0
@@ -83,8 +84,8 @@ def test_thermometer_staircase_worked_by_hand() -> None:
 @pytest.mark.parametrize(("sensor", "seed"), [("gyro", 5), ("msra", 5), ("gyro", 11), ("msra", 11)])
 def test_concealed_controls_show_no_grid(sensor: str, seed: int) -> None:
     rec, _ = concealed_recording(sensor, None, seed)
-    steps = nm.NonMean.before(rec)
-    assert steps.smooth_s == nm.DEFAULT_SMOOTH_S and not (steps.thermometer and steps.thermometer.staircase)
+    steps = smoothing(rec)
+    assert steps.smooth_s == DEFAULT_SMOOTH_S and not steps.staircase and not steps.findings("Hz")
     assert lattice_step(rec.output) is None
 
 
@@ -139,8 +140,8 @@ def test_diagnosis_names_a_quantised_output(tmp_path: Path, lsb: float) -> None:
     assert found["quantisation"]["where"]["level"] == pytest.approx(q, rel=1e-9)
     assert d.model["effects"]["quantisation"] == {"step": pytest.approx(q, rel=1e-9)}
     # a grid adds q^2/12 of variance: the fit is no worse than that
-    assert d.final["rmse_heldout"] < 1.05 * np.sqrt(1.0 + lsb**2 / 12.0) * truth.white_sigma
-    assert d.noise["white_sigma"] == pytest.approx(np.sqrt(1.0 + lsb**2 / 12.0) * truth.white_sigma, rel=0.05)
+    assert d.final.rmse_heldout < 1.05 * np.sqrt(1.0 + lsb**2 / 12.0) * truth.white_sigma
+    assert d.noise.white_sigma == pytest.approx(np.sqrt(1.0 + lsb**2 / 12.0) * truth.white_sigma, rel=0.05)
     assert "quantisation: {step: " in write_report(d, tmp_path / "r")["model.yaml"].read_text()
 
 
@@ -156,7 +157,7 @@ def test_diagnosis_names_a_whole_degree_thermometer() -> None:
     assert found["thermometer_quantisation"]["where"] == {"level": 1.0}
     assert report["statistics"]["thermometer_smooth_s"] > 3 * 120.0
     assert d.model["effects"]["thermometer_quantisation"] == {"step_c": 1.0}
-    assert d.final["rmse_heldout"] < 1.01 * truth.white_sigma
+    assert d.final.rmse_heldout < 1.01 * truth.white_sigma
 
 
 def test_noise_on_a_coarse_grid_is_measured_and_simulated_right() -> None:
@@ -169,11 +170,14 @@ def test_noise_on_a_coarse_grid_is_measured_and_simulated_right() -> None:
     y = np.round(rng.standard_normal(n) / 1.5) * 1.5
     t = np.arange(n, dtype=float)
     temp = np.linspace(0.0, 40.0, n)
-    d = nm.NonMean()
-    data = d.prefit(DiagnosisData("gyro", "deg/s", t, temp, temp, np.zeros(n), np.zeros(n), y,
-                                  np.zeros(n, dtype=np.int64), 1.57, 1.0, 120.0))
+    screens = [s for s in BEFORE_FIT if s.id != "outliers"]  # the output's grid, clipping and noise level
+    screened = run_screens(screens, ScreenInput(None, DiagnosisData(
+        "gyro", "deg/s", t, temp, temp, np.zeros(n), np.zeros(n), y, np.zeros(n, dtype=np.int64), 1.57, 1.0, 120.0)))
+    data = screened.data
     assert data.white_sigma == pytest.approx(np.sqrt(1.0 + 1.5**2 / 12.0), rel=0.02)
+    assert "quantisation step (1.5) exceeds its white noise" in screened.not_tested["variance"]
     model = {"effects": {"white_noise": {"density": data.white_sigma}}}
-    d.write_model(model)
+    for key in (k for k in MODEL_ORDER if k in screened.results):
+        screened.results[key].write_model(model)
     assert model["effects"]["white_noise"]["density"] == pytest.approx(1.0, rel=0.03)
     assert model["effects"]["quantisation"] == {"step": pytest.approx(1.5)}

@@ -34,15 +34,16 @@ def test_conversion_drops_the_glitch_and_converts_units() -> None:
 
 def test_short_record_gets_short_blocks_and_the_surrogate_test(gyro_y) -> None:
     st = gyro_y.statistics
-    assert st["cv_block_s"] < 300.0 and st["significance_test"] == SURROGATE
+    assert st.plan.block_s < 300.0 and st.significance_test == SURROGATE
+    assert st.to_json()["cv_block_s"] == st.plan.block_s and st.to_json()["significance_test"] == SURROGATE
 
 
 def test_temperature_structure_is_kept_not_called_noise(gyro_y) -> None:
     kept = set(gyro_y.effect_ids) & TEMPERATURE_EFFECTS
     assert kept, gyro_y.verdict
     for e in gyro_y.effects:
-        if e["id"] in TEMPERATURE_EFFECTS:
-            assert e["evidence"]["test"] == SURROGATE and e["evidence"]["p_value"] <= 0.005
+        if e.id in TEMPERATURE_EFFECTS:
+            assert e.evidence["test"] == SURROGATE and e.evidence["p_value"] <= 0.005
     assert gyro_y.effect_ids != ["bias_instability"]
     # deterministic before stochastic: flicker only once the reference finds no more structure
     if "bias_instability" in gyro_y.effect_ids:
@@ -50,13 +51,13 @@ def test_temperature_structure_is_kept_not_called_noise(gyro_y) -> None:
 
 
 def test_final_far_below_baseline_and_near_the_reference(gyro_y) -> None:
-    sigma = gyro_y.noise["white_sigma"]
-    base, final = gyro_y.baseline["rmse_heldout"], gyro_y.final["rmse_heldout"]
-    ref = gyro_y.reference["rmse_heldout"]
+    sigma = gyro_y.noise.white_sigma
+    base, final = gyro_y.baseline.rmse_heldout, gyro_y.final.rmse_heldout
+    ref = gyro_y.reference.rmse_heldout
     assert final < 0.5 * base
     assert final < 2.0 * sigma
     assert final <= WITHIN_REFERENCE * ref
-    assert gyro_y.reference["final_over_reference"] == pytest.approx(final / ref)
+    assert gyro_y.reference.final_over_reference == pytest.approx(final / ref)
 
 
 def test_report_says_which_test_and_shows_the_reference(gyro_y, tmp_path) -> None:

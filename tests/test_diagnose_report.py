@@ -11,6 +11,7 @@ from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
 from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.plots import plot_allan, plot_evidence, write_plots
+from tcbench.diagnose.result import Confusion
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -72,7 +73,7 @@ def test_missing_allan_and_confusable_pair(found: Diagnosis, tmp_path: Path) -> 
     the test that separates it in the markdown."""
     test = "soaks approached from above and from below"
     d = replace(found, series=replace(found.series, allan_before=None, allan_after=None),
-                confusable=[{"effects": ["hysteresis", "thermal_lag"], "test": test}])
+                confusable=[Confusion(("hysteresis", "thermal_lag"), test)])
     for plot, name in ((plot_allan, "allan.png"), (plot_evidence, "evidence.png")):
         path = plot(d, tmp_path / name)
         assert path.read_bytes()[:8] == PNG_MAGIC

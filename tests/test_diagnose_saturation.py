@@ -47,10 +47,10 @@ def test_clipped_sine_worked_by_hand() -> None:
     assert np.isin(clipped, sat.index).all()  # every clipped sample gets zero weight
     assert sat.index.size < 0.5 * y.size  # and the record keeps most of its samples
     finding = sat.finding("deg/s")
-    assert finding["shape"] == "saturation" and finding["library"] is False
-    assert finding["where"]["level"] == [2.5, -2.8]
-    assert finding["params"]["upper"] == 2.5 and finding["params"]["lower"] == -2.8
-    assert "range" in finding["explanation"] and "datasheet" in finding["confirm_with"]
+    assert finding.shape == "saturation" and finding.library is False
+    assert finding.where["level"] == [2.5, -2.8]
+    assert finding.params["upper"] == 2.5 and finding.params["lower"] == -2.8
+    assert "range" in finding.explanation and "datasheet" in finding.confirm_with
 
 
 def test_one_sided_clip_gives_its_temperature_band() -> None:
@@ -143,6 +143,6 @@ def test_diagnosis_names_a_clipped_recording(tmp_path: Path) -> None:
     low, high = sat["where"]["temperature_c"]
     assert low <= float(np.min(d.series.temp_c)) + 1.0 and high >= float(np.max(d.series.temp_c)) - 1.0
     # the fit without the clipped samples is as good as the clean record's
-    assert d.final["rmse_heldout"] < 1.05 * truth.white_sigma
+    assert d.final.rmse_heldout < 1.05 * truth.white_sigma
     files = write_report(d, tmp_path / "report")
     assert "saturation: {upper: " in files["model.yaml"].read_text()

@@ -94,7 +94,7 @@ def test_cli_on_a_record_too_small_exits_2_with_one_line(
     (300, 30.0, lambda t, _: 25.0 + 10.0 * np.sin(t / 1800.0), {"variance"}),  # too few samples for 12 blocks
 ])
 def test_marginal_records_finish_with_the_reasons(n: int, dt_s: float, temp: TempFn, expected: set[str]) -> None:
-    not_tested = diagnose(_record(n, dt_s, temp)).statistics["not_tested"]
+    not_tested = diagnose(_record(n, dt_s, temp)).statistics.not_tested
     assert expected <= set(not_tested) and all(isinstance(v, str) and v for v in not_tested.values())
 
 

@@ -53,8 +53,8 @@ def test_sigma_doubling_at_30_degc_worked_by_hand() -> None:
     effect, params = v.model_effect()  # type: ignore[misc]
     assert effect == "noise_temperature" and params["growth_per_c"] > 0
     finding = v.finding("deg/s")
-    assert finding["shape"] == "variance" and finding["where"]["temperature_c"][0] == pytest.approx(low, abs=1e-3)
-    assert "quality factor" in finding["explanation"] and "Allan deviation per temperature band" in finding["confirm_with"]
+    assert finding.shape == "variance" and finding.where["temperature_c"][0] == pytest.approx(low, abs=1e-3)
+    assert "quality factor" in finding.explanation and "Allan deviation per temperature band" in finding.confirm_with
 
 
 def test_noise_growing_with_time_is_told_from_temperature() -> None:
@@ -155,7 +155,7 @@ def test_diagnosis_names_noise_growing_with_temperature(tmp_path: Path) -> None:
     # the white sigma is the record's RMS (sqrt((1 + 4) / 2) = 1.58 sigma), not the median
     # difference's 1.35, so the Allan test does not take the noisy half for flicker
     assert "bias_instability" not in found
-    assert d.noise["white_sigma"] == pytest.approx(np.sqrt(2.5) * truth.white_sigma, rel=0.05)
+    assert d.noise.white_sigma == pytest.approx(np.sqrt(2.5) * truth.white_sigma, rel=0.05)
     # model.yaml: the noise level follows temperature instead of one white sigma, and a
     # simulation of it shows the same growth
     spec = read_model(write_report(d, tmp_path / "r")["model.yaml"])

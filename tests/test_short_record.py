@@ -16,7 +16,7 @@ from scipy.signal import lfilter
 
 from tcbench.cli import main
 from tcbench.diagnose.crossval import block_folds
-from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
+from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
 from tcbench.diagnose.plan import FOLDS, min_full_duration_s
 from tcbench.diagnose.short_record import short_record
 from tcbench.diagnose.short_tests import MIN_FIT_SAMPLES

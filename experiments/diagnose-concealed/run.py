@@ -62,9 +62,9 @@ def one(sensor: str, effect: str | None, seed: int) -> dict:
         "sensor": sensor, "truth": effect or "nothing", "seed": seed, "named": label(named),
         "correct": named == ([effect] if effect else []), "ratio": truth.ratio,
         "white_sigma": truth.white_sigma, "params": truth.params,
-        "baseline_rmse_heldout_over_sigma": d.baseline["rmse_heldout"] / truth.white_sigma,
-        "final_rmse_heldout_over_sigma": d.final["rmse_heldout"] / truth.white_sigma,
-        "confusable": ";".join("/".join(c["effects"]) for c in d.confusable),
+        "baseline_rmse_heldout_over_sigma": d.baseline.rmse_heldout / truth.white_sigma,
+        "final_rmse_heldout_over_sigma": d.final.rmse_heldout / truth.white_sigma,
+        "confusable": ";".join("/".join(c.effects) for c in d.confusable),
         "seconds": time.perf_counter() - t0, "hours": rec.time_s[-1] / 3600.0,
     }
 

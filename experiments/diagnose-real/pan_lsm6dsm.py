@@ -58,8 +58,8 @@ def main() -> None:
         d = diagnose(rec, name=f"PAN LSM6DSM gyro {axis} (cooling, 25 bursts)")
         write_report(d, args.out / axis)
         print(f"{axis}: {d.verdict}")
-        print(f"   baseline RMSE held-out {d.baseline['rmse_heldout']:.4g}, final {d.final['rmse_heldout']:.4g}, "
-              f"white {d.noise['white_sigma']:.4g} deg/s")
+        print(f"   baseline RMSE held-out {d.baseline.rmse_heldout:.4g}, final {d.final.rmse_heldout:.4g}, "
+              f"white {d.noise.white_sigma:.4g} deg/s")
         for c in d.candidates:
             print(f"   {c.effect:20s} {c.status:16s} gain {c.gain:9.1f}  wald {c.wald:8.1f}  {c.reason}")
 

@@ -59,10 +59,10 @@ def axis_section(d: Diagnosis, record: str, axis: str, files: dict[str, Path], o
     if not d.effects:
         lines += ["No finding.", ""]
     for f in d.effects:
-        kind = "library" if f["library"] else "not library"
-        where = format_where(f["where"], f["params"].get("unit", d.unit), t0)
-        lines += [f"- **{f['id']}** ({f['shape']}, {kind}); where: {where}. {_sentence(f['explanation'])} "
-                  f"*Confirm with:* {_sentence(f['confirm_with'])}"]
+        kind = "library" if f.library else "not library"
+        where = format_where(f.where, f.params.get("unit", d.unit), t0)
+        lines += [f"- **{f.id}** ({f.shape}, {kind}); where: {where}. {_sentence(f.explanation)} "
+                  f"*Confirm with:* {_sentence(f.confirm_with)}"]
     return [*lines, ""]
 
 
@@ -80,10 +80,10 @@ def diagnose_record(record: str, out: Path) -> tuple[list[str], list[str]]:
         seconds = time.perf_counter() - t0
         files = write_report(d, out / record / axis)
         sections += axis_section(d, record, axis, files, out)
-        s = d.noise["white_sigma"]
-        rows.append(f"| {record} | {axis} | {d.baseline['rmse_heldout'] / s:.2f} sigma | "
-                    f"{d.final['rmse_heldout'] / s:.2f} sigma | {d.reference['rmse_heldout'] / s:.2f} sigma | "
-                    f"{d.reference['final_over_reference']:.2f} | {d.statistics['significance_test']} | "
+        s = d.noise.white_sigma
+        rows.append(f"| {record} | {axis} | {d.baseline.rmse_heldout / s:.2f} sigma | "
+                    f"{d.final.rmse_heldout / s:.2f} sigma | {d.reference.rmse_heldout / s:.2f} sigma | "
+                    f"{d.reference.final_over_reference:.2f} | {d.statistics.significance_test} | "
                     f"{', '.join(d.effect_ids) or '-'} | {seconds:.1f} |")
         print(f"{record} {axis}: {d.verdict}", flush=True)
     return rows, sections

@@ -260,24 +260,24 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
             raise ConfigError(outcome.error)
         raise RuntimeError(f"the diagnosis failed: {outcome.error}")
     diag, written = outcome.diagnosis, outcome.written
-    sigma = float(diag.noise["white_sigma"])
-    before, after = float(diag.baseline["rmse_heldout"]), float(diag.final["rmse_heldout"])
+    sigma = float(diag.noise.white_sigma)
+    before, after = float(diag.baseline.rmse_heldout), float(diag.final.rmse_heldout)
     print(f"\nVerdict: {diag.verdict}")
     for e in diag.effects:
-        params = ", ".join(f"{k} {v:.4g}" for k, v in e.get("params", {}).items())
-        ev = e.get("evidence", {})
+        params = ", ".join(f"{k} {v:.4g}" for k, v in e.params.items())
+        ev = e.evidence
         evidence = (f"dropping it raises the held-out squared error by {ev['gain_sigma2']:.4g} sigma^2 "
                     f"(threshold {ev.get('threshold_sigma2', float('nan')):g}; {ev.get('test', 'test')})"
                     if "gain_sigma2" in ev else ", ".join(f"{k} {_fmt(v)}" for k, v in ev.items()))
-        print(f"  found {e['id']} ({e.get('shape', '')}){': ' + params if params else ''}")
-        print(f"    where: {_where(e.get('where', {}))}")
+        print(f"  found {e.id} ({e.shape}){': ' + params if params else ''}")
+        print(f"    where: {_where(e.where)}")
         print(f"    evidence: {evidence}")
     hit = cfg.diagnose_effect in diag.effect_ids
     print(f"  the hidden effect was {hidden.effect}: {'found' if hit else 'NOT found'}")
     print(f"Held-out RMSE (white noise sigma {sigma:.4g} {diag.unit}; a model that misses nothing reaches ~1 sigma):")
     _print_table(["model", f"RMSE held-out ({diag.unit})", "in sigma"],
-                 [[" + ".join(diag.baseline["model"]), before, before / sigma],
-                  [" + ".join(diag.final["model"]), after, after / sigma]])
+                 [[" + ".join(diag.baseline.model), before, before / sigma],
+                  [" + ".join(diag.final.model), after, after / sigma]])
     paths = list(written.values())
     client = tracking.client(uri)
     exp = client.get_experiment_by_name(experiment)

@@ -148,8 +148,8 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
         raise CommandError(f"{cfg.recording}: {exc}") from None
     written = _written(write_report, diag, cfg)
     print(f"tcbench: {diag.verdict}")
-    print(f"  baseline RMSE held-out {diag.baseline['rmse_heldout']:.4g} {diag.unit}, final "
-          f"{diag.final['rmse_heldout']:.4g} {diag.unit}, white noise {diag.noise['white_sigma']:.4g} {diag.unit}")
+    print(f"  baseline RMSE held-out {diag.baseline.rmse_heldout:.4g} {diag.unit}, final "
+          f"{diag.final.rmse_heldout:.4g} {diag.unit}, white noise {diag.noise.white_sigma:.4g} {diag.unit}")
     print(f"  wrote {', '.join(str(p) for p in written.values())}")
     return DiagnosisOutcome(diag, written)
 

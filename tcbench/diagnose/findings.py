@@ -50,6 +50,11 @@ class Finding:
         extra = out.pop("extra")
         return out | extra
 
+    @classmethod
+    def from_json(cls, entry: Mapping[str, Any]) -> Finding:
+        """The finding of a report.json ``effects`` entry (keys beyond :data:`KEYS` as ``extra``)."""
+        return cls(**{k: entry[k] for k in KEYS}, extra={k: v for k, v in entry.items() if k not in KEYS})
+
 
 def check_finding(entry: Mapping[str, Any]) -> None:
     """Raise ``ValueError`` naming what a finding ``entry`` lacks or gets wrong."""

@@ -40,6 +40,7 @@ from scipy.stats import chi2, norm
 from tcbench.sensors.segments import segments
 from tcbench.signal.allan import allan_deviation
 
+FALSE_ALARM = 0.01  # of the diagnosis' mismatch scan and of its flicker test
 MIN_SAMPLES = 100
 N_FAMILIES = 5  # time spans, temperature bands, heating/cooling, soak/ramp, frequency band
 MIN_WINDOWS = 10  # the time scan shrinks its windows to have at least this many

@@ -16,8 +16,10 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
-from tcbench.diagnose.diagnosis import REFERENCE_RATIO, Diagnosis
-from tcbench.diagnose.plan import SURROGATE
+from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.reference import REFERENCE_RATIO
+from tcbench.diagnose.result import Diagnosis
+from tcbench.diagnose.significance import SURROGATE
 from tcbench.diagnose.surrogate import LEVEL
 
 PLOT_CAPTIONS = {
@@ -180,16 +182,16 @@ def _scalar_params(params: dict[str, Any], unit: str) -> str:
     return "; ".join(out) or "-"
 
 
-def _listed_table(f: dict[str, Any], unit: str, t0: float) -> list[str]:
+def _listed_table(f: Finding, unit: str, t0: float) -> list[str]:
     """Lists of one length in ``params`` and ``evidence`` (instants, sizes, scores) as a table,
     with hours from the start beside ``time_s``."""
-    columns = {k: v for k, v in f["params"].items() if isinstance(v, (list, tuple)) and v
+    columns = {k: v for k, v in f.params.items() if isinstance(v, (list, tuple)) and v
                and all(isinstance(x, (int, float)) for x in v)}
     if not columns:
         return []
     n = len(next(iter(columns.values())))
     columns = {k: v for k, v in columns.items() if len(v) == n}
-    columns |= {k: v for k, v in f["evidence"].items() if isinstance(v, (list, tuple)) and len(v) == n
+    columns |= {k: v for k, v in f.evidence.items() if isinstance(v, (list, tuple)) and len(v) == n
                 and all(isinstance(x, (int, float)) for x in v)}
     header, cols = [], []
     for k, v in columns.items():
@@ -200,35 +202,34 @@ def _listed_table(f: dict[str, Any], unit: str, t0: float) -> list[str]:
             cols.append([_g((x - t0) / 3600.0, 4) for x in v])
     rows = list(zip(*cols, strict=True))
     out = _table(header, rows)
-    count = f["params"].get("count")
+    count = f.params.get("count")
     if isinstance(count, int) and count > n:
         out.append(f"({n} largest of {count} listed.)")
     return [*out, ""]
 
 
-def finding_section(f: dict[str, Any], unit: str, t0: float) -> list[str]:
+def finding_section(f: Finding, unit: str, t0: float) -> list[str]:
     """One finding of the report contract (any ``id``): shape, library or not, parameters,
     where, evidence, what it cannot be told from, confirm-with, listed values and explanation."""
-    kind = "library effect" if f.get("library") else "not a library effect"
-    shape = f.get("shape", "-")
-    unit_here = str(f["params"].get("unit", unit))
-    out = [f"### {f['id']} ({shape}, {kind})", "",
-           f"- Shape: {shape}" + (f" ({SHAPE_SIGNATURE[shape]})" if shape in SHAPE_SIGNATURE else ""),
-           f"- Parameters: {_scalar_params(f['params'], unit_here)}",
-           f"- Where: {format_where(f.get('where', {}), unit_here, t0)}",
-           f"- Evidence: {_evidence_text(f.get('evidence', {}))}"]
-    if f.get("confusable_with"):
-        out.append(f"- Cannot be told from: {', '.join(f['confusable_with'])} (see below)")
-    out += [f"- Confirm with: {f.get('confirm_with', '-')}", ""]
+    kind = "library effect" if f.library else "not a library effect"
+    unit_here = str(f.params.get("unit", unit))
+    out = [f"### {f.id} ({f.shape}, {kind})", "",
+           f"- Shape: {f.shape}" + (f" ({SHAPE_SIGNATURE[f.shape]})" if f.shape in SHAPE_SIGNATURE else ""),
+           f"- Parameters: {_scalar_params(f.params, unit_here)}",
+           f"- Where: {format_where(f.where, unit_here, t0)}",
+           f"- Evidence: {_evidence_text(f.evidence)}"]
+    if f.extra.get("confusable_with"):
+        out.append(f"- Cannot be told from: {', '.join(f.extra['confusable_with'])} (see below)")
+    out += [f"- Confirm with: {f.confirm_with}", ""]
     out += _listed_table(f, unit_here, t0)
-    return [*out, f.get("explanation", ""), ""]
+    return [*out, f.explanation, ""]
 
 
-def findings_table(effects: list[dict[str, Any]], unit: str, t0: float) -> list[str]:
+def findings_table(effects: list[Finding], unit: str, t0: float) -> list[str]:
     """One row per finding: id, shape, library, where."""
     return _table(["finding", "shape", "library", "where"],
-                  ([f["id"], f.get("shape", "-"), "yes" if f.get("library") else "no",
-                    format_where(f.get("where", {}), str(f["params"].get("unit", unit)), t0)] for f in effects))
+                  ([f.id, f.shape, "yes" if f.library else "no",
+                    format_where(f.where, str(f.params.get("unit", unit)), t0)] for f in effects))
 
 
 def not_tested_section(not_tested: dict[str, str]) -> list[str]:
@@ -242,44 +243,42 @@ def not_tested_section(not_tested: dict[str, str]) -> list[str]:
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
     the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
-    sigma = float(d.noise["white_sigma"])
+    sigma = float(d.noise.white_sigma)
     t0 = float(d.series.t_s[0]) if len(d.series.t_s) else 0.0
     out = [f"# Diagnosis of {d.recording or 'recording'} ({d.sensor})", "",
            f"**Verdict:** {d.verdict}", ""]
 
     out += ["## Fit", "",
-            (f"White noise sigma {_g(sigma)} {d.unit} per sample, {int(d.noise.get('samples', 0))} samples, "
-             f"{int(d.noise.get('folds', 0))}-fold blocked cross-validation. The held-out RMSE of a model that "
+            (f"White noise sigma {_g(sigma)} {d.unit} per sample, {int(d.noise.samples)} samples, "
+             f"{int(d.noise.folds)}-fold blocked cross-validation. The held-out RMSE of a model that "
              "misses nothing is close to 1 sigma."), ""]
     rows = []
     for label, fit in (("baseline", d.baseline), ("final", d.final)):
-        rows.append([label, ", ".join(fit.get("model", [])), _g(fit["rmse_fit"]), _g(fit["rmse_heldout"]),
-                     f"{_g(fit['rmse_heldout'] / sigma, 3)} sigma"])
+        rows.append([label, ", ".join(fit.model), _g(fit.rmse_fit), _g(fit.rmse_heldout),
+                     f"{_g(fit.rmse_heldout / sigma, 3)} sigma"])
     ref = d.reference
-    if ref:
-        rows.append(["reference (no physics)", f"ridge on {len(ref['terms'])} temperature terms", _g(ref["rmse_fit"]),
-                     _g(ref["rmse_heldout"]), f"{_g(ref['rmse_heldout'] / sigma, 3)} sigma"])
+    if ref is not None:
+        rows.append(["reference (no physics)", f"ridge on {len(ref.terms)} temperature terms", _g(ref.rmse_fit),
+                     _g(ref.rmse_heldout), f"{_g(ref.rmse_heldout / sigma, 3)} sigma"])
     out += _table(["model", "terms", f"RMSE fit ({d.unit})", f"RMSE held-out ({d.unit})", "held-out / white sigma"],
                   rows)
     out.append("")
-    if ref:
-        ratio = ref["final_over_reference"]
-        out += [(f"The reference is a {ref['what']} ({', '.join(ref['terms'])}); it names no physics and says how "
+    if ref is not None:
+        ratio = ref.final_over_reference
+        out += [(f"The reference is a {ref.what} ({', '.join(ref.terms)}); it names no physics and says how "
                  f"far a model driven by the thermometer can go on this recording. Final / reference held-out RMSE: "
                  f"**{_g(ratio, 3)}**"
                  + (f", above {_g(REFERENCE_RATIO)}: deterministic temperature structure remains in the final "
-                    "residual, so bias instability is not judged." if ref["deterministic_structure_remains"] else ".")),
+                    "residual, so bias instability is not judged." if ref.deterministic_structure_remains else ".")),
                 ""]
-    st = d.statistics
-    if "significance_test" in st:  # not_tested alone does not describe the plan
-        test = st["significance_test"]
-        why = (f"the recording holds {st['clusters']} clusters of {_g(st['cluster_s'])} s, too few for the "
-               "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
-               f"candidate model's residual (p <= {_g(LEVEL)})" if test == SURROGATE else
-               f"{st['clusters']} clusters of {_g(st['cluster_s'])} s for the cluster-robust Wald test (an effect that "
-               "removes most of the excess error and fails it is tried by the surrogate test instead)")
-        out += [(f"Statistics sized to this recording: blocks of {_g(st['cv_block_s'])} s in {st['folds']} interleaved "
-                 f"folds; {why}."), ""]
+    plan = d.statistics.plan
+    why = (f"the recording holds {plan.n_clusters} clusters of {_g(plan.cluster_s)} s, too few for the "
+           "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
+           f"candidate model's residual (p <= {_g(LEVEL)})" if plan.test.name == SURROGATE else
+           f"{plan.n_clusters} clusters of {_g(plan.cluster_s)} s for the cluster-robust Wald test (an effect that "
+           "removes most of the excess error and fails it is tried by the surrogate test instead)")
+    out += [(f"Statistics sized to this recording: blocks of {_g(plan.block_s)} s in {plan.k} interleaved "
+             f"folds; {why}."), ""]
 
     out += ["## Where the starting model misses", ""]
     if d.mismatch:
@@ -315,8 +314,8 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     out += ["## Effects this recording cannot tell apart", ""]
     if d.confusable:
         for c in d.confusable:
-            a, b = c["effects"]
-            out.append(f"- **{a}** cannot be told from **{b}**. A test that would separate them: {c['test']}.")
+            a, b = c.effects
+            out.append(f"- **{a}** cannot be told from **{b}**. A test that would separate them: {c.test}.")
     else:
         out.append("None.")
     out.append("")
@@ -331,7 +330,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
                   ([e.effect, e.status, _gain_cell(e), _test_cell(e), _value_cell(e), e.reason]
                    for e in d.candidates))
     out.append("")
-    out += not_tested_section(d.statistics.get("not_tested", {}))
+    out += not_tested_section(d.statistics.not_tested)
 
     if plots:
         out += ["## Plots", ""]

@@ -35,12 +35,12 @@ Detection, on the residual ``r`` of the current model (output unit):
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
 from scipy.ndimage import median_filter
 from scipy.stats import norm
 
+from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
 
 ALPHA = 0.01  # family-wise false-alarm probability over the whole record
@@ -80,25 +80,23 @@ class Outliers:
     def count(self) -> int:
         return int(self.index.size)
 
-    def finding(self, unit: str) -> dict[str, Any]:
+    def finding(self, unit: str) -> Finding:
         """The report.json ``effects`` entry (``id`` and ``shape`` ``outliers``, not a library
         effect); times and sizes listed for the :data:`MAX_LISTED` largest, in time order."""
         keep = np.sort(np.argsort(-np.abs(self.z), kind="stable")[:MAX_LISTED])
         times = [round(float(t), 6) for t in self.time_s[keep]]
-        return {
-            "id": "outliers", "shape": "outliers", "library": False,
-            "params": {"count": self.count, "time_s": times,
-                       "size": [float(s) for s in self.size[keep]], "unit": unit},
-            "where": {"time_s": times},
-            "evidence": {"robust_z": [round(float(z), 2) for z in self.z[keep]], "bound_z": round(self.bound, 3),
-                         "robust_sigma": self.scale, "false_alarm": ALPHA,
-                         "test": f"|residual - running median of {WINDOW}| / (1.4826 MAD) above the Bonferroni "
-                                 f"bound for the record's samples"},
-            "explanation": (f"{self.count} sample(s) up to {float(np.max(np.abs(self.size))):.4g} {unit} "
-                            f"({float(np.max(np.abs(self.z))):.3g} robust sigma) off the local level: "
-                            + EXPLANATION),
-            "confirm_with": CONFIRM_WITH,
-        }
+        return Finding(
+            id="outliers", shape="outliers", library=False,
+            params={"count": self.count, "time_s": times, "size": [float(s) for s in self.size[keep]], "unit": unit},
+            where={"time_s": times},
+            evidence={"robust_z": [round(float(z), 2) for z in self.z[keep]], "bound_z": round(self.bound, 3),
+                      "robust_sigma": self.scale, "false_alarm": ALPHA,
+                      "test": f"|residual - running median of {WINDOW}| / (1.4826 MAD) above the Bonferroni "
+                              f"bound for the record's samples"},
+            explanation=(f"{self.count} sample(s) up to {float(np.max(np.abs(self.size))):.4g} {unit} "
+                         f"({float(np.max(np.abs(self.z))):.3g} robust sigma) off the local level: " + EXPLANATION),
+            confirm_with=CONFIRM_WITH,
+        )
 
 
 def find_outliers(t_s: np.ndarray, residual: np.ndarray, white_sigma: float, *, alpha: float = ALPHA,

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.signal import lombscargle, periodogram
 
 from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
-from tcbench.diagnose.diagnosis import Diagnosis
+from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.locate import AllanExcess
 from tcbench.sensors.segments import segments, within_rate_hz
 
@@ -92,9 +92,9 @@ def located(d: Diagnosis, key: str) -> list[tuple[str, str, object]]:
     follow the findings' order so that one finding has one colour in every plot."""
     out = []
     for i, f in enumerate(d.effects):
-        where = f.get("where") or {}
+        where = f.where or {}
         if key in where and where[key] is not None:
-            out.append((str(f["id"]), FINDING_COLOURS[i % len(FINDING_COLOURS)], where[key]))
+            out.append((str(f.id), FINDING_COLOURS[i % len(FINDING_COLOURS)], where[key]))
     return out
 
 
@@ -141,12 +141,12 @@ def mark_levels(ax: plt.Axes, d: Diagnosis, unit: str) -> int:
     unit when it gives none) is ``unit``; the number of lines drawn."""
     drawn = 0
     for i, f in enumerate(d.effects):
-        where = f.get("where") or {}
-        if where.get("level") is None or str((f.get("params") or {}).get("unit", d.unit)) != unit:
+        where = f.where or {}
+        if where.get("level") is None or str((f.params or {}).get("unit", d.unit)) != unit:
             continue
         colour = FINDING_COLOURS[i % len(FINDING_COLOURS)]
         for k, level in enumerate(_numbers(where["level"])):
-            ax.axhline(level, color=colour, lw=1.2, ls="-.", zorder=3, label=f"{f['id']}: level" if k == 0 else None)
+            ax.axhline(level, color=colour, lw=1.2, ls="-.", zorder=3, label=f"{f.id}: level" if k == 0 else None)
             drawn += 1
     return drawn
 
@@ -184,7 +184,7 @@ def plot_spectrum(d: Diagnosis, path: Path) -> Path:
     every frequency; line: log-binned means) against the white-noise level ``2 sigma^2 / fs``,
     with each finding's located lines (``frequency_hz`` or ``period_s``) marked."""
     s = d.series
-    sigma = float(d.noise["white_sigma"])
+    sigma = float(d.noise.white_sigma)
     fig, ax = plt.subplots(figsize=(7, 4))
     method, floor = "periodogram", float("inf")
     fs = within_rate_hz(np.asarray(s.t_s, dtype=np.float64))
@@ -242,7 +242,7 @@ def plot_residuals(d: Diagnosis, path: Path) -> Path:
     temperature bands shaded; the grey band is +-1 white sigma."""
     s = d.series
     t, temp = np.asarray(s.t_s, dtype=np.float64), np.asarray(s.temp_c, dtype=np.float64)
-    sigma = float(d.noise["white_sigma"])
+    sigma = float(d.noise.white_sigma)
     step = max(1, int(np.ceil(t.size / MAX_POINTS)))
     t_h = (t - t[0]) / 3600.0
     times, bands = _spans(d)
@@ -274,8 +274,8 @@ def plot_residuals(d: Diagnosis, path: Path) -> Path:
                          label="located temperature band" if i == 0 else None)
         mark_times(ax_t, d, float(t[0]), float(t[-1]))
         mark_bands(ax_c, d, (float(np.min(temp)), float(np.max(temp))))
-        rmse = fit["rmse_heldout"]
-        terms = ", ".join(fit.get("model", [])) or "minimal"
+        rmse = fit.rmse_heldout
+        terms = ", ".join(fit.model) or "minimal"
         sep = "\n" if len(terms) > 40 else " "  # a long list of terms on a line of its own
         ax_t.set_title(f"{label} ({terms}):{sep}RMSE held-out {rmse:.4g} {d.unit} = {rmse / sigma:.3g} σ", fontsize=9)
         ax_t.set_xlabel("time (h)")
@@ -289,7 +289,7 @@ def plot_residuals(d: Diagnosis, path: Path) -> Path:
     axes[0, 0].set_ylabel(f"held-out residual ({d.unit})")
     axes[1, 0].set_ylabel(f"held-out residual ({d.unit})")
     fig.suptitle(f"{d.recording or 'recording'} ({d.sensor}): baseline RMSE held-out "
-                 f"{d.baseline['rmse_heldout']:.4g} {d.unit}, final {d.final['rmse_heldout']:.4g} {d.unit}; "
+                 f"{d.baseline.rmse_heldout:.4g} {d.unit}, final {d.final.rmse_heldout:.4g} {d.unit}; "
                  "shaded: mismatch located on the starting model", fontsize=10)
     return _save(fig, path)
 
@@ -309,7 +309,7 @@ def plot_allan(d: Diagnosis, path: Path) -> Path:
     (+ thermometer) noise line and flagging bound; says so when one is not available."""
     fig, ax = plt.subplots(figsize=(7, 5))
     missing = []
-    same = d.final.get("model") == d.baseline.get("model")
+    same = d.final.model == d.baseline.model
     after = "final model (= starting model)" if same else "final model"
     for ex, colour, label, marker, ms in ((d.series.allan_before, BEFORE_COLOUR, "starting model", "o", 6),
                                           (d.series.allan_after, AFTER_COLOUR, after, "s", 3)):

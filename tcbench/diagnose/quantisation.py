@@ -33,7 +33,6 @@ min at levels such as 9.7 and 20.2 degC) read in whole degrees the smoothed temp
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -97,7 +96,7 @@ class OutputQuantisation:
     white_sigma: float
     levels: int
 
-    def finding(self, unit: str) -> dict[str, Any]:
+    def finding(self, unit: str) -> Finding:
         """The report.json ``effects`` entry (``quantisation``, written to model.yaml as the
         library's ``quantisation: {step}``)."""
         return Finding(
@@ -112,7 +111,7 @@ class OutputQuantisation:
                         f"({self.step / self.white_sigma:.3g} white sigma, {self.levels} levels used): "
                         + OUTPUT_EXPLANATION,
             confirm_with=OUTPUT_CONFIRM,
-        ).to_json()
+        )
 
 
 def find_output_quantisation(output: np.ndarray, white_sigma: float) -> OutputQuantisation | None:
@@ -140,7 +139,7 @@ class ThermometerSteps:
     default_smooth_s: float
     staircase: bool
 
-    def finding(self) -> dict[str, Any]:
+    def finding(self) -> Finding:
         """The report.json ``effects`` entry (``thermometer_quantisation``, shape quantisation)."""
         widened = self.smooth_s > self.default_smooth_s
         return Finding(
@@ -158,7 +157,7 @@ class ThermometerSteps:
                          + (f" (from {self.default_smooth_s:.0f} s to {self.smooth_s:.0f} s)" if widened
                             else " (the default window already spans enough steps)")),
             confirm_with=THERMO_CONFIRM,
-        ).to_json()
+        )
 
 
 def thermometer_steps(t_s: np.ndarray, temp_c: np.ndarray, default_smooth_s: float) -> ThermometerSteps | None:

@@ -22,6 +22,7 @@ from tcbench.diagnose.signals import DiagnosisData, lagged
 ALPHAS = np.geomspace(1e-8, 1e-1, 15)
 N_LAGS = 6  # time constants, log-spaced
 MAX_LAG_FRACTION = 0.25  # the longest lag: a quarter of the recording
+REFERENCE_RATIO = 1.25  # final / reference held-out RMSE above which deterministic structure remains
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,11 @@ class Reference:
     def to_json(self) -> dict[str, object]:
         return {"rmse_heldout": self.rmse_heldout, "rmse_fit": self.rmse_fit, "terms": self.terms,
                 "ridge_alpha": self.alpha}
+
+    def structure_remains(self, final_rmse: float) -> bool:
+        """Whether a model of held-out RMSE ``final_rmse`` leaves deterministic temperature
+        structure: above :data:`REFERENCE_RATIO` times this reference's."""
+        return final_rmse > REFERENCE_RATIO * self.rmse_heldout
 
 
 def lag_grid_s(data: DiagnosisData) -> np.ndarray:

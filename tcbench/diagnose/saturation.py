@@ -85,7 +85,7 @@ class Saturation:
         """``model.yaml``'s ``saturation`` parameters (only the sides found)."""
         return {k: s.level for k, s in (("upper", self.upper), ("lower", self.lower)) if s is not None}
 
-    def finding(self, unit: str) -> dict[str, Any]:
+    def finding(self, unit: str) -> Finding:
         """The report.json ``effects`` entry (``saturation``)."""
         sides = {k: s for k, s in (("upper", self.upper), ("lower", self.lower)) if s is not None}
         levels = [s.level for s in sides.values()]
@@ -107,7 +107,7 @@ class Saturation:
                         + (f", between {self.temperature_c[0]:.3g} and {self.temperature_c[1]:.3g} degC"
                            if self.temperature_c else "") + ": " + EXPLANATION,
             confirm_with=CONFIRM_WITH,
-        ).to_json()
+        )
 
 
 def _side(y: np.ndarray, tol: float, width: float, h: float, alpha: float) -> tuple[Side, np.ndarray] | None:

@@ -104,7 +104,7 @@ class Variance:
             return "noise_temperature", {"density": float(density), "growth_per_c": self.found.slope, "ref_c": self.ref}
         return "noise_time", {"density": float(density), "growth_per_h": 3600.0 * self.found.slope, "ref_s": self.ref}
 
-    def finding(self, unit: str) -> dict[str, Any]:
+    def finding(self, unit: str) -> Finding:
         """The report.json ``effects`` entry (shape ``variance``)."""
         test = self.found
         assert test is not None
@@ -127,7 +127,7 @@ class Variance:
                          f"and is highest between {band[0]:.6g} and {band[1]:.6g} {span}: "
                          + EXPLANATION[test.against]),
             confirm_with=CONFIRM_WITH[test.against],
-        ).to_json()
+        )
 
     def relative_sigma(self, temp_c: np.ndarray, t_s: np.ndarray) -> np.ndarray:
         """Per-sample noise level relative to the record's RMS (1 where nothing was found): the

@@ -17,8 +17,8 @@ from tcbench.runner.kinds import JobKind, JobNames, announce
 
 def diagnosis_metrics(diag: Any) -> dict[str, float]:
     """The held-out RMSEs of the baseline and final models, in the unit and in white-noise sigmas."""
-    sigma = float(diag.noise["white_sigma"])
-    before, after = float(diag.baseline["rmse_heldout"]), float(diag.final["rmse_heldout"])
+    sigma = float(diag.noise.white_sigma)
+    before, after = float(diag.baseline.rmse_heldout), float(diag.final.rmse_heldout)
     out = {"rmse_heldout_before": before, "rmse_heldout_after": after, "white_sigma": sigma,
            "effects_found": float(len(diag.effect_ids))}
     if sigma > 0:
@@ -58,8 +58,8 @@ class DiagnoseKind(JobKind):
             run.log_metrics(diag.metrics())
         else:
             run.set_tag("tcbench.effects_found", ",".join(diag.effect_ids) or "none")
-            run.log_params({f"found.{e['id']}.{k}": f"{v:.6g}" for e in diag.effects
-                            for k, v in e.get("params", {}).items() if isinstance(v, (int, float))})
+            run.log_params({f"found.{e.id}.{k}": f"{v:.6g}" for e in diag.effects
+                            for k, v in e.params.items() if isinstance(v, (int, float))})
             run.log_metrics(diagnosis_metrics(diag))
         announce(run, c)
         return [p for p in outcome.written.values() if Path(p).is_file()]

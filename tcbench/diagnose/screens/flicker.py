@@ -1,0 +1,147 @@
+"""Flicker (``bias_instability``): the Allan test of the final model's in-sample residual against
+white noise plus the thermometer noise the model inherits, and the recheck of the kept effects
+with that flicker in the noise model.
+
+Deterministic before stochastic: while the physics-agnostic reference beats the final model by
+more than :data:`~tcbench.diagnose.reference.REFERENCE_RATIO`, an Allan excess is the structure
+the model leaves, not flicker; and the recheck may not hand flicker structure the reference
+shows. The Allan test reads the in-sample residual: a held-out one carries each fold's
+coefficient error, constant over its blocks, which looks like slow noise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from tcbench.diagnose.attribute import Attribution, recheck_with_flicker
+from tcbench.diagnose.crossval import Fit
+from tcbench.diagnose.design import Model
+from tcbench.diagnose.evidence import Evidence
+from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.library_findings import Extent, library_finding
+from tcbench.diagnose.locate import FALSE_ALARM, AllanExcess, allan_excess, why_no_allan
+from tcbench.diagnose.reference import Reference
+from tcbench.diagnose.result import Confusion, rmse
+from tcbench.diagnose.screens.base import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.terms import terms
+from tcbench.diagnose.thermometer import propagated_noise
+
+ID = "bias_instability"
+FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
+TIME_EFFECTS = tuple(t.id for t in terms() if t.flicker_mimics)  # what a slow random excursion of the bias can mimic
+FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every power-on and ageing keeps "
+                "its sign, a flicker excursion does neither")
+
+
+@dataclass(frozen=True)
+class Flicker(ScreenResult):
+    """The Allan test of one fit's residual (None where the record allows none) and the flicker
+    coefficient ``b`` when it flattens above the white (plus thermometer) line and is not the
+    structure the model leaves; ``declared`` whether the starting model has it already;
+    ``attribution`` the final model after the recheck, where it dropped effects."""
+
+    allan: AllanExcess | None
+    b: float | None
+    extent: Extent
+    declared: bool = False
+    attribution: Attribution | None = None
+
+    @property
+    def named(self) -> bool:
+        """Whether the diagnosis names flicker as found."""
+        return self.b is not None and not self.declared
+
+    def evidence(self) -> Evidence:
+        """How ``bias_instability`` fared; for a kept one ``gain`` is the Allan ratio at the
+        first flagged tau and ``threshold`` its bound."""
+        if self.declared:
+            return Evidence(ID, "in the model", reason="declared in the starting model")
+        allan = self.allan
+        if allan is None:
+            return Evidence(ID, "not identifiable", reason="no Allan deviation on this record")
+        if self.b is None or allan.first_over is None:
+            return Evidence(ID, "rejected", reason="the residual's Allan deviation follows the white-noise line")
+        k = allan.first_over
+        return Evidence(ID, "kept", float(allan.adev[k] / allan.white[k]), float(allan.bound[k]),
+                        reason=f"Allan deviation above the white line from tau = {allan.tau_s[k]:.4g} s")
+
+    def findings(self, unit: str) -> list[Finding]:
+        if not self.named:
+            return []
+        ev = self.evidence()
+        tau_s = float(self.allan.tau_s[self.allan.first_over])  # type: ignore[union-attr,index]
+        return [library_finding(ID, {"b": self.b}, {"allan_ratio": ev.gain, "bound": ev.threshold, "tau_s": tau_s},
+                                self.extent)]
+
+    def write_model(self, model: dict[str, Any]) -> None:
+        if self.named:
+            model["effects"][ID] = {"b": self.b}
+
+    def confusions(self, found: list[str]) -> list[Confusion]:
+        """The effects found that a slow random excursion of the bias can mimic."""
+        return [Confusion((e, ID), FLICKER_TEST) for e in found if e in TIME_EFFECTS] if self.named else []
+
+
+def flicker_test(att: Attribution, fit: Fit, model: Model) -> tuple[AllanExcess | None, float | None]:
+    """Allan test of the in-sample residual of ``fit`` (of ``model``) against white noise plus the
+    thermometer noise the model inherits; the flicker coefficient ``b`` when it flattens above both."""
+    designer = att.designer
+    data = designer.data
+    thermometer = propagated_noise(designer, model, fit.beta)
+    ex = allan_excess(data.t_s, fit.residual, data.white_sigma, FALSE_ALARM, estimated=True, coloured=thermometer)
+    if ex is None or ex.first_over is None:
+        return ex, None
+    excess = np.sqrt(np.maximum(ex.adev**2 - ex.white**2, 0.0))
+    return ex, float(excess[ex.first_over:].max() / FLICKER_FLOOR)
+
+
+def final_rmse(att: Attribution) -> float:
+    """The held-out RMSE of the final model of ``att`` (output unit)."""
+    return rmse(att.final_fit.sse_heldout, att.designer.data.n)
+
+
+class FlickerScreen(Screen):
+    """The Allan test of the final residual; when it finds flicker behind kept effects, they are
+    tested again with that flicker in the noise model (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`)
+    and the test is run again on what remains."""
+
+    id = ID
+    stage = AFTER
+
+    def skip(self, given: ScreenInput) -> str | None:
+        return why_no_allan(given.data.t_s)  # type: ignore[union-attr]
+
+    def run(self, given: ScreenInput) -> Flicker:
+        att, reference = given.attribution, given.reference
+        assert att is not None and reference is not None
+        allan, b = flicker_test(att, att.final_fit, att.final)
+        found = Flicker(allan, b, Extent.of(att.designer.data), ID in given.declared)
+        if reference.structure_remains(final_rmse(att)):  # an Allan excess made by it is not flicker
+            return replace(found, b=None)
+        if found.b is None or len(att.final.ids) <= len(att.base.ids):
+            return found
+        rechecked = recheck_with_flicker(att, found.b)
+        if rechecked is att or reference.structure_remains(final_rmse(rechecked)):
+            return found
+        allan, b = flicker_test(rechecked, rechecked.final_fit, rechecked.final)
+        return replace(found, allan=allan, b=b, attribution=rechecked)
+
+
+def flicker_evidence(found: ScreenResult | None, skipped: str | None, declared: bool, reference: Reference,
+                     final: float, unit: str) -> Evidence:
+    """How ``bias_instability`` fared: as the screen's result says, or not identifiable where the
+    screen was skipped; not tested while deterministic structure remains (the final model's
+    held-out RMSE ``final`` above the ``reference``'s ratio): flicker is judged only once that
+    structure is modelled."""
+    if declared:
+        return Evidence(ID, "in the model", reason="declared in the starting model")
+    if reference.structure_remains(final):
+        return Evidence(ID, "not tested", reason=(
+            f"deterministic temperature structure remains (the reference reaches {reference.rmse_heldout:.4g}, "
+            f"the final model {final:.4g} {unit} held out): flicker is judged only once it is modelled"))
+    if isinstance(found, Flicker):
+        return found.evidence()
+    return Evidence(ID, "not identifiable", reason=skipped or "no Allan deviation on this record")

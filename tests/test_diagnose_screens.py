@@ -1,0 +1,72 @@
+"""The diagnosis' screens (tcbench.diagnose.screens) as objects: how a stage runs its screens and
+files their skip reasons, and the plans of the stages."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from tcbench.diagnose.screens import AFTER_FIT, BEFORE_FIT, FINDINGS_ORDER, MODEL_ORDER, ThermometerScreen
+from tcbench.diagnose.screens.base import AFTER, BEFORE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.signals import DiagnosisData
+
+
+def _data(hours: float, sigma: float = 1.0) -> DiagnosisData:
+    t = np.arange(0.0, hours * 3600.0, 1.0)
+    n = t.size
+    temp = np.linspace(0.0, 40.0, n)
+    return DiagnosisData("gyro", "deg/s", t, temp, temp, np.zeros(n), np.zeros(n), np.zeros(n),
+                         np.zeros(n, dtype=np.int64), sigma, 1.0, 120.0)
+
+
+@dataclass(frozen=True)
+class _Halved(ScreenResult):
+    data: DiagnosisData | None = None
+
+    def not_tested(self) -> str | None:
+        return "ran, but could not tell"
+
+
+class _Skips(Screen):
+    id, stage = "skips", BEFORE
+
+    def skip(self, given: ScreenInput) -> str | None:
+        return "never applies"
+
+    def run(self, given: ScreenInput) -> ScreenResult:
+        raise AssertionError("a skipped screen must not run")
+
+
+class _Halves(Screen):
+    id, stage = "halves", BEFORE
+
+    def run(self, given: ScreenInput) -> _Halved:
+        assert given.data is not None
+        return _Halved(replace(given.data, white_sigma=given.data.white_sigma / 2.0))
+
+
+class _Reads(Screen):
+    id, stage = "reads", BEFORE
+
+    def skip(self, given: ScreenInput) -> str | None:  # sees what the screens before it left
+        assert given.data is not None and given.data.white_sigma == 0.5 and "halves" in given.results
+        return None
+
+    def run(self, given: ScreenInput) -> ScreenResult:
+        return ScreenResult()
+
+
+def test_a_stage_runs_its_screens_in_order_and_files_every_reason_under_the_screen_id() -> None:
+    screened = run_screens([_Skips(), _Halves(), _Reads(), _Skips()], ScreenInput(None, _data(1.0)))
+    assert screened.not_tested == {"skips": "never applies", "halves": "ran, but could not tell"}
+    assert list(screened.results) == ["halves", "reads"]
+    assert screened.data.white_sigma == 0.5
+
+
+def test_the_plans_hold_one_screen_per_detector_by_stage() -> None:
+    assert all(s.stage == BEFORE for s in BEFORE_FIT) and all(s.stage == AFTER for s in AFTER_FIT)
+    ids = [s.id for s in (*BEFORE_FIT, *AFTER_FIT)]
+    assert ids == ["quantisation", "saturation", "variance", "outliers", "bias_instability", "variance"]
+    known = {*ids, ThermometerScreen.id}
+    assert set(FINDINGS_ORDER) == known and set(MODEL_ORDER) == known - {"bias_instability"}
