@@ -62,6 +62,47 @@ __all__ = ["REFERENCE_RATIO", "Diagnosis", "Series", "base_model", "diagnose"]
 log = logging.getLogger(__name__)
 
 
+def base_model(effects: dict[str, dict[str, float]]) -> Model:
+    """The starting :class:`Model` for effects already declared (``{id: params}``, as in
+    ``model.yaml``); their nonlinear parameters stay fixed, their amplitudes are refitted."""
+    model = Model()
+    for effect, params in effects.items():
+        if effect not in DETERMINISTIC:
+            continue
+        name = term(effect).param
+        model = model.with_effect(effect, float(params[name]) if name else None)
+    return model
+
+
+def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, float]]]:
+    """Core polynomial and effect parameters of the final model, in model.yaml's form."""
+    d: Designer = att.designer
+    beta = att.final_fit.beta
+    n_core = len(d.core_names())
+    bias = [float(b) for b in beta[:3]]
+    if n_core < 6:  # one input level a: the fit is output = bias(T), written as bias(T) - a plus a unit scale factor
+        bias[0] -= float(np.median(d.data.input)) if d.data.input.size else 0.0
+    core = {"kind": "polynomial", "centre_c": d.centre_c, "half_range_c": d.half_range_c, "bias": bias,
+            "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
+    effects: dict[str, dict[str, float]] = {}
+    if att.final.lag_tau_s:
+        effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
+    i = n_core
+    for effect, value in att.final.terms:
+        m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
+        coef, i = beta[i:i + m], i + m
+        effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
+                           else term(effect).params(float(coef[0]), value, d.half_range_c))
+    return core, effects
+
+
+def _open_ids(evidence: dict[str, Evidence]) -> list[str]:
+    """The open-world ids with evidence, in :data:`TERMS` order, further instances after the first."""
+    order = list(TERMS)
+    ids = [e for e in evidence if is_open(e)]
+    return sorted(ids, key=lambda e: (order.index(kind_of(e).id), len(e), e))  # type: ignore[union-attr]
+
+
 def diagnose(
     rec: Recording,
     *,
@@ -199,47 +240,6 @@ def _series(att: Attribution, flicker: ScreenResult | None) -> Series:
     data = att.designer.data
     return Series(data.t_s, data.temp_c, att.base_fit.heldout_residual, att.final_fit.heldout_residual,
                   flicker_test(att, att.base_fit, att.base)[0], flicker.allan if isinstance(flicker, Flicker) else None)
-
-
-def base_model(effects: dict[str, dict[str, float]]) -> Model:
-    """The starting :class:`Model` for effects already declared (``{id: params}``, as in
-    ``model.yaml``); their nonlinear parameters stay fixed, their amplitudes are refitted."""
-    model = Model()
-    for effect, params in effects.items():
-        if effect not in DETERMINISTIC:
-            continue
-        name = term(effect).param
-        model = model.with_effect(effect, float(params[name]) if name else None)
-    return model
-
-
-def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, float]]]:
-    """Core polynomial and effect parameters of the final model, in model.yaml's form."""
-    d: Designer = att.designer
-    beta = att.final_fit.beta
-    n_core = len(d.core_names())
-    bias = [float(b) for b in beta[:3]]
-    if n_core < 6:  # one input level a: the fit is output = bias(T), written as bias(T) - a plus a unit scale factor
-        bias[0] -= float(np.median(d.data.input)) if d.data.input.size else 0.0
-    core = {"kind": "polynomial", "centre_c": d.centre_c, "half_range_c": d.half_range_c, "bias": bias,
-            "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
-    effects: dict[str, dict[str, float]] = {}
-    if att.final.lag_tau_s:
-        effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
-    i = n_core
-    for effect, value in att.final.terms:
-        m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
-        coef, i = beta[i:i + m], i + m
-        effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
-                           else term(effect).params(float(coef[0]), value, d.half_range_c))
-    return core, effects
-
-
-def _open_ids(evidence: dict[str, Evidence]) -> list[str]:
-    """The open-world ids with evidence, in :data:`TERMS` order, further instances after the first."""
-    order = list(TERMS)
-    ids = [e for e in evidence if is_open(e)]
-    return sorted(ids, key=lambda e: (order.index(kind_of(e).id), len(e), e))  # type: ignore[union-attr]
 
 
 def _found(effect: str, ev: Evidence, params: dict[str, float], unit: str, extent: Extent) -> Finding:
