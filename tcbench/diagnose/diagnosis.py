@@ -23,7 +23,6 @@ from tcbench.diagnose.attribute import (
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model
 from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
 from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.open_terms import TERMS, is_open, kind_of, open_finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch, allan_excess, locate, why_no_allan
 from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S, NonMean
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
@@ -31,7 +30,7 @@ from tcbench.diagnose.plan import SURROGATE, min_full_duration_s
 from tcbench.diagnose.reference import Reference, reference_fit
 from tcbench.diagnose.surrogate import LEVEL
 from tcbench.diagnose.signals import DiagnosisData, prepare
-from tcbench.diagnose.terms import term, terms
+from tcbench.diagnose.terms import is_open, open_finding, report_order, term, terms
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
@@ -185,16 +184,16 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
     for effect, value in att.final.terms:
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
         coef, i = beta[i:i + m], i + m
-        effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
+        effects[effect] = (term(effect).params(coef, value) if is_open(effect)
                            else term(effect).params(float(coef[0]), value, d.half_range_c))
     return core, effects
 
 
 def _open_ids(evidence: dict[str, Evidence]) -> list[str]:
-    """The open-world ids with evidence, in :data:`TERMS` order, further instances after the first."""
-    order = list(TERMS)
+    """The open-world ids with evidence, in :func:`report_order`, further instances after the first."""
+    order = list(report_order())
     ids = [e for e in evidence if is_open(e)]
-    return sorted(ids, key=lambda e: (order.index(kind_of(e).id), len(e), e))  # type: ignore[union-attr]
+    return sorted(ids, key=lambda e: (order.index(term(e).id), len(e), e))
 
 
 def _flicker(

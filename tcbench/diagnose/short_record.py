@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.discover import NODE_SPANS, NODE_TAU_S
 from tcbench.diagnose.nonmean import DEFAULT_SMOOTH_S
 from tcbench.diagnose.plan import FOLDS, min_full_duration_s
 from tcbench.diagnose.short_tests import (
@@ -36,6 +35,7 @@ from tcbench.diagnose.short_tests import (
     white_noise,
 )
 from tcbench.diagnose.signals import MAD_TO_SIGMA, fitted_window_s, smooth_temperature
+from tcbench.diagnose.terms.temperature_shapes import NODE_SPANS, NODE_TAU_S
 from tcbench.sensors import kinds
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
