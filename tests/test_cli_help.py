@@ -4,6 +4,7 @@ unknown option is one line with exit code 2. In process, so the whole file takes
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -213,3 +214,27 @@ def test_leaderboard_flag_values_keep_backslashes_and_quotes(capsys: pytest.Capt
     """Hydra's grammar escapes a backslash only before a quote: ``a\\b`` stays one backslash."""
     assert main(["leaderboard", "--cfg", "job", "--experiment", "a\\b", "--experiment", "c'd\\"]) == 0
     assert yaml.safe_load(capsys.readouterr().out)["experiments"] == ["a\\b", "c'd\\"]
+
+
+class _ClosedPipe:
+    """A stdout whose reader has gone (``tcbench --help | head -1``): writing raises BrokenPipeError."""
+
+    def __init__(self, fd: int) -> None:
+        self._fd = fd
+
+    def write(self, text: str) -> int:
+        raise BrokenPipeError(32, "Broken pipe")
+
+    def flush(self) -> None:
+        raise BrokenPipeError(32, "Broken pipe")
+
+    def fileno(self) -> int:
+        return self._fd
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["list"], ["help", "run"]])
+def test_output_into_a_closed_pipe_is_no_error(argv, monkeypatch, tmp_path, capfd):
+    with open(tmp_path / "stdout", "w") as real:
+        monkeypatch.setattr(sys, "stdout", _ClosedPipe(real.fileno()))
+        assert main(argv) == 0
+    assert "Traceback" not in capfd.readouterr().err

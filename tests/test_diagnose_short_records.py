@@ -23,10 +23,10 @@ from tcbench.diagnose.locate import why_no_allan
 from tcbench.diagnose.markdown import not_tested_section
 from tcbench.diagnose.plan import FOLDS, plan_for
 from tcbench.diagnose.report import write_report
-from tcbench.diagnose.signals import prepare
+from tcbench.diagnose.signals import DiagnosisData, prepare
+from tcbench.diagnose.terms import term, terms
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
-OPEN_WORLD = ("bias_step", "transient", "periodic", "gated_periodic", "temperature_bump", "second_node")
 TempFn = Callable[[np.ndarray, np.random.Generator], np.ndarray]
 
 
@@ -109,6 +109,39 @@ def test_detector_requirements_name_the_record_value() -> None:
     bursts = np.concatenate([np.arange(500.0), 1e4 + np.arange(500.0)])
     assert "this one has 1 gap(s)" in why_no_allan(bursts)  # type: ignore[operator]
     assert why_no_steps(np.arange(3600.0)) is None and why_no_lines(np.arange(3600.0)) is None
+
+
+def _data(t_s: np.ndarray, temp_c: np.ndarray) -> DiagnosisData:
+    n = t_s.size
+    return DiagnosisData("gyro", "deg/s", t_s, temp_c, temp_c, np.gradient(temp_c, t_s), np.zeros(n), np.zeros(n),
+                         np.zeros(n, dtype=np.int64), 1.0, 1.0, 0.0)
+
+
+def test_each_open_world_term_says_why_it_cannot_be_tested() -> None:
+    """why_untestable is every open-world term's own reason (OpenTerm.skip), in the registry's order."""
+    tiny = _data(np.arange(6) * 10.0, np.full(6, 20.0))
+    fold = np.arange(6) % 5
+    why = why_untestable(Designer(tiny), fold)
+    assert why == {t.id: r for t in terms(open=True) if (r := t.skip(tiny, fold)) is not None}
+    assert list(why) == ["bias_step", "transient", "periodic", "gated_periodic", "duty_cycle", "temperature_bump",
+                         "second_node"]
+    assert why["bias_step"] == why["transient"] == why_no_steps(tiny.t_s)
+    assert why["periodic"] == why["gated_periodic"] == why["duty_cycle"] == why_no_lines(tiny.t_s)
+    assert why["second_node"] == ("a second thermal node needs what thermal lag needs: the temperature never changes "
+                                  "faster than 0.05 degC/min")
+    t = np.arange(500.0)  # steps testable after the first 50 s block, but under 600 s of record after it
+    short = _data(t, 20.0 + 10.0 * t / t[-1])
+    fold = (t // 50.0).astype(np.int64) % 5
+    assert term("bias_step").skip(short, fold) is None and term("bias_step").skip(short) is None
+    assert term("transient").skip(short, fold) == (
+        "a transient of time constant 300 s needs 600 s of record after a testable step; this record has 449 s "
+        "after the earliest one")
+    assert term("transient").skip(short) is None  # folds unknown: only the change points' needs are checked
+    assert term("second_node").skip(short, fold) == (
+        "a second thermal node of time constant 600 s needs a record of more than 2400 s; this record spans 499 s")
+    halves = (t >= 250.0).astype(np.int64)  # two blocks: no time with two folds on each side
+    assert term("bias_step").skip(short, halves) == term("transient").skip(short, halves) == (
+        "a step needs samples of two cross-validation folds on each side; this record has no such time")
 
 
 def test_markdown_section_only_when_something_was_not_tested() -> None:

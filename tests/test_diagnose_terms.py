@@ -1,5 +1,5 @@
-"""The library terms of the diagnosis (tcbench.diagnose.terms): one term per library effect the
-diagnosis models, each column the simulator's formula, a consistent registry."""
+"""The terms of the diagnosis (tcbench.diagnose.terms): one term per library effect the diagnosis
+models and one per open-world structure, each column the simulator's formula, a consistent registry."""
 
 from __future__ import annotations
 
@@ -12,11 +12,21 @@ import pytest
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
 from tcbench.diagnose.attribute import CONFUSABLE
 from tcbench.diagnose.design import DETERMINISTIC, Designer
-from tcbench.diagnose.open_terms import TERMS as OPEN_TERMS
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.diagnose.terms import Term, confusable_pairs, is_term, term, terms
+from tcbench.diagnose.findings import WHERE_KEYS, check_finding
+from tcbench.diagnose.terms import (
+    OpenTerm,
+    Term,
+    confusable_pairs,
+    is_open,
+    is_term,
+    open_finding,
+    report_order,
+    term,
+    terms,
+)
 from tcbench.diagnose.terms.base import signals
-from tcbench.sensors.effects import EFFECTS, Signals, make_effect
+from tcbench.sensors.effects import EFFECTS, REPEATABLE, Signals, make_effect
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 from tcbench.compensation.fitted_model import RIG_EFFECTS
 
@@ -40,7 +50,20 @@ def test_every_library_effect_the_diagnosis_models_has_exactly_one_term() -> Non
     for t in terms():
         assert EFFECTS[t.id] is t.effect  # the term is that effect of the library, not a look-alike
     assert len({t.effect for t in terms()}) == len(terms())
-    assert not set(OPEN_TERMS) & {t.id for t in terms()}  # an id is either a library term or an open-world one
+    assert not {t.id for t in terms(open=True)} & {t.id for t in terms()}  # a library term or an open-world one
+
+
+def test_every_repeatable_effect_is_an_open_world_term_in_the_registry() -> None:
+    open_ids = [t.id for t in terms(open=True)]
+    assert set(open_ids) == set(REPEATABLE)
+    assert open_ids == ["bias_step", "transient", "periodic", "gated_periodic", "duty_cycle", "temperature_bump",
+                        "second_node"]  # the order of a round's search and of the "not tested" reasons
+    assert report_order() == ("bias_step", "periodic", "gated_periodic", "duty_cycle", "transient",
+                              "temperature_bump", "second_node")  # the report's candidates: by shape
+    for t in terms(open=True):
+        assert isinstance(t, OpenTerm) and t.open_world and is_open(t.id) and EFFECTS[t.id] is t.effect
+        assert t.n_params(None) == t.n_coef + len(t.value_names)
+    assert not any(is_open(t.id) for t in terms())
 
 
 def test_ids_unique_and_a_second_registration_refused() -> None:
@@ -129,9 +152,22 @@ def test_skip_reasons_where_the_recording_cannot_show_the_effect() -> None:
 
 
 def test_unknown_ids_are_refused() -> None:
-    assert not is_term("bias_step")
+    assert not is_term("no_such_effect") and not is_open("no_such_effect")
     with pytest.raises(KeyError, match="known: thermal_lag"):
-        term("bias_step")
+        term("no_such_effect")
+    for unknown in ("bias_step_4", "bias_step_1", "hysteresis_2"):  # only further instances of an open-world term
+        assert not is_term(unknown)
+        with pytest.raises(KeyError):
+            term(unknown)
+
+
+def test_further_instances_are_their_open_world_term() -> None:
+    step = term("bias_step")
+    assert term("bias_step_2") is step and term("bias_step_3") is step and is_open("transient_2")
+    assert step.free_id(()) == "bias_step"
+    assert step.free_id(("warmup", "bias_step")) == "bias_step_2"
+    assert step.free_id(("bias_step", "bias_step_2")) == "bias_step_3"
+    assert step.free_id(("bias_step", "bias_step_2", "bias_step_3")) is None
 
 
 def test_noise_and_rig_tuples_come_from_the_effect_classes() -> None:
@@ -139,3 +175,76 @@ def test_noise_and_rig_tuples_come_from_the_effect_classes() -> None:
                                        "noise_temperature", "noise_time"}
     assert set(RIG_EFFECTS) == {"periodic", "gated_periodic", "duty_cycle"}
     assert all(issubclass(type(t), Term) for t in terms())
+
+
+# Each open-world term at a value, with the coefficients of a fit; ``exact``: its columns are the
+# simulator's formula to the last bit (the second node lags on the diagnosis's time grid, the
+# effect at the mean sample interval; a line's cosine is the effect's sine a quarter cycle on).
+OPEN_CASES = {
+    "bias_step": ((3000.0,), [0.8], True),
+    "transient": ((2000.0, 600.0), [-1.3], True),
+    "periodic": ((900.0,), [0.4, -0.25], False),
+    "gated_periodic": ((600.0, 1500.0, 5000.0), [0.3, 1.0, -0.5, 0.2, 0.1, -0.1, 0.05, 0.0, 0.0, 0.02, -0.01], True),
+    "duty_cycle": ((600.0, 70.0, 0.35, 1500.0, 5000.0), [-0.3, 0.8], True),
+    "temperature_bump": ((30.0, 4.0), [0.7], True),
+    "second_node": ((900.0,), [0.2], False),
+}
+
+
+def test_every_open_world_term_has_a_case() -> None:
+    assert set(OPEN_CASES) == {t.id for t in terms(open=True)}
+
+
+@pytest.mark.parametrize("effect", list(OPEN_CASES))
+def test_open_world_columns_are_the_simulators_effect(effect: str) -> None:
+    """Each column is the output term the simulator adds for the term's parameters with that
+    column's coefficient 1 and the others 0 (to the last bit where the formula is shared)."""
+    d = _data()
+    t = term(effect)
+    value, coef, exact = OPEN_CASES[effect]
+    assert isinstance(t, OpenTerm) and len(value) == len(t.value_names) and len(coef) == t.n_coef
+    cols = t.columns(d, value, d.temp_c)
+    assert cols.shape == (d.t_s.size, t.n_coef)
+    s = signals(d, d.temp_c)
+    for j in range(t.n_coef):
+        unit = t.params(np.eye(t.n_coef)[j], value)
+        simulated = make_effect(effect, **unit).term(s, np.random.default_rng(0))
+        if exact:
+            np.testing.assert_array_equal(cols[:, j], simulated)
+        else:
+            np.testing.assert_allclose(cols[:, j], simulated, rtol=1e-9, atol=1e-9)
+    np.testing.assert_array_equal(Designer(d).columns(effect, value, None), cols)  # the design's columns are the term's
+
+
+@pytest.mark.parametrize("effect", list(OPEN_CASES))
+def test_open_world_params_round_trip_through_the_simulator(effect: str) -> None:
+    """The fitted coefficients and value, as :meth:`OpenTerm.params` reports them, simulate the
+    columns times the coefficients, and the columns fitted to that give the same parameters back."""
+    d = _data()
+    t = term(effect)
+    value, coef, _ = OPEN_CASES[effect]
+    assert isinstance(t, OpenTerm)
+    cols = t.columns(d, value, d.temp_c)
+    params = t.params(np.asarray(coef), value)
+    assert tuple(params[name] for name in t.value_names) == value
+    fx = make_effect(effect, **params)  # model.yaml reads it back
+    assert set(params) <= {f.name for f in dataclasses.fields(fx)}
+    simulated = fx.term(signals(d, d.temp_c), np.random.default_rng(0))
+    np.testing.assert_allclose(cols @ np.asarray(coef), simulated, rtol=1e-9, atol=1e-9)
+    back, *_ = np.linalg.lstsq(cols, simulated, rcond=None)
+    assert t.params(back, value) == pytest.approx(params, rel=1e-6, abs=1e-9)
+
+
+@pytest.mark.parametrize("effect", list(OPEN_CASES))
+def test_open_world_finding_follows_the_report_contract(effect: str) -> None:
+    d = _data()
+    t = term(effect)
+    value, coef, _ = OPEN_CASES[effect]
+    assert isinstance(t, OpenTerm)
+    params = t.params(np.asarray(coef), value)
+    assert set(t.where(params=params)) <= set(WHERE_KEYS) and t.where() == {}
+    entry = open_finding(f"{effect}_2", params, {"gain_sigma2": 40.0}, d.unit)
+    check_finding(entry)
+    assert entry["id"] == f"{effect}_2" and entry["shape"] == t.shape and entry["library"] is False
+    assert entry["explanation"] == t.explanation(params, d.unit) and entry["confirm_with"] == t.confirm_with
+    assert entry["where"] == t.where(params=params) and d.unit in entry["explanation"]

@@ -42,6 +42,10 @@ def test_listed_with_its_shape(site: Path, tmp_path: Path) -> None:
     line = next(x for x in listed.stdout.splitlines() if x.split()[:1] == [TERM])
     assert "temperature_dynamics" in line and "(from tcbench-rate2)" in line
     assert "thermal_lag" in listed.stdout and "BROKEN" not in listed.stdout
+    open_world = [x for x in listed.stdout.splitlines() if x.endswith("(open world, from tcbench)")]
+    assert [x.split()[0] for x in open_world] == ["bias_step", "transient", "periodic", "gated_periodic", "duty_cycle",
+                                                  "temperature_bump", "second_node"]  # after the library's
+    assert listed.stdout.splitlines().index(line) < listed.stdout.splitlines().index(open_world[0])
 
 
 def test_diagnose_names_the_plugin_effect_only_where_it_is(site: Path, tmp_path: Path) -> None:

@@ -526,7 +526,15 @@ COMMANDS: dict[str, Callable[[list[str]], int]] = {name: _handler(spec) for name
 
 
 def main(argv: list[str] | None = None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        return _main(list(sys.argv[1:] if argv is None else argv))
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: not an error of ours
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's last flush does not fail again
+        return 0
+
+
+def _main(argv: list[str]) -> int:
     if len(argv) == 2 and argv[0] == "help" and argv[1] in COMMANDS:  # tcbench help simulate
         argv = [argv[1], "--help"]
     if not argv or argv[0] in {"-h", "--help", "help"}:
@@ -545,10 +553,6 @@ def main(argv: list[str] | None = None) -> int:
         raise
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
-    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
-        sys.stderr.close()
-        return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

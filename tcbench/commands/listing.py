@@ -62,16 +62,17 @@ def work(cfg: ListConfig) -> int:
 
 
 def _list_terms() -> None:
-    """The diagnosis's terms (built-in and installed) with their shape and a line each, then the
-    broken term and effect plugins with their error."""
+    """The diagnosis's terms (built-in and installed), the library's then the open world's, with
+    their shape and a line each, then the broken term and effect plugins with their error."""
     from tcbench.diagnose.terms import broken_terms, term_source, terms
     from tcbench.sensors.effects import PLUGINS as EFFECT_PLUGINS
 
     print("terms:")
-    for t in terms():
+    for t in (*terms(), *terms(open=True)):
         doc = " ".join((type(t).__doc__ or "").strip().split("\n\n")[0].split())
         doc = re.sub(r" \(:\w+:`[^)]*\)", "", doc.split(". ")[0].rstrip(".")).replace("``", "")
-        print(f"  {t.id:24s} {t.shape:22s} {doc}  (from {term_source(t.id)})")
+        world = "open world, " if t.open_world else ""
+        print(f"  {t.id:24s} {t.shape:22s} {doc}  ({world}from {term_source(t.id)})")
     for name, err in broken_terms().items():
         print(f"  {name:24s} BROKEN: {err}")
     for name, err in EFFECT_PLUGINS.broken().items():

@@ -40,11 +40,10 @@ from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
 from tcbench.diagnose.discover import OPEN_THRESHOLD, best_open
 from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_significant
-from tcbench.diagnose.open_terms import is_open, term_threshold
 from tcbench.diagnose.plan import StatsPlan, plan_for
 from tcbench.diagnose.significance import SURROGATE, SignificanceTest
 from tcbench.diagnose.surrogate import surrogate_test
-from tcbench.diagnose.terms import confusable_pairs, term
+from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
 
@@ -223,7 +222,7 @@ def attribute(
         value = _value(model, effect)
         searched = [value] if is_open(effect) else None
         ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
-                             if cost > (term_threshold(effect, open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test.name))
+                             if cost > (open_term(effect).gain_threshold(open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test.name))
         if not ok:
             model = reduced
             evidence[effect].status = "rejected"

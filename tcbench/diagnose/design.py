@@ -20,7 +20,9 @@ effect                 column(s)                        searched
 =====================  ===============================  =====================
 
 ``bias_instability`` is noise, not a regressor; it is judged from the residual's Allan
-deviation (:mod:`tcbench.diagnose.attribute`).
+deviation (:mod:`tcbench.diagnose.attribute`). An open-world term
+(:class:`~tcbench.diagnose.terms.OpenTerm`) adds its columns at a tuple of nonlinear
+parameters found by :mod:`tcbench.diagnose.discover`.
 """
 
 from __future__ import annotations
@@ -31,9 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.open_terms import kind_of, term_columns
 from tcbench.diagnose.signals import DiagnosisData, lagged
-from tcbench.diagnose.terms import term, terms
+from tcbench.diagnose.terms import is_open, open_term, term, terms
 
 DETERMINISTIC = tuple(t.id for t in terms() if t.deterministic)  # the forward selection's candidates, in order
 ALL_EFFECTS = tuple(t.id for t in terms())
@@ -43,7 +44,7 @@ ALL_EFFECTS = tuple(t.id for t in terms())
 class Model:
     """A model of the output: the minimal model, an optional die lag, and added effect terms
     ``(effect_id, nonlinear parameter or None)``; an open-world term
-    (:mod:`tcbench.diagnose.open_terms`) has a tuple of nonlinear parameters."""
+    (:class:`~tcbench.diagnose.terms.OpenTerm`) has a tuple of nonlinear parameters."""
 
     lag_tau_s: float | None = None
     terms: tuple[tuple[str, Any], ...] = ()
@@ -66,8 +67,7 @@ class Model:
     @property
     def n_params(self) -> int:
         """Extra parameters over the minimal model: each term's coefficients and searched values."""
-        return (1 if self.lag_tau_s else 0) + sum(
-            kind.n_params() if (kind := kind_of(e)) else 1 + (v is not None) for e, v in self.terms)
+        return (1 if self.lag_tau_s else 0) + sum(term(e).n_params(v) for e, v in self.terms)
 
 
 @dataclass
@@ -124,11 +124,11 @@ class Designer:
     def columns(self, effect: str, value: Any, lag_tau_s: float | None) -> np.ndarray:
         """The column(s) (n, m) of ``effect`` at ``value`` on the model temperature of ``lag_tau_s``."""
         temp = self.temperature(lag_tau_s)
-        if kind_of(effect) is None:
+        if not is_open(effect):
             return self.column(effect, value, temp, lag_tau_s)[:, None]
         key = (effect, value, lag_tau_s)
         if key not in self._open_cache:
-            self._open_cache[key] = term_columns(self.data, effect, value, temp)
+            self._open_cache[key] = open_term(effect).columns(self.data, value, temp)
         return self._open_cache[key]
 
     def matrix(self, model: Model) -> np.ndarray:

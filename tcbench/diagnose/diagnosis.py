@@ -25,7 +25,6 @@ from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.locate import FALSE_ALARM, Mismatch, locate
-from tcbench.diagnose.open_terms import TERMS, is_open, kind_of, open_finding
 from tcbench.diagnose.plan import min_full_duration_s
 from tcbench.diagnose.reference import REFERENCE_RATIO, reference_fit
 from tcbench.diagnose.result import (
@@ -54,7 +53,7 @@ from tcbench.diagnose.screens.outliers import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
 from tcbench.diagnose.screens.variance import relative_sigma
 from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, DiagnosisData, prepare
-from tcbench.diagnose.terms import term
+from tcbench.diagnose.terms import is_open, open_finding, report_order, term
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
@@ -91,16 +90,16 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
     for effect, value in att.final.terms:
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
         coef, i = beta[i:i + m], i + m
-        effects[effect] = (kind.params(value, coef) if (kind := kind_of(effect))
+        effects[effect] = (term(effect).params(coef, value) if is_open(effect)
                            else term(effect).params(float(coef[0]), value, d.half_range_c))
     return core, effects
 
 
 def _open_ids(evidence: dict[str, Evidence]) -> list[str]:
-    """The open-world ids with evidence, in :data:`TERMS` order, further instances after the first."""
-    order = list(TERMS)
+    """The open-world ids with evidence, in :func:`report_order`, further instances after the first."""
+    order = list(report_order())
     ids = [e for e in evidence if is_open(e)]
-    return sorted(ids, key=lambda e: (order.index(kind_of(e).id), len(e), e))  # type: ignore[union-attr]
+    return sorted(ids, key=lambda e: (order.index(term(e).id), len(e), e))
 
 
 def diagnose(

@@ -47,7 +47,7 @@ def library_finding(
     """The report finding of a kept library ``effect`` with its fitted ``params`` and the
     ``evidence`` that kept it, on a recording of ``extent``; ``confusable_with`` (the effects
     this recording cannot tell it from) rides along as an extra key when not empty."""
-    if not is_term(effect):
+    if not is_term(effect) or term(effect).open_world:
         raise ValueError(f"{effect!r} is not an effect of the library; known: {', '.join(SHAPE)}")
     t = term(effect)
     return Finding(

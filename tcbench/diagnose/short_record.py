@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.discover import NODE_SPANS, NODE_TAU_S
 from tcbench.diagnose.plan import FOLDS, min_full_duration_s
 from tcbench.diagnose.short_tests import (
     ALPHA,
@@ -35,6 +34,7 @@ from tcbench.diagnose.short_tests import (
     white_noise,
 )
 from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, MAD_TO_SIGMA, fitted_window_s, smooth_temperature
+from tcbench.diagnose.terms.temperature_shapes import NODE_SPANS, NODE_TAU_S
 from tcbench.sensors import kinds
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments

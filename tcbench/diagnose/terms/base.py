@@ -11,7 +11,8 @@ in the order they were defined. Installed packages add terms under the entry-poi
 are imported once, on the first look-up, and come after the built-in ones. The term's effect must
 be known to the effect library (a built-in, or an entry point of ``tcbench.effects``). A plugin
 that fails to import, names no :class:`Term`, clashes with a built-in id or models an unknown
-effect is skipped and listed by :func:`broken_terms`.
+effect is skipped and listed by :func:`broken_terms`. The open-world terms (:mod:`.open_base`)
+share the registry: :func:`terms` lists the library's, ``terms(open=True)`` the open world's.
 """
 
 from __future__ import annotations
@@ -77,7 +78,9 @@ class Term(ABC):
     - ``confusable``: ``{other id: the test that would tell the two apart}``, declared on one
       side of each pair (:meth:`partners` gives both);
     - ``flicker_mimics``: a slow random excursion of the bias can look like it;
-    - ``cached``: its column is costly; the designer keeps it per value and model temperature.
+    - ``cached``: its column is costly; the designer keeps it per value and model temperature;
+    - ``open_world``: structure outside the library (:class:`~.open_base.OpenTerm`), not a
+      candidate of the library's forward selection.
     """
 
     id: ClassVar[str] = ""
@@ -90,6 +93,7 @@ class Term(ABC):
     confusable: ClassVar[Mapping[str, str]] = {}
     flicker_mimics: ClassVar[bool] = False
     cached: ClassVar[bool] = False
+    open_world: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -110,6 +114,10 @@ class Term(ABC):
         """The regressor at nonlinear parameter ``value`` on the model temperature ``temp_c``
         (``centre_c`` and ``half_range_c`` scale the temperature as the minimal model does)."""
         raise ValueError(f"effect {self.id!r} has no regressor")
+
+    def n_params(self, value: Any) -> int:
+        """Parameters it adds to the minimal model at ``value``: its coefficient and its searched value."""
+        return 1 + (value is not None)
 
     def past_grid(self, data: DiagnosisData) -> float | None:
         """How far the search may go past the grid's top when the best value is there, or None."""
@@ -204,21 +212,31 @@ def term_source(term_id: str) -> str:
 
 
 def term(term_id: str) -> Term:
-    """The registered term ``term_id``; ``KeyError`` naming the known ones otherwise."""
-    try:
-        return _registry()[term_id]
-    except KeyError:
-        raise KeyError(f"no term {term_id!r}; known: {', '.join(_REGISTRY)}") from None
+    """The registered term ``term_id``, or the open-world term of a further instance of it
+    (``bias_step_2``: a second step, as the effect library names it); ``KeyError`` naming the
+    known ones otherwise."""
+    registry = _registry()
+    if term_id in registry:
+        return registry[term_id]
+    cls = effect_class(term_id)  # a further instance's effect is its term's
+    if cls is not None and cls.id != term_id and cls.id in registry and registry[cls.id].open_world:
+        return registry[cls.id]
+    raise KeyError(f"no term {term_id!r}; known: {', '.join(_REGISTRY)}")
 
 
-def terms() -> tuple[Term, ...]:
-    """Every registered term: the built-in ones in the order defined, then the installed ones."""
-    return tuple(_registry().values())
+def terms(open: bool = False) -> tuple[Term, ...]:
+    """The registered library terms (``open``: the open-world terms): the built-in ones in the
+    order defined, then the installed ones."""
+    return tuple(t for t in _registry().values() if t.open_world == open)
 
 
 def is_term(term_id: str) -> bool:
-    """Whether ``term_id`` is a registered term."""
-    return term_id in _registry()
+    """Whether ``term_id`` is a registered term (or a further instance of an open-world one)."""
+    try:
+        term(term_id)
+    except KeyError:
+        return False
+    return True
 
 
 def confusable_pairs() -> dict[frozenset[str], str]:
