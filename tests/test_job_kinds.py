@@ -100,31 +100,3 @@ def test_untracked_jobs_of_a_new_kind_fail_into_the_list(echo: None) -> None:
     assert run_job({"kind": "echo", "message": "hi", "seed": 0, "tracking": track}) == "hi"
     assert isinstance(run_job({"kind": "echo", "message": "boom", "seed": 0, "tracking": track}), JobFailure)
     assert [f.name for f in FAILURES] == ["echo-boom"]
-
-
-def test_the_default_learner_is_read_once_and_each_job_gets_its_own_copy(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A compensation job without a learner (config.yaml's ``learner: null``) gets the default
-    learner's option file, read once per process however many jobs are planned and run."""
-    from tcbench.config_dir import group_options
-    from tcbench.runner import compensation_config
-
-    top = yaml.safe_load((conf_dir() / "config.yaml").read_text())
-    assert {"learner": None} in top["defaults"] and compensation_config.DEFAULT_LEARNER in group_options("learner")
-    default = f"{compensation_config.DEFAULT_LEARNER}.yaml"
-    expected = yaml.safe_load((conf_dir() / "learner" / default).read_text())
-    reads: list[Path] = []
-    read_text = Path.read_text
-
-    def counted(self: Path, *args: Any, **kwargs: Any) -> str:
-        reads.extend([self] if self.name == default else [])
-        return read_text(self, *args, **kwargs)
-
-    compensation_config._default_learner.cache_clear()
-    monkeypatch.setattr(Path, "read_text", counted)
-    kind = kinds.kind_of({"kind": "compensation"})
-    first = kind.prepare({"learner": None, "seed": 0})["learner"]
-    assert first == expected and first["name"] == compensation_config.DEFAULT_LEARNER
-    first["hidden"] = -1  # one job's copy
-    assert [compensation_config.learner_of({}) for _ in range(5)] == [expected] * 5
-    assert len(reads) == 1
-    assert compensation_config.learner_of({"learner": {"name": "elman"}}) == {"name": "elman"}

@@ -19,6 +19,7 @@ from typing import Any
 
 from tcbench.commands.errors import CommandError, cannot_write, free_outputs, refused_output, say_replaced, writable_folder
 from tcbench.commands.schemas import ExportConfig
+from tcbench.sensors import kinds
 from tcbench.staging import OutputRefusedError, moved, staged_dir
 
 FORMATS = ("px4", "ardupilot")
@@ -103,8 +104,9 @@ def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) 
     logged = {c.px4_device_id for c in axes.values()}
     if len(logged) == 1 and None not in logged:
         return int(logged.pop())  # type: ignore[arg-type]
-    raise CommandError(f"device_id=: PX4 applies TC_{'G' if sensor == 'gyro' else 'A'}{cfg.px4_instance}_* only to "
-                       f"the {sensor} whose device id it names; give it (its CAL_{'GYRO' if sensor == 'gyro' else 'ACC'}n_ID "
+    kind = kinds.get(sensor)
+    raise CommandError(f"device_id=: PX4 applies TC_{kind.px4_letter}{cfg.px4_instance}_* only to "
+                       f"the {sensor} whose device id it names; give it (its CAL_{kind.px4_cal}n_ID "
                        "parameter, or the log's), or formats=[ardupilot]")
 
 

@@ -25,7 +25,7 @@ TRACKING = {
 RUN_PARAMS = {
     "task": "the task, an option of the group task (task.<key>=VALUE sets one of its keys)",
     "optimiser": "the optimiser, an option of the group optimiser (optimiser.<key>=VALUE sets one of its keys)",
-    "learner": "compensation tasks: the learner, an option of the group learner (null: bp)",
+    "learner": "compensation tasks: the learner, an option of the group learner (default: the task's, bp)",
     "experiment": "a whole study in one file, an option of the group experiment (experiment=paper_fa_ifa)",
     "seed": "run seed: the task instance and the optimiser's streams derive from it",
     "budget": "objective evaluations per run, initial population included",

@@ -20,16 +20,18 @@ from pathlib import Path
 import numpy as np
 
 from tcbench.compensation.px4 import AXES, ORDER, OffsetPolynomial, reexpanded
+from tcbench.sensors import kinds
 
 TEMP_REFERENCE_C = 35.0
 SCALE = 1.0e6
-LETTERS = {"accel": "ACC", "gyro": "GYR"}
 
 
 def _letters(sensor: str) -> str:
-    if sensor not in LETTERS:
-        raise ValueError(f"ArduPilot's temperature calibration covers {', '.join(LETTERS)}, not {sensor!r}")
-    return LETTERS[sensor]
+    """The letters of ``sensor``'s ``INS_TCALn_*`` parameters (its kind's ``ardupilot_letters``)."""
+    covered = {k.name: k.ardupilot_letters for k in kinds.registry().values() if k.ardupilot_letters}
+    if sensor not in covered:
+        raise ValueError(f"ArduPilot's temperature calibration covers {', '.join(sorted(covered))}, not {sensor!r}")
+    return covered[sensor]  # type: ignore[return-value]
 
 
 def ardupilot_parameters(sensors: Mapping[str, Mapping[str, OffsetPolynomial]], imu: int = 1,

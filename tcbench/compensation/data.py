@@ -40,7 +40,7 @@ import numpy as np
 
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.metrics.accelerometer import four_position
-from tcbench.metrics.report import DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G
+from tcbench.sensors import kinds
 from tcbench.sensors.data_hash import shared_recordings
 from tcbench.sensors.recording import Recording, RecordingError, read_recording
 from tcbench.sensors.simulate import simulate_recording
@@ -256,7 +256,6 @@ def file_data(protocol: str, train_files: list[str], test_files: list[str], trai
         raise TaskDataError(f"{shared[0]} is both a training and a test recording (the same data); a task never "
                             "tests on its own training runs")
     sfs = [r.recording.meta.extra.get("scale_factor_hz_per_g") for r in train + test if r.recording.meta.extra]
-    default = DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G if SENSORS[protocol] == "msra" else 1.0
-    sf = float(next((s for s in sfs if s), default))
+    sf = float(next((s for s in sfs if s), kinds.get(SENSORS[protocol]).nominal_scale_factor))
     return MSRAData(protocol, train, test, sf, train_on, rate_window_s, "files",
                     {"train_files": list(train_files), "test_files": list(test_files)})

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors import noise
+from tcbench.sensors.kinds import get as sensor_kind
 from tcbench.sensors.kinds import profile_input, unit
 from tcbench.sensors.models import MSRA, SensorModel
 from tcbench.sensors.protocols import Chamber, Profile, _from_segments
@@ -218,7 +219,7 @@ def concealed_profile(sensor: str, rng: np.random.Generator, sizing: Sizing | No
     segments = [Segment(level, float(s), "", 0.0, 0.0) for level, s in zip(levels, soaks_s, strict=True)]
     profile = _from_segments("concealed", sensor, segments, start_c, rate_hz, chamber)
     zeros = np.zeros_like(profile.t_s)
-    accel = _accel_cycle(profile.t_s, rng, z.dwell_s) if sensor == "msra" else zeros.copy()
+    accel = _accel_cycle(profile.t_s, rng, z.dwell_s) if sensor_kind(sensor).positions else zeros.copy()
     info: dict[str, float | str] = {
         **profile.info, "start_c": start_c, "air_tau_s": chamber.air_tau_s,
         "levels_c": " ".join(f"{x:.6f}" for x in levels), "soaks_s": " ".join(f"{s:.0f}" for s in soaks_s),
@@ -286,7 +287,7 @@ def _build(sensor: str, effect: str | None, seed: int) -> _Parts:
     else:
         params = _shape_params(effect, r_params)
         hidden = model.with_effects({effect: params}).simulate(profile, r_effect) - base
-        accel = profile.accel_g if sensor == "msra" else None
+        accel = profile.accel_g if sensor_kind(sensor).positions else None
         left = _rms(unexplained(hidden, minimal_columns(profile.temp_c, accel)))
         ratio = float(r_scale.uniform(*RATIO))
         if effect in _AMPLITUDE:

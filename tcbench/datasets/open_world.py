@@ -83,6 +83,7 @@ from tcbench.sensors.effects import (
     Transient,
 )
 from tcbench.sensors.recording import Recording, make_recording
+from tcbench.sensors.kinds import get as sensor_kind
 from tcbench.sensors.kinds import profile_input
 
 SHAPE: dict[str, str] = {
@@ -324,7 +325,7 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
     factor = float(np.exp(r_scale.uniform(*np.log(NOISE_FACTOR))))
     rho = float(r_scale.uniform(*RATIO))
     sigma = default_sigma * factor
-    draw = _Draw(profile.t_s, profile.temp_c, profile.accel_g if sensor == "msra" else None, base,
+    draw = _Draw(profile.t_s, profile.temp_c, profile.accel_g if sensor_kind(sensor).positions else None, base,
                  np.ones(n, dtype=bool), float(profile.info["start_c"]))
     white = noise.white(n, 1.0, r_white)  # unit noise, scaled below
     reading = profile.temp_c + r_thermo.standard_normal(n) * THERMOMETER_NOISE_C

@@ -43,7 +43,6 @@ from tcbench.signal.allan import (
 )
 
 log = logging.getLogger(__name__)
-DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G = 200.0
 
 
 @dataclass
@@ -63,8 +62,9 @@ def _scale_factor(rec: Recording, override: float | None) -> float:
     value = rec.meta.extra.get("scale_factor_hz_per_g") if rec.meta.extra else None
     if value:
         return float(value)
-    log.warning("no scale factor in the sidecar; using the nominal %g Hz/g", DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G)
-    return DEFAULT_MSRA_SCALE_FACTOR_HZ_PER_G
+    nominal = kinds.get(str(rec.meta.sensor)).nominal_scale_factor
+    log.warning("no scale factor in the sidecar; using the nominal %g Hz/g", nominal)
+    return nominal
 
 
 def _allan_lines(p: NoiseParameters) -> dict[str, tuple[float, float, float]]:
@@ -240,12 +240,13 @@ def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None 
             f"{rec.meta.device_id}: {rec.meta.extra.get('protocol', '') if rec.meta.extra else ''}",
             segment=segments(rec.time_s),
         )
-    pos = _positions(rec) if kinds.get(str(sensor)).positions else None
+    kind = kinds.get(str(sensor))
+    pos = _positions(rec) if kind.positions else None
     if pos is not None and np.isin(pos, ["+1g", "-1g"]).any():  # a four-position test
         report = _four_position(rec, pos, out, files)
-    elif sensor == "msra":
+    elif kind.report == "zero_bias":
         report = _msra(rec, scale_factor, out, files)
-    elif sensor == "gyro":
+    elif kind.report == "rate":
         report = _gyro(rec, out, files)
     else:
         report = _kind(rec, out, files)

@@ -3,17 +3,14 @@ compensation, gyro and task layers it checks, below the config and job modules t
 
 from __future__ import annotations
 
-import copy
-import functools
+from dataclasses import dataclass
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-import yaml
 
 from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.methods import BASELINES
-from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
@@ -25,79 +22,122 @@ def _error(message: str) -> Exception:
     return ConfigError(message)
 
 
-# a compensation job's learner when its config gives none (config.yaml's defaults list has
-# ``learner: null``: optimisation jobs take no learner)
-DEFAULT_LEARNER = "bp"
+@dataclass(frozen=True)
+class LearnerConfig:
+    """A compensation job's learner: its name (a registered learner or a baseline), its
+    parameters (the config's ``learner`` but ``name`` and ``label``) and its leaderboard label."""
+
+    name: str
+    params: dict[str, Any]
+    label: Any = None
+
+    @property
+    def baseline(self) -> bool:
+        """Whether it is a baseline (``raw``, ``oracle`` ...): no learner to train."""
+        return self.name in BASELINES
+
+    @property
+    def env_learner(self) -> str | None:
+        """The ``learner`` argument of the task's env: its name, None for a baseline."""
+        return None if self.baseline else self.name
 
 
-@functools.cache
-def _default_learner() -> dict[str, Any]:
-    """The option :data:`DEFAULT_LEARNER` of the config group ``learner``, read once."""
-    return dict(yaml.safe_load((conf_dir() / "learner" / f"{DEFAULT_LEARNER}.yaml").read_text(encoding="utf-8")))
+@dataclass(frozen=True)
+class OptimiserConfig:
+    """A compensation job's optimiser of the learner's initial weights (``none``: a random
+    start): its name, its parameters and its leaderboard label."""
+
+    name: str
+    params: dict[str, Any]
+    label: Any = None
 
 
-def learner_of(c: dict[str, Any]) -> dict[str, Any]:
-    """The job's learner config, a copy; the default learner's when none is given."""
-    if c.get("learner"):
-        return dict(c["learner"])
-    return copy.deepcopy(_default_learner())
+def learner_of(c: dict[str, Any]) -> LearnerConfig:
+    """The job's learner: its config's ``learner``, which the task's defaults list fills when
+    the command line gives none (``bp``); a ConfigError when the config has none."""
+    given = c.get("learner")
+    if not given:
+        known = ", ".join([*learners.REGISTRY.names(), *BASELINES])
+        raise _error(f"learner: a compensation task needs one; known: {known}")
+    params = dict(given)
+    name = str(params.pop("name", None))
+    label = params.pop("label", None)
+    return LearnerConfig(name, params, label)
 
 
-def validate_compensation(c: dict[str, Any], task: dict[str, Any]) -> None:
-    """Learner, optimiser and task of a compensation job; raise ConfigError naming the key."""
-    spec = task_spec(str(task["name"]))
+def optimiser_of(c: dict[str, Any]) -> OptimiserConfig:
+    """The job's optimiser of the learner's initial weights (its config's ``optimiser``)."""
+    params = dict(c["optimiser"])
+    name = str(params.pop("name", None))
+    label = params.pop("label", None)
+    return OptimiserConfig(name, params, label)
+
+
+def build_env(task: dict[str, Any], learner: LearnerConfig, budget: int) -> Any:
+    """The unwrapped env of a compensation job (``gym.make`` of its task's id); a ConfigError
+    naming the task when the env refuses its arguments."""
+    try:
+        return gym.make(task_spec(str(task["name"])).gym_id, learner=learner.env_learner,
+                        learner_params=learner.params, budget=budget, **task_kwargs(task)).unwrapped
+    except ValueError as exc:
+        raise _error(f"task {task['name']}: {exc}") from None
+
+
+def validate_compensation(c: dict[str, Any], task: dict[str, Any], env: Any = None) -> Any:
+    """Learner, optimiser and task of a compensation job; raise ConfigError naming the key. The
+    env checked: ``env`` when given (built from the same arguments by an earlier check of this
+    job), else built now."""
     learner = learner_of(c)
-    name = str(learner.pop("name", None))
-    learner.pop("label", None)
-    if name not in BASELINES:
+    name = learner.name
+    if not learner.baseline:
         try:
             cls = learners.get(name)
         except learners.UnknownLearnerError as exc:
             raise _error(f"{exc}, {', '.join(BASELINES)}") from None
         try:
-            make_params(cls, {k: v for k, v in learner.items() if k != "form" or v != "auto"})  # type: ignore[arg-type]
+            make_params(cls, {k: v for k, v in learner.params.items() if k != "form" or v != "auto"})  # type: ignore[arg-type]
         except (TypeError, ValueError) as exc:
             text = str(exc)
             raise _error(f"learner {text}" if text.startswith(f"{name}") else f"learner {name}: {text}") from None
-    kwargs = task_kwargs(task)
-    try:
-        env: Any = gym.make(spec.gym_id, learner=None if name in BASELINES else name, learner_params=learner,
-                            budget=c["budget"], **kwargs).unwrapped
-    except ValueError as exc:
-        raise _error(f"task {task['name']}: {exc}") from None
+    if env is None:
+        env = build_env(task, learner, c["budget"])
     try:
         env.check_files()
     except TaskDataError as exc:
         raise _error(str(exc)) from None
-    if learner.get("offsets") == "per_run" and not getattr(env, "passes_runs", False):
+    if learner.params.get("offsets") == "per_run" and not getattr(env, "passes_runs", False):
         raise _error(f"learner.offsets=per_run: task {task['name']} does not pass the runs of its training rows "
                      "(msra_zerobias, msra_fulltemp and accel_chamber do)")
     known = getattr(env, "baselines", BASELINES)
-    if name in BASELINES and name not in known:
+    if learner.baseline and name not in known:
         raise _error(f"learner {name} is not a baseline of task {task['name']} (its baselines: {', '.join(known)})")
     if getattr(env, "needs_tuning", False):
         _check_tuner(task)
-    opt = dict(c["optimiser"])
-    oname = str(opt.pop("name", None))
-    opt.pop("label", None)
-    if oname == "none" or env.learner is None or not env.learner.searchable:
+    _check_optimiser(optimiser_of(c), env, c["budget"])
+    return env
+
+
+def _check_optimiser(opt: OptimiserConfig, env: Any, budget: int) -> None:
+    """The optimiser of the learner's initial weights: none, or a registered single-objective one
+    with valid parameters and a budget of at least one generation (a learner that can be searched)."""
+    if opt.name == "none" or env.learner is None or not env.learner.searchable:
         return
     try:
-        ocls = optimisers.get(oname)
-        params = make_params(ocls, opt)
+        ocls = optimisers.get(opt.name)
+        params = make_params(ocls, opt.params)
     except optimisers.UnknownOptimiserError as exc:
         raise _error(f"{exc}, none") from None
     except (TypeError, ValueError) as exc:
-        raise _error(f"optimiser {oname}: {exc}") from None
+        raise _error(f"optimiser {opt.name}: {exc}") from None
     if not ocls.single_objective:
-        raise _error(f"optimiser {oname} is multi-objective only; initial weights have one objective")
-    if c["budget"] < params.population:
-        raise _error(f"budget of {c['budget']} evaluations is smaller than one generation "
-                     f"(optimiser {oname}: population {params.population})")
+        raise _error(f"optimiser {opt.name} is multi-objective only; initial weights have one objective")
+    if budget < params.population:
+        raise _error(f"budget of {budget} evaluations is smaller than one generation "
+                     f"(optimiser {opt.name}: population {params.population})")
     try:
-        ocls(env.lower, env.upper, c["budget"], np.random.default_rng(0), params)
+        ocls(env.lower, env.upper, budget, np.random.default_rng(0), params)
     except ValueError as exc:
-        raise _error(f"optimiser {oname}: {exc}") from None
+        raise _error(f"optimiser {opt.name}: {exc}") from None
 
 
 def _check_tuner(task: dict[str, Any]) -> None:

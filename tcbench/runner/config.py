@@ -21,7 +21,7 @@ from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.outputs import folder_problem
 from tcbench.params import coerce_param, make_params
-from tcbench.tasks import TASKS, UnknownTaskError, task_kwargs, task_spec
+from tcbench.tasks import TASKS, TaskSpec, UnknownTaskError, task_kwargs, task_spec
 from tcbench.tasks.schemas import (  # noqa: F401 - the schemas' home before tasks/schemas.py
     BBOBTaskConfig,
     GyroTaskConfig,
@@ -48,9 +48,10 @@ def checked_task(task: dict[str, Any], schema: type) -> dict[str, Any]:
     return out
 
 
-def validate(cfg: DictConfig | dict[str, Any]) -> None:
-    """Check ranges and names of a composed job config; raise :class:`ConfigError` if wrong."""
-    c = as_dict(cfg)
+def checked_config(c: dict[str, Any]) -> tuple[TaskSpec, dict[str, Any]]:
+    """What every run job's config must get right (seed, budget, the experiment's name, the task's
+    name, ``tracking.ioh_dir``): the task's spec and its config checked against the spec's schema;
+    :class:`ConfigError` naming the key otherwise."""
     if c["seed"] < 0:
         raise ConfigError(f"seed must be >= 0, got {c['seed']}")
     if c["budget"] < 1:
@@ -71,7 +72,14 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
                           f"not for task {name}")
     if ioh_dir and (problem := folder_problem(ioh_dir)):
         raise ConfigError(f"tracking.ioh_dir={ioh_dir}: {problem}")
-    task = checked_task(c["task"], spec.schema)
+    return spec, checked_task(c["task"], spec.schema)
+
+
+def validate(cfg: DictConfig | dict[str, Any]) -> None:
+    """Check ranges and names of a composed job config; raise :class:`ConfigError` if wrong."""
+    c = as_dict(cfg)
+    spec, task = checked_config(c)
+    name = str(c["task"].get("name"))
     if spec.is_compensation:
         validate_compensation(c, task)
         return
@@ -87,6 +95,7 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
         raise
     except (KeyError, ValueError) as exc:
         raise ConfigError(f"task: {exc}") from None
+    ioh_dir = c.get("tracking", {}).get("ioh_dir")
     if ioh_dir and getattr(env, "n_objectives", 1) > 1:
         raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are for one objective; task {name} has "
                           f"{env.n_objectives}")

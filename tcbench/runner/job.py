@@ -94,8 +94,9 @@ def run_job(cfg: Any, *, record_user_errors: bool = True) -> Any:
 def _run(kind: JobKind, c: dict[str, Any], record_user_errors: bool = True) -> Any:
     track = c.get("tracking") or {}
     if not track.get("enabled"):
-        outcome = kind.execute(c)
-        log.info("%s", kind.summary(outcome, c))
+        job = kind.job(c)
+        outcome = kind.execute(job)
+        log.info("%s", kind.summary(outcome, job))
         return outcome
 
     from tcbench.tracking import store as tracking
@@ -116,7 +117,8 @@ def _run(kind: JobKind, c: dict[str, Any], record_user_errors: bool = True) -> A
     }
     if kind.opens_run_after_work:
         try:
-            outcome = kind.execute(c)
+            job = kind.job(c)
+            outcome = kind.execute(job)
         except BaseException as exc:
             if isinstance(exc, ConfigError) and not record_user_errors:
                 raise  # the user's mistake in a single command: one line, no run
@@ -128,11 +130,12 @@ def _run(kind: JobKind, c: dict[str, Any], record_user_errors: bool = True) -> A
             raise ConfigError(f"the files are written, but MLflow could not record them: {exc}") from None
     with tracking.job_run(c, names.run, tags) as run:
         if not kind.opens_run_after_work:
-            outcome = kind.execute(c)
+            job = kind.job(c)
+            outcome = kind.execute(job)
         with tempfile.TemporaryDirectory() as tmp:
             where = Path(tmp)
             (where / "config.yaml").write_text(yaml.safe_dump(c, sort_keys=False))
-            for f in [where / "config.yaml", *kind.record(run, outcome, c, where)]:
+            for f in [where / "config.yaml", *kind.record(run, outcome, job, where)]:
                 run.log_artifact(f)
-    log.info("%s", kind.summary(outcome, c))
+    log.info("%s", kind.summary(outcome, job))
     return outcome

@@ -275,15 +275,27 @@ def run_compensation(
     """Compensate an MSRA or gyro task: ``learner`` ``raw``/``oracle`` scores a baseline; a learner
     whose initial parameters an optimiser may search (``optimiser`` not ``none``) is trained
     from the best vector found within ``budget`` evaluations (X-BP, seed 000 Fig. 5); otherwise
-    it trains from its own random start (or in closed form)."""
+    it trains from its own random start (or in closed form). The task's env is built here
+    (:func:`compensate` runs on one already built)."""
     from tcbench.compensation.methods import BASELINES
 
     name = learner["name"]
-    baseline = name in BASELINES
     kwargs = tasks.task_kwargs(task)
     params = {k: v for k, v in learner.items() if k not in {"name", "label"}}
-    env = gym.make(tasks.task_id(task["name"]), budget=budget, learner=None if baseline else name,
+    env = gym.make(tasks.task_id(task["name"]), budget=budget, learner=None if name in BASELINES else name,
                    learner_params=params, **kwargs).unwrapped
+    opt_params = {k: v for k, v in optimiser.items() if k not in {"name", "label"}}
+    return compensate(env, name, optimiser["name"], opt_params, budget, seed, progress)
+
+
+def compensate(env: Any, learner: str, optimiser: str, optimiser_params: dict[str, Any], budget: int, seed: int,
+               progress: bool = False) -> CompensationResult:
+    """:func:`run_compensation` on ``env``, the task's env built (not yet reset) for the learner or
+    baseline named ``learner`` and ``budget`` evaluations; ``optimiser`` with ``optimiser_params``
+    searches the learner's initial weights (``none``: a random start)."""
+    from tcbench.compensation.methods import BASELINES
+
+    baseline = learner in BASELINES
     env_seed, rng = seed_streams(seed)
     tuning = None
     if getattr(env, "needs_tuning", False):
@@ -292,13 +304,12 @@ def run_compensation(
     env.reset(seed=env_seed, options={"k": tuning.k, "alpha": tuning.alpha} if tuning else None)
     trace = Trace()
     if baseline:
-        return CompensationResult(env.score_baseline(name), None, trace, 0, float("nan"), 0.0, 0.0, tuning)
+        return CompensationResult(env.score_baseline(learner), None, trace, 0, float("nan"), 0.0, 0.0, tuning)
     t0 = time.perf_counter()
     init = None
     init_loss = float("nan")
-    if env.learner.searchable and optimiser["name"] != "none":
-        opt_params = {k: v for k, v in optimiser.items() if k not in {"name", "label"}}
-        opt = registry.create(optimiser["name"], env.lower, env.upper, budget, rng, opt_params)
+    if env.learner.searchable and optimiser != "none":
+        opt = registry.create(optimiser, env.lower, env.upper, budget, rng, optimiser_params)
         trace = ask_tell(opt, env, budget, progress)[0].trace
         init, init_loss = opt.best.x, float(opt.best.f)
     elif env.learner.searchable:

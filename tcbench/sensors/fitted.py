@@ -72,8 +72,9 @@ class PolynomialModel(SensorModel):
 
     @property
     def scale_factor_hz_per_g(self) -> float | None:
-        """Nominal MSRA scale factor at ``centre_c`` (Hz/g); None for other kinds."""
-        return self.scale_factor[0] if self.sensor == "msra" else None
+        """Nominal scale factor at ``centre_c`` (Hz/g) of a kind whose output is in another unit than
+        its input (an MSRA's, :attr:`~tcbench.sensors.kinds.SensorKind.scaled`); None for other kinds."""
+        return self.scale_factor[0] if kinds.get(self.sensor).scaled else None
 
     def normalised(self, temp_c: np.ndarray) -> np.ndarray:
         """``u = (T - centre_c) / half_range_c`` (dimensionless)."""

@@ -1,7 +1,8 @@
 """Job kinds: what differs between the jobs one runner (:func:`tcbench.runner.job.run_job`) runs.
 
-A kind says how a job is named (:meth:`JobKind.names`), runs it (:meth:`JobKind.execute`) and
-what of its outcome goes to MLflow (:meth:`JobKind.record`); the runner does the rest the same
+A kind says how a job is named (:meth:`JobKind.names`), what it is made of once checked
+(:meth:`JobKind.job`), runs it (:meth:`JobKind.execute`) and what of its outcome goes to MLflow
+(:meth:`JobKind.record`); the runner does the rest the same
 way for every kind: the memory limit, resume, the run's tags and params, the config artifact,
 the FAILED path. A job's kind is its config's ``kind`` key (``simulate``, ``metrics``,
 ``import``, ``diagnose``, ``leaderboard``: the primary configs ``conf/<command>.yaml``) or, for ``tcbench run``,
@@ -64,18 +65,25 @@ class JobKind:
     def names(self, c: dict[str, Any]) -> JobNames:
         raise NotImplementedError
 
-    def execute(self, c: dict[str, Any]) -> Any:
-        """Check the config and run the job; its outcome. User errors raise one line."""
+    def job(self, c: dict[str, Any]) -> Any:
+        """The job that :meth:`execute`, :meth:`record` and :meth:`summary` take, made once from the
+        prepared config ``c`` as the job starts (inside its MLflow run: a ConfigError it raises is
+        recorded FAILED). Default: ``c`` itself; a kind may check it here and build what the work
+        needs (a typed job)."""
+        return c
+
+    def execute(self, job: Any) -> Any:
+        """Check the config and run the job (:meth:`job`'s); its outcome. User errors raise one line."""
         raise NotImplementedError
 
-    def record(self, run: Any, outcome: Any, c: dict[str, Any], where: Path) -> list[Path]:
+    def record(self, run: Any, outcome: Any, job: Any, where: Path) -> list[Path]:
         """Log the outcome's metrics and series on ``run`` (:class:`tcbench.tracking.store.JobRun`);
         the artifact files, written into ``where``."""
         return []
 
-    def summary(self, outcome: Any, c: dict[str, Any]) -> str:
+    def summary(self, outcome: Any, job: Any) -> str:
         """One line for the log when the job ends."""
-        return f"{self.names(c).run} done"
+        return f"{self.names(job).run} done"
 
 
 def planned(c: dict[str, Any]) -> dict[str, Any]:

@@ -14,10 +14,10 @@ from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.errors import ConfigError
 from tcbench.runner.compensation_config import learner_of
-from tcbench.runner.config import validate
+from tcbench.runner.compensation_job import CompensationJob, in_sample, keep, prepare_job
 from tcbench.runner.kinds import JobKind, JobNames
-from tcbench.runner.loop import CompensationResult, VMDTuning, run_compensation
-from tcbench.sensors.data_hash import DataHashError, content_hash, shared_recordings
+from tcbench.runner.loop import CompensationResult, VMDTuning, compensate
+from tcbench.sensors.data_hash import DataHashError, content_hash
 from tcbench.tasks import task_spec
 
 log = logging.getLogger(__name__)
@@ -45,13 +45,6 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
     front = pipeline(task)  # type: ignore[arg-type]
     back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
     return "+".join(p for p in (front, back) if p) or "raw"
-
-
-def in_sample(task: dict[str, Any]) -> list[str]:
-    """The test files of ``task`` that are also training files (the same path or the same bytes)."""
-    if not task.get("train_files") or not task.get("test_files"):
-        return []
-    return shared_recordings(task["train_files"], task["test_files"])
 
 
 def in_sample_warning(shared: list[str]) -> str:
@@ -145,33 +138,33 @@ def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:
 
 
 class CompensationKind(JobKind):
-    def prepare(self, c: dict[str, Any]) -> dict[str, Any]:
-        return {**c, "learner": learner_of(c)}  # the default learner made explicit: logged and hashed
+    """A compensation job: checked and prepared once (:class:`~tcbench.runner.compensation_job.CompensationJob`,
+    its env built once per process), then run, recorded and summed up from that job."""
 
     def plan_check(self, c: dict[str, Any]) -> None:
-        validate(c)
+        keep(self.job(c))  # the env built for the check serves the job when it runs in this process
 
     def names(self, c: dict[str, Any]) -> JobNames:
-        learner = learner_of(c)
+        learner_of(c)  # a config without a learner: one line naming the key
         try:
             tkey = task_spec(str(c["task"]["name"])).key(c["task"])
             data = data_tags(c["task"])
         except DataHashError as exc:
             raise ConfigError(str(exc)) from None
-        method = compensation_label(learner, c["optimiser"], c["task"])
+        method = compensation_label(c["learner"], c["optimiser"], c["task"])
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
                         {"tcbench.task_name": str(c["task"]["name"]), **data})
 
-    def execute(self, c: dict[str, Any]) -> CompensationResult:
-        validate(c)
-        shared = in_sample(c["task"])
-        if shared:
-            log.warning("%s", in_sample_warning(shared))
-        optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
-        learner = {k: v for k, v in learner_of(c).items() if k != "label"}
-        return run_compensation(c["task"], learner, optimiser, c["budget"], c["seed"], c["progress"])
+    def job(self, c: dict[str, Any]) -> CompensationJob:
+        return prepare_job(c, self.names)
 
-    def record(self, run: Any, result: CompensationResult, c: dict[str, Any], where: Path) -> list[Path]:
+    def execute(self, job: CompensationJob) -> CompensationResult:
+        if job.in_sample:
+            log.warning("%s", in_sample_warning(list(job.in_sample)))
+        return compensate(job.env, job.learner.name, job.optimiser.name, job.optimiser.params, job.budget,
+                          job.seed, job.progress)
+
+    def record(self, run: Any, result: CompensationResult, job: CompensationJob, where: Path) -> list[Path]:
         summary = result.score.summary()
         primary = PRIMARY[result.score.protocol]
         tuned = {"vmd_k": float(result.tuning.k), "vmd_alpha": result.tuning.alpha,
@@ -197,12 +190,12 @@ class CompensationKind(JobKind):
                 nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
                 files.append(where / f"nodes_test{i}.csv")
         files += gyro_tables(result, where)
-        if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
-            n = self.names(c)
-            files += figures(result.score, loss, where, f"{n.method} on {n.task}, seed {c['seed']}", result.tuning)
+        if job.plots is not False:  # null: plot (a sweep's launcher decides)
+            n = job.names
+            files += figures(result.score, loss, where, f"{n.method} on {n.task}, seed {job.seed}", result.tuning)
         return files
 
-    def summary(self, result: CompensationResult, c: dict[str, Any]) -> str:
+    def summary(self, result: CompensationResult, job: CompensationJob) -> str:
         s, primary = result.score.summary(), PRIMARY[result.score.protocol]
-        return (f"{self.names(c).run}: {primary} {s[primary]:.4g} (raw {s[f'raw_{primary}']:.4g}), "
+        return (f"{job.names.run}: {primary} {s[primary]:.4g} (raw {s[f'raw_{primary}']:.4g}), "
                 f"{result.score.train_key} {s[result.score.train_key]:.3g}")

@@ -22,6 +22,7 @@ from typing import Any
 BUILTIN = ("msra", "gyro", "accel")
 ENTRY_POINT_GROUP = "tcbench.sensor_kinds"
 INPUT_FIELDS = ("accel_g", "rate_dps")  # the Profile/Signals field a kind's input is
+REPORTS = ("inertial", "zero_bias", "rate")  # the metrics ``tcbench metrics`` reads off a run (SensorKind.report)
 
 
 @dataclass(frozen=True)
@@ -38,12 +39,24 @@ class SensorKind:
         unit mistake, not a measurement.
     device: device seed -> simulated :class:`~tcbench.sensors.models.Unit`.
     protocols: protocol name -> profile builder (:mod:`tcbench.sensors.protocols`).
-    positions: whether recordings may carry position labels (+0g, +1g, -0g, -1g).
+    positions: whether recordings may carry position labels (+0g, +1g, -0g, -1g): the unit can be
+        turned through gravity (a test may cycle its input through +1, 0, -1 g).
     input_step: the input step (input unit) of the truth's sensitivity difference.
     noise_unit, noise_scale: the unit bias and noise figures are reported in, and the factor
         from the output unit to it (``°/h``, 3600 for a gyro in deg/s).
     ulog_topic, ulog_unit: PX4's topic of this kind and the unit it logs the axes in.
     px4_letter: the letter of PX4's thermal-calibration parameters (``TC_G*``, ``TC_A*``).
+    px4_cal: the kind's name in PX4's sensor-calibration parameters (``CAL_GYROn_ID``, ``CAL_ACCn_ID``).
+    ardupilot_letters: the letters of ArduPilot's temperature-calibration parameters
+        (``INS_TCALn_GYR*``, ``INS_TCALn_ACC*``); None: ArduPilot calibrates no such kind.
+    report: the metrics ``tcbench metrics`` reads off a run without complete four-position groups
+        (:data:`REPORTS`): ``inertial``, the bias (output less the applied input) in ``noise_unit``:
+        its stability, noise density, bias instability, slope against temperature and hysteresis;
+        ``zero_bias``, seed 000's zero-bias stability in µg through the device's scale factor;
+        ``rate``, seed 001's Allan read-offs in °/h, the 60 → -40 °C drift and the rate against
+        temperature.
+    nominal_scale_factor: the output per input unit assumed when a recording's sidecar gives none
+        (``scale_factor_hz_per_g``): 1 for a kind whose output is in its input's unit.
     default_protocol: the protocol ``tcbench simulate`` runs when none is given (None: the first
         of ``protocols``).
     power_on: what a new power-on changes in a unit's model, ``(model, rng) -> (model as it runs,
@@ -68,6 +81,10 @@ class SensorKind:
     ulog_topic: str | None = None
     ulog_unit: str | None = None
     px4_letter: str | None = None
+    px4_cal: str | None = None
+    ardupilot_letters: str | None = None
+    report: str = "inertial"
+    nominal_scale_factor: float = 1.0
     extra: Mapping[str, Any] = field(default_factory=dict)
     default_protocol: str | None = None
     power_on: Callable[[Any, Any], tuple[Any, dict[str, float]]] | None = None
@@ -78,11 +95,20 @@ class SensorKind:
                              f"got {self.input_field!r}")
         if not self.protocols:
             raise ValueError(f"sensor kind {self.name!r} has no protocol")
+        if self.report not in REPORTS:
+            raise ValueError(f"sensor kind {self.name!r}: report must be one of {', '.join(REPORTS)}, "
+                             f"got {self.report!r}")
         if self.default_protocol is None:
             object.__setattr__(self, "default_protocol", next(iter(self.protocols)))
         elif self.default_protocol not in self.protocols:
             raise ValueError(f"sensor kind {self.name!r}: default_protocol {self.default_protocol!r} is not one of its "
                              f"protocols ({', '.join(self.protocols)})")
+
+    @property
+    def scaled(self) -> bool:
+        """Whether its output is in another unit than its input (an MSRA's Hz for g): read as the
+        input, it needs the device's scale factor (a recording's ``scale_factor_hz_per_g``)."""
+        return self.input_unit != self.output_unit
 
     @property
     def units(self) -> dict[str, str]:

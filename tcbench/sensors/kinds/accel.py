@@ -189,6 +189,8 @@ KIND = SensorKind(
     ulog_topic="sensor_accel",
     ulog_unit="m/s^2",
     px4_letter="A",
+    px4_cal="ACC",
+    ardupilot_letters="ACC",
     # the noise density in µg/√Hz as a velocity random walk in m/s/√h: 1e-6 g0 m/s^2 per µg, 60 √s per √h
     extra={"random_walk": {"vrw_m_per_s_per_sqrt_h": 9.80665e-6 * 60.0}},
 )

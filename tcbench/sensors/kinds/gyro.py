@@ -101,4 +101,7 @@ KIND = SensorKind(
     ulog_topic="sensor_gyro",
     ulog_unit="rad/s",
     px4_letter="G",
+    px4_cal="GYRO",
+    ardupilot_letters="GYR",
+    report="rate",  # seed 001's read-offs
 )

@@ -19,6 +19,7 @@ from tcbench.sensors.thermal import gauss_markov
 from tcbench.sensors.timing import current_timing
 
 SLOPE_REPEAT = 0.001  # the bias slope's run-to-run change, relative std: a resonant part's (see power_on)
+NOMINAL_SCALE_FACTOR_HZ_PER_G = 200.0  # assumed when a recording's sidecar gives no scale factor
 
 
 def msra_unit(device_seed: int) -> Unit:
@@ -137,4 +138,6 @@ KIND = SensorKind(
     positions=True,
     noise_unit="µg",
     noise_scale=float("nan"),  # Hz -> µg needs the device's scale factor (metrics read it from the sidecar)
+    report="zero_bias",  # seed 000's Table 1
+    nominal_scale_factor=NOMINAL_SCALE_FACTOR_HZ_PER_G,
 )

@@ -1,0 +1,90 @@
+"""A compensation job prepared once from its config (:func:`prepare_job`): the checked task, its
+env's arguments, the learner and the optimiser, the job's names and the env it runs on.
+
+The env is built once per job in a process: the plan check of a command line
+(:meth:`~tcbench.runner.kinds.JobKind.plan_check`, before any job starts) keeps the env it built
+and checked for the job that runs next in the same process with the same env arguments
+(:func:`keep`), which takes it instead of building another (an env is fresh until its first
+``reset``: a check reads it, never steps it). A job on a worker process is prepared there.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from tcbench.runner.compensation_config import LearnerConfig, OptimiserConfig, learner_of, optimiser_of, \
+    validate_compensation
+from tcbench.runner.config import checked_config
+from tcbench.runner.kinds import JobNames
+from tcbench.sensors.data_hash import shared_recordings
+from tcbench.tasks import TaskSpec, task_kwargs
+
+
+@dataclass(frozen=True)
+class CompensationJob:
+    """One compensation job, checked: what its names, its run, its record and its summary need.
+
+    task: the task's config as checked against its schema; task_kwargs: its env's keyword
+    arguments. plots: ``tracking.plots`` (null: draw). in_sample: the test files that are also
+    training files. env: the task's env (unwrapped), built once and not yet reset."""
+
+    spec: TaskSpec
+    task: dict[str, Any]
+    task_kwargs: dict[str, Any]
+    learner: LearnerConfig
+    optimiser: OptimiserConfig
+    budget: int
+    seed: int
+    progress: bool
+    plots: bool | None
+    names: JobNames
+    in_sample: tuple[str, ...]
+    env: Any = field(repr=False, compare=False)
+
+    @property
+    def env_key(self) -> str:
+        """What the env is built from, as one string (:func:`env_key`)."""
+        return env_key(self.spec, self.learner, self.budget, self.task_kwargs)
+
+
+def env_key(spec: TaskSpec, learner: LearnerConfig, budget: int, kwargs: dict[str, Any]) -> str:
+    """The arguments of a compensation env (``gym.make`` of ``spec.gym_id``) as one string: two
+    jobs with the same key start from the same env."""
+    return json.dumps([spec.gym_id, learner.env_learner, learner.params, budget, kwargs], sort_keys=True,
+                      default=str)
+
+
+def in_sample(task: dict[str, Any]) -> list[str]:
+    """The test files of ``task`` that are also training files (the same path or the same bytes)."""
+    if not task.get("train_files") or not task.get("test_files"):
+        return []
+    return shared_recordings(task["train_files"], task["test_files"])
+
+
+# The env a plan check built, by its key, for the job that runs next in this process (one at most).
+_kept: dict[str, Any] = {}
+
+
+def keep(job: CompensationJob) -> None:
+    """Keep ``job``'s env for the next job prepared in this process from the same env arguments
+    (the plan check's job hands it to the job that runs); one env is kept at most."""
+    _kept.clear()
+    _kept[job.env_key] = job.env
+
+
+def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) -> CompensationJob:
+    """The compensation job of config ``c``, checked as :func:`validate
+    <tcbench.runner.config.validate>` checks it (one-line ConfigErrors naming the key), then named
+    (``names(c)``), with its env: the one a plan check kept for these arguments (:func:`keep`),
+    else built now."""
+    spec, task = checked_config(c)
+    learner, optimiser = learner_of(c), optimiser_of(c)
+    kwargs = task_kwargs(task)
+    kept = _kept.pop(env_key(spec, learner, c["budget"], kwargs), None)
+    env = validate_compensation(c, task, kept)
+    plots = (c.get("tracking") or {}).get("plots")
+    return CompensationJob(spec, task, kwargs, learner, optimiser, int(c["budget"]), int(c["seed"]),
+                           bool(c["progress"]), plots, names(c), tuple(in_sample(c["task"])), env)
