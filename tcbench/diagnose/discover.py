@@ -18,7 +18,7 @@ the detectors search positions and periods: it is set on recordings with nothing
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence, not_significant
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import Search, open_term, terms
+
+if TYPE_CHECKING:
+    from tcbench.diagnose.significance import SignificanceTest
 
 OPEN_THRESHOLD = 25.0  # penalised held-out gain (sigma^2 units) an open-world term must exceed
 
@@ -72,7 +75,7 @@ class _Screen:
         return float(proj @ proj)
 
 
-def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: str, wald_threshold: float,
+def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: SignificanceTest, wald_threshold: float,
               threshold: float = OPEN_THRESHOLD) -> tuple[str, float, tuple[float, ...]] | None:
     """One round: the open-world term that adds most to ``model`` and passes (``(id, gain,
     value)``), or None; every term's :class:`~tcbench.diagnose.evidence.Evidence` is written
