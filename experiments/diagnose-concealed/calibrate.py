@@ -17,8 +17,11 @@ import numpy as np
 from joblib import Parallel, delayed
 
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.diagnose.attribute import DETECTION_THRESHOLD, WALD_THRESHOLD
 from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.settings import DEFAULTS
+
+DETECTION_THRESHOLD = DEFAULTS.selection.detection_threshold_sigma2
+WALD_THRESHOLD = DEFAULTS.selection.wald_threshold
 
 
 def _one(sensor: str, seed: int) -> tuple[str, float, float, list[str]]:
