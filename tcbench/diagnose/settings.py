@@ -22,13 +22,14 @@ settings from it without importing the diagnosis.
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 import typing
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["DEFAULTS", "DetectorSettings", "DiagnoseSettings", "SettingsError", "differing", "documented",
-           "from_mapping", "to_mapping"]
+           "from_mapping", "meanings", "to_mapping", "yaml_lines"]
 
 
 class SettingsError(ValueError):
@@ -70,7 +71,7 @@ class SelectionSettings:
     """The forward selection: the held-out gain and the significance a term needs."""
 
     detection_threshold_sigma2: float = setting(
-        10.0, "penalised held-out gain (white-noise variance units) a library effect must exceed; "
+        10.0, "penalised held-out gain a library effect must exceed; "
               "calibrated on controls (experiments/diagnose-concealed/calibrate.py)")
     open_threshold_sigma2: float = setting(
         25.0, "the same for an open-world term, higher because its detectors search positions and periods; "
@@ -97,11 +98,11 @@ class PlanSettings:
     block_windows: float = setting(
         2.0, "a CV block spans at least this many thermometer-smoothing windows, so a held-out block is not "
              "predicted by its neighbours' smoothed thermometer")
-    max_block_s: float = setting(900.0, "longest CV block and cluster (s): the length the library proof was "
+    max_block_s: float = setting(900.0, "longest CV block and cluster: the length the library proof was "
                                         "calibrated with on 8-12 h records")
-    blocks_per_record: int = setting(24, "a CV block is this share of the record (at least four per fold)", COUNT)
+    blocks_per_record: int = setting(24, "CV blocks the record is cut into, within the block bounds (at least four per fold)", COUNT)
     cluster_windows: float = setting(2.5, "a Wald cluster spans at least this many thermometer-smoothing windows")
-    clusters_per_record: int = setting(32, "a Wald cluster is this share of the record", COUNT)
+    clusters_per_record: int = setting(32, "Wald clusters the record is cut into, within the cluster bounds", COUNT)
     min_clusters: int = setting(
         24, "fewer clusters than this cannot estimate the variance of slow noise: the surrogate test decides",
         COUNT)
@@ -133,7 +134,7 @@ class SmoothingSettings:
     """The thermometer smoothing (:mod:`tcbench.diagnose.signals`)."""
 
     default_window_s: float = setting(
-        120.0, "smoothing window (s) of a record without a coarse staircase; a shorter fitted one must beat it")
+        120.0, "smoothing window of a record without a coarse staircase; a shorter fitted one must beat it")
     bias_to_noise: float = setting(
         0.5, "the fitted window halves while the smoothing's RMS bias exceeds this share of its noise")
 
@@ -142,7 +143,7 @@ class SmoothingSettings:
 class DataSettings:
     """What a record must hold to be diagnosed at all (:func:`tcbench.diagnose.signals.prepare`)."""
 
-    min_span_c: float = setting(2.0, "least temperature span (degC): a model cannot be identified at constant "
+    min_span_c: float = setting(2.0, "least temperature span: a model cannot be identified at constant "
                                      "temperature")
     min_samples: int = setting(200, "fewest samples a diagnosis takes", COUNT)
 
@@ -154,16 +155,16 @@ class LocateSettings:
     false_alarm: float = setting(0.01, "family-wise false-alarm probability of the scan on white noise",
                                  PROBABILITY)
     min_samples: int = setting(100, "fewest samples the scan takes", COUNT)
-    window_s: float = setting(180.0, "window of the time scan (s)")
-    band_c: float = setting(5.0, "temperature bin of the band scan and the two-group tests (degC)")
-    still_rate_c_per_min: float = setting(0.05, "|dT/dt| (degC/min) that separates soak from ramp")
-    rate_window_s: float = setting(60.0, "span over which dT/dt is taken (s)")
+    window_s: float = setting(180.0, "window of the time scan")
+    band_c: float = setting(5.0, "temperature bin of the band scan and the two-group tests")
+    still_rate_c_per_min: float = setting(0.05, "|dT/dt| that separates soak from ramp")
+    rate_window_s: float = setting(60.0, "span over which dT/dt is taken")
     min_windows: int = setting(10, "the time scan shrinks its windows to have at least this many", COUNT)
     max_windows: int = setting(1500, "... and widens them to have at most this many (memory of the K x K scan)",
                                COUNT)
     min_group_samples: int = setting(10, "a temperature bin enters a two-group test with this many per group",
                                      COUNT)
-    min_allan_samples: int = setting(10, "shortest Allan tau (samples); the longest is a tenth of the record",
+    min_allan_samples: int = setting(10, "shortest Allan tau; the longest is a tenth of the record",
                                      COUNT)
     max_findings: int = setting(20, "most regions reported per scan family", COUNT)
 
@@ -174,20 +175,20 @@ class DetectorSettings:
 
     max_bins: int = setting(3000, "most time bins of the residual the change-point search reads", COUNT)
     line_bins: int = setting(1200, "most time bins of the periodogram (periods down to three bins)", COUNT)
-    min_bin_s: float = setting(10.0, "narrowest time bin (s)")
+    min_bin_s: float = setting(10.0, "narrowest time bin")
     duty_phases: int = setting(64, "phase bins a switched load's cycle is folded into", TWO)
     n_changes: int = setting(3, "change points proposed per round", COUNT)
     n_lines: int = setting(3, "periodogram peaks proposed per round", COUNT)
     n_bumps: int = setting(3, "temperature bumps proposed per round", COUNT)
     gap_factor: float = setting(5.0, "a gap longer than this many median sample spacings may hide a restart")
     max_gaps: int = setting(12, "longest gaps proposed as restarts", COUNT)
-    bump_widths_c: tuple[float, ...] = setting((1.0, 1.5, 2.5, 4.0, 6.0), "widths (degC) of the Gaussian bumps "
+    bump_widths_c: tuple[float, ...] = setting((1.0, 1.5, 2.5, 4.0, 6.0), "widths of the Gaussian bumps "
                                                                          "matched against the residual")
     bump_spans: float = setting(4.0, "a bump of width w is searched where the temperature spans this many w")
     min_step_bins: int = setting(8, "binned residual means the change-point search needs", TWO)
     min_line_bins: int = setting(16, "binned residual means the periodogram needs", FOUR)
     line_cycles: float = setting(1.5, "the longest period searched fits this many times in the span")
-    temp_bin_c: float = setting(0.1, "temperature bin of the bump search (degC)")
+    temp_bin_c: float = setting(0.1, "temperature bin of the bump search")
 
 
 @dataclass(frozen=True)
@@ -212,8 +213,8 @@ class SaturationSettings:
     density_ratio: float = setting(3.0, "density at the extreme over the next cell's that an unclipped output "
                                         "can reach")
     min_count: int = setting(5, "fewest samples at the clip level", COUNT)
-    tol_sigma: float = setting(1e-3, "tolerance of the clip level for a continuous output (white sigmas)")
-    next_sigma: float = setting(0.25, "width of the cell next to the clip level (white sigmas)")
+    tol_sigma: float = setting(1e-3, "tolerance of the clip level for a continuous output")
+    next_sigma: float = setting(0.25, "width of the cell next to the clip level")
     episode_gap_samples: int = setting(30, "clipped samples closer than this belong to one episode", COUNT)
     max_episode_share: float = setting(0.5, "episodes wider than this share of the record: only the clipped "
                                             "samples get zero weight", SHARE)
@@ -225,7 +226,7 @@ class SaturationSettings:
 class QuantisationSettings:
     """The output (and thermometer) read on a grid (:mod:`tcbench.diagnose.quantisation`)."""
 
-    tolerance_steps: float = setting(0.02, "how far a jump may sit from an integer multiple of the step (steps)",
+    tolerance_steps: float = setting(0.02, "how far a jump may sit from an integer multiple of the step",
                                      PROBABILITY)
     min_fraction: float = setting(0.99, "share of the non-zero jumps that must be multiples of the step", SHARE)
     min_resultant: float = setting(0.99, "phase alignment of the values on the lattice (mean resultant length)",
@@ -240,11 +241,11 @@ class QuantisationSettings:
 class ThermometerSettings:
     """The thermometer's staircase and the smoothing it needs (:func:`~tcbench.diagnose.quantisation.thermometer_steps`)."""
 
-    min_step_c: float = setting(0.05, "a thermometer lattice finer than this (degC) is not reported")
-    dither_spread_steps: float = setting(0.36, "reading spread about its smoothed value (steps) above which it "
+    min_step_c: float = setting(0.05, "a thermometer lattice finer than this is not reported")
+    dither_spread_steps: float = setting(0.36, "reading spread about its smoothed value above which it "
                                                "is dithered")
     periods: float = setting(3.0, "staircase periods the widened smoothing window spans")
-    rate_window_s: float = setting(1800.0, "window of the local line that gives the typical ramp rate (s)")
+    rate_window_s: float = setting(1800.0, "window of the local line that gives the typical ramp rate")
     moving_share: float = setting(0.2, "a sample is on a ramp when its |rate| is above this share of the 90th "
                                        "percentile", SHARE)
 
@@ -297,8 +298,7 @@ class ShortSettings:
                                     COUNT)
     side_share: float = setting(0.05, "... and this share of the record: a step at the edge is the edge's noise",
                                 PROBABILITY)
-    min_slope_span_c: float = setting(0.5, "a temperature slope needs the smoothed thermometer to move this much "
-                                           "(degC)")
+    min_slope_span_c: float = setting(0.5, "a temperature slope needs the smoothed thermometer to move this much")
     ramp_share: float = setting(0.5, "a ramp starts where |dT/dt| rises through this share of its largest value",
                                 SHARE)
     one_way_corr: float = setting(0.9, "|corr(time, temperature)| above which a slope is also a drift in time",
@@ -367,7 +367,7 @@ def _typed(key: str, kind: Any, value: Any) -> Any:
     return number(value, kind)
 
 
-def from_mapping(given: Mapping[str, Any] | None, cls: type = None, prefix: str = "settings.") -> Any:  # type: ignore[assignment]
+def from_mapping(given: Mapping[str, Any] | None, cls: type | None = None, prefix: str = "settings.") -> Any:
     """The settings ``given`` as a mapping (``{section: {field: value}}``, e.g. ``conf/diagnose.yaml``'s
     ``settings:``), missing ones at their defaults; :class:`SettingsError` naming the key of an
     unknown setting, a value of the wrong type or one its check refuses."""
@@ -404,13 +404,68 @@ def to_mapping(settings: Any) -> dict[str, Any]:
 
 def differing(settings: Any, defaults: Any = None) -> dict[str, Any]:
     """``{dotted key: value}`` of the settings that differ from ``defaults`` (:data:`DEFAULTS`)."""
-    base = dict((k, v) for k, _, v in _walk(DEFAULTS if defaults is None else defaults, ""))
+    base = {k: v for k, _, v in _walk(DEFAULTS if defaults is None else defaults, "")}
     return {k: v for k, _, v in _walk(settings, "") if base.get(k) != v}
 
 
 def documented(settings: Any = None, prefix: str = "settings.") -> list[tuple[str, Any, str]]:
     """``(dotted key, default, reason)`` of every setting, in order (the ``--help`` lines)."""
     return [(k, v, f.metadata["doc"]) for k, f, v in _walk(DEFAULTS if settings is None else settings, prefix)]
+
+
+# the unit a setting's name ends in, longest first; a name without one takes its check's word
+UNITS = (("_sigma2_per_param", "white-noise variances per parameter"), ("_c_per_min", "degC/min"),
+         ("_sigma2", "white-noise variances"), ("_sigma", "white sigmas"), ("_samples", "samples"),
+         ("_steps", "lattice steps"), ("_windows", "smoothing windows"), ("_s", "s"), ("_c", "degC"))
+WORDS = {POSITIVE.says: "number", NONNEGATIVE.says: "number", PROBABILITY.says: "probability", SHARE.says: "share",
+         FACTOR.says: "factor", COUNT.says: "count", TWO.says: "count", FOUR.says: "count", ODD.says: "count",
+         SEED.says: "seed"}
+
+
+def unit(name: str, f: dataclasses.Field[Any]) -> str:
+    """The unit of the setting ``name`` (read off its name), or what kind of number it is."""
+    found = next((u for suffix, u in UNITS if name.endswith(suffix)), None)
+    return found or WORDS[f.metadata["check"].says]
+
+
+def meanings(settings: Any = None) -> dict[str, str]:
+    """``{settings.<section>.<key>: "[unit] reason"}`` of every setting (``tcbench diagnose --help``)."""
+    return {k: f"[{unit(k.rsplit('.', 1)[-1], f)}] {f.metadata['doc']}"
+            for k, f, _ in _walk(DEFAULTS if settings is None else settings, "settings.")}
+
+
+def _yaml_value(value: Any) -> str:
+    """``value`` as YAML that YAML 1.1 readers also take for a number (``1.0e-05``, not ``1e-05``)."""
+    if isinstance(value, tuple | list):
+        return "[" + ", ".join(_yaml_value(v) for v in value) + "]"
+    text = repr(value)
+    mantissa, e, exponent = text.partition("e")
+    return f"{mantissa}.0e{exponent}" if e and "." not in mantissa else text
+
+
+def yaml_lines(settings: Any = None, keys: Any = None, indent: str = "  ") -> list[str]:
+    """``settings:`` as commented YAML: every section and setting of ``settings`` (default
+    :data:`DEFAULTS`), or only the dotted ``keys`` (``selection.wald_threshold``), each setting
+    after a comment with its unit and reason."""
+    settings = DEFAULTS if settings is None else settings
+    wanted = None if keys is None else set(keys)
+    lines = ["settings:  # the statistics of the diagnosis (tcbench.diagnose.settings.DiagnoseSettings)"]
+
+    def walk(obj: Any, prefix: str, depth: int) -> list[str]:
+        out: list[str] = []
+        pad = indent * depth
+        for f in dataclasses.fields(obj):
+            value, key = getattr(obj, f.name), f"{prefix}{f.name}"
+            if dataclasses.is_dataclass(value):
+                inner = walk(value, f"{key}.", depth + 1)
+                if inner:
+                    out += [f"{pad}{f.name}:  # {f.metadata['doc']}", *inner]
+            elif wanted is None or key in wanted:
+                why = textwrap.wrap(f"[{unit(f.name, f)}] {f.metadata['doc']}", width=116 - len(pad))
+                out += [*(f"{pad}# {line}" for line in why), f"{pad}{f.name}: {_yaml_value(value)}"]
+        return out
+
+    return lines + walk(settings, "", 1)
 
 
 def sections(settings: Any = None) -> list[tuple[str, str]]:
