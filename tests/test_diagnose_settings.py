@@ -156,3 +156,27 @@ def test_a_setting_reaches_its_stage() -> None:
     assert any(m.what.startswith("time span") for m in locate(t, temp, drift, 1.0, LocateSettings(false_alarm=0.5)))
     assert not any(m.what.startswith("time span") for m in locate(t, temp, drift, 1.0,
                                                                   LocateSettings(false_alarm=1e-9)))
+
+
+def test_a_diagnosis_runs_with_its_settings_and_its_report_records_them() -> None:
+    """The same concealed thermal lag: found at the defaults; with gain thresholds no gain
+    reaches it is not kept and its candidate says against what; report.json records every setting
+    and report.md names the ones changed."""
+    from tcbench.datasets.concealed import concealed_recording
+    from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.markdown import render_markdown
+
+    rec, _ = concealed_recording("msra", "thermal_lag", 1)
+    default = diagnose(rec, name="lag")
+    strict = DiagnoseSettings(selection=replace(DEFAULTS.selection, detection_threshold_sigma2=1e6,
+                                                open_threshold_sigma2=1e6))
+    high = diagnose(rec, name="lag", settings=strict)
+    assert default.effect_ids == ["thermal_lag"] and "thermal_lag" not in high.effect_ids
+    report, high_report = default.to_json(), high.to_json()
+    assert report["statistics"]["settings"] == to_mapping(DEFAULTS)
+    assert high_report["statistics"]["settings"]["selection"]["detection_threshold_sigma2"] == 1e6
+    lag = next(c for c in high_report["candidates"] if c["id"] == "thermal_lag")
+    assert lag["status"] == "rejected" and lag["threshold_sigma2"] == 1e6
+    assert "Settings that differ" not in render_markdown(default, {})
+    assert ("`selection.detection_threshold_sigma2 = 1000000.0` (default 10.0)"
+            in render_markdown(high, {}))

@@ -18,7 +18,7 @@ from typing import Any
 from tcbench.diagnose.attribute import Evidence
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.result import Diagnosis
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
 from tcbench.diagnose.significance import SURROGATE
 
 PLOT_CAPTIONS = {
@@ -241,6 +241,24 @@ def not_tested_section(not_tested: dict[str, str]) -> list[str]:
             *(f"- **{name}**: {reason}." for name, reason in not_tested.items()), ""]
 
 
+def settings_note(settings: DiagnoseSettings) -> list[str]:
+    """The settings of ``tcbench diagnose`` that differ from the defaults, one ``key = value``
+    each (report.json ``statistics.settings`` has them all); nothing at the defaults."""
+    changed = differing(settings)
+    if not changed:
+        return []
+    said = ", ".join(f"`{k} = {list(v) if isinstance(v, tuple) else v}` (default {_default(k)})"
+                     for k, v in changed.items())
+    return [f"Settings that differ from the defaults: {said}.", ""]
+
+
+def _default(key: str) -> Any:
+    value: Any = DEFAULTS
+    for part in key.split("."):
+        value = getattr(value, part)
+    return list(value) if isinstance(value, tuple) else value
+
+
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
     the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
@@ -281,6 +299,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
            "removes most of the excess error and fails it is tried by the surrogate test instead)")
     out += [(f"Statistics sized to this recording: blocks of {_g(plan.block_s)} s in {plan.k} interleaved "
              f"folds; {why}."), ""]
+    out += settings_note(settings)
 
     out += ["## Where the starting model misses", ""]
     if d.mismatch:

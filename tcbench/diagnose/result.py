@@ -17,7 +17,7 @@ from tcbench.diagnose.locate import AllanExcess, Mismatch
 from tcbench.diagnose.outliers import Outliers
 from tcbench.diagnose.plan import StatsPlan
 from tcbench.diagnose.reference import Reference
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, to_mapping
 from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import term
 
@@ -103,7 +103,8 @@ class Statistics:
     """How the diagnosis tested this record: the plan (blocks, folds, clusters, significance
     test), the thermometer smoothing window (s), the screens' entries, ``{detector: why it could
     not run}``, where two windows were tried, ``{window (s): final held-out RMSE}``, and the
-    settings it ran with."""
+    settings it ran with (report.json's ``statistics.settings``: every section and key, so a
+    report says what it was tested with whatever the defaults of a later version)."""
 
     plan: StatsPlan
     smooth_s: float
@@ -122,6 +123,7 @@ class Statistics:
             out["not_tested"] = self.not_tested
         if self.smooth_tried_s:
             out["thermometer_smooth_tried_s"] = self.smooth_tried_s
+        out["settings"] = to_mapping(self.settings)
         return out
 
 
