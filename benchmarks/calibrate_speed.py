@@ -103,14 +103,13 @@ def method_step(method: str, rec: Any, branches: list[Any], train: int,
 def _diagnosed(rec: Any, b: Any) -> Any:
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.model_file import to_sensor_model
-    from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
-    from tcbench.diagnose.plan import FOLDS
+    from tcbench.diagnose.plan import min_full_duration_s
     from tcbench.diagnose.report import model_spec
     from tcbench.sensors.recording import make_recording
 
     part = make_recording(rec.time_s[b.start:b.stop], rec.temperature_c[b.start:b.stop], rec.input[b.start:b.stop],
                           rec.output[b.start:b.stop], sensor="gyro", sample_rate_hz=1.0, device_id="day")
-    diagnosis = diagnose(part, name="training part", min_duration_s=FOLDS * 2 * DEFAULT_SMOOTH_S)
+    diagnosis = diagnose(part, name="training part", min_duration_s=min_full_duration_s())
     return to_sensor_model(model_spec(diagnosis))
 
 

@@ -27,6 +27,8 @@ SLOW = ("mlflow", "matplotlib", "scipy", "pandas", "pyarrow", "torch", "sklearn"
         "tcbench.leaderboard")
 # and what --help does not need either: the help is built from the schemas
 NOT_FOR_HELP = ("hydra", "omegaconf", "hydra_plugins")
+# but the diagnosis's settings are plain dataclasses of the standard library: diagnose's schema holds them
+LIGHT = ("tcbench.diagnose", "tcbench.diagnose.settings")
 
 ERRORS = [  # (command line, what its one line says)
     (["run", "bogus=1"], "bogus: no such config key"),
@@ -71,13 +73,14 @@ def probe(argvs: list[list[str]], cwd: Path) -> dict:
 
 
 def slow(modules: list[str], prefixes: tuple[str, ...]) -> list[str]:
-    """The modules a prefix names: the module and its submodules, or with a trailing dot only its submodules."""
+    """The modules a prefix names: the module and its submodules, or with a trailing dot only its
+    submodules; the :data:`LIGHT` ones spared."""
     def named(module: str, prefix: str) -> bool:
         if prefix.endswith("."):
             return module.startswith(prefix)
         return module == prefix or module.startswith(prefix + ".")
 
-    return [m for m in modules if any(named(m, p) for p in prefixes)]
+    return [m for m in modules if any(named(m, p) for p in prefixes) and m not in LIGHT]
 
 
 def test_help_of_every_command_imports_nothing_slow(tmp_path: Path) -> None:

@@ -18,14 +18,13 @@ from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model
 from tcbench.diagnose.quantisation import (
-    PERIODS,
     find_output_quantisation,
     lattice_step,
     thermometer_steps,
 )
 from tcbench.diagnose.report import write_report
 from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens, smoothing
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
+from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors.recording import Recording, read_recording
 from tcbench.sensors.simulate import simulate_recording
 
@@ -69,7 +68,7 @@ def test_thermometer_staircase_worked_by_hand() -> None:
     steps = thermometer_steps(t, reading, 120.0)
     assert steps is not None and steps.staircase
     assert steps.step_c == 1.0 and steps.rate_c_per_s == pytest.approx(rate, rel=0.05)
-    assert steps.smooth_s == pytest.approx(PERIODS * 600.0, rel=0.05)
+    assert steps.smooth_s == pytest.approx(DEFAULTS.screens.thermometer.periods * 600.0, rel=0.05)
     finding = steps.finding()
     assert finding.id == "thermometer_quantisation" and finding.shape == "quantisation"
     assert finding.where == {"level": 1.0} and "whole degrees" in finding.explanation
@@ -85,7 +84,7 @@ def test_thermometer_staircase_worked_by_hand() -> None:
 def test_concealed_controls_show_no_grid(sensor: str, seed: int) -> None:
     rec, _ = concealed_recording(sensor, None, seed)
     steps = smoothing(rec)
-    assert steps.smooth_s == DEFAULT_SMOOTH_S and not steps.staircase and not steps.findings("Hz")
+    assert steps.smooth_s == DEFAULTS.smoothing.default_window_s and not steps.staircase and not steps.findings("Hz")
     assert lattice_step(rec.output) is None
 
 

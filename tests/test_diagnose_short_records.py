@@ -21,7 +21,7 @@ from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.discover import why_untestable
 from tcbench.diagnose.locate import why_no_allan
 from tcbench.diagnose.markdown import not_tested_section
-from tcbench.diagnose.plan import FOLDS, plan_for
+from tcbench.diagnose.plan import plan_for
 from tcbench.diagnose.report import write_report
 from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.terms import term, terms
@@ -70,7 +70,7 @@ def test_normal_record_runs_every_open_world_detector() -> None:
     rec, _ = concealed_recording("gyro", None, 5)  # ~10.7 h, tens of degC
     data = prepare(rec)
     plan = plan_for(data)
-    assert why_untestable(Designer(data), block_folds(data.t_s, plan.block_s, FOLDS)) == {}
+    assert why_untestable(Designer(data), block_folds(data.t_s, plan.block_s, plan.k)) == {}
     assert why_no_allan(data.t_s) is None
 
 

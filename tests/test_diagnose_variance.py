@@ -20,7 +20,8 @@ from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, read_model, to_sensor_model
 from tcbench.diagnose.report import write_report
 from tcbench.diagnose.signals import prepare
-from tcbench.diagnose.variance import ALPHA, MIN_SIGMA_RATIO, find_variance, paired_differences
+from tcbench.diagnose.settings import DEFAULTS
+from tcbench.diagnose.variance import find_variance, paired_differences
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording
 
@@ -82,7 +83,7 @@ def test_false_alarms_at_one_percent(tails: str) -> None:
     draw = (lambda: rng.standard_normal(N)) if tails == "gauss" else (lambda: rng.standard_t(5, N))
     alarms = sum(find_variance(t, temp, draw(), run, 1.0).found is not None for _ in range(300))
     assert alarms <= 8
-    assert ALPHA == 0.01
+    assert DEFAULTS.screens.variance.alpha == 0.01
 
 
 def test_a_small_significant_change_is_not_reported() -> None:
@@ -92,7 +93,7 @@ def test_a_small_significant_change_is_not_reported() -> None:
     v = find_variance(t, temp, rng.standard_normal(t.size) * np.where(temp > 30.0, 1.1, 1.0), run, 1.0)
     tested = {x.against: x for x in v.tests}
     assert tested["temperature"].p_value < 1e-6 and v.found is None
-    assert tested["temperature"].sigma_band[1] / tested["temperature"].sigma_band[0] < MIN_SIGMA_RATIO
+    assert tested["temperature"].sigma_band[1] / tested["temperature"].sigma_band[0] < DEFAULTS.screens.variance.min_sigma_ratio
 
 
 def test_short_record_says_so() -> None:

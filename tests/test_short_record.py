@@ -16,12 +16,14 @@ from scipy.signal import lfilter
 
 from tcbench.cli import main
 from tcbench.diagnose.crossval import block_folds
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S
-from tcbench.diagnose.plan import FOLDS, min_full_duration_s
+from tcbench.diagnose.plan import min_full_duration_s
+from tcbench.diagnose.settings import DEFAULTS
 from tcbench.diagnose.short_record import short_record
-from tcbench.diagnose.short_tests import MIN_FIT_SAMPLES
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
+FOLDS = DEFAULTS.plan.folds
+DEFAULT_SMOOTH_S = DEFAULTS.smoothing.default_window_s
+MIN_FIT_SAMPLES = DEFAULTS.short.min_fit_samples
 RATE_HZ = 500.0
 RAMP_START_S = 50.0
 RAMP_END_S = 200.0

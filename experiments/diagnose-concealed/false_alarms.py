@@ -93,7 +93,8 @@ def one(sensor: str, form: Form, seed: int) -> dict[str, Any]:
     effects = list(report.get("effects", []))
     return row | {"outcome": "alarm" if effects else "clean", "found": _label(effects),
                   "seconds": time.perf_counter() - t0, "error": "",
-                  "stats": json.dumps(report.get("statistics", {}), default=str)}
+                  "stats": json.dumps({k: v for k, v in report.get("statistics", {}).items() if k != "settings"},
+                                      default=str)}
 
 
 def cells(df: pd.DataFrame) -> pd.DataFrame:

@@ -28,9 +28,10 @@ from pan_lsm6dsm import DATA as PAN_DATA
 from pan_lsm6dsm import convert as pan_gyro
 
 from tcbench.datasets.real import TOFUPILOT_CSV, tofupilot_gyro
-from tcbench.diagnose.diagnosis import REFERENCE_RATIO, Diagnosis, diagnose
+from tcbench.diagnose.diagnosis import Diagnosis, diagnose
 from tcbench.diagnose.markdown import format_where
 from tcbench.diagnose.report import write_report
+from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors.recording import Recording
 
 RECORDS: dict[str, tuple[Callable[[str], Recording], str, Path]] = {
@@ -100,7 +101,7 @@ def main() -> None:
     done = [diagnose_record(record, args.out) for record in records]
     rows = [row for r, _ in done for row in r]
     sections = [line for _, sec in done for line in sec]
-    head = [f"# Real gyro recordings: final model against the physics-agnostic reference (target <= {REFERENCE_RATIO:g})",
+    head = [f"# Real gyro recordings: final model against the physics-agnostic reference (target <= {DEFAULTS.reference.structure_ratio:g})",
             "", "Held-out RMSE in white sigma (first differences); blocks, folds and the significance test as in "
             "each report.json `statistics`. Command: `python experiments/diagnose-real/run.py`.", ""]
     findings = ["", "## Findings per axis", "",

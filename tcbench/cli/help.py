@@ -60,7 +60,8 @@ def usage(name: str) -> str:
     lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "",
              textwrap.fill(spec.description, width=100), "",
              "parameters (key=value, default after =):"]
-    rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", spec.params.get(key, ""))
+    meanings = spec.meanings()
+    rows = [(f"{key}={'(required)' if key in spec.required else _shown(default)}", meanings.get(key, ""))
             for key, default in parameters(schema) if key not in IGNORED + HIDDEN]
     width = max(len(left) for left, _ in rows) + 2
     lines += [f"  {left:{width}s}{meaning}" for left, meaning in rows]

@@ -1,17 +1,18 @@
 """What ``tcbench diagnose`` does with its config: the checks made before any work
-(:func:`check_diagnose`) and the diagnosis with its report (:func:`diagnose_recording`); a record
-shorter than a full diagnosis needs gets the short-record report of the tests its length allows
-(:mod:`tcbench.diagnose.short_record`). It runs as a job of :mod:`tcbench.runner.kinds.diagnosis`
+(:func:`check_diagnose`: the settings first, :func:`diagnose_settings`) and the diagnosis with
+its report (:func:`diagnose_recording`); a record shorter than a full diagnosis needs gets the
+short-record report of the tests its length allows (:mod:`tcbench.diagnose.short_record`). It runs as a job of :mod:`tcbench.runner.kinds.diagnosis`
 through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import logging
 import math
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -44,11 +45,28 @@ class DiagnosisOutcome:
     written: dict[str, Path]
 
 
+def diagnose_settings(cfg: DiagnoseConfig) -> Any:
+    """The :class:`~tcbench.diagnose.settings.DiagnoseSettings` of ``cfg.settings``; a
+    :class:`CommandError` naming the key of a setting that is not one or a value it cannot take
+    (a threshold <= 0, a probability outside (0, 1) ...)."""
+    from tcbench.diagnose.settings import SettingsError, from_mapping
+
+    given = cfg.settings
+    mapping = dataclasses.asdict(given) if dataclasses.is_dataclass(given) else given
+    if mapping is not None and not isinstance(mapping, Mapping):
+        raise CommandError(f"settings: a mapping of sections (settings.selection.wald_threshold=30), got {given!r}")
+    try:
+        return from_mapping(mapping)
+    except SettingsError as exc:
+        raise CommandError(str(exc)) from None
+
+
 def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, float]]]:
-    """Every argument before any work: the recording (read and validated), its sensor and the
-    effects the model file declares already modelled."""
+    """Every argument before any work: the settings, the recording (read and validated), its
+    sensor and the effects the model file declares already modelled."""
     from tcbench.diagnose.model_file import ModelFileError, read_model
 
+    diagnose_settings(cfg)
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
     if cfg.sensor is not None and not kinds.known(cfg.sensor):
@@ -139,11 +157,12 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     from tcbench.diagnose.signals import DiagnosisDataError
 
     rec, sensor, declared = check_diagnose(cfg)
-    if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s():
-        return _short_record(cfg, rec, sensor)
+    settings = diagnose_settings(cfg)
+    if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s(settings):
+        return _short_record(cfg, rec, sensor, settings)
     try:
         with progress(Path(cfg.recording).name, rec.time_s.size):
-            diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name)
+            diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name, settings=settings)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
     written = _written(write_report, diag, cfg)
@@ -174,12 +193,13 @@ def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
     return dict(written)
 
 
-def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str) -> DiagnosisOutcome:
-    """The short-record report of ``rec``, written to ``out``; prints what ran and what needs more time."""
+def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str, settings: Any) -> DiagnosisOutcome:
+    """The short-record report of ``rec`` (its tests at ``settings``), written to ``out``; prints
+    what ran and what needs more time."""
     from tcbench.diagnose.short_record import short_record
     from tcbench.diagnose.short_report import write_short_report
 
-    report = short_record(rec, sensor, name=Path(cfg.recording).name)
+    report = short_record(rec, sensor, name=Path(cfg.recording).name, settings=settings)
     written = _written(write_short_report, report, cfg)
     print(f"tcbench: {report.verdict}")
     ran = [f"{t.id} ({t.status})" for t in report.tests if t.ran]

@@ -45,7 +45,8 @@ class CommandSpec:
     (``runs_here``: a module whose ``check(cfg)`` and ``work(cfg) -> int`` take the schema's
     dataclass; for work that needs no worker: a listing, two small files, a quickstart that runs
     sweeps of its own), never both. ``params`` gives the meaning of every key of the schema (dotted
-    for nested dataclasses; a dict-valued key is one entry)."""
+    for nested dataclasses; a dict-valued key is one entry), or ``more_params`` (a ``module:function``
+    returning ``{key: meaning}``) for keys documented where they are defined."""
 
     name: str
     summary: str  # its line in ``tcbench --help``
@@ -64,6 +65,7 @@ class CommandSpec:
     kinds: dict[str, str] = field(default_factory=dict)  # job kind -> ``module:Class`` of its JobKind
     runs_here: str | None = None  # the module running its jobs in this process, one after another
     inputs: tuple[str, ...] = ()  # keys naming the files its jobs read (checked to exist before any work)
+    more_params: str | None = None  # ``module:function`` -> {key: meaning} of keys documented where defined
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "config", self.config or self.name)
@@ -74,6 +76,10 @@ class CommandSpec:
     def schema_class(self) -> type:
         """The dataclass schema of its primary config (imported now)."""
         return load(self.schema)  # type: ignore[no-any-return]
+
+    def meanings(self) -> dict[str, str]:
+        """The meaning of every key: :attr:`params` and those of :attr:`more_params` (imported now)."""
+        return {**self.params, **(load(self.more_params)() if self.more_params else {})}
 
 
 def load(path: str) -> Any:
@@ -310,9 +316,11 @@ SPECS: dict[str, CommandSpec] = {
                         "time spent on a terminal",
             **TRACKING,
         },
+        more_params="tcbench.diagnose.settings:meanings",  # settings.<section>.<key>: the statistics
         examples=(
             "tcbench diagnose recording=recordings/msra-fulltemp-dev0-seed0.csv out=diagnosis",
             "tcbench diagnose recording=run.csv out=diag2 model=diagnosis/model.yaml",
+            "tcbench diagnose recording=run.csv settings.selection.wald_threshold=30 settings.locate.false_alarm=0.05",
             "tcbench diagnose -m recording=a.csv,b.csv 'out=diagnoses/${stem:recording}' hydra.launcher.n_jobs=2",
         ),
         output="OUT/report.json, OUT/report.md, plots and OUT/model.yaml; MLflow experiment 'diagnoses' "

@@ -6,10 +6,13 @@ kind that runs it (:mod:`tcbench.runner.kinds`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import re
+import typing
 from dataclasses import dataclass, field
 from typing import Any
 
+from tcbench.diagnose.settings import DiagnoseSettings
 from tcbench.tracking.config import TrackingConfig
 
 
@@ -91,11 +94,38 @@ class ImportConfig:
 DIAGNOSE_MAX_ROWS = 1_000_000
 
 
+def _mutable(cls: type) -> type:
+    """A plain dataclass with the fields, types and defaults of the frozen settings section
+    ``cls`` (a tuple as a list): OmegaConf makes a frozen dataclass read-only, so no ``key=value``
+    could change it. Made once here, named ``<Section>Config`` in this module (a sweep's configs
+    are pickled by name)."""
+    hints = typing.get_type_hints(cls)
+    fields: list[tuple[str, Any, Any]] = []
+    for f in dataclasses.fields(cls):
+        kind = hints[f.name]
+        if dataclasses.is_dataclass(kind):
+            sub = _mutable(kind)  # type: ignore[arg-type]
+            fields.append((f.name, sub, field(default_factory=sub)))
+        elif typing.get_origin(kind) is tuple:
+            fields.append((f.name, list[float], field(default_factory=lambda d=f.default: list(d))))
+        else:
+            fields.append((f.name, kind, field(default=f.default)))
+    made = dataclasses.make_dataclass(f"{cls.__name__}Config", fields)
+    made.__module__, made.__doc__ = __name__, cls.__doc__
+    globals()[made.__name__] = made
+    return made
+
+
+# ``tcbench diagnose settings.<section>.<key>=``: the statistics of tcbench.diagnose.settings.DiagnoseSettings
+DiagnoseSettingsConfig = _mutable(DiagnoseSettings)
+
+
 @dataclass
 class DiagnoseConfig:
     """``tcbench diagnose``: the recording, the output directory, the sensor kind for a recording
-    without a sidecar, the model file of effects already modelled, and the most rows diagnosed
-    (:mod:`tcbench.diagnose.cost`)."""
+    without a sidecar, the model file of effects already modelled, the most rows diagnosed
+    (:mod:`tcbench.diagnose.cost`) and the statistics of the diagnosis (``settings``, checked by
+    :func:`tcbench.diagnose.settings.from_mapping`)."""
 
     kind: str = "diagnose"
     recording: str = ""
@@ -105,6 +135,7 @@ class DiagnoseConfig:
     model: str | None = None
     max_rows: int | None = DIAGNOSE_MAX_ROWS  # null: no limit
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="diagnoses"))
+    settings: DiagnoseSettingsConfig = field(default_factory=DiagnoseSettingsConfig)  # type: ignore[valid-type]
 
 
 @dataclass

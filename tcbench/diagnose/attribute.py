@@ -7,18 +7,19 @@ Each round tries every effect not yet in the model at every value of its grid, s
 (the held-out SSE from blocked cross-validation with blocks sized to the recording,
 :mod:`tcbench.diagnose.plan`; ``v`` the variance of the noise along the added signal: white
 output noise plus the thermometer's noise carried through the model; the ``2`` per parameter is
-Akaike's penalty). The effect with the largest gain is kept when its gain exceeds ``threshold``
-and it is significant against the residual's slow noise, by the strongest test the recording
+Akaike's penalty; the numbers, thresholds, penalty, share of the excess and most effects, are
+:class:`~tcbench.diagnose.settings.SelectionSettings`). The effect with the largest gain is kept
+when its gain exceeds ``threshold`` and it is significant against the residual's slow noise, by the strongest test the recording
 supports (the :class:`~tcbench.diagnose.significance.SignificanceTest` its plan holds):
 
 - with enough clusters, a Wald statistic with a variance robust to slow noise (cluster scores
   with Bartlett-weighted neighbours, never above the known-noise Wald) above
-  ``wald_threshold``; both thresholds are checked on recordings with nothing missing
+  the Wald threshold; both thresholds are checked on recordings with nothing missing
   (``experiments/diagnose-concealed/calibrate.py``);
 - with few clusters (a short recording), or when the effect removes at least half of the
   held-out error above the noise and the Wald test still rejects it (its cluster variance then
   counts the structure still unexplained as noise), the spectral surrogate test of
-  :mod:`tcbench.diagnose.surrogate` at p <= its ``LEVEL``.
+  :mod:`tcbench.diagnose.surrogate` at p <= its level.
 
 Each effect's evidence says which test decided. Its nonlinear parameter is then refined
 between its grid neighbours. After the forward pass each kept effect must still earn its place,
@@ -38,26 +39,30 @@ from scipy.optimize import minimize_scalar
 
 from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
-from tcbench.diagnose.discover import OPEN_THRESHOLD, best_open
-from tcbench.diagnose.evidence import DETECTION_THRESHOLD, Evidence, not_significant
+from tcbench.diagnose.discover import best_open
+from tcbench.diagnose.evidence import Evidence, not_significant
 from tcbench.diagnose.plan import StatsPlan, plan_for
+from tcbench.diagnose.settings import (
+    DEFAULTS,
+    DiagnoseSettings,
+    FlickerSettings,
+    SelectionSettings,
+    SurrogateSettings,
+)
 from tcbench.diagnose.significance import SURROGATE, SignificanceTest
 from tcbench.diagnose.surrogate import surrogate_test
 from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
 from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker
 
-PENALTY_PER_PARAM = 2.0
-WALD_THRESHOLD = 25.0  # cluster-robust Wald statistic; same calibration
-MOST_OF_EXCESS = 0.5  # an effect removing this share of the held-out error above noise is never dropped by the Wald test alone
-SURROGATE_SEED = 20240611  # the surrogate test's generator: same recording, same diagnosis
 CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}
 
 
 @dataclass
 class Attribution:
     """Outcome of :func:`attribute`: the final model and its fit, the baseline's fit, the
-    per-effect evidence and the confusable pairs ``(kept, alternative, test that would tell)``."""
+    per-effect evidence and the confusable pairs ``(kept, alternative, test that would tell)``,
+    and the settings it was made with."""
 
     base: Model
     final: Model
@@ -69,15 +74,18 @@ class Attribution:
     fold: np.ndarray
     k: int
     plan: StatsPlan | None = None
+    settings: DiagnoseSettings = DEFAULTS
 
 
 class _Scorer:
-    """Held-out fits of models on one recording, memoised."""
+    """Held-out fits of models on one recording, memoised; gains penalised and excess judged
+    as ``selection`` says, surrogates drawn from ``rng``."""
 
     def __init__(self, designer: Designer, fold: np.ndarray, k: int, cluster: np.ndarray,
-                 rng: np.random.Generator | None = None) -> None:
+                 selection: SelectionSettings = DEFAULTS.selection, rng: np.random.Generator | None = None) -> None:
         self.designer, self.fold, self.k, self.cluster = designer, fold, k, cluster
-        self.rng = rng if rng is not None else np.random.default_rng(SURROGATE_SEED)
+        self.selection = selection
+        self.rng = rng if rng is not None else np.random.default_rng(DEFAULTS.surrogate.seed)
         self.sigma2 = designer.data.white_sigma**2
         self._memo: dict[Model, Fit] = {}
         self._noise_memo: dict[tuple[Model, Model], tuple[float, float]] = {}
@@ -105,7 +113,7 @@ class _Scorer:
         white, total = self._noise(base, model)
         drop = (self.fit(base).sse_heldout - self.fit(model).sse_heldout) / self.sigma2
         share = white / total if total > 0 else 1.0
-        return drop * share - PENALTY_PER_PARAM * (model.n_params - base.n_params)
+        return drop * share - self.selection.penalty_sigma2_per_param * (model.n_params - base.n_params)
 
     def wald(self, base: Model, model: Model) -> float:
         """Robust Wald statistic (cluster covariance), never above the one with the known
@@ -115,30 +123,31 @@ class _Scorer:
         known = float(z @ self.fit(base).residual) ** 2 / max(self._noise(base, model)[1], 1e-300)
         return min(robust, known)
 
-    def surrogate_p(self, base: Model, effect: str, value: Any, searched: list[Any] | None = None) -> float:
-        """p-value of adding ``effect`` to ``base`` by the surrogate test, searched over its
-        grid (or the values ``searched``) and ``value``; the noise model is the residual of
-        ``base`` plus ``effect`` at ``value``."""
+    def surrogate_p(self, base: Model, effect: str, value: Any, searched: list[Any] | None,
+                    settings: SurrogateSettings) -> float:
+        """p-value of adding ``effect`` to ``base`` by the surrogate test of ``settings``,
+        searched over its grid (or the values ``searched``) and ``value``; the noise model is the
+        residual of ``base`` plus ``effect`` at ``value``."""
         grid = grid_values(effect) if searched is None else list(searched)
         values = [*grid, *([value] if value is not None and value not in grid else [])]
         xs = [self.designer.matrix(base.with_effect(effect, v)) for v in values]
         noise = self.fit(base.with_effect(effect, value)).residual
-        p, _ = surrogate_test(self.designer.matrix(base), xs, self.designer.data.output, noise, self.rng)
+        p, _ = surrogate_test(self.designer.matrix(base), xs, self.designer.data.output, noise, self.rng, settings)
         return p
 
     def removes_most(self, base: Model, model: Model) -> bool:
-        """Whether ``model`` removes at least :data:`MOST_OF_EXCESS` of the held-out squared
-        error that ``base`` leaves above the white noise."""
+        """Whether ``model`` removes at least the selection's ``most_of_excess`` of the held-out
+        squared error that ``base`` leaves above the white noise."""
         excess = self.fit(base).sse_heldout - self.designer.data.n * self.sigma2
         drop = self.fit(base).sse_heldout - self.fit(model).sse_heldout
-        return excess > 0 and drop >= MOST_OF_EXCESS * excess
+        return excess > 0 and drop >= self.selection.most_of_excess * excess
 
-    def significant(self, base: Model, effect: str, value: Any, test: SignificanceTest, wald_threshold: float,
+    def significant(self, base: Model, effect: str, value: Any, test: SignificanceTest,
                     searched: list[Any] | None = None) -> tuple[bool, float, float, str]:
         """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise by
         ``test``: ``(passed, robust Wald, surrogate p-value, name of the test that decided)``."""
         wald = self.wald(base, base.with_effect(effect, value))
-        return test.judge(self, base, effect, value, wald, wald_threshold, searched)
+        return test.judge(self, base, effect, value, wald, searched)
 
     def best(self, base: Model, effect: str) -> tuple[float, float | None]:
         """Best gain of adding ``effect`` to ``base`` over its grid, then refined."""
@@ -161,26 +170,27 @@ def attribute(
     designer: Designer,
     base: Model | None = None,
     *,
-    threshold: float = DETECTION_THRESHOLD,
-    wald_threshold: float = WALD_THRESHOLD,
+    settings: DiagnoseSettings = DEFAULTS,
     plan: StatsPlan | None = None,
-    max_effects: int = 6,
-    seed: int = SURROGATE_SEED,
     open_world: bool = True,
-    open_threshold: float = OPEN_THRESHOLD,
+    open_threshold: float | None = None,
 ) -> Attribution:
-    """Forward selection of the library's deterministic effects onto ``base`` (see module doc);
-    ``plan`` the blocks, clusters and test (default: sized to the recording by
-    :func:`~tcbench.diagnose.plan.plan_for`), ``seed`` that of the surrogate test's generator;
-    with ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the
-    library's effects in every round, kept above ``open_threshold``."""
+    """Forward selection of the library's deterministic effects onto ``base`` (see module doc),
+    its thresholds, penalty and most effects ``settings.selection``, the surrogate test's
+    generator seeded with ``settings.surrogate.seed``; ``plan`` the blocks, clusters and test
+    (default: sized to the recording by :func:`~tcbench.diagnose.plan.plan_for`); with
+    ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the library's
+    effects in every round, kept above ``open_threshold`` (default the selection's)."""
+    selection = settings.selection
+    threshold, max_effects = selection.detection_threshold_sigma2, selection.max_effects
+    open_threshold = selection.open_threshold_sigma2 if open_threshold is None else open_threshold
     base = base or Model()
     data = designer.data
-    plan = plan or plan_for(data)
+    plan = plan or plan_for(data, settings)
     k = plan.k
     fold = block_folds(data.t_s, plan.block_s, k)
     cluster = np.floor((data.t_s - data.t_s[0]) / plan.cluster_s).astype(np.int64)
-    scorer = _Scorer(designer, fold, k, cluster, np.random.default_rng(seed))
+    scorer = _Scorer(designer, fold, k, cluster, selection, np.random.default_rng(settings.surrogate.seed))
     evidence: dict[str, Evidence] = {}
     for effect in DETERMINISTIC:
         if effect in base.ids:
@@ -194,7 +204,8 @@ def attribute(
         if not open_effects and not open_world:
             break
         tried = {e: scorer.best(model, e) for e in open_effects}
-        beyond = best_open(scorer, model, evidence, plan.test, wald_threshold, open_threshold) if open_world else None
+        beyond = (best_open(scorer, model, evidence, plan.test, open_threshold, settings.detectors) if open_world
+                  else None)
         for e, (g, v) in tried.items():
             if g <= threshold:
                 evidence[e] = Evidence(e, "rejected", g, threshold, v, "held-out gain below the threshold",
@@ -202,9 +213,9 @@ def attribute(
         passing = []
         for e in (e for e in tried if tried[e][0] > threshold):
             g, v = tried[e]
-            ok, wald, p, test = scorer.significant(model, e, v, plan.test, wald_threshold)
-            evidence[e] = Evidence(e, "rejected", g, threshold, v, not_significant(test, p), wald=wald, test=test,
-                                   p_value=p)
+            ok, wald, p, test = scorer.significant(model, e, v, plan.test)
+            evidence[e] = Evidence(e, "rejected", g, threshold, v, not_significant(plan.test, test, p), wald=wald,
+                                   test=test, p_value=p)
             if ok:
                 passing.append(e)
         if beyond is not None:
@@ -221,7 +232,7 @@ def attribute(
         cost = scorer.gain(reduced, model)
         value = _value(model, effect)
         searched = [value] if is_open(effect) else None
-        ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, wald_threshold, searched)
+        ok, wald, p, test = (scorer.significant(reduced, effect, value, plan.test, searched)
                              if cost > (open_term(effect).gain_threshold(open_threshold) if is_open(effect) else threshold) else (False, scorer.wald(reduced, model), float("nan"), plan.test.name))
         if not ok:
             model = reduced
@@ -233,7 +244,7 @@ def attribute(
             ev.value = None if is_open(effect) else value  # an open-world term's values are in its params
     confusions = _confusions(scorer, model, base, evidence, threshold)
     return Attribution(base, model, scorer.fit(base), scorer.fit(model), evidence, confusions,
-                       designer, fold, k, plan)
+                       designer, fold, k, plan, settings)
 
 
 def _value(model: Model, effect: str) -> float | None:
@@ -262,18 +273,21 @@ def _confusions(
     return out
 
 
-def recheck_with_flicker(att: Attribution, b: float, *, draws: int = 16, seed: int = 0,
-                         wald_threshold: float = WALD_THRESHOLD) -> Attribution:
+def recheck_with_flicker(att: Attribution, b: float, settings: FlickerSettings = DEFAULTS.screens.flicker
+                         ) -> Attribution:
     """Drop kept effects that are not significant once flicker of coefficient ``b`` (found in
-    the final residual) is part of the noise model. A slow random excursion of the bias can
-    look like a warm-up or a trend; the variance of each effect's score under that flicker is
-    taken over ``draws`` realisations (fixed ``seed``, so the diagnosis is repeatable)."""
+    the final residual) is part of the noise model: their Wald statistic with it at or below the
+    selection's Wald threshold (``att.settings``). A slow random excursion of the bias can look
+    like a warm-up or a trend; the variance of each effect's score under that flicker is taken
+    over ``settings.recheck_draws`` realisations (fixed ``settings.recheck_seed``, so the
+    diagnosis is repeatable)."""
     data = att.designer.data
+    wald_threshold = att.settings.selection.wald_threshold
     cluster = np.zeros(data.n, dtype=np.int64)  # the robust test is not used here
-    scorer = _Scorer(att.designer, att.fold, att.k, cluster)
-    rng = np.random.default_rng(seed)
+    scorer = _Scorer(att.designer, att.fold, att.k, cluster, att.settings.selection)
+    rng = np.random.default_rng(settings.recheck_seed)
     dt_s = float(np.median(np.diff(data.t_s)))
-    bank = np.stack([flicker(data.n, dt_s, b, rng) for _ in range(draws)])
+    bank = np.stack([flicker(data.n, dt_s, b, rng) for _ in range(settings.recheck_draws)])
     model = att.final
     for effect in [e for e in att.final.ids if e not in att.base.ids]:
         if att.evidence[effect].test == SURROGATE:

@@ -11,13 +11,16 @@ empty), so a 24 h record at 100 Hz costs what a 1 Hz one does.
   segmentation (``ruptures.Binseg``, l2 cost), each refined to the sample by the two-sample
   mean statistic within a bin of it; the first sample after every long gap (a restart) too.
 - **spectral lines** (:func:`line_periods`): Lomb-Scargle periodogram of the binned residual
-  (gapped and burst records included) on at most :data:`LINE_BINS` bins, the highest peaks
+  (gapped and burst records included) on at most ``line_bins`` bins, the highest peaks
   with periods between three bins and two thirds of the span.
   :func:`line_window` locates where a line is present (a cycle in part of the run) by complex
   demodulation.
 - **temperature bumps** (:func:`bump_centres`): a matched filter of Gaussian bumps of several
   widths against the residual averaged in 0.1 degC bins of the model temperature, each bump
   taken orthogonal to the quadratic in temperature the model already holds.
+
+Their numbers (bins, how many of each they propose, the bump widths ...) are
+:class:`~tcbench.diagnose.settings.DetectorSettings`.
 """
 
 from __future__ import annotations
@@ -26,28 +29,16 @@ import numpy as np
 import ruptures
 from scipy.signal import find_peaks, lombscargle
 
-MAX_BINS = 3000
-DUTY_PHASES = 64  # phase bins a switched load's cycle is folded into
-LINE_BINS = 1200  # the periodogram's bins: periods down to 3 bins (90 s on a 10 h record)
-MIN_BIN_S = 10.0
-N_CHANGES = 3
-N_LINES = 3
-N_BUMPS = 3
-GAP_FACTOR = 5.0  # a gap longer than this many median sample spacings may hide a restart
-MAX_GAPS = 12
-BUMP_WIDTHS_C = (1.0, 1.5, 2.5, 4.0, 6.0)
-BUMP_SPANS = 4.0  # a bump of width w is searched where the temperature spans at least this many w
-MIN_STEP_BINS = 8  # binned residual means the change-point search needs
-MIN_LINE_BINS = 16  # binned residual means the periodogram needs
-LINE_CYCLES = 1.5  # the longest period searched fits this many times in the span
-TEMP_BIN_C = 0.1
+from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
+
+DETECTORS = DEFAULTS.detectors
 
 
-def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = MAX_BINS
+def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = DETECTORS.max_bins, min_bin_s: float = DETECTORS.min_bin_s
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """``(centre_s, mean, count, width_s)`` of ``r`` in time bins of ``width_s`` (at least
-    :data:`MIN_BIN_S`, at most ``max_bins`` of them); empty bins left out."""
-    width = bin_width(t_s, max_bins)
+    ``min_bin_s``, at most ``max_bins`` of them); empty bins left out."""
+    width = bin_width(t_s, max_bins, min_bin_s)
     idx = ((t_s - t_s[0]) / width).astype(np.int64)
     count = np.bincount(idx).astype(float)
     total = np.bincount(idx, weights=r)
@@ -56,10 +47,10 @@ def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = MAX_BINS
     return centre, total[keep] / count[keep], count[keep], width
 
 
-def bin_width(t_s: np.ndarray, max_bins: int = MAX_BINS) -> float:
+def bin_width(t_s: np.ndarray, max_bins: int = DETECTORS.max_bins, min_bin_s: float = DETECTORS.min_bin_s) -> float:
     """The width (s) of :func:`binned`'s time bins."""
     span = float(t_s[-1] - t_s[0])
-    return max(MIN_BIN_S, span / max_bins, float(np.median(np.diff(t_s))))
+    return max(min_bin_s, span / max_bins, float(np.median(np.diff(t_s))))
 
 
 def _refine_step(t_s: np.ndarray, cum: np.ndarray, around_s: float, half_s: float) -> int:
@@ -75,33 +66,33 @@ def _refine_step(t_s: np.ndarray, cum: np.ndarray, around_s: float, half_s: floa
     return int(k[np.argmax(stat)])
 
 
-def step_times(t_s: np.ndarray, r: np.ndarray, n_changes: int = N_CHANGES) -> list[float]:
-    """Candidate step times (s): the first sample after each change point of the mean of ``r``,
-    and after each of the longest gaps."""
-    centre, mean, _, width = binned(t_s, r)
+def step_times(t_s: np.ndarray, r: np.ndarray, settings: DetectorSettings = DETECTORS) -> list[float]:
+    """Candidate step times (s): the first sample after each of the ``n_changes`` change points
+    of the mean of ``r``, and after each of the ``max_gaps`` longest gaps."""
+    centre, mean, _, width = binned(t_s, r, settings.max_bins, settings.min_bin_s)
     out: list[float] = []
     cum = np.concatenate(([0.0], np.cumsum(r)))
-    if mean.size >= MIN_STEP_BINS:
-        n_bkps = min(n_changes, mean.size // 4)
+    if mean.size >= settings.min_step_bins:
+        n_bkps = min(settings.n_changes, mean.size // 4)
         algo = ruptures.Binseg(model="l2", min_size=2).fit(mean)
         for b in algo.predict(n_bkps=n_bkps)[:-1]:
             around = 0.5 * (centre[b - 1] + centre[b])
             out.append(float(t_s[_refine_step(t_s, cum, around, width)]))
     dt = np.diff(t_s)
-    gaps = np.flatnonzero(dt > GAP_FACTOR * np.median(dt))
-    for g in gaps[np.argsort(-dt[gaps])][:MAX_GAPS]:
+    gaps = np.flatnonzero(dt > settings.gap_factor * np.median(dt))
+    for g in gaps[np.argsort(-dt[gaps])][:settings.max_gaps]:
         out.append(float(t_s[g + 1]))
     return sorted(set(out))
 
 
-def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list[float]:
-    """Periods (s) of the highest Lomb-Scargle peaks of ``r``, between three bins and two
-    thirds of the span."""
-    centre, mean, count, width = binned(t_s, r, LINE_BINS)
+def line_periods(t_s: np.ndarray, r: np.ndarray, settings: DetectorSettings = DETECTORS) -> list[float]:
+    """Periods (s) of the ``n_lines`` highest Lomb-Scargle peaks of ``r``, between three bins
+    and the span over ``line_cycles``."""
+    centre, mean, count, width = binned(t_s, r, settings.line_bins, settings.min_bin_s)
     span = float(t_s[-1] - t_s[0])
-    if mean.size < MIN_LINE_BINS:
+    if mean.size < settings.min_line_bins:
         return []
-    f_lo, f_hi = LINE_CYCLES / span, 1.0 / (3.0 * width)
+    f_lo, f_hi = settings.line_cycles / span, 1.0 / (3.0 * width)
     if f_hi <= f_lo:
         return []
     df = 0.5 / span  # two frequencies per Fourier bin; the period is refined by the scorer
@@ -109,17 +100,18 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, n_lines: int = N_LINES) -> list
     power = lombscargle(centre - centre[0], mean - np.average(mean, weights=count), 2.0 * np.pi * freq,
                         normalize=False)
     peaks, _ = find_peaks(power, distance=4)
-    best = list(peaks[np.argsort(-power[peaks])][:n_lines])
+    best = list(peaks[np.argsort(-power[peaks])][:settings.n_lines])
     if power.size > 4 and power[0] > power[1:5].max():  # a slow line (under two cycles) peaks at the low edge
         best.append(0)
     return [float(1.0 / freq[i]) for i in best]
 
 
-def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float) -> tuple[float, float]:
+def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float, settings: DetectorSettings = DETECTORS
+                ) -> tuple[float, float]:
     """``(start_s, end_s)`` where a line of ``period_s`` is present in ``r``: the contiguous span
     around its strongest part where the complex-demodulated amplitude, averaged over two
     periods, stays above half its peak."""
-    centre, mean, count, width = binned(t_s, r, LINE_BINS)
+    centre, mean, count, width = binned(t_s, r, settings.line_bins, settings.min_bin_s)
     z = mean * count * np.exp(-2j * np.pi * centre / period_s)
     m = min(max(int(round(2.0 * period_s / width)), 1), centre.size)  # 'same' would return the longer
     kernel = np.ones(m)
@@ -134,7 +126,7 @@ def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float) -> tuple[float,
 
 
 def duty_phase(t_s: np.ndarray, r: np.ndarray, period_s: float, start_s: float, end_s: float,
-               n_phases: int = DUTY_PHASES) -> tuple[float, float]:
+               n_phases: int = DETECTORS.duty_phases) -> tuple[float, float]:
     """``(on_s, duty)`` of a load switched on for a share ``duty`` of every ``period_s`` inside
     ``[start_s, end_s)``: ``r`` folded on the period into ``n_phases`` phase bins, and the
     contiguous arc of bins (wrapping) whose mean differs most from the rest's, by the
@@ -156,21 +148,23 @@ def duty_phase(t_s: np.ndarray, r: np.ndarray, period_s: float, start_s: float, 
     return float(best[0] * period_s / n_phases), float((best[1] + 1) / n_phases)
 
 
-def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> list[tuple[float, float]]:
-    """``(centre_c, width_c)`` of the Gaussian bumps in temperature that best match ``r``,
-    each bump orthogonal to ``1, T, T^2`` (sample-weighted)."""
+def bump_centres(temp_c: np.ndarray, r: np.ndarray, settings: DetectorSettings = DETECTORS
+                 ) -> list[tuple[float, float]]:
+    """``(centre_c, width_c)`` of the ``n_bumps`` Gaussian bumps in temperature that best match
+    ``r``, each bump orthogonal to ``1, T, T^2`` (sample-weighted)."""
+    bin_c = settings.temp_bin_c
     lo, hi = float(temp_c.min()), float(temp_c.max())
     span = hi - lo
-    idx = ((temp_c - lo) / TEMP_BIN_C).astype(np.int64)
+    idx = ((temp_c - lo) / bin_c).astype(np.int64)
     count = np.bincount(idx).astype(float)
     total = np.bincount(idx, weights=r)
-    tb = lo + (np.arange(count.size) + 0.5) * TEMP_BIN_C
+    tb = lo + (np.arange(count.size) + 0.5) * bin_c
     u = (tb - 0.5 * (lo + hi)) / max(0.5 * span, 1e-9)
     core = np.column_stack([np.ones_like(u), u, u * u])
     gram = core.T @ (core * count[:, None])
     found: list[tuple[float, float, float]] = []
-    for w in (w for w in BUMP_WIDTHS_C if BUMP_SPANS * w <= span):
-        centres = np.arange(lo + w, hi - w + 1e-9, max(TEMP_BIN_C, w / 8.0))
+    for w in (w for w in settings.bump_widths_c if settings.bump_spans * w <= span):
+        centres = np.arange(lo + w, hi - w + 1e-9, max(bin_c, w / 8.0))
         if centres.size == 0:
             continue
         g = np.exp(-0.5 * ((tb[:, None] - centres[None, :]) / w) ** 2)  # (bins, centres)
@@ -181,41 +175,41 @@ def bump_centres(temp_c: np.ndarray, r: np.ndarray, n_bumps: int = N_BUMPS) -> l
         i = int(np.argmax(score))
         found.append((float(score[i]), float(centres[i]), float(w)))
     found.sort(reverse=True)
-    return [(c, w) for _, c, w in found[:n_bumps]]
+    return [(c, w) for _, c, w in found[:settings.n_bumps]]
 
 
-def _bins(t_s: np.ndarray, max_bins: int) -> int:
+def _bins(t_s: np.ndarray, max_bins: int, min_bin_s: float) -> int:
     """How many non-empty bins :func:`binned` makes of ``t_s``."""
-    width = bin_width(t_s, max_bins)
+    width = bin_width(t_s, max_bins, min_bin_s)
     return int(np.unique(((t_s - t_s[0]) / width).astype(np.int64)).size)
 
 
-def why_no_steps(t_s: np.ndarray) -> str | None:
+def why_no_steps(t_s: np.ndarray, settings: DetectorSettings = DETECTORS) -> str | None:
     """Why :func:`step_times` cannot search change points on a record sampled at ``t_s``, or None."""
-    n = _bins(t_s, MAX_BINS)
-    if n >= MIN_STEP_BINS:
+    n = _bins(t_s, settings.max_bins, settings.min_bin_s)
+    if n >= settings.min_step_bins:
         return None
-    return (f"change points need at least {MIN_STEP_BINS} bins of {bin_width(t_s):.4g} s of the residual; "
-            f"this record has {n}")
+    return (f"change points need at least {settings.min_step_bins} bins of "
+            f"{bin_width(t_s, settings.max_bins, settings.min_bin_s):.4g} s of the residual; this record has {n}")
 
 
-def why_no_lines(t_s: np.ndarray) -> str | None:
+def why_no_lines(t_s: np.ndarray, settings: DetectorSettings = DETECTORS) -> str | None:
     """Why :func:`line_periods` cannot search spectral lines on ``t_s``, or None."""
-    n, width = _bins(t_s, LINE_BINS), bin_width(t_s, LINE_BINS)
-    if n < MIN_LINE_BINS:
-        return (f"spectral lines need at least {MIN_LINE_BINS} bins of {width:.4g} s of the residual; "
+    n, width = _bins(t_s, settings.line_bins, settings.min_bin_s), bin_width(t_s, settings.line_bins, settings.min_bin_s)
+    if n < settings.min_line_bins:
+        return (f"spectral lines need at least {settings.min_line_bins} bins of {width:.4g} s of the residual; "
                 f"this record has {n}")
-    longest, shortest = float(t_s[-1] - t_s[0]) / LINE_CYCLES, 3.0 * width
+    longest, shortest = float(t_s[-1] - t_s[0]) / settings.line_cycles, 3.0 * width
     if longest <= shortest:
-        return (f"a line needs {LINE_CYCLES:g} cycles inside the record and 3 bins per cycle: the longest "
+        return (f"a line needs {settings.line_cycles:g} cycles inside the record and 3 bins per cycle: the longest "
                 f"testable period ({longest:.4g} s) is below the shortest ({shortest:.4g} s)")
     return None
 
 
-def why_no_bumps(temp_c: np.ndarray) -> str | None:
+def why_no_bumps(temp_c: np.ndarray, settings: DetectorSettings = DETECTORS) -> str | None:
     """Why :func:`bump_centres` cannot search temperature bumps on ``temp_c``, or None."""
-    span, w = float(np.ptp(temp_c)), min(BUMP_WIDTHS_C)
-    if BUMP_SPANS * w <= span:
+    span, w = float(np.ptp(temp_c)), min(settings.bump_widths_c)
+    if settings.bump_spans * w <= span:
         return None
-    return (f"a temperature bump of width {w:g} degC needs a temperature span of {BUMP_SPANS * w:g} degC; "
+    return (f"a temperature bump of width {w:g} degC needs a temperature span of {settings.bump_spans * w:g} degC; "
             f"this record spans {span:.3g} degC")

@@ -6,7 +6,9 @@ the screens before the fit (:mod:`tcbench.diagnose.screens`: output grid, clippi
 outliers), forward selection (:mod:`tcbench.diagnose.attribute`), where the starting model
 misses (:mod:`tcbench.diagnose.locate`), the screens after the final fit (flicker and the recheck
 of the kept effects, the variance of the residual) and the report. The :class:`Diagnosis` it
-returns is the report: :meth:`Diagnosis.to_json` is DESIGN.md's ``report.json``.
+returns is the report: :meth:`Diagnosis.to_json` is DESIGN.md's ``report.json``. Every stage is
+given its section of the :class:`~tcbench.diagnose.settings.DiagnoseSettings` the diagnosis runs
+with.
 """
 
 from __future__ import annotations
@@ -18,15 +20,15 @@ from typing import Any
 import numpy as np
 from joblib import Parallel, delayed
 
-from tcbench.diagnose.attribute import DETECTION_THRESHOLD, Attribution, Evidence, attribute
+from tcbench.diagnose.attribute import Attribution, Evidence, attribute
 from tcbench.diagnose.crossval import Fit
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model
-from tcbench.diagnose.discover import OPEN_THRESHOLD, why_untestable
+from tcbench.diagnose.discover import why_untestable
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.locate import FALSE_ALARM, Mismatch, locate
+from tcbench.diagnose.locate import Mismatch, locate
 from tcbench.diagnose.plan import min_full_duration_s
-from tcbench.diagnose.reference import REFERENCE_RATIO, reference_fit
+from tcbench.diagnose.reference import reference_fit
 from tcbench.diagnose.result import (
     Confusion,
     Diagnosis,
@@ -39,25 +41,32 @@ from tcbench.diagnose.result import (
     significance_json,
 )
 from tcbench.diagnose.screens import (
-    AFTER_FIT,
-    BEFORE_FIT,
     FINDINGS_ORDER,
     MODEL_ORDER,
+    Screened,
     ScreenInput,
     ScreenResult,
-    Screened,
+    after_fit,
+    before_fit,
     run_screens,
 )
-from tcbench.diagnose.screens.flicker import ID as FLICKER, Flicker, flicker_evidence, flicker_test
+from tcbench.diagnose.screens.flicker import ID as FLICKER
+from tcbench.diagnose.screens.flicker import Flicker, flicker_evidence, flicker_test
 from tcbench.diagnose.screens.outliers import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
 from tcbench.diagnose.screens.variance import relative_sigma
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, DiagnosisData, prepare
+from tcbench.diagnose.settings import (
+    DEFAULTS,
+    DiagnoseSettings,
+    LocateSettings,
+    SelectionSettings,
+)
+from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.terms import is_open, open_finding, report_order, term
 from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
-__all__ = ["REFERENCE_RATIO", "Diagnosis", "Series", "base_model", "diagnose"]
+__all__ = ["DiagnoseSettings", "Diagnosis", "Series", "base_model", "diagnose"]
 log = logging.getLogger(__name__)
 
 
@@ -108,12 +117,14 @@ def diagnose(
     sensor: str | None = None,
     declared: dict[str, dict[str, float]] | None = None,
     name: str = "",
-    threshold: float = DETECTION_THRESHOLD,
     min_duration_s: float | None = None,
+    settings: DiagnoseSettings | None = None,
 ) -> Diagnosis:
     """Diagnose ``rec`` against the minimal model plus the effects ``declared`` already modelled
-    (``{effect_id: params}``). Raises :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a
-    recording that cannot show anything, or that is shorter than ``min_duration_s`` (default
+    (``{effect_id: params}``), with the statistics of ``settings`` (default
+    :data:`~tcbench.diagnose.settings.DEFAULTS`). Raises
+    :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a recording that cannot show
+    anything, or that is shorter than ``min_duration_s`` (default
     :func:`~tcbench.diagnose.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short_record`
     tells what a shorter one can).
 
@@ -125,67 +136,72 @@ def diagnose(
     cycle, 7.5 s against 120 s made the final model 1.5x worse), while on a short record with
     nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
     paid for like a term, is the judge the diagnosis uses for everything else."""
-    min_duration_s = min_full_duration_s() if min_duration_s is None else min_duration_s
-    fitted = smoothing(rec)  # a coarse thermometer staircase widens the smoothing window
-    if fitted.default_smooth_s >= DEFAULT_SMOOTH_S:
-        return _diagnose(rec, fitted, sensor, declared or {}, name, threshold, min_duration_s)
+    settings = DEFAULTS if settings is None else settings
+    min_duration_s = min_full_duration_s(settings) if min_duration_s is None else min_duration_s
+    default_s = settings.smoothing.default_window_s
+    fitted = smoothing(rec, settings=settings)  # a coarse thermometer staircase widens the smoothing window
+    if fitted.default_smooth_s >= default_s:
+        return _diagnose(rec, fitted, sensor, declared or {}, name, settings, min_duration_s)
     # the two diagnoses are independent: one per core (same results as in turn, in about half the time)
-    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, s, sensor, declared or {}, name, threshold, min_duration_s)
-                               for s in (fitted, smoothing(rec, DEFAULT_SMOOTH_S)))
+    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, s, sensor, declared or {}, name, settings, min_duration_s)
+                               for s in (fitted, smoothing(rec, default_s, settings)))
     # the default window is a model choice like a term: it must pay the open-world gain threshold
     sse = [d.final.rmse_heldout ** 2 * d.noise.samples for d in tried]
     gain = (sse[0] - sse[1]) / tried[0].noise.white_sigma ** 2
-    best = tried[1] if gain > OPEN_THRESHOLD else tried[0]
+    best = tried[1] if gain > settings.selection.open_threshold_sigma2 else tried[0]
     best.statistics.smooth_tried_s = {f"{d.statistics.smooth_s:g}": round(float(d.final.rmse_heldout), 6)
                                       for d in tried}
     return best
 
 
 def _diagnose(rec: Recording, smooth: Smoothing, sensor: str | None, declared: dict[str, dict[str, float]],
-              name: str, threshold: float, min_duration_s: float) -> Diagnosis:
+              name: str, settings: DiagnoseSettings, min_duration_s: float) -> Diagnosis:
     """:func:`diagnose` with the thermometer smoothed as ``smooth`` says, stage by stage."""
-    data = prepare(rec, sensor, smooth_s=smooth.smooth_s, min_duration_s=min_duration_s)
+    data = prepare(rec, sensor, smooth_s=smooth.smooth_s, min_duration_s=min_duration_s,
+                   min_span_c=settings.data.min_span_c, min_samples=settings.data.min_samples)
     start = ScreenInput(rec, data, base_model(declared), frozenset(declared),
                         {ThermometerScreen.id: smooth})
-    before = run_screens(BEFORE_FIT, start)  # output grid, clipping, noise level, outliers: zero weight from here
+    before = run_screens(before_fit(settings), start)  # output grid, clipping, noise level, outliers: zero weight
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", before.data.n,
              before.data.white_sigma, before.data.unit)
-    att = select(before.given, threshold)
-    mismatch = misfit(att, att.base_fit, att.base)  # where the starting model misses
-    reference = reference_fit(before.data, att.fold, att.k)
-    after = run_screens(AFTER_FIT, replace(before.given, attribution=att, reference=reference))  # flicker, variance
+    att = select(before.given, settings)
+    mismatch = misfit(att, att.base_fit, att.base, settings.locate)  # where the starting model misses
+    reference = reference_fit(before.data, att.fold, att.k, settings.reference)
+    after = run_screens(after_fit(settings), replace(before.given, attribution=att, reference=reference))
     return report(name, declared, before, after, mismatch)
 
 
-def select(given: ScreenInput, threshold: float) -> Attribution:
+def select(given: ScreenInput, settings: DiagnoseSettings = DEFAULTS) -> Attribution:
     """Forward selection of the library's and the open world's terms onto the starting model,
     on the data the screens left; the open-world threshold raised where the noise level changes."""
     assert given.data is not None
-    return attribute(Designer(given.data), given.base, threshold=threshold,
-                     open_threshold=_open_threshold(relative_sigma(given)))
+    return attribute(Designer(given.data), given.base, settings=settings,
+                     open_threshold=_open_threshold(relative_sigma(given), settings.selection))
 
 
-def misfit(att: Attribution, fit: Fit, model: Model) -> list[Mismatch]:
+def misfit(att: Attribution, fit: Fit, model: Model, settings: LocateSettings = DEFAULTS.locate) -> list[Mismatch]:
     """Where the held-out residual of ``fit`` (of ``model``) departs from its noise: white plus
     the thermometer noise the model inherits."""
     data = att.designer.data
-    return locate(data.t_s, data.temp_c, fit.heldout_residual, data.white_sigma, FALSE_ALARM,
+    return locate(data.t_s, data.temp_c, fit.heldout_residual, data.white_sigma, settings,
                   coloured=propagated_noise(att.designer, model, fit.beta))
 
 
 def report(name: str, declared: dict[str, dict[str, float]], before: Screened, after: Screened,
            mismatch: list[Mismatch]) -> Diagnosis:
     """The :class:`Diagnosis`: the final model's fit and findings, what every screen contributes
-    (findings, model.yaml terms, statistics) and why what was not tested was not."""
+    (findings, model.yaml terms, statistics) and why what was not tested was not; the settings
+    are the attribution's."""
     att, reference, results = after.given.attribution, after.given.reference, after.results
     assert att is not None and reference is not None
+    settings = att.settings
     data, n = att.designer.data, att.designer.data.n
     flicker = results.get(FLICKER)
     final_rmse = rmse(att.final_fit.sse_heldout, n)
     core, fitted = _physical(att)
     found = [e for e in att.final.ids if e not in att.base.ids]
     evidence = att.evidence
-    effects = [_found(e, evidence[e], fitted[e], data.unit, Extent.of(data)) for e in found]
+    effects = [_found(e, evidence[e], fitted[e], data.unit, Extent.of(data), att) for e in found]
     effects += [f for key in FINDINGS_ORDER if key in results for f in results[key].findings(data.unit)]
     evidence[FLICKER] = flicker_evidence(flicker, after.not_tested.get(FLICKER), FLICKER in declared, reference,
                                          final_rmse, data.unit)
@@ -195,20 +211,22 @@ def report(name: str, declared: dict[str, dict[str, float]], before: Screened, a
     return Diagnosis(
         sensor=data.sensor, unit=data.unit, recording=name,
         baseline=FitSummary.of(att.base_fit, n, att.base.ids), mismatch=mismatch,
-        remaining=_remaining(att, flicker), effects=effects, final=FitSummary.of(att.final_fit, n, att.final.ids),
+        remaining=_remaining(att, flicker, settings.locate), effects=effects,
+        final=FitSummary.of(att.final_fit, n, att.final.ids),
         noise=Noise(data.white_sigma, thermometer_sigma(att.designer), n, att.k),
         reference=ReferenceSummary.of(reference, final_rmse, data.white_sigma),
         statistics=Statistics(att.plan, data.smooth_s, _screen_statistics(results),
-                              _not_tested(att, evidence, before, after, declared)),
+                              _not_tested(att, evidence, before, after, declared), settings=settings),
         candidates=[evidence[e] for e in (*DETERMINISTIC, *_open_ids(evidence), FLICKER) if e in evidence],
-        confusable=confusable, model=_model_file(data, core, fitted, declared, results), series=_series(att, flicker),
+        confusable=confusable, model=_model_file(data, core, fitted, declared, results),
+        series=_series(att, flicker, settings),
         outliers=spikes.found if isinstance(spikes, Spikes) else None,
     )
 
 
-def _remaining(att: Attribution, flicker: ScreenResult | None) -> list[Mismatch]:
+def _remaining(att: Attribution, flicker: ScreenResult | None, settings: LocateSettings) -> list[Mismatch]:
     """Where the final model still misses; once flicker is named, its slow excess is explained."""
-    remaining = misfit(att, att.final_fit, att.final)
+    remaining = misfit(att, att.final_fit, att.final, settings)
     if isinstance(flicker, Flicker) and flicker.b is not None:
         remaining = [m for m in remaining if not m.what.startswith("low-frequency")]
     return remaining
@@ -234,17 +252,22 @@ def _screen_statistics(results: dict[str, ScreenResult]) -> dict[str, Any]:
     return {k: v for r in results.values() for k, v in r.statistics().items()}
 
 
-def _series(att: Attribution, flicker: ScreenResult | None) -> Series:
+def _series(att: Attribution, flicker: ScreenResult | None, settings: DiagnoseSettings) -> Series:
     """The arrays behind the plots: held-out residuals and Allan tests of the starting and the final model."""
     data = att.designer.data
+    before = flicker_test(att, att.base_fit, att.base, settings.screens.flicker.false_alarm,
+                          settings.locate.min_allan_samples)[0]
     return Series(data.t_s, data.temp_c, att.base_fit.heldout_residual, att.final_fit.heldout_residual,
-                  flicker_test(att, att.base_fit, att.base)[0], flicker.allan if isinstance(flicker, Flicker) else None)
+                  before, flicker.allan if isinstance(flicker, Flicker) else None)
 
 
-def _found(effect: str, ev: Evidence, params: dict[str, float], unit: str, extent: Extent) -> Finding:
+def _found(effect: str, ev: Evidence, params: dict[str, float], unit: str, extent: Extent,
+           att: Attribution) -> Finding:
     """The finding of a term the forward selection kept (library or open world)."""
     ev.reason = "dropping it costs more held-out error than chance allows"
-    said = {"gain_sigma2": round(float(ev.gain), 2), "threshold_sigma2": float(ev.threshold), **significance_json(ev)}
+    assert att.plan is not None
+    said = {"gain_sigma2": round(float(ev.gain), 2), "threshold_sigma2": float(ev.threshold),
+            **significance_json(ev, att.plan.test)}
     return (Finding.from_json(open_finding(effect, params, said, unit)) if is_open(effect) else
             library_finding(effect, params, said, extent, ev.confusable_with))
 
@@ -256,17 +279,19 @@ def _not_tested(att: Attribution, evidence: dict[str, Evidence], before: Screene
     too coarse or too narrow in temperature for, and every screen skipped (or that could not
     test it) but one declared in the starting model."""
     why = {e: ev.reason for e, ev in evidence.items() if ev.status in ("not identifiable", "not tested")}
-    why |= {e: r for e, r in why_untestable(att.designer, att.fold).items() if e not in evidence}
+    why |= {e: r for e, r in why_untestable(att.designer, att.fold, att.settings.detectors).items()
+            if e not in evidence}
     for screen, reason in (before.not_tested | after.not_tested).items():
         if screen not in declared:
             why.setdefault(screen, reason)
     return why
 
 
-def _open_threshold(relative_sigma: np.ndarray | None) -> float:
+def _open_threshold(relative_sigma: np.ndarray | None, selection: SelectionSettings = DEFAULTS.selection) -> float:
     """The open-world terms' gain threshold: gains are in units of the record's RMS noise
     variance, so where the noise level changes a search that lands in the noisiest part finds
-    chance gains larger by its variance ratio (up to 4x)."""
+    chance gains larger by its variance ratio (up to ``open_threshold_max_factor``)."""
     if relative_sigma is None:
-        return OPEN_THRESHOLD
-    return OPEN_THRESHOLD * float(np.clip(np.max(relative_sigma) ** 2, 1.0, 4.0))
+        return selection.open_threshold_sigma2
+    factor = float(np.clip(np.max(relative_sigma) ** 2, 1.0, selection.open_threshold_max_factor))
+    return selection.open_threshold_sigma2 * factor

@@ -26,7 +26,8 @@ number of tests:
   first differences) widens the bound.
 
 ``sigma`` (per-sample white-noise standard deviation, unit of ``r``) is ``white_sigma`` when given,
-otherwise ``1.4826 MAD(diff(r)) / sqrt(2)``, which drift and steps barely move.
+otherwise ``1.4826 MAD(diff(r)) / sqrt(2)``, which drift and steps barely move. The false-alarm
+probability, windows, bins and rates are :class:`~tcbench.diagnose.settings.LocateSettings`.
 """
 
 from __future__ import annotations
@@ -37,19 +38,13 @@ from typing import Any
 import numpy as np
 from scipy.stats import chi2, norm
 
+from tcbench.diagnose.settings import DEFAULTS, LocateSettings
 from tcbench.sensors.segments import segments
 from tcbench.signal.allan import allan_deviation
 
-FALSE_ALARM = 0.01  # of the diagnosis' mismatch scan and of its flicker test
-MIN_SAMPLES = 100
 N_FAMILIES = 5  # time spans, temperature bands, heating/cooling, soak/ramp, frequency band
-MIN_WINDOWS = 10  # the time scan shrinks its windows to have at least this many
-MAX_WINDOWS = 1500  # ... and widens them to have at most this many (memory of the K x K scan)
-MIN_GROUP = 10  # a temperature bin enters a two-group test with at least this many per group
-MIN_ALLAN_M = 10  # the frequency test starts at tau = 10 samples
 MAD_TO_SIGMA = 1.4826
 SIGMA2_REL_VAR = 7.0  # N * var(sigma_hat^2 / sigma^2) for the MAD of first differences (measured)
-MAX_FINDINGS = 20  # per scan family
 
 
 @dataclass(frozen=True)
@@ -72,7 +67,7 @@ class Mismatch:
 
 def _check(
     t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, white_sigma: float | None,
-    false_alarm: float,
+    false_alarm: float, min_samples: int,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     arrays = {}
     for name, a in (("t_s", t_s), ("temp_c", temp_c), ("residual", residual)):
@@ -89,8 +84,8 @@ def _check(
         raise ValueError(
             f"t_s, temp_c and residual must have the same length, got {t.size}, {temp.size}, {r.size}"
         )
-    if t.size < MIN_SAMPLES:
-        raise ValueError(f"residual needs at least {MIN_SAMPLES} samples, got {t.size}")
+    if t.size < min_samples:
+        raise ValueError(f"residual needs at least {min_samples} samples, got {t.size}")
     if not (np.diff(t) > 0).all():
         raise ValueError("t_s must be strictly increasing")
     if white_sigma is not None and not (np.isfinite(white_sigma) and white_sigma > 0):
@@ -111,7 +106,8 @@ def _sidak(alpha: float, n_tests: int) -> float:
     return float(-np.expm1(np.log1p(-alpha) / max(n_tests, 1)))
 
 
-def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float) -> list[tuple[int, int, float]]:
+def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float, max_findings: int
+          ) -> list[tuple[int, int, float]]:
     """Runs ``[i, j)`` of consecutive bins with ``|z| > z_thr``, greedy by largest ``|z|`` without
     overlap, adjacent same-sign runs merged; returns ``(i, j, z)``."""
     s = np.r_[0.0, np.cumsum(sums)]
@@ -123,7 +119,7 @@ def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float) -> l
     picks: list[tuple[int, int, float]] = []
     used = np.zeros(k, dtype=np.int64)
     alive = absz > z_thr
-    while alive.any() and len(picks) < MAX_FINDINGS:
+    while alive.any() and len(picks) < max_findings:
         best = int(np.argmax(np.where(alive, absz, -np.inf)))
         a, b = int(i[best]), int(j[best])
         picks.append((a, b, float(z[best])))
@@ -140,7 +136,7 @@ def _scan(sums: np.ndarray, counts: np.ndarray, sigma: float, z_thr: float) -> l
     return merged
 
 
-def _binned_scan(idx: np.ndarray, r: np.ndarray, sigma: float, alpha: float
+def _binned_scan(idx: np.ndarray, r: np.ndarray, sigma: float, alpha: float, max_findings: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, list[tuple[int, int, float]]]:
     """Residual summed per bin ``idx``; the non-empty bins, their counts and sums, the Šidák
     threshold over all runs of consecutive non-empty bins, and the runs that exceed it."""
@@ -149,14 +145,15 @@ def _binned_scan(idx: np.ndarray, r: np.ndarray, sigma: float, alpha: float
     keep = np.flatnonzero(counts > 0)
     k = keep.size
     z_thr = float(norm.isf(_sidak(alpha, k * (k + 1) // 2) / 2.0))
-    return keep, counts, sums, z_thr, _scan(sums[keep], counts[keep], sigma, z_thr)
+    return keep, counts, sums, z_thr, _scan(sums[keep], counts[keep], sigma, z_thr, max_findings)
 
 
-def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, window_s: float) -> list[Mismatch]:
+def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, settings: LocateSettings
+                ) -> list[Mismatch]:
     span_s = t[-1] - t[0]
-    w = min(max(window_s, span_s / MAX_WINDOWS), span_s / MIN_WINDOWS)
+    w = min(max(settings.window_s, span_s / settings.max_windows), span_s / settings.min_windows)
     idx = np.minimum(((t - t[0]) / w).astype(np.int64), int(np.ceil(span_s / w)) - 1)
-    keep, counts, sums, z_thr, runs = _binned_scan(idx, r, sigma, alpha)
+    keep, counts, sums, z_thr, runs = _binned_scan(idx, r, sigma, alpha, settings.max_findings)
     out = []
     for a, b, z in runs:
         n = counts[keep[a] : keep[b - 1] + 1].sum()
@@ -168,11 +165,12 @@ def _time_spans(t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, window
 
 
 def _temperature_bands(
-    t: np.ndarray, temp: np.ndarray, r: np.ndarray, sigma: float, alpha: float, band_c: float
+    t: np.ndarray, temp: np.ndarray, r: np.ndarray, sigma: float, alpha: float, settings: LocateSettings
 ) -> list[Mismatch]:
+    band_c = settings.band_c
     lo = np.floor(temp.min() / band_c) * band_c
     idx = ((temp - lo) / band_c).astype(np.int64)
-    keep, _, _, z_thr, runs = _binned_scan(idx, r, sigma, alpha)
+    keep, _, _, z_thr, runs = _binned_scan(idx, r, sigma, alpha, settings.max_findings)
     out = []
     for a, b, z in runs:
         b_lo, b_hi = keep[a], keep[b - 1]
@@ -196,10 +194,11 @@ def _rate_c_per_s(t: np.ndarray, temp: np.ndarray, rate_window_s: float) -> np.n
 
 
 def _two_group_z(
-    temp: np.ndarray, r: np.ndarray, in_a: np.ndarray, in_b: np.ndarray, band_c: float, rho: float
+    temp: np.ndarray, r: np.ndarray, in_a: np.ndarray, in_b: np.ndarray, band_c: float, rho: float,
+    min_group: int,
 ) -> tuple[float, np.ndarray] | None:
     """Welch-type z of mean(r | a) - mean(r | b) stratified by temperature bins; also the mask
-    of samples in bins that entered. None when no bin has ``MIN_GROUP`` samples of both."""
+    of samples in bins that entered. None when no bin has ``min_group`` samples of both."""
     lo = np.floor(temp.min() / band_c) * band_c
     idx = ((temp - lo) / band_c).astype(np.int64)
     nb = int(idx.max()) + 1
@@ -213,7 +212,7 @@ def _two_group_z(
             var = (s2 - s1 * mean) / (n - 1)
         stats.append((n, mean, var))
     (na, ma, va), (nbb, mb, vb) = stats
-    ok = (na >= MIN_GROUP) & (nbb >= MIN_GROUP)
+    ok = (na >= min_group) & (nbb >= min_group)
     if not ok.any():
         return None
     shrink = (1.0 - rho) / (1.0 + rho)
@@ -233,12 +232,12 @@ def _lag1(r: np.ndarray) -> float:
 
 
 def _group_tests(
-    t: np.ndarray, temp: np.ndarray, r: np.ndarray, alpha: float, band_c: float,
-    rate_eps_c_per_s: float, rate_window_s: float, inflation: float = 1.0,
+    t: np.ndarray, temp: np.ndarray, r: np.ndarray, alpha: float, settings: LocateSettings, inflation: float = 1.0,
 ) -> list[Mismatch]:
     """Heating vs cooling and soak vs ramp; ``inflation`` (>= 1) is the variance of a window
     mean over its white-noise value, from known coloured noise, when it exceeds lag-1's."""
-    rate = _rate_c_per_s(t, temp, rate_window_s)
+    rate = _rate_c_per_s(t, temp, settings.rate_window_s)
+    rate_eps_c_per_s = settings.still_rate_c_per_min / 60.0
     rho = _lag1(r)
     rho = max(rho, (inflation - 1.0) / (inflation + 1.0))  # (1 - rho) / (1 + rho) = 1 / inflation
     z_thr = float(norm.isf(alpha / 2.0))
@@ -248,7 +247,7 @@ def _group_tests(
     )
     out = []
     for what, a, b in tests:
-        res = _two_group_z(temp, r, a, b, band_c, rho)
+        res = _two_group_z(temp, r, a, b, settings.band_c, rho, settings.min_group_samples)
         if res is None or abs(res[0]) <= z_thr:
             continue
         z, used = res
@@ -270,34 +269,35 @@ class AllanExcess:
     first_over: int | None
 
 
-def why_no_allan(t: np.ndarray) -> str | None:
-    """Why :func:`allan_excess` cannot test a residual sampled at ``t``, or None."""
+def why_no_allan(t: np.ndarray, min_samples: int = DEFAULTS.locate.min_allan_samples) -> str | None:
+    """Why :func:`allan_excess` cannot test a residual sampled at ``t`` (its shortest tau
+    ``min_samples`` samples), or None."""
     n = t.size
     m_max = min(n // 10, (n - 1) // 2)
     gaps = int(segments(t)[-1]) if n else 0
     if gaps:
         return (f"the Allan deviation needs a record without gaps; this one has {gaps} gap(s) of more than "
                 "five sample intervals (bursts, or samples given zero weight)")
-    if m_max < MIN_ALLAN_M:
-        return (f"the Allan deviation needs clusters of {MIN_ALLAN_M} samples at a tenth of the record "
-                f"({10 * MIN_ALLAN_M} samples); this record has {n}")
+    if m_max < min_samples:
+        return (f"the Allan deviation needs clusters of {min_samples} samples at a tenth of the record "
+                f"({10 * min_samples} samples); this record has {n}")
     return None
 
 
 def allan_excess(
     t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool,
-    coloured: np.ndarray | None = None,
+    coloured: np.ndarray | None = None, min_samples: int = DEFAULTS.locate.min_allan_samples,
 ) -> AllanExcess | None:
     """The frequency-band test (module doc) at level ``alpha``; None when the residual is too
-    short for tau >= 10 samples at N / 10, or made of bursts (an Allan deviation across gaps
-    means nothing). ``coloured`` is a known non-white noise (one
+    short for tau >= ``min_samples`` samples at N / 10, or made of bursts (an Allan deviation
+    across gaps means nothing). ``coloured`` is a known non-white noise (one
     realisation, per sample) whose Allan variance is added to the white line."""
     n = r.size
     fs = (n - 1) / (t[-1] - t[0])
     m_max = min(n // 10, (n - 1) // 2)
-    if why_no_allan(t) is not None:
+    if why_no_allan(t, min_samples) is not None:
         return None
-    m = MIN_ALLAN_M * 2 ** np.arange(int(np.log2(m_max / MIN_ALLAN_M)) + 1)
+    m = min_samples * 2 ** np.arange(int(np.log2(m_max / min_samples)) + 1)
     ad = allan_deviation(r, fs, m / fs)
     m = np.round(ad.tau_s * fs)
     edf = (3.0 * (n - 1) / (2.0 * m) - 2.0 * (n - 2) / n) * 4.0 * m**2 / (4.0 * m**2 + 5.0)
@@ -313,9 +313,10 @@ def allan_excess(
 
 
 def _frequency_band(
-    t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool, coloured: np.ndarray | None = None
+    t: np.ndarray, r: np.ndarray, sigma: float, alpha: float, estimated: bool, coloured: np.ndarray | None,
+    min_samples: int,
 ) -> list[Mismatch]:
-    ex = allan_excess(t, r, sigma, alpha, estimated, coloured)
+    ex = allan_excess(t, r, sigma, alpha, estimated, coloured, min_samples)
     if ex is None or ex.first_over is None:
         return []
     k = ex.first_over
@@ -328,27 +329,24 @@ def locate(
     temp_c: np.ndarray,
     residual: np.ndarray,
     white_sigma: float | None,
-    false_alarm: float = 0.01,
+    settings: LocateSettings = DEFAULTS.locate,
     *,
-    window_s: float = 180.0,
-    band_c: float = 5.0,
-    rate_eps_c_per_s: float = 0.05 / 60.0,
-    rate_window_s: float = 60.0,
     coloured: np.ndarray | None = None,
 ) -> list[Mismatch]:
     """Departures of ``residual`` (any unit) from white noise of per-sample sigma ``white_sigma``
     (same unit; None: estimated robustly), at time ``t_s`` (s) and temperature ``temp_c`` (°C).
 
-    The probability of any finding on pure white noise is at most about ``false_alarm``.
-    ``window_s`` is the time-scan window, ``band_c`` the temperature bin, ``rate_eps_c_per_s``
-    (°C/s, default 0.05 °C/min) the dT/dt that separates soak from ramp, dT/dt taken over
-    ``rate_window_s``. Findings come in family order: time spans, temperature bands, heating vs
+    The probability of any finding on pure white noise is at most about ``settings.false_alarm``.
+    ``settings.window_s`` is the time-scan window, ``band_c`` the temperature bin,
+    ``still_rate_c_per_min`` (default 0.05 °C/min) the dT/dt that separates soak from ramp, dT/dt
+    taken over ``rate_window_s``. Findings come in family order: time spans, temperature bands, heating vs
     cooling, soak vs ramp, frequency band. ``coloured`` is one realisation of a known non-white
     noise in the residual (e.g. a thermometer's, carried through the model): the scans widen
     sigma by its variance over a window, the frequency test adds its Allan variance. Raises ValueError for non-finite values, unequal
-    lengths, fewer than 100 samples or non-increasing ``t_s``.
+    lengths, fewer than ``settings.min_samples`` samples or non-increasing ``t_s``.
     """
-    t, temp, r = _check(t_s, temp_c, residual, white_sigma, false_alarm)
+    false_alarm, window_s = settings.false_alarm, settings.window_s
+    t, temp, r = _check(t_s, temp_c, residual, white_sigma, false_alarm, settings.min_samples)
     estimated = white_sigma is None
     sigma = robust_white_sigma(r) if estimated else float(white_sigma)
     if not sigma > 0:
@@ -360,8 +358,8 @@ def locate(
         sums, counts = np.bincount(window, coloured), np.bincount(window)
         scan_sigma = float(np.sqrt(sigma**2 + np.mean(sums**2) / np.mean(counts)))
     return [
-        *_time_spans(t, r, scan_sigma, alpha, window_s),
-        *_temperature_bands(t, temp, r, scan_sigma, alpha, band_c),
-        *_group_tests(t, temp, r, alpha, band_c, rate_eps_c_per_s, rate_window_s, (scan_sigma / sigma) ** 2),
-        *_frequency_band(t, r, sigma, alpha, estimated, coloured),
+        *_time_spans(t, r, scan_sigma, alpha, settings),
+        *_temperature_bands(t, temp, r, scan_sigma, alpha, settings),
+        *_group_tests(t, temp, r, alpha, settings, (scan_sigma / sigma) ** 2),
+        *_frequency_band(t, r, sigma, alpha, estimated, coloured, settings.min_allan_samples),
     ]

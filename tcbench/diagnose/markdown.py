@@ -15,12 +15,11 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
+from tcbench.diagnose.attribute import Evidence
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.reference import REFERENCE_RATIO
 from tcbench.diagnose.result import Diagnosis
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
 from tcbench.diagnose.significance import SURROGATE
-from tcbench.diagnose.surrogate import LEVEL
 
 PLOT_CAPTIONS = {
     "residuals": "Held-out residual of the starting and the final model against time and temperature "
@@ -149,9 +148,9 @@ def format_where(where: dict[str, Any], unit: str, t0: float) -> str:
     return "; ".join(parts) if parts else "not localised: the whole record"
 
 
-def _evidence_text(ev: dict[str, Any]) -> str:
-    """Evidence in words: the held-out gain and its test, the Allan ratio, the outlier bound,
-    or any other evidence as ``name = value`` pairs."""
+def _evidence_text(ev: dict[str, Any], settings: DiagnoseSettings = DEFAULTS) -> str:
+    """Evidence in words: the held-out gain and its test (at ``settings``' Wald threshold and
+    surrogate level), the Allan ratio, the outlier bound, or any other evidence as ``name = value`` pairs."""
     if "allan_ratio" in ev:
         return (f"Allan deviation {_g(ev['allan_ratio'], 3)} times the white-noise line from tau = "
                 f"{_g(ev.get('tau_s'))} s, above the bound {_g(ev.get('bound'), 3)}.")
@@ -159,9 +158,10 @@ def _evidence_text(ev: dict[str, Any]) -> str:
         line = (f"dropping it raises the held-out squared error by {_g(ev['gain_sigma2'])} sigma^2 "
                 f"(penalised), against a threshold of {_g(ev.get('threshold_sigma2'))} sigma^2")
         if ev.get("test") == SURROGATE:
-            return line + f"; significant by the {SURROGATE} test, p = {_g(ev.get('p_value'), 3)} <= {_g(LEVEL)}."
+            return (line + f"; significant by the {SURROGATE} test, p = {_g(ev.get('p_value'), 3)} <= "
+                    f"{_g(settings.surrogate.level)}.")
         if "robust_wald" in ev:
-            return line + f"; cluster-robust Wald {_g(ev['robust_wald'], 3)} > {_g(WALD_THRESHOLD)}."
+            return line + f"; cluster-robust Wald {_g(ev['robust_wald'], 3)} > {_g(settings.selection.wald_threshold)}."
         if ev.get("test"):
             return line + f"; test: {ev['test']}."
         return line + "."
@@ -208,16 +208,17 @@ def _listed_table(f: Finding, unit: str, t0: float) -> list[str]:
     return [*out, ""]
 
 
-def finding_section(f: Finding, unit: str, t0: float) -> list[str]:
+def finding_section(f: Finding, unit: str, t0: float, settings: DiagnoseSettings = DEFAULTS) -> list[str]:
     """One finding of the report contract (any ``id``): shape, library or not, parameters,
-    where, evidence, what it cannot be told from, confirm-with, listed values and explanation."""
+    where, evidence (read at ``settings``), what it cannot be told from, confirm-with, listed
+    values and explanation."""
     kind = "library effect" if f.library else "not a library effect"
     unit_here = str(f.params.get("unit", unit))
     out = [f"### {f.id} ({f.shape}, {kind})", "",
            f"- Shape: {f.shape}" + (f" ({SHAPE_SIGNATURE[f.shape]})" if f.shape in SHAPE_SIGNATURE else ""),
            f"- Parameters: {_scalar_params(f.params, unit_here)}",
            f"- Where: {format_where(f.where, unit_here, t0)}",
-           f"- Evidence: {_evidence_text(f.evidence)}"]
+           f"- Evidence: {_evidence_text(f.evidence, settings)}"]
     if f.extra.get("confusable_with"):
         out.append(f"- Cannot be told from: {', '.join(f.extra['confusable_with'])} (see below)")
     out += [f"- Confirm with: {f.confirm_with}", ""]
@@ -240,10 +241,29 @@ def not_tested_section(not_tested: dict[str, str]) -> list[str]:
             *(f"- **{name}**: {reason}." for name, reason in not_tested.items()), ""]
 
 
+def settings_note(settings: DiagnoseSettings) -> list[str]:
+    """The settings of ``tcbench diagnose`` that differ from the defaults, one ``key = value``
+    each (report.json ``statistics.settings`` has them all); nothing at the defaults."""
+    changed = differing(settings)
+    if not changed:
+        return []
+    said = ", ".join(f"`{k} = {list(v) if isinstance(v, tuple) else v}` (default {_default(k)})"
+                     for k, v in changed.items())
+    return [f"Settings that differ from the defaults: {said}.", ""]
+
+
+def _default(key: str) -> Any:
+    value: Any = DEFAULTS
+    for part in key.split("."):
+        value = getattr(value, part)
+    return list(value) if isinstance(value, tuple) else value
+
+
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
     the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
     sigma = float(d.noise.white_sigma)
+    settings = d.statistics.settings
     t0 = float(d.series.t_s[0]) if len(d.series.t_s) else 0.0
     out = [f"# Diagnosis of {d.recording or 'recording'} ({d.sensor})", "",
            f"**Verdict:** {d.verdict}", ""]
@@ -268,17 +288,18 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
         out += [(f"The reference is a {ref.what} ({', '.join(ref.terms)}); it names no physics and says how "
                  f"far a model driven by the thermometer can go on this recording. Final / reference held-out RMSE: "
                  f"**{_g(ratio, 3)}**"
-                 + (f", above {_g(REFERENCE_RATIO)}: deterministic temperature structure remains in the final "
+                 + (f", above {_g(settings.reference.structure_ratio)}: deterministic temperature structure remains in the final "
                     "residual, so bias instability is not judged." if ref.deterministic_structure_remains else ".")),
                 ""]
     plan = d.statistics.plan
     why = (f"the recording holds {plan.n_clusters} clusters of {_g(plan.cluster_s)} s, too few for the "
            "cluster-robust Wald test, so effects are tested against surrogates with the spectrum of the "
-           f"candidate model's residual (p <= {_g(LEVEL)})" if plan.test.name == SURROGATE else
+           f"candidate model's residual (p <= {_g(settings.surrogate.level)})" if plan.test.name == SURROGATE else
            f"{plan.n_clusters} clusters of {_g(plan.cluster_s)} s for the cluster-robust Wald test (an effect that "
            "removes most of the excess error and fails it is tried by the surrogate test instead)")
     out += [(f"Statistics sized to this recording: blocks of {_g(plan.block_s)} s in {plan.k} interleaved "
              f"folds; {why}."), ""]
+    out += settings_note(settings)
 
     out += ["## Where the starting model misses", ""]
     if d.mismatch:
@@ -309,7 +330,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     if d.effects:
         out += [*findings_table(d.effects, d.unit, t0), ""]
     for effect in d.effects:
-        out += finding_section(effect, d.unit, t0)
+        out += finding_section(effect, d.unit, t0, settings)
 
     out += ["## Effects this recording cannot tell apart", ""]
     if d.confusable:
@@ -321,10 +342,12 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     out.append("")
 
     out += ["## All candidates", "",
-            ("Gain: drop in held-out squared error, in units of the white-noise variance, less 2 per added "
+            ("Gain: drop in held-out squared error, in units of the white-noise variance, less "
+             f"{_g(settings.selection.penalty_sigma2_per_param)} per added "
              "parameter. An effect is kept when its gain exceeds the threshold and it is significant: its "
-             f"cluster-robust Wald statistic exceeds {_g(WALD_THRESHOLD)}, or, where that test cannot be used, "
-             f"the surrogate test's p-value is at most {_g(LEVEL)} (the column says which). For bias_instability "
+             f"cluster-robust Wald statistic exceeds {_g(settings.selection.wald_threshold)}, or, where that test "
+             f"cannot be used, the surrogate test's p-value is at most {_g(settings.surrogate.level)} (the column "
+             "says which). For bias_instability "
              "the number is the Allan ratio against its bound instead."), ""]
     out += _table(["effect", "status", "gain (sigma^2)", "significance", "best parameter", "reason"],
                   ([e.effect, e.status, _gain_cell(e), _test_cell(e), _value_cell(e), e.reason]

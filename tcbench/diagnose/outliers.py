@@ -9,47 +9,44 @@ significance tests never see them) and reports them as a finding of their own.
 
 Detection, on the residual ``r`` of the current model (output unit):
 
-1. **Local level**: ``r`` minus the median of its :data:`WINDOW` - 1 neighbours (the sample
+1. **Local level**: ``r`` minus the median of its ``window_samples`` - 1 neighbours (the sample
    itself left out, so the difference has Gaussian tails under white noise; mirrored at the
    ends, so the last sample is judged against its predecessors). The median ignores runs
    shorter than half the window and follows steps and slow structure the model misses, so only
    isolated departures remain.
 2. **Robust scale**: ``s = 1.4826 * MAD`` of that high-passed residual (the white sigma when
-   the MAD is below :data:`MIN_SCALE` of it: on an output quantised to about two sigma or more
+   the MAD is below ``min_scale_sigma`` of it: on an output quantised to about two sigma or more
    most samples equal their neighbours' median, and the MAD reads 0.002 sigma).
 3. **Bound on the record's length**: with ``n`` samples and a family-wise false-alarm level
-   ``alpha`` (:data:`ALPHA` = 1 %), a sample is an outlier when ``|z| = |r - median| / s``
-   exceeds ``z_n = TAIL * Phi^-1(1 - alpha / (2 n))`` (Bonferroni over the ``n`` two-sided
+   ``alpha`` (1 %), a sample is an outlier when ``|z| = |r - median| / s``
+   exceeds ``z_n = tail * Phi^-1(1 - alpha / (2 n))`` (Bonferroni over the ``n`` two-sided
    tests): a record of pure Gaussian noise has probability at most ``alpha`` of showing any
-   outlier. :data:`TAIL` = 1.1 because a sample minus the median of its neighbours has heavier
+   outlier. ``tail`` = 1.1 because a sample minus the median of its neighbours has heavier
    tails than its MAD implies (its standard deviation is 3 % above 1.4826 MAD, and the median
    is itself noisy); without it 4 % of clean 24 h records at 1 Hz showed an outlier, with it
    none of 300 (measured, see tests/test_diagnose_outliers.py). For a 24 h record at 1 Hz
-   (``n = 86400``) ``z_n = 5.83``; for 4200 samples 5.19. :data:`MIN_Z` keeps the bound at
+   (``n = 86400``) ``z_n = 5.83``; for 4200 samples 5.19. ``min_z`` keeps the bound at
    4.5 or more for short records, where the MAD itself is uncertain.
 4. **Isolated**: flagged samples are grouped into runs of consecutive indices; a run longer
-   than :data:`MAX_RUN` samples is structure (a step, a saturation), not a spike, and is left
+   than ``max_run_samples`` samples is structure (a step, a saturation), not a spike, and is left
    to the other detectors.
+
+The numbers are :class:`~tcbench.diagnose.settings.OutlierSettings`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.ndimage import median_filter
 from scipy.stats import norm
 
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.settings import DEFAULTS, OutlierSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
 
-ALPHA = 0.01  # family-wise false-alarm probability over the whole record
-MIN_Z = 4.5  # the bound never drops below this many robust sigmas
-TAIL = 1.1  # the difference from a neighbours' median has heavier tails than its MAD implies
-WINDOW = 31  # samples in the running median that sets the local level
-MAX_RUN = 5  # the longest run of consecutive samples still called a spike
 MAX_LISTED = 20  # outliers listed by time and size in the report; the count covers all
-MIN_SCALE = 0.5  # of the white sigma: a robust scale below it is a coarse grid's, not the noise's
 
 EXPLANATION = ("isolated samples far beyond the noise: candidate causes are a bus or logging glitch (a corrupted "
                "or duplicated frame), a mechanical shock or a vibration burst, an electrostatic discharge, or a "
@@ -58,16 +55,17 @@ CONFIRM_WITH = ("the logger's error and dropped-frame counters for those times, 
                 "or an accelerometer channel logged alongside (a shock shows on it at the same instant)")
 
 
-def z_bound(n: int, alpha: float = ALPHA) -> float:
+def z_bound(n: int, settings: OutlierSettings = DEFAULTS.screens.outliers) -> float:
     """Two-sided Bonferroni bound on ``|z|`` for ``n`` Gaussian samples at family-wise level
-    ``alpha``, times :data:`TAIL` (at least :data:`MIN_Z`)."""
-    return float(max(TAIL * norm.isf(alpha / (2.0 * max(n, 1))), MIN_Z))
+    ``settings.alpha``, times ``settings.tail`` (at least ``settings.min_z``)."""
+    return float(max(settings.tail * norm.isf(settings.alpha / (2.0 * max(n, 1))), settings.min_z))
 
 
 @dataclass(frozen=True)
 class Outliers:
     """Outliers of one record: sample indices, times (s), sizes (output unit: residual minus
-    the local median), robust z of each, the robust scale (output unit) and the bound on ``|z|``."""
+    the local median), robust z of each, the robust scale (output unit), the bound on ``|z|`` and
+    the settings of the test."""
 
     index: np.ndarray
     time_s: np.ndarray
@@ -75,6 +73,7 @@ class Outliers:
     z: np.ndarray
     scale: float
     bound: float
+    settings: OutlierSettings = field(default=DEFAULTS.screens.outliers, repr=False)
 
     @property
     def count(self) -> int:
@@ -90,42 +89,44 @@ class Outliers:
             params={"count": self.count, "time_s": times, "size": [float(s) for s in self.size[keep]], "unit": unit},
             where={"time_s": times},
             evidence={"robust_z": [round(float(z), 2) for z in self.z[keep]], "bound_z": round(self.bound, 3),
-                      "robust_sigma": self.scale, "false_alarm": ALPHA,
-                      "test": f"|residual - running median of {WINDOW}| / (1.4826 MAD) above the Bonferroni "
-                              f"bound for the record's samples"},
+                      "robust_sigma": self.scale, "false_alarm": self.settings.alpha,
+                      "test": f"|residual - running median of {self.settings.window_samples}| / (1.4826 MAD) above "
+                              f"the Bonferroni bound for the record's samples"},
             explanation=(f"{self.count} sample(s) up to {float(np.max(np.abs(self.size))):.4g} {unit} "
                          f"({float(np.max(np.abs(self.z))):.3g} robust sigma) off the local level: " + EXPLANATION),
             confirm_with=CONFIRM_WITH,
         )
 
 
-def find_outliers(t_s: np.ndarray, residual: np.ndarray, white_sigma: float, *, alpha: float = ALPHA,
-                  max_run: int = MAX_RUN, relative_sigma: np.ndarray | None = None) -> Outliers:
+def find_outliers(t_s: np.ndarray, residual: np.ndarray, white_sigma: float, *,
+                  settings: OutlierSettings = DEFAULTS.screens.outliers,
+                  relative_sigma: np.ndarray | None = None) -> Outliers:
     """Isolated outliers of ``residual`` (output unit, samples at ``t_s`` in s); see the module
     doc. ``white_sigma`` (output unit) is the scale when the MAD is zero. ``relative_sigma``
     (per sample, RMS 1) is the noise level where it changes with temperature or time: each
     sample is then judged against its own level, not the record's."""
     r = np.asarray(residual, dtype=float)
     n = r.size
-    bound = z_bound(n, alpha)
+    bound = z_bound(n, settings)
     empty = np.zeros(0, dtype=np.int64)
-    if n < WINDOW:
-        return Outliers(empty, np.zeros(0), np.zeros(0), np.zeros(0), float(white_sigma), bound)
-    footprint = np.ones(WINDOW, dtype=bool)
-    footprint[WINDOW // 2] = False  # the level a sample is judged against does not contain it
+    window = settings.window_samples
+    if n < window:
+        return Outliers(empty, np.zeros(0), np.zeros(0), np.zeros(0), float(white_sigma), bound, settings)
+    footprint = np.ones(window, dtype=bool)
+    footprint[window // 2] = False  # the level a sample is judged against does not contain it
     high = r - median_filter(r, footprint=footprint, mode="mirror")
     level = np.ones(n) if relative_sigma is None else np.asarray(relative_sigma, dtype=float)
     scale = float(MAD_TO_SIGMA * np.median(np.abs(high / level - np.median(high / level))))
-    if not scale > MIN_SCALE * white_sigma:  # a grid coarser than the noise: the MAD reads near 0
+    if not scale > settings.min_scale_sigma * white_sigma:  # a grid coarser than the noise: the MAD reads near 0
         scale = float(white_sigma)
     z = high / (scale * level)
     flagged = np.abs(z) > bound
     edges = np.diff(np.concatenate(([0], flagged.astype(np.int8), [0])))
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    short = (ends - starts) <= max_run
+    short = (ends - starts) <= settings.max_run_samples
     index = (np.concatenate([np.arange(a, b) for a, b in zip(starts[short], ends[short], strict=True)])
              if short.any() else empty)
-    return Outliers(index, t_s[index], high[index], z[index], scale, bound)
+    return Outliers(index, t_s[index], high[index], z[index], scale, bound, settings)
 
 
 def without(data: DiagnosisData, index: np.ndarray) -> DiagnosisData:

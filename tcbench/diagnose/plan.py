@@ -12,11 +12,14 @@ slow noise. Both need time spans that fit the recording:
   2.5 smoothing windows and 15 min.
 - **The significance test** (an object of :mod:`tcbench.diagnose.significance`): the
   cluster-robust Wald statistic needs many clusters to estimate the variance of slow noise; with
-  fewer than :data:`MIN_CLUSTERS` the recording cannot support it and the diagnosis uses a
+  fewer than ``min_clusters`` the recording cannot support it and the diagnosis uses a
   surrogate test instead (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric
   bootstrap under a noise model with the spectrum of the candidate model's own residual.
 - **The shortest record** (:func:`min_full_duration_s`): five folds of one block each, a block
-  two smoothing windows long: 20 min at the default 120 s window. Shorter, a fold holds less
+  two smoothing windows long: 20 min at the default 120 s window.
+
+The numbers (folds, blocks and clusters per record, windows per block and cluster, the longest
+block, the fewest clusters) are :class:`~tcbench.diagnose.settings.PlanSettings`. Shorter, a fold holds less
   than one whole block, or none, and its held-out samples are predicted by the smoothed
   thermometer of their own neighbours. A shorter record gets the tests its length allows
   (:mod:`tcbench.diagnose.short_record`).
@@ -28,21 +31,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcbench.diagnose.significance import (
-    ROBUST_WALD,
-    ROBUST_WALD_TEST,
-    SURROGATE,
-    SURROGATE_TEST,
-    SignificanceTest,
-)
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, DiagnosisData
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
+from tcbench.diagnose.significance import ROBUST_WALD, SURROGATE, SignificanceTest, significance_tests
+from tcbench.diagnose.signals import DiagnosisData
 
-FOLDS = 5
-BLOCK_WINDOWS = 2.0  # a CV block spans at least this many thermometer-smoothing windows
-MAX_BLOCK_S = 900.0
-BLOCKS_PER_RECORD = 24
-CLUSTERS_PER_RECORD = 32
-MIN_CLUSTERS = 24
 __all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan_for"]
 
 
@@ -63,18 +55,24 @@ class StatsPlan:
                 "clusters": self.n_clusters, "significance_test": self.test.name}
 
 
-def plan_for(data: DiagnosisData) -> StatsPlan:
-    """The statistics for ``data`` (see module doc)."""
+def plan_for(data: DiagnosisData, settings: DiagnoseSettings = DEFAULTS) -> StatsPlan:
+    """The statistics for ``data`` (see module doc), sized by ``settings.plan``; the tests at
+    ``settings``' Wald threshold and surrogate level."""
+    plan = settings.plan
     span = float(data.t_s[-1] - data.t_s[0])
-    block_s = float(np.clip(span / BLOCKS_PER_RECORD, min(BLOCK_WINDOWS * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
-    cluster_s = float(np.clip(span / CLUSTERS_PER_RECORD, min(2.5 * data.smooth_s, MAX_BLOCK_S), MAX_BLOCK_S))
+    block_s = float(np.clip(span / plan.blocks_per_record, min(plan.block_windows * data.smooth_s, plan.max_block_s),
+                            plan.max_block_s))
+    cluster_s = float(np.clip(span / plan.clusters_per_record,
+                              min(plan.cluster_windows * data.smooth_s, plan.max_block_s), plan.max_block_s))
     n_clusters = int(np.floor(span / cluster_s)) + 1
-    test = ROBUST_WALD_TEST if n_clusters >= MIN_CLUSTERS else SURROGATE_TEST
-    return StatsPlan(block_s, FOLDS, cluster_s, n_clusters, test)
+    robust, surrogate = significance_tests(settings)
+    test = robust if n_clusters >= plan.min_clusters else surrogate
+    return StatsPlan(block_s, plan.folds, cluster_s, n_clusters, test)
 
 
-def min_full_duration_s(smooth_s: float = DEFAULT_SMOOTH_S) -> float:
-    """The shortest record (s) a full diagnosis takes: :data:`FOLDS` cross-validation folds of one
-    block each, a block :data:`BLOCK_WINDOWS` thermometer-smoothing windows of ``smooth_s`` long
-    (1200 s at the default 120 s window)."""
-    return FOLDS * BLOCK_WINDOWS * smooth_s
+def min_full_duration_s(settings: DiagnoseSettings = DEFAULTS, smooth_s: float | None = None) -> float:
+    """The shortest record (s) a full diagnosis takes: ``settings.plan.folds`` cross-validation
+    folds of one block each, a block ``settings.plan.block_windows`` thermometer-smoothing windows
+    of ``smooth_s`` (default ``settings.smoothing.default_window_s``) long (1200 s by default)."""
+    window_s = settings.smoothing.default_window_s if smooth_s is None else smooth_s
+    return settings.plan.folds * settings.plan.block_windows * window_s

@@ -29,7 +29,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.signal import lombscargle, periodogram
 
-from tcbench.diagnose.attribute import WALD_THRESHOLD, Evidence
+from tcbench.diagnose.attribute import Evidence
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.locate import AllanExcess
 from tcbench.sensors.segments import segments, within_rate_hz
@@ -350,7 +350,8 @@ def plot_evidence(d: Diagnosis, path: Path) -> Path:
     y = np.arange(len(det))[::-1]
     gains = np.array([e.gain for e in det], dtype=np.float64)
     finite = np.isfinite(gains)
-    threshold = float(det[0].threshold) if det else 10.0
+    selection = d.statistics.settings.selection
+    threshold = selection.detection_threshold_sigma2
     span = float(np.nanmax(np.abs(gains[finite]))) if finite.any() else threshold
     span = max(span, threshold) * 30.0
     ax.barh(y[finite], gains[finite], color=[STATUS_COLOUR.get(e.status, "0.6") for e, f in zip(det, finite) if f],
@@ -365,7 +366,7 @@ def plot_evidence(d: Diagnosis, path: Path) -> Path:
         ax.text(x_text, yi, f"  {note}  " if ha == "left" else f"{note}  ", va="center", ha=ha, fontsize=7)
     ax.axvline(threshold, color="k", ls="--", lw=1, label=f"detection threshold {threshold:g} σ²")
     for yi, e in zip(y, det, strict=True):  # open-world terms need more: their detectors search
-        if float(e.threshold) != threshold:
+        if np.isfinite(e.gain) and float(e.threshold) != threshold:
             ax.plot([e.threshold, e.threshold], [yi - 0.4, yi + 0.4], color="k", ls=":", lw=1.5)
     ax.axvline(0.0, color="k", lw=0.5)
     ax.set_xscale("symlog", linthresh=max(threshold, 1.0))
@@ -377,7 +378,7 @@ def plot_evidence(d: Diagnosis, path: Path) -> Path:
             ax.barh([np.nan], [np.nan], color=colour, label=status)
     ax.set(xlabel="penalised held-out gain (σ² units; symlog)",
            title=f"{d.recording or 'recording'}: candidate effects "
-                 f"(kept needs gain > {threshold:g} and robust Wald > {WALD_THRESHOLD:g})")
+                 f"(kept needs gain > {threshold:g} and robust Wald > {selection.wald_threshold:g})")
     ax.legend(fontsize=7, loc="lower right")
     ax.grid(True, axis="x", alpha=0.3)
     _flicker_panel(ax_b, flicker)

@@ -6,21 +6,21 @@ noise to dither them:
 
 1. the smallest non-zero jump between consecutive samples is the candidate step ``q0`` (a
    noisy output jumps by one step often; a noise-free staircase does at every level change);
-2. every non-zero jump must be an integer multiple of ``q0`` to :data:`TOLERANCE` of a step,
+2. every non-zero jump must be an integer multiple of ``q0`` to ``tolerance_steps`` of a step,
    and ``q`` is refined as the median of jump / multiple;
 3. **not chance**: the values' phases ``2 pi (y - y0) / q`` must line up, mean resultant
-   length ``R`` at least :data:`MIN_RESULTANT` (1 on an exact lattice; about ``1/sqrt(n)`` for
+   length ``R`` at least ``min_resultant`` (1 on an exact lattice; about ``1/sqrt(n)`` for
    values off it, so a record of 200 samples or more cannot reach it by chance);
-4. a lattice finer than :data:`MIN_STEP_SIGMA` of the white noise (float storage, a CSV's
+4. a lattice finer than ``min_step_sigma`` of the white noise (float storage, a CSV's
    last decimal) is real but harmless, and is not reported.
 
 **Thermometer.** A thermometer that reads whole degrees (a Bosch IMU's register) or 1/16 degC
 puts the same staircase on the temperature the model is driven by. With enough noise to dither
-it (the reading's spread about its smoothed value at least :data:`DITHER_SPREAD` of a step), the
+it (the reading's spread about its smoothed value at least ``dither_spread_steps`` of a step), the
 staircase averages out in the diagnosis' smoothing; without it, a window shorter than a few
 staircase periods ``q / |dT/dt|`` follows the steps, up to ``q / 2`` off. :func:`thermometer_steps`
 then reports the staircase (id ``thermometer_quantisation``) and widens the smoothing window to
-:data:`PERIODS` staircase periods at the record's typical ramp rate (capped at a quarter of the
+``periods`` staircase periods at the record's typical ramp rate (capped at a quarter of the
 record). Measured on a 0-40 degC triangle read in whole degrees with 0.02 degC of noise, the
 smoothed temperature's RMS error: 0.26 degC with the 120 s window at 0.1 degC/min, 0.020 with
 3 periods (1800 s), and 0.22 vs 0.029 at 0.3 degC/min; wider windows lose at the ramps' corners.
@@ -28,27 +28,24 @@ Through a soak at a temperature between two steps the undithered reading stays u
 off for the whole soak, which no window recovers: on the concealed MSRA profile (soaks of 35-50
 min at levels such as 9.7 and 20.2 degC) read in whole degrees the smoothed temperature is
 0.23 degC RMS off with 120 s and still 0.21 degC with the adapted 493 s.
+
+The numbers are :class:`~tcbench.diagnose.settings.QuantisationSettings` (the lattice, the output)
+and :class:`~tcbench.diagnose.settings.ThermometerSettings` (the staircase).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.settings import (
+    DEFAULTS,
+    QuantisationSettings,
+    ThermometerSettings,
+)
 from tcbench.diagnose.signals import local_linear
-
-TOLERANCE = 0.02  # of a step: how far a jump may sit from an integer multiple of it
-MIN_FRACTION = 0.99  # of the non-zero jumps that must be multiples of the step
-MIN_RESULTANT = 0.99  # phase alignment of the values on the lattice
-MIN_JUMPS = 20  # non-zero jumps needed to judge a lattice
-MIN_STEP_SIGMA = 0.05  # an output lattice finer than this many white sigmas is not reported
-MIN_STEP_C = 0.05  # a thermometer lattice finer than this (degC) is not reported
-DITHER_SPREAD = 0.36  # reading spread about its smoothed value, in steps, above which it is dithered
-PERIODS = 3.0  # staircase periods the thermometer smoothing spans
-RATE_WINDOW_S = 1800.0  # window of the local line that gives the typical ramp rate
-MOVING = 0.2  # a sample is on a ramp when its |rate| is above this fraction of the 90th percentile
 
 OUTPUT_EXPLANATION = ("the output sits on a grid: the resolution of the converter or frequency counter, or a "
                       "fixed-point register; below about one step of noise the grid adds q^2/12 of variance and, "
@@ -64,7 +61,8 @@ THERMO_CONFIRM = ("the temperature register's resolution in the datasheet, or a 
                   "resolution logged alongside")
 
 
-def lattice_step(values: np.ndarray, *, min_resultant: float = MIN_RESULTANT) -> tuple[float, float] | None:
+def lattice_step(values: np.ndarray, settings: QuantisationSettings = DEFAULTS.screens.quantisation
+                 ) -> tuple[float, float] | None:
     """The step ``q`` of the lattice ``values`` lie on and the phases' resultant length ``R``,
     or None when they are not clearly on one (see the module doc)."""
     y = np.asarray(values, dtype=float)
@@ -74,17 +72,17 @@ def lattice_step(values: np.ndarray, *, min_resultant: float = MIN_RESULTANT) ->
     floor = 1e-9 * max(float(np.max(np.abs(y))), 1e-300)
     jumps = np.abs(np.diff(y))
     jumps = jumps[jumps > floor]
-    if jumps.size < MIN_JUMPS:
+    if jumps.size < settings.min_jumps:
         return None
     q0 = float(jumps.min())
     multiple = np.round(jumps / q0)
-    on = np.abs(jumps / q0 - multiple) <= TOLERANCE
-    if on.mean() < MIN_FRACTION:
+    on = np.abs(jumps / q0 - multiple) <= settings.tolerance_steps
+    if on.mean() < settings.min_fraction:
         return None
     q = float(np.median(jumps[on] / multiple[on]))
     phase = 2.0 * np.pi * ((y - y[0]) / q)
     resultant = float(np.hypot(np.cos(phase).mean(), np.sin(phase).mean()))
-    return (q, resultant) if resultant >= min_resultant else None
+    return (q, resultant) if resultant >= settings.min_resultant else None
 
 
 @dataclass(frozen=True)
@@ -95,6 +93,7 @@ class OutputQuantisation:
     resultant: float
     white_sigma: float
     levels: int
+    settings: QuantisationSettings = field(default=DEFAULTS.screens.quantisation, repr=False)
 
     def finding(self, unit: str) -> Finding:
         """The report.json ``effects`` entry (``quantisation``, written to model.yaml as the
@@ -103,7 +102,7 @@ class OutputQuantisation:
             id="quantisation", shape="quantisation", library=False,
             params={"step": self.step},
             where={"level": self.step},
-            evidence={"resultant": round(self.resultant, 6), "min_resultant": MIN_RESULTANT,
+            evidence={"resultant": round(self.resultant, 6), "min_resultant": self.settings.min_resultant,
                       "step_over_sigma": round(self.step / self.white_sigma, 4), "levels": self.levels,
                       "test": "every non-zero sample-to-sample jump an integer multiple of the step and every "
                               "value's phase on the lattice (mean resultant length)"},
@@ -114,15 +113,17 @@ class OutputQuantisation:
         )
 
 
-def find_output_quantisation(output: np.ndarray, white_sigma: float) -> OutputQuantisation | None:
-    """The output's lattice, when it is clearly one and at least :data:`MIN_STEP_SIGMA` of the
+def find_output_quantisation(output: np.ndarray, white_sigma: float,
+                             settings: QuantisationSettings = DEFAULTS.screens.quantisation
+                             ) -> OutputQuantisation | None:
+    """The output's lattice, when it is clearly one and at least ``min_step_sigma`` of the
     white noise ``white_sigma`` (output unit); None otherwise."""
-    found = lattice_step(output)
-    if found is None or not found[0] >= MIN_STEP_SIGMA * white_sigma:
+    found = lattice_step(output, settings)
+    if found is None or not found[0] >= settings.min_step_sigma * white_sigma:
         return None
     q, resultant = found
     levels = int(np.unique(np.round((np.asarray(output, dtype=float) - output[0]) / q)).size)
-    return OutputQuantisation(q, resultant, float(white_sigma), levels)
+    return OutputQuantisation(q, resultant, float(white_sigma), levels, settings)
 
 
 @dataclass(frozen=True)
@@ -138,6 +139,7 @@ class ThermometerSteps:
     smooth_s: float
     default_smooth_s: float
     staircase: bool
+    settings: ThermometerSettings = field(default=DEFAULTS.screens.thermometer, repr=False)
 
     def finding(self) -> Finding:
         """The report.json ``effects`` entry (``thermometer_quantisation``, shape quantisation)."""
@@ -146,11 +148,11 @@ class ThermometerSteps:
             id="thermometer_quantisation", shape="quantisation", library=False,
             params={"step_c": self.step_c, "smooth_s": self.smooth_s},
             where={"level": self.step_c},
-            evidence={"spread_steps": round(self.spread_steps, 4), "dither_spread_steps": DITHER_SPREAD,
+            evidence={"spread_steps": round(self.spread_steps, 4), "dither_spread_steps": self.settings.dither_spread_steps,
                       "typical_rate_c_per_min": round(60.0 * self.rate_c_per_s, 4),
                       "staircase_period_s": round(self.period_s, 2),
                       "test": "thermometer values on a lattice; reading spread about its smoothed value below "
-                              f"{DITHER_SPREAD} step (not dithered)"},
+                              f"{self.settings.dither_spread_steps} step (not dithered)"},
             explanation=(f"the thermometer reads in steps of {self.step_c:.4g} degC "
                          f"(a step every {self.period_s:.0f} s at the typical {60.0 * self.rate_c_per_s:.3g} "
                          "degC/min): " + THERMO_EXPLANATION
@@ -160,23 +162,25 @@ class ThermometerSteps:
         )
 
 
-def thermometer_steps(t_s: np.ndarray, temp_c: np.ndarray, default_smooth_s: float) -> ThermometerSteps | None:
-    """The thermometer's lattice and the smoothing window it needs, or None when the reading
-    is not on a lattice coarser than :data:`MIN_STEP_C` (see the module doc)."""
-    found = lattice_step(temp_c)
-    if found is None or found[0] < MIN_STEP_C:
+def thermometer_steps(t_s: np.ndarray, temp_c: np.ndarray, default_smooth_s: float,
+                      settings: ThermometerSettings = DEFAULTS.screens.thermometer,
+                      lattice: QuantisationSettings = DEFAULTS.screens.quantisation) -> ThermometerSteps | None:
+    """The thermometer's lattice (found as ``lattice`` says) and the smoothing window it needs,
+    or None when the reading is not on a lattice coarser than ``min_step_c`` (see the module doc)."""
+    found = lattice_step(temp_c, lattice)
+    if found is None or found[0] < settings.min_step_c:
         return None
     q = found[0]
     duration_s = float(t_s[-1] - t_s[0])
     value, _ = local_linear(t_s, temp_c, min(default_smooth_s, duration_s))
     spread = float(np.std(temp_c - value)) / q
-    _, slow_rate = local_linear(t_s, temp_c, min(RATE_WINDOW_S, 0.25 * duration_s))
+    _, slow_rate = local_linear(t_s, temp_c, min(settings.rate_window_s, 0.25 * duration_s))
     speed = np.abs(slow_rate)
     top = float(np.quantile(speed, 0.9))
-    typical = float(np.median(speed[speed >= MOVING * top])) if top > 0 else 0.0
+    typical = float(np.median(speed[speed >= settings.moving_share * top])) if top > 0 else 0.0
     period = q / typical if typical > 0 else np.inf
-    staircase = spread < DITHER_SPREAD
+    staircase = spread < settings.dither_spread_steps
     window = default_smooth_s
     if staircase:
-        window = float(np.clip(PERIODS * period, default_smooth_s, max(default_smooth_s, 0.25 * duration_s)))
-    return ThermometerSteps(q, spread, typical, float(period), window, default_smooth_s, staircase)
+        window = float(np.clip(settings.periods * period, default_smooth_s, max(default_smooth_s, 0.25 * duration_s)))
+    return ThermometerSteps(q, spread, typical, float(period), window, default_smooth_s, staircase, settings)

@@ -9,6 +9,8 @@ final model far above it leaves deterministic structure in its residual.
 
 The ridge penalty is chosen among :data:`ALPHAS` (relative to the mean diagonal of the Gram of
 the standardised columns) by the held-out error itself, so the reference is slightly optimistic.
+How many lags, the longest, and the ratio above which structure remains are
+:class:`~tcbench.diagnose.settings.ReferenceSettings`.
 """
 
 from __future__ import annotations
@@ -17,24 +19,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.diagnose.settings import DEFAULTS, ReferenceSettings
 from tcbench.diagnose.signals import DiagnosisData, lagged
 
 ALPHAS = np.geomspace(1e-8, 1e-1, 15)
-N_LAGS = 6  # time constants, log-spaced
-MAX_LAG_FRACTION = 0.25  # the longest lag: a quarter of the recording
-REFERENCE_RATIO = 1.25  # final / reference held-out RMSE above which deterministic structure remains
 
 
 @dataclass(frozen=True)
 class Reference:
     """The reference fit: held-out and fit RMSE (output unit), the terms and the ridge
-    penalty chosen; ``heldout_residual`` per sample."""
+    penalty chosen; ``heldout_residual`` per sample; ``structure_ratio`` the final / reference
+    held-out RMSE above which structure remains."""
 
     rmse_heldout: float
     rmse_fit: float
     terms: list[str]
     alpha: float
     heldout_residual: np.ndarray
+    structure_ratio: float = DEFAULTS.reference.structure_ratio
 
     def to_json(self) -> dict[str, object]:
         return {"rmse_heldout": self.rmse_heldout, "rmse_fit": self.rmse_fit, "terms": self.terms,
@@ -42,20 +44,21 @@ class Reference:
 
     def structure_remains(self, final_rmse: float) -> bool:
         """Whether a model of held-out RMSE ``final_rmse`` leaves deterministic temperature
-        structure: above :data:`REFERENCE_RATIO` times this reference's."""
-        return final_rmse > REFERENCE_RATIO * self.rmse_heldout
+        structure: above :attr:`structure_ratio` times this reference's."""
+        return final_rmse > self.structure_ratio * self.rmse_heldout
 
 
-def lag_grid_s(data: DiagnosisData) -> np.ndarray:
-    """Time constants (s) of the reference's lags: from the smoothing window to a quarter of
-    the recording, :data:`N_LAGS` log-spaced."""
+def lag_grid_s(data: DiagnosisData, settings: ReferenceSettings = DEFAULTS.reference) -> np.ndarray:
+    """Time constants (s) of the reference's lags: from the smoothing window to ``max_lag_share``
+    of the recording, ``n_lags`` log-spaced."""
     span = float(data.t_s[-1] - data.t_s[0])
     lo = max(data.smooth_s / 2.0, 2.0 / data.sample_rate_hz)
-    hi = max(MAX_LAG_FRACTION * span, 2.0 * lo)
-    return np.geomspace(lo, hi, N_LAGS)
+    hi = max(settings.max_lag_share * span, 2.0 * lo)
+    return np.geomspace(lo, hi, settings.n_lags)
 
 
-def reference_terms(data: DiagnosisData) -> tuple[np.ndarray, list[str]]:
+def reference_terms(data: DiagnosisData, settings: ReferenceSettings = DEFAULTS.reference
+                    ) -> tuple[np.ndarray, list[str]]:
     """Columns (n, p) of the reference library (without the intercept) and their names."""
     temp = data.temp_c
     centre = 0.5 * (temp.min() + temp.max())
@@ -65,7 +68,7 @@ def reference_terms(data: DiagnosisData) -> tuple[np.ndarray, list[str]]:
     for p in (1, 2, 3):
         cols.append(u**p)
         names.append(f"u^{p}")
-    for tau in lag_grid_s(data):
+    for tau in lag_grid_s(data, settings):
         ul = (lagged(data.t_s, temp, float(tau)) - centre) / half
         cols += [ul, ul * ul]
         names += [f"lag(u, {tau:.0f} s)", f"lag(u, {tau:.0f} s)^2"]
@@ -102,9 +105,10 @@ def _ridge_heldout(xs: np.ndarray, y: np.ndarray, fold: np.ndarray, k: int, alph
     return heldout, y - x1 @ beta
 
 
-def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int) -> Reference:
+def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int,
+                  settings: ReferenceSettings = DEFAULTS.reference) -> Reference:
     """The reference fitted to ``data.output`` under the folds ``fold`` (``k`` of them)."""
-    x, names = reference_terms(data)
+    x, names = reference_terms(data, settings)
     mu, sd = x.mean(axis=0), x.std(axis=0)
     sd[sd == 0] = 1.0
     xs = (x - mu) / sd
@@ -118,4 +122,5 @@ def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int) -> Reference:
     assert best is not None
     sse, alpha, heldout, resid = best
     n = y.size
-    return Reference(float(np.sqrt(sse / n)), float(np.sqrt(resid @ resid / n)), names, alpha, heldout)
+    return Reference(float(np.sqrt(sse / n)), float(np.sqrt(resid @ resid / n)), names, alpha, heldout,
+                     settings.structure_ratio)

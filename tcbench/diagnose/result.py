@@ -16,8 +16,9 @@ from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.locate import AllanExcess, Mismatch
 from tcbench.diagnose.outliers import Outliers
 from tcbench.diagnose.plan import StatsPlan
-from tcbench.diagnose.reference import REFERENCE_RATIO, Reference
-from tcbench.diagnose.significance import named
+from tcbench.diagnose.reference import Reference
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, to_mapping
+from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import term
 
 REFERENCE_WHAT = ("ridge regression on the smoothed thermometer temperature, its powers, first-order lags at "
@@ -101,13 +102,16 @@ class ReferenceSummary:
 class Statistics:
     """How the diagnosis tested this record: the plan (blocks, folds, clusters, significance
     test), the thermometer smoothing window (s), the screens' entries, ``{detector: why it could
-    not run}`` and, where two windows were tried, ``{window (s): final held-out RMSE}``."""
+    not run}``, where two windows were tried, ``{window (s): final held-out RMSE}``, and the
+    settings it ran with (report.json's ``statistics.settings``: every section and key, so a
+    report says what it was tested with whatever the defaults of a later version)."""
 
     plan: StatsPlan
     smooth_s: float
     screens: dict[str, Any] = field(default_factory=dict)
     not_tested: dict[str, str] = field(default_factory=dict)
     smooth_tried_s: dict[str, float] = field(default_factory=dict)
+    settings: DiagnoseSettings = DEFAULTS
 
     @property
     def significance_test(self) -> str:
@@ -119,6 +123,7 @@ class Statistics:
             out["not_tested"] = self.not_tested
         if self.smooth_tried_s:
             out["thermometer_smooth_tried_s"] = self.smooth_tried_s
+        out["settings"] = to_mapping(self.settings)
         return out
 
 
@@ -156,10 +161,11 @@ class Diagnosis:
 
     @property
     def deterministic_remains(self) -> bool:
-        """Whether the physics-agnostic reference beats the final model by more than
-        :data:`REFERENCE_RATIO` held out: temperature structure the model leaves in its residual."""
+        """Whether the physics-agnostic reference beats the final model by more than the settings'
+        ``reference.structure_ratio`` held out: temperature structure the model leaves in its residual."""
         ref = self.reference.rmse_heldout if self.reference is not None else None
-        return bool(ref) and self.final.rmse_heldout > REFERENCE_RATIO * ref  # type: ignore[operator]
+        ratio = self.statistics.settings.reference.structure_ratio
+        return bool(ref) and self.final.rmse_heldout > ratio * ref  # type: ignore[operator]
 
     @property
     def effect_ids(self) -> list[str]:
@@ -202,22 +208,22 @@ class Diagnosis:
             "effects": [f.to_json() for f in self.effects],
             "final": self.final.to_json(), "reference": self.reference.to_json() if self.reference else {},
             "statistics": self.statistics.to_json(), "noise": self.noise.to_json(),
-            "candidates": [evidence_json(e) for e in self.candidates],
+            "candidates": [evidence_json(e, self.statistics.plan.test) for e in self.candidates],
             "confusable": [c.to_json() for c in self.confusable],
         }
 
 
-def significance_json(e: Evidence) -> dict[str, Any]:
-    """Which significance test decided for ``e`` and its statistic."""
-    return named(e.test).to_json(e.wald, e.p_value) if e.test else {}
+def significance_json(e: Evidence, test: SignificanceTest) -> dict[str, Any]:
+    """Which significance test decided for ``e`` (one ``test``, the plan's, decides by) and its statistic."""
+    return test.decided_by(e.test).to_json(e.wald, e.p_value) if e.test else {}
 
 
-def evidence_json(e: Evidence) -> dict[str, Any]:
-    """report.json's ``candidates`` entry of ``e``."""
+def evidence_json(e: Evidence, test: SignificanceTest) -> dict[str, Any]:
+    """report.json's ``candidates`` entry of ``e``, judged by the plan's ``test``."""
     out: dict[str, Any] = {"id": e.effect, "status": e.status, "reason": e.reason}
     if np.isfinite(e.gain):
         out |= {"gain_sigma2": round(float(e.gain), 2), "threshold_sigma2": float(e.threshold)}
-    out |= significance_json(e)
+    out |= significance_json(e, test)
     if e.value is not None and e.effect in DETERMINISTIC and (name := term(e.effect).param):
         out[name] = float(e.value)
     return out

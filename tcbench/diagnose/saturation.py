@@ -6,45 +6,39 @@ extreme: many samples at (or within a tiny tolerance of) the maximum, where an u
 output has one maximum and its density falls towards it. :func:`find_saturation` tests each side:
 
 - **top cell**: the samples within ``tol`` of the extreme value, ``tol`` half the output's
-  lattice step when it is quantised, else :data:`TOL_SIGMA` white sigmas (so a clip followed by
+  lattice step when it is quantised, else ``tol_sigma`` white sigmas (so a clip followed by
   a little rounding is still one level);
 - **next cell**: the samples in the adjacent ``h`` below it (above it for a floor), ``h`` one
-  lattice step or :data:`NEXT_SIGMA` white sigmas, whichever is larger;
+  lattice step or ``next_sigma`` white sigmas, whichever is larger;
 - **test**: without clipping, the density of the output near its extreme is at most
-  :data:`RATIO` times its density in the next cell (a noisy output's density falls towards its
+  ``density_ratio`` times its density in the next cell (a noisy output's density falls towards its
   extreme; even a noise-free sine on a lattice, whose density rises towards its peak, puts at most
   about 2.4 times the next level's count on its top level). So of the samples in the two cells
-  the top one holds a fraction ``p0 = RATIO w_top / (RATIO w_top + h)`` at most (``w_top`` =
+  the top one holds a fraction ``p0 = ratio w_top / (ratio w_top + h)`` at most (``w_top`` =
   ``tol`` for a continuous output, one step on a lattice: 0.012 and 0.75). Clipping is called when
-  the top cell holds at least :data:`MIN_COUNT` samples and a binomial test rejects ``p0`` at
-  :data:`ALPHA` / 2 per side (1 % family-wise).
+  the top cell holds at least ``min_count`` samples and a binomial test rejects ``p0`` at
+  ``alpha`` / 2 per side (1 % family-wise).
 
 The clipped samples, and the unclipped ones between clipped samples less than
-:data:`EPISODE_GAP` samples apart (they are the truncated lower part of the same distribution,
+``episode_gap_samples`` samples apart (they are the truncated lower part of the same distribution,
 biased away from the clip), get zero weight in every fit (:func:`~tcbench.diagnose.outliers.without`),
-unless that would remove more than :data:`MAX_EPISODE_FRACTION` of the record, in which case only
+unless that would remove more than ``max_episode_share`` of the record, in which case only
 the clipped samples are. ``model.yaml`` gets ``saturation: {upper, lower}`` so that
-``tcbench simulate model=`` clips its output the same way.
+``tcbench simulate model=`` clips its output the same way. The numbers are
+:class:`~tcbench.diagnose.settings.SaturationSettings`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy.stats import binom
 
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.settings import DEFAULTS, SaturationSettings
 from tcbench.diagnose.signals import DiagnosisData
-
-ALPHA = 0.01  # family-wise over the two sides
-RATIO = 3.0  # density at the extreme over the next cell's that an unclipped output can reach
-MIN_COUNT = 5  # samples at the clip level at least
-TOL_SIGMA = 1e-3  # white sigmas: the tolerance of the clip level for a continuous output
-NEXT_SIGMA = 0.25  # white sigmas: the width of the cell next to the clip level
-EPISODE_GAP = 30  # samples: clipped samples closer than this belong to one episode
-MAX_EPISODE_FRACTION = 0.5  # episodes wider than this fraction of the record: drop only the clipped samples
 
 EXPLANATION = ("the output is held at a flat ceiling or floor: the sensor's measurement range, the converter "
                "at full scale (ADC clipping), or a digital filter's accumulator overflowing; the clipped "
@@ -68,7 +62,8 @@ class Side:
 @dataclass(frozen=True)
 class Saturation:
     """Saturation of one record: the sides found (``upper``/``lower``, None if not clipped),
-    the indices given zero weight, the clipped ones' temperature band (degC) and time span (s)."""
+    the indices given zero weight, the clipped ones' temperature band (degC) and time span (s),
+    and the settings of the test."""
 
     upper: Side | None
     lower: Side | None
@@ -76,6 +71,7 @@ class Saturation:
     clipped: int
     temperature_c: tuple[float, float] | None
     time_s: tuple[float, float] | None
+    settings: SaturationSettings = field(default=DEFAULTS.screens.saturation, repr=False)
 
     @property
     def found(self) -> bool:
@@ -99,10 +95,10 @@ class Saturation:
             where=where,
             evidence={"sides": {k: {"count": s.count, "next_count": s.next_count, "p_value": float(s.p_value)}
                                 for k, s in sides.items()},
-                      "density_ratio_bound": RATIO, "false_alarm": ALPHA,
+                      "density_ratio_bound": self.settings.density_ratio, "false_alarm": self.settings.alpha,
                       "time_s": [round(self.time_s[0], 3), round(self.time_s[1], 3)] if self.time_s else None,
                       "test": "samples at the extreme value against the adjacent cell: binomial test against "
-                              f"a density at most {RATIO:g} times the adjacent one's"},
+                              f"a density at most {self.settings.density_ratio:g} times the adjacent one's"},
             explanation=f"the output is clipped at {said}"
                         + (f", between {self.temperature_c[0]:.3g} and {self.temperature_c[1]:.3g} degC"
                            if self.temperature_c else "") + ": " + EXPLANATION,
@@ -110,49 +106,52 @@ class Saturation:
         )
 
 
-def _side(y: np.ndarray, tol: float, width: float, h: float, alpha: float) -> tuple[Side, np.ndarray] | None:
+def _side(y: np.ndarray, tol: float, width: float, h: float, alpha: float, settings: SaturationSettings
+          ) -> tuple[Side, np.ndarray] | None:
     """The clipped side at the maximum of ``y`` (samples within ``tol``, a cell ``width`` wide
-    against the next ``h``), or None."""
+    against the next ``h``) at level ``alpha``, or None."""
     level = float(np.max(y))
     at = y >= level - tol
     count = int(at.sum())
     next_count = int(np.count_nonzero((y < level - tol) & (y >= level - tol - h)))
-    p0 = RATIO * width / (RATIO * width + h)
+    ratio = settings.density_ratio
+    p0 = ratio * width / (ratio * width + h)
     p_value = float(binom.sf(count - 1, count + next_count, p0))
-    if count < MIN_COUNT or p_value >= alpha:
+    if count < settings.min_count or p_value >= alpha:
         return None
     return Side(level, count, next_count, p_value), at
 
 
-def find_saturation(data: DiagnosisData, step: float = 0.0, *, alpha: float = ALPHA) -> Saturation:
+def find_saturation(data: DiagnosisData, step: float = 0.0, *,
+                    settings: SaturationSettings = DEFAULTS.screens.saturation) -> Saturation:
     """Clipping of ``data.output`` at its maximum and/or minimum (see the module doc); ``step``
     is the output's lattice step (output unit, 0 when it is not quantised)."""
     y = np.asarray(data.output, dtype=float)
     sigma = float(data.white_sigma)
-    tol = max(0.5 * step, TOL_SIGMA * sigma, 1e-12 * float(np.max(np.abs(y))))
-    h = max(step, NEXT_SIGMA * sigma)
+    tol = max(0.5 * step, settings.tol_sigma * sigma, 1e-12 * float(np.max(np.abs(y))))
+    h = max(step, settings.next_sigma * sigma)
     width = 2.0 * tol if step > 0 else tol
-    upper = _side(y, tol, width, h, 0.5 * alpha)
-    lower = _side(-y, tol, width, h, 0.5 * alpha)
+    upper = _side(y, tol, width, h, 0.5 * settings.alpha, settings)
+    lower = _side(-y, tol, width, h, 0.5 * settings.alpha, settings)
     clipped = np.zeros(y.size, dtype=bool)
     for side in (upper, lower):
         if side is not None:
             clipped |= side[1]
     if not clipped.any():
-        return Saturation(None, None, np.zeros(0, dtype=np.int64), 0, None, None)
+        return Saturation(None, None, np.zeros(0, dtype=np.int64), 0, None, None, settings)
     hits = np.flatnonzero(clipped)
     episode = clipped.copy()
-    close = np.diff(hits) < EPISODE_GAP
+    close = np.diff(hits) < settings.episode_gap_samples
     starts, ends = hits[:-1][close], hits[1:][close]
     if starts.size:  # fill each short gap between clipped samples (vectorised by a difference array)
         mark = np.zeros(y.size + 1, dtype=np.int64)
         np.add.at(mark, starts, 1)
         np.add.at(mark, ends, -1)
         episode |= np.cumsum(mark[:-1]) > 0
-    index = np.flatnonzero(episode if episode.mean() <= MAX_EPISODE_FRACTION else clipped)
+    index = np.flatnonzero(episode if episode.mean() <= settings.max_episode_share else clipped)
     lower_side = Side(-lower[0].level, lower[0].count, lower[0].next_count, lower[0].p_value) if lower else None
     return Saturation(
         upper[0] if upper else None, lower_side, index, int(hits.size),
         (float(data.temp_c[hits].min()), float(data.temp_c[hits].max())),
-        (float(data.t_s[hits].min()), float(data.t_s[hits].max())),
+        (float(data.t_s[hits].min()), float(data.t_s[hits].max())), settings,
     )

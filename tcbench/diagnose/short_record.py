@@ -11,20 +11,21 @@ samples and temperature allow and lists, with the duration each needs, the ones 
 The thermometer is smoothed as in a diagnosis (:func:`~tcbench.diagnose.signals.fitted_window_s`
 over at most the default window); the input, when it varies, is a column of every fit; the
 step found, when significant, is a column of the slope's fit and both are removed from the
-residual the noise test reads.
+residual the noise test reads. The numbers are the settings' ``short`` section
+(:class:`~tcbench.diagnose.settings.ShortSettings`), with the plan's and the smoothing's for what a
+full diagnosis needs.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.plan import FOLDS, min_full_duration_s
+from tcbench.diagnose.plan import min_full_duration_s
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.short_tests import (
-    ALPHA,
-    MIN_FIT_SAMPLES,
     NOT_RUN,
     SIGNIFICANT,
     ShortTest,
@@ -33,24 +34,21 @@ from tcbench.diagnose.short_tests import (
     temperature_slope,
     white_noise,
 )
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, MAD_TO_SIGMA, fitted_window_s, smooth_temperature
+from tcbench.diagnose.signals import MAD_TO_SIGMA, fitted_window_s, smooth_temperature
 from tcbench.diagnose.terms.temperature_shapes import NODE_SPANS, NODE_TAU_S
 from tcbench.sensors import kinds
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 
-MIN_SLOPE_SPAN_C = 0.5  # a temperature slope needs the smoothed thermometer to move this much
-RAMP_SHARE = 0.5  # a ramp starts where |dT/dt| rises through this share of its largest value
-ONE_WAY_CORR = 0.9  # |corr(time, temperature)| above which a temperature slope is also a drift in time
 DRIFT = ("a drift in time (ageing, warm-up, a random walk): the temperature moves one way on this record; "
          "one that heats and cools tells them apart")
-SEED = 0  # the surrogates' generator: a report is repeatable
+_WORDS = {1: "one", 2: "two", 3: "three", 4: "four"}  # a small count in words
 
 
 @dataclass
 class ShortRecordReport:
     """The report of a short record: the tests run (:class:`~tcbench.diagnose.short_tests.ShortTest`)
-    and those it needs more time for (``{id, needs_s, what}``)."""
+    and those it needs more time for (``{id, needs_s, what}``), and the settings they ran with."""
 
     sensor: str
     unit: str
@@ -63,10 +61,11 @@ class ShortRecordReport:
     ramp_starts_s: list[float]
     tests: list[ShortTest]
     needs_more_time: list[dict[str, Any]]
+    settings: DiagnoseSettings = field(default=DEFAULTS, repr=False)
 
     @property
     def full_duration_s(self) -> float:
-        return min_full_duration_s()
+        return min_full_duration_s(self.settings)
 
     @property
     def ran(self) -> list[str]:
@@ -97,7 +96,7 @@ class ShortRecordReport:
             "verdict": self.verdict, "duration_s": self.duration_s, "samples": self.samples,
             "sample_rate_hz": self.sample_rate_hz, "temperature_span_c": self.temperature_span_c,
             "thermometer_smooth_s": self.smooth_s, "ramp_starts_s": self.ramp_starts_s,
-            "full_diagnosis_needs_s": self.full_duration_s, "level": ALPHA,
+            "full_diagnosis_needs_s": self.full_duration_s, "level": self.settings.short.alpha,
             "tests": [t.to_json() for t in self.tests], "needs_more_time": self.needs_more_time,
         }
 
@@ -116,16 +115,18 @@ class ShortRecordReport:
         return out
 
 
-def needs_more_time(duration_s: float) -> list[dict[str, Any]]:
+def needs_more_time(duration_s: float, settings: DiagnoseSettings = DEFAULTS) -> list[dict[str, Any]]:
     """What a full diagnosis would test and the record length each needs, for a record of ``duration_s``."""
-    full = min_full_duration_s()
+    full = min_full_duration_s(settings)
+    folds, window_s = settings.plan.folds, settings.smoothing.default_window_s
     node = max(full, NODE_SPANS * float(NODE_TAU_S[0]))
     rows = [
         {"id": "effect_attribution", "needs_s": full,
          "what": (f"the full diagnosis (thermal lag, hysteresis, warm-up, ageing, temperature rate, cubic, "
                   f"nonlinearity, bias instability, the open-world terms, saturation, quantisation, outliers), "
-                  f"each scored held out by {FOLDS}-fold blocked cross-validation: {FOLDS} folds of one block of "
-                  f"two {DEFAULT_SMOOTH_S:g}-s thermometer-smoothing windows")},
+                  f"each scored held out by {folds}-fold blocked cross-validation: {folds} folds of one block of "
+                  f"{_WORDS.get(settings.plan.block_windows, f'{settings.plan.block_windows:g}')} {window_s:g}-s "
+                  "thermometer-smoothing windows")},
         {"id": "second_node", "needs_s": node,
          "what": f"a second thermal node: more than {NODE_SPANS:g} times its shortest time constant "
                  f"({NODE_TAU_S[0]:g} s)"},
@@ -133,12 +134,13 @@ def needs_more_time(duration_s: float) -> list[dict[str, Any]]:
     return [r for r in rows if duration_s < r["needs_s"]]
 
 
-def ramp_starts(t_s: np.ndarray, rate_c_per_s: np.ndarray) -> np.ndarray:
-    """Times where |dT/dt| rises through :data:`RAMP_SHARE` of its largest value."""
+def ramp_starts(t_s: np.ndarray, rate_c_per_s: np.ndarray, ramp_share: float = DEFAULTS.short.ramp_share
+                ) -> np.ndarray:
+    """Times where |dT/dt| rises through ``ramp_share`` of its largest value."""
     a = np.abs(rate_c_per_s)
     if a.size < 2 or not a.max() > 0:
         return np.empty(0)
-    above = a >= RAMP_SHARE * a.max()
+    above = a >= ramp_share * a.max()
     return t_s[np.flatnonzero(above[1:] & ~above[:-1]) + 1]
 
 
@@ -152,43 +154,46 @@ def _white_sigma(y: np.ndarray, same: np.ndarray) -> float:
     return sigma if sigma > 0 else float(np.sqrt(np.mean(d * d) / 2.0))
 
 
-def short_record(rec: Recording, sensor: str | None = None, name: str = "") -> ShortRecordReport:
-    """The tests ``rec`` supports (see module doc), whatever its length."""
+def short_record(rec: Recording, sensor: str | None = None, name: str = "",
+                 settings: DiagnoseSettings = DEFAULTS) -> ShortRecordReport:
+    """The tests ``rec`` supports (see module doc), whatever its length, with ``settings``."""
+    short, default_s = settings.short, settings.smoothing.default_window_s
     kind = str(sensor or rec.meta.sensor)
     unit = str((rec.meta.units or {}).get("output", kinds.get(kind).output_unit))
     t, temp, u, y = rec.time_s, rec.temperature_c, rec.input, rec.output
     n = t.size
     duration_s = float(t[-1] - t[0]) if n else 0.0
     rate_hz = float(rec.meta.sample_rate_hz or (1.0 / np.median(np.diff(t)) if n > 1 else 1.0))
-    window_s = fitted_window_s(t, temp, DEFAULT_SMOOTH_S) if n > 1 else DEFAULT_SMOOTH_S
+    window_s = fitted_window_s(t, temp, default_s, settings.smoothing.bias_to_noise) if n > 1 else default_s
     temp_s, rate = smooth_temperature(t, temp, window_s) if n > 1 else (temp, np.zeros(n))
     span_c = float(np.ptp(temp_s)) if n else 0.0
     moves = n > 1 and np.ptp(u) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
     same = (np.diff(segments(t)) == 0) & (np.abs(np.diff(u)) <= 1e-9 * max(1.0, float(np.max(np.abs(u)))))
     sigma = _white_sigma(y, same) if n > 1 else 0.0
     columns = [np.ones(n), *([u] if moves else [])]
-    starts = ramp_starts(t, rate) if span_c >= MIN_SLOPE_SPAN_C else np.empty(0)
-    slope_ok = span_c >= MIN_SLOPE_SPAN_C
+    starts = ramp_starts(t, rate, short.ramp_share) if span_c >= short.min_slope_span_c else np.empty(0)
+    slope_ok = span_c >= short.min_slope_span_c
     base = np.column_stack([*columns, *([temp_s - temp_s.mean()] if slope_ok else [])])
-    step, step_column = level_step(t, y, base, np.random.default_rng(SEED), sigma)
+    step, step_column = level_step(t, y, base, np.random.default_rng(short.seed), sigma, short,
+                                   settings.surrogate.draws)
     if step.ran and starts.size:
         gap = float(np.min(np.abs(starts - step.values["time_s"])))
         step.values |= {"nearest_ramp_start_s": float(starts[np.argmin(np.abs(starts - step.values["time_s"]))]),
                         "at_ramp_start": gap <= window_s / 2.0}
     others = np.column_stack([*columns, *([step_column] if step_column is not None else [])])
-    if slope_ok or n < MIN_FIT_SAMPLES:
-        slope = temperature_slope(temp_s, y, others)
-        if slope.ran and abs(float(np.corrcoef(t, temp_s)[0, 1])) > ONE_WAY_CORR:
+    if slope_ok or n < short.min_fit_samples:
+        slope = temperature_slope(temp_s, y, others, short)
+        if slope.ran and abs(float(np.corrcoef(t, temp_s)[0, 1])) > short.one_way_corr:
             slope.values["confusable_with"] = DRIFT
     else:
         slope = ShortTest("temperature_slope", "slope of the output against temperature", NOT_RUN,
-                          reason=f"needs the temperature to change by {MIN_SLOPE_SPAN_C:g} degC; "
+                          reason=f"needs the temperature to change by {short.min_slope_span_c:g} degC; "
                                  f"this record's changes by {span_c:.3g} degC")
     fit = np.column_stack([others, *([temp_s] if slope_ok else [])])
     q = basis(fit) if n else fit
     residual = y - q @ (q.T @ y)
-    noise = white_noise(t, residual, sigma, rate_hz)
+    noise = white_noise(t, residual, sigma, rate_hz, short.alpha, settings.locate.min_allan_samples)
     return ShortRecordReport(
         sensor=kind, unit=unit, recording=name, duration_s=duration_s, samples=int(n), sample_rate_hz=rate_hz,
         temperature_span_c=span_c, smooth_s=float(window_s), ramp_starts_s=[float(s) for s in starts],
-        tests=[slope, step, noise], needs_more_time=needs_more_time(duration_s))
+        tests=[slope, step, noise], needs_more_time=needs_more_time(duration_s, settings), settings=settings)

@@ -7,7 +7,7 @@
   interval. Along a one-way ramp it is also a drift in time: the report says so.
 - **level step** (:func:`level_step`): the one step of the output's level, under the same
   temperature slope, that lowers the squared error most, searched at every sample at least
-  :data:`MIN_SIDE_SAMPLES` (and :data:`SIDE_SHARE` of the record) from either end. The search is
+  ``min_side_samples`` (and ``side_share`` of the record) from either end. The search is
   exact and O(n): with ``e`` the residual of the base fit (orthonormal basis ``Q``) and ``H_k``
   the step at sample ``k``, the drop is ``(sum_{i>=k} e_i)^2 / (n - k - |sum_{i>=k} Q_i|^2)``.
   The step found is studentised, ``t^2 = (size / se)^2`` with the spectral standard error, and
@@ -25,6 +25,7 @@
   the white line (:func:`tcbench.diagnose.locate.allan_excess`).
 
 Each returns a :class:`ShortTest`; a test the record cannot support is ``not run`` with the reason.
+The level, the fewest samples and the step's margins are :class:`~tcbench.diagnose.settings.ShortSettings`.
 """
 
 from __future__ import annotations
@@ -35,13 +36,11 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.locate import allan_excess, why_no_allan
+from tcbench.diagnose.settings import DEFAULTS, ShortSettings
 from tcbench.diagnose.spectral_se import SpectralError, spectral_error
-from tcbench.diagnose.surrogate import CHUNK, DRAWS, phase_surrogates
+from tcbench.diagnose.surrogate import CHUNK, phase_surrogates
 
-ALPHA = 0.01  # level of every short-record test; intervals are 1 - ALPHA
-MIN_FIT_SAMPLES = 30  # a slope and its noise's autocorrelation need at least this many samples
-MIN_SIDE_SAMPLES = 15  # a level step is searched this many samples (at least) from either end
-SIDE_SHARE = 0.05  # ... and this share of the record: a step at the very edge is the edge's noise
+SHORT = DEFAULTS.short
 SIGNIFICANT, NOT_SIGNIFICANT, NOT_RUN = "significant", "not significant", "not run"
 WHITE, NOT_WHITE = "white", "excess over white noise"
 
@@ -79,13 +78,14 @@ def _interval(value: float, err: SpectralError, alpha: float) -> dict[str, float
     return {"se": err.se, "ci_low": value - half, "ci_high": value + half, "ci_level": 1.0 - alpha, "dof": err.dof}
 
 
-def temperature_slope(temp_c: np.ndarray, y: np.ndarray, others: np.ndarray, alpha: float = ALPHA) -> ShortTest:
-    """The slope of ``y`` against ``temp_c`` beside the columns ``others`` (n, p)."""
+def temperature_slope(temp_c: np.ndarray, y: np.ndarray, others: np.ndarray,
+                      settings: ShortSettings = SHORT) -> ShortTest:
+    """The slope of ``y`` against ``temp_c`` beside the columns ``others`` (n, p), at ``settings.alpha``."""
     what = "slope of the output against temperature (standard error from the residual's spectrum)"
-    n = y.size
-    if n < MIN_FIT_SAMPLES:
+    n, alpha = y.size, settings.alpha
+    if n < settings.min_fit_samples:
         return ShortTest("temperature_slope", what, NOT_RUN,
-                         reason=f"needs at least {MIN_FIT_SAMPLES} samples; this record has {n}")
+                         reason=f"needs at least {settings.min_fit_samples} samples; this record has {n}")
     q = basis(others)
     x = temp_c - q @ (q.T @ temp_c)
     sxx = float(x @ x)
@@ -99,16 +99,17 @@ def temperature_slope(temp_c: np.ndarray, y: np.ndarray, others: np.ndarray, alp
     return ShortTest("temperature_slope", what, SIGNIFICANT if p <= alpha else NOT_SIGNIFICANT, values)
 
 
-def _side(n: int) -> int:
-    return max(MIN_SIDE_SAMPLES, int(np.ceil(SIDE_SHARE * n)))
+def _side(n: int, settings: ShortSettings) -> int:
+    return max(settings.min_side_samples, int(np.ceil(settings.side_share * n)))
 
 
-def why_no_step(n: int) -> str | None:
+def why_no_step(n: int, settings: ShortSettings = SHORT) -> str | None:
     """Why a record of ``n`` samples cannot be searched for a level step, or None."""
-    need = 2 * MIN_SIDE_SAMPLES + 1
+    need = 2 * settings.min_side_samples + 1
     if n >= need:
         return None
-    return f"needs at least {need} samples ({MIN_SIDE_SAMPLES} on either side of a step); this record has {n}"
+    return (f"needs at least {need} samples ({settings.min_side_samples} on either side of a step); this record "
+            f"has {n}")
 
 
 def step_drops(q: np.ndarray, e: np.ndarray, lo: int, hi: int) -> np.ndarray:
@@ -150,15 +151,17 @@ def _best_step(q: np.ndarray, e: np.ndarray, k: int) -> _Step:
 
 
 def level_step(t_s: np.ndarray, y: np.ndarray, base: np.ndarray, rng: np.random.Generator, sigma: float,
-               alpha: float = ALPHA, draws: int = DRAWS) -> tuple[ShortTest, np.ndarray | None]:
+               settings: ShortSettings = SHORT, draws: int = DEFAULTS.surrogate.draws
+               ) -> tuple[ShortTest, np.ndarray | None]:
     """The largest level step of ``y`` beside the columns ``base`` (n, p), its size, interval and
-    search-wide p-value; with the step's column (n,) when it is significant."""
+    search-wide p-value (at most ``draws`` surrogates, at ``settings.alpha``); with the step's
+    column (n,) when it is significant."""
     what = "one step of the output's level, searched at every sample (surrogate p-value of the search)"
-    n = y.size
-    why = why_no_step(n)
+    n, alpha = y.size, settings.alpha
+    why = why_no_step(n, settings)
     if why is not None:
         return ShortTest("level_step", what, NOT_RUN, reason=why), None
-    side = _side(n)
+    side = _side(n, settings)
     q = basis(base)
     e = y - q @ (q.T @ y)
     found = _best_step(q, e, side + int(np.argmax(step_drops(q, e[:, None], side, n - side)[:, 0])))
@@ -185,13 +188,13 @@ def level_step(t_s: np.ndarray, y: np.ndarray, base: np.ndarray, rng: np.random.
 
 
 def white_noise(t_s: np.ndarray, residual: np.ndarray, sigma: float, sample_rate_hz: float,
-                alpha: float = ALPHA) -> ShortTest:
+                alpha: float = SHORT.alpha, min_allan_samples: int = DEFAULTS.locate.min_allan_samples) -> ShortTest:
     """The white sigma and density of the output and the residual's Allan deviation against the
-    white line at the taus the record allows."""
+    white line at the taus the record allows (from ``min_allan_samples`` samples), at ``alpha``."""
     what = "white-noise level: sigma from first differences, Allan deviation against the white line"
     values: dict[str, Any] = {"white_sigma": sigma, "density_per_sqrt_hz": sigma / float(np.sqrt(sample_rate_hz))}
-    why = why_no_allan(t_s)
-    ex = None if why else allan_excess(t_s, residual, sigma, alpha, estimated=True)
+    why = why_no_allan(t_s, min_allan_samples)
+    ex = None if why else allan_excess(t_s, residual, sigma, alpha, estimated=True, min_samples=min_allan_samples)
     if ex is None:
         return ShortTest("white_noise", what, NOT_RUN, values, reason=why or "no Allan deviation on this record")
     values |= {"tau_s": ex.tau_s.tolist(), "allan_deviation": ex.adev.tolist(), "white_line": ex.white.tolist(),

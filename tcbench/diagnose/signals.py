@@ -16,13 +16,13 @@ from itertools import pairwise
 import numpy as np
 from scipy.signal import lfilter, oaconvolve, savgol_coeffs, savgol_filter
 
+from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors import kinds
 from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 
 MAD_TO_SIGMA = 1.4826
-DEFAULT_SMOOTH_S = 120.0  # the thermometer smoothing window (s) of a record without a coarse staircase
 GRID_S = 1.0  # clock of the lag filter and the play operator
 MAX_GRID_SAMPLES = 5_000_000  # that clock over the recording: 58 days at 1 s
 
@@ -122,12 +122,10 @@ def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
     return value, rate
 
 
-BIAS_TO_NOISE = 0.5  # the window halves while the smoothing's RMS bias exceeds this share of its noise
-
-
-def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> float:
+def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
+                    bias_to_noise: float = DEFAULTS.smoothing.bias_to_noise) -> float:
     """The thermometer smoothing window fitted to the profile's time scales: ``window_s`` halved
-    while the bias it puts on the smoothed temperature exceeds :data:`BIAS_TO_NOISE` of the
+    while the bias it puts on the smoothed temperature exceeds ``bias_to_noise`` of the
     thermometer noise it leaves (a deterministic error, e.g. at the corners of a fast ramp
     through a short package lag, is read by the output's temperature and acceleration terms as
     structure; the noise is accounted for by :mod:`tcbench.diagnose.thermometer`). A quadratic
@@ -155,7 +153,7 @@ def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> flo
         noise_wide = sigma_c * smooth_temperature(t_s, white, w)[0]
         noise_narrow = sigma_c * smooth_temperature(t_s, white, w / 2.0)[0]
         bias2 = np.mean((wide - narrow) ** 2) - np.mean((noise_wide - noise_narrow) ** 2)
-        if bias2 <= (BIAS_TO_NOISE * (15.0 / 16.0)) ** 2 * np.mean(noise_wide**2):
+        if bias2 <= (bias_to_noise * (15.0 / 16.0)) ** 2 * np.mean(noise_wide**2):
             break
         w /= 2.0
     return w
@@ -232,10 +230,10 @@ def prepare(
     rec: Recording,
     sensor: str | None = None,
     *,
-    smooth_s: float = 120.0,
+    smooth_s: float = DEFAULTS.smoothing.default_window_s,
     min_duration_s: float = 0.0,
-    min_span_c: float = 2.0,
-    min_samples: int = 200,
+    min_span_c: float = DEFAULTS.data.min_span_c,
+    min_samples: int = DEFAULTS.data.min_samples,
 ) -> DiagnosisData:
     """Arrays for diagnosing ``rec``; ``sensor`` overrides the sidecar's kind.
 

@@ -1,25 +1,27 @@
 """The significance tests an effect with a gain above the threshold must pass, as objects.
 
 :class:`~tcbench.diagnose.plan.StatsPlan` holds the one a recording supports
-(:func:`~tcbench.diagnose.plan.plan_for`); the forward selection asks it through
-:meth:`SignificanceTest.judge`, and every :class:`~tcbench.diagnose.evidence.Evidence` names the
-test that decided by its :attr:`~SignificanceTest.name` (report.json's ``test`` and
-``statistics.significance_test``):
+(:func:`~tcbench.diagnose.plan.plan_for`, from the settings' thresholds and level); the forward
+selection asks it through :meth:`SignificanceTest.judge`, and every
+:class:`~tcbench.diagnose.evidence.Evidence` names the test that decided by its
+:attr:`~SignificanceTest.name` (report.json's ``test`` and ``statistics.significance_test``);
+:meth:`SignificanceTest.decided_by` finds that test again from the plan's:
 
-- :class:`RobustWald`: the cluster-robust Wald statistic above the Wald threshold; an effect that
+- :class:`RobustWald`: the cluster-robust Wald statistic above its threshold; an effect that
   removes most of the held-out error above the noise and fails it is tried by the surrogate test
   instead (its cluster variance then counts the structure still unexplained as noise);
 - :class:`SpectralSurrogate`: the parametric bootstrap of :mod:`tcbench.diagnose.surrogate`, at
-  p <= its ``LEVEL``.
+  p <= its settings' ``level``.
 """
 
 from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol
 
-from tcbench.diagnose.surrogate import LEVEL
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, SurrogateSettings
 
 ROBUST_WALD = "cluster-robust Wald"
 SURROGATE = "spectral surrogate (parametric bootstrap)"
@@ -32,7 +34,8 @@ class Scorer(Protocol):
 
     def removes_most(self, base: Any, model: Any) -> bool: ...
 
-    def surrogate_p(self, base: Any, effect: str, value: Any, searched: list[Any] | None = None) -> float: ...
+    def surrogate_p(self, base: Any, effect: str, value: Any, searched: list[Any] | None,
+                    settings: SurrogateSettings) -> float: ...
 
 
 class SignificanceTest(ABC):
@@ -40,13 +43,17 @@ class SignificanceTest(ABC):
 
     name: ClassVar[str]
 
-    def __reduce__(self) -> tuple[Any, tuple[str]]:
-        return named, (self.name,)  # one object per test, also across processes
-
     @abstractmethod
-    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float, wald_threshold: float,
+    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float,
               searched: list[Any] | None = None) -> Judgement:
         """Adding ``effect`` at ``value`` to the model ``base``, whose robust Wald statistic is ``wald``."""
+
+    def decided_by(self, name: str) -> SignificanceTest:
+        """The test named ``name`` (an evidence's ``test``) that this one decides by: itself, or
+        the test it hands an effect to."""
+        if name != self.name:
+            raise KeyError(f"{self.name} does not decide by {name!r}")
+        return self
 
     def why_not(self, p: float) -> str:
         """Why an effect with a gain above the threshold was rejected (surrogate p-value ``p``)."""
@@ -60,45 +67,49 @@ class SignificanceTest(ABC):
         return out
 
 
+@dataclass(frozen=True)
 class SpectralSurrogate(SignificanceTest):
-    """The surrogate test (:func:`~tcbench.diagnose.surrogate.surrogate_test`) at p <= ``LEVEL``."""
+    """The surrogate test (:func:`~tcbench.diagnose.surrogate.surrogate_test`) at p <= ``settings.level``."""
 
-    name = SURROGATE
+    settings: SurrogateSettings = DEFAULTS.surrogate
+    name: ClassVar[str] = SURROGATE
 
-    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float, wald_threshold: float,
+    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float,
               searched: list[Any] | None = None) -> Judgement:
-        p = scorer.surrogate_p(base, effect, value, searched)
-        return p <= LEVEL, wald, p, self.name
+        p = scorer.surrogate_p(base, effect, value, searched, self.settings)
+        return p <= self.settings.level, wald, p, self.name
 
     def why_not(self, p: float) -> str:
         return (f"not significant against the residual's slow noise (surrogate test p = {p:.3g} above "
-                f"{LEVEL:g})")
+                f"{self.settings.level:g})")
 
     def to_json(self, wald: float, p: float) -> dict[str, Any]:
         out = super().to_json(wald, p)
         if math.isfinite(p):
-            out |= {"p_value": round(float(p), 4), "level": LEVEL}
+            out |= {"p_value": round(float(p), 4), "level": self.settings.level}
         return out
 
 
+@dataclass(frozen=True)
 class RobustWald(SignificanceTest):
-    """The cluster-robust Wald statistic above ``wald_threshold``; the surrogate test decides for
-    an effect that removes most of the excess held-out error and fails it."""
+    """The cluster-robust Wald statistic above ``wald_threshold``; the ``surrogate`` test decides
+    for an effect that removes most of the excess held-out error and fails it."""
 
-    name = ROBUST_WALD
+    wald_threshold: float = DEFAULTS.selection.wald_threshold
+    surrogate: SpectralSurrogate = field(default_factory=SpectralSurrogate)
+    name: ClassVar[str] = ROBUST_WALD
 
-    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float, wald_threshold: float,
+    def judge(self, scorer: Scorer, base: Any, effect: str, value: Any, wald: float,
               searched: list[Any] | None = None) -> Judgement:
-        if wald > wald_threshold or not scorer.removes_most(base, base.with_effect(effect, value)):
-            return wald > wald_threshold, wald, float("nan"), self.name
-        return SURROGATE_TEST.judge(scorer, base, effect, value, wald, wald_threshold, searched)
+        if wald > self.wald_threshold or not scorer.removes_most(base, base.with_effect(effect, value)):
+            return wald > self.wald_threshold, wald, float("nan"), self.name
+        return self.surrogate.judge(scorer, base, effect, value, wald, searched)
+
+    def decided_by(self, name: str) -> SignificanceTest:
+        return self.surrogate if name == self.surrogate.name else super().decided_by(name)
 
 
-SURROGATE_TEST = SpectralSurrogate()
-ROBUST_WALD_TEST = RobustWald()
-TESTS: dict[str, SignificanceTest] = {t.name: t for t in (ROBUST_WALD_TEST, SURROGATE_TEST)}
-
-
-def named(name: str) -> SignificanceTest:
-    """The test whose :attr:`~SignificanceTest.name` is ``name`` (an evidence's ``test``)."""
-    return TESTS[name]
+def significance_tests(settings: DiagnoseSettings = DEFAULTS) -> tuple[RobustWald, SpectralSurrogate]:
+    """The robust Wald test and the surrogate test at ``settings``' Wald threshold and level."""
+    surrogate = SpectralSurrogate(settings.surrogate)
+    return RobustWald(settings.selection.wald_threshold, surrogate), surrogate

@@ -9,7 +9,8 @@ Each surrogate is added to the starting model's fit and the whole search is repe
 the statistic is the largest in-sample drop of squared error over every candidate value of the
 effect's nonlinear parameter, exactly as for the recording. The p-value is
 ``(1 + #{surrogate >= observed}) / (1 + draws)``; the draws stop as soon as the p-value is sure
-to exceed :data:`LEVEL` (then it is estimated from the draws made).
+to exceed the test's level (then it is estimated from the draws made); the draws and the level
+are the :class:`~tcbench.diagnose.settings.SurrogateSettings` given.
 
 Everything is linear least squares on fixed design matrices, so all surrogates are scored at
 once through the QR factor of each design (O(n p draws)). Time is the sample index (bursts are
@@ -22,8 +23,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-DRAWS = 199
-LEVEL = 0.005  # p-value at or below which the effect is kept: no surrogate reaches it (1 / (1 + DRAWS))
+from tcbench.diagnose.settings import DEFAULTS, SurrogateSettings
+
 CHUNK = 64  # surrogates scored together (memory n x CHUNK)
 
 
@@ -51,12 +52,13 @@ def surrogate_test(
     y: np.ndarray,
     noise: np.ndarray,
     rng: np.random.Generator,
-    draws: int = DRAWS,
+    settings: SurrogateSettings = DEFAULTS.surrogate,
 ) -> tuple[float, float]:
     """``(p_value, observed drop)`` of adding an effect to the model of design ``base_x``
     (n, p), the effect searched over the designs ``candidate_xs`` (one per value of its
     nonlinear parameter); ``noise`` is the null model's residual (output unit), ``y`` the
-    output. The drop is the largest in-sample SSE reduction, in output unit squared."""
+    output. The drop is the largest in-sample SSE reduction, in output unit squared; at most
+    ``settings.draws`` surrogates, stopped once the p-value is sure to exceed ``settings.level``."""
     qb = _basis(base_x)
     qall = np.ascontiguousarray(np.hstack([qb, *(_basis(x) for x in candidate_xs)]).T)  # (P, n)
     starts = np.cumsum([0, qb.shape[1], *(x.shape[1] for x in candidate_xs)])[:-1]
@@ -69,6 +71,7 @@ def surrogate_test(
 
     observed = float(drops(y[:, None])[0])
     fitted = qb @ (qb.T @ y)  # the starting model's fit: the null's deterministic part
+    draws, level = settings.draws, settings.level
     exceed = 0
     done = 0
     while done < draws:
@@ -76,6 +79,6 @@ def surrogate_test(
         ys = np.ascontiguousarray(fitted[:, None] + phase_surrogates(noise, m, rng))
         exceed += int(np.sum(drops(ys) >= observed))
         done += m
-        if (1.0 + exceed) / (1.0 + draws) > LEVEL:
+        if (1.0 + exceed) / (1.0 + draws) > level:
             break  # the verdict is settled; the p-value below is estimated from the draws made
     return (1.0 + exceed) / (1.0 + done), observed

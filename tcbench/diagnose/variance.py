@@ -11,49 +11,44 @@ Test (:func:`find_variance`), on the final model's in-sample residual ``r``:
    run of constant input, no farther apart than 1.5 sample intervals. Differencing removes the
    slow structure (a missed temperature term, flicker) that would otherwise look like scatter;
    non-overlapping pairs are independent under white noise, each ``d ~ N(0, 2 sigma^2)``.
-   ``|d|`` is clipped at :data:`CLIP` robust sigmas, so a residual glitch cannot make a block noisy.
-2. **Blocks**: consecutive pairs in ``B`` blocks of ``m`` or ``m + 1 >=`` :data:`MIN_PAIRS` pairs (at most
-   :data:`MAX_BLOCKS` blocks); ``v_b = log(mean d^2)`` per block, ``x_b`` its mean temperature
+   ``|d|`` is clipped at ``clip_sigma`` robust sigmas, so a residual glitch cannot make a block noisy.
+2. **Blocks**: consecutive pairs in ``B`` blocks of ``m`` or ``m + 1 >=`` ``min_pairs`` pairs (at most
+   ``max_blocks`` blocks); ``v_b = log(mean d^2)`` per block, ``x_b`` its mean temperature
    (or time).
 3. **F test**: regress ``v_b`` on ``[1, z, z^2]`` (``z`` the standardised temperature, or time)
    against a constant: ``F = ((RSS0 - RSS1) / 2) / (RSS1 / (B - 3))``, which follows ``F(2, B - 3)``
    under constant variance whatever the shape of the noise (its scatter is estimated from the
-   blocks themselves). Temperature and time each at :data:`ALPHA` / 2 (Bonferroni: 1 %
+   blocks themselves). Temperature and time each at ``alpha`` / 2 (Bonferroni: 1 %
    family-wise); when both pass, the one with the larger F names the finding. A record with
-   fewer than :data:`MIN_BLOCKS` blocks is not tested and says so.
+   fewer than ``min_blocks`` blocks is not tested and says so.
    **Size**: a significant change is reported only when the noisiest bin's sigma (step 4) is at
-   least :data:`MIN_SIGMA_RATIO` times the quietest's. A long record makes a few per cent
+   least ``min_sigma_ratio`` times the quietest's. A long record makes a few per cent
    significant (the concealed gyro with a thermal lag, seed 2: p = 0.004, sigma 0.0022 to 0.0024,
    a chance alarm at the 1 % level); such a change moves the held-out RMSE by well under 1 % and
    is not worth a model term. Under constant noise the bins' ratio scatters by about 5 % (8 bins
    of 50 blocks of 40 pairs).
-4. **Where**: the blocks in :data:`BINS` bins of equal count along temperature (time); the band
+4. **Where**: the blocks in ``bins`` bins of equal count along temperature (time); the band
    is the run of bins around the noisiest whose log-variance is above the midpoint of the
    noisiest and the quietest bin.
 5. **Model**: ``log sigma`` linear in temperature (time), its slope from the blocks' linear
    regression and its level from the pairs; ``model.yaml`` gets ``noise_temperature: {density,
    growth_per_c, ref_c}`` (or ``noise_time: {density, growth_per_h, ref_s}``) in place of
    ``white_noise``, so ``tcbench simulate model=`` draws noise of the same changing level.
+
+The numbers are :class:`~tcbench.diagnose.settings.VarianceSettings`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy.stats import f as f_dist
 
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.settings import DEFAULTS, VarianceSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA
-
-ALPHA = 0.01  # family-wise over the temperature and the time test
-MIN_PAIRS = 16  # pairs per block at least
-MAX_BLOCKS = 400
-MIN_BLOCKS = 12
-CLIP = 8.0  # robust sigmas at which a pair difference is clipped
-BINS = 8
-MIN_SIGMA_RATIO = 1.2  # noisiest over quietest bin's sigma below which a change is not reported
 
 EXPLANATION = {
     "temperature": ("the noise level changes with temperature: the resonator's quality factor and damping, the "
@@ -94,6 +89,7 @@ class Variance:
     sample_rate_hz: float
     reason: str = ""
     rms_sigma: float = 0.0  # per-sample RMS sigma over the record (output unit): the level sums of squares see
+    settings: VarianceSettings = field(default=DEFAULTS.screens.variance, repr=False)
 
     def model_effect(self) -> tuple[str, dict[str, float]] | None:
         """The effect id and parameters written to ``model.yaml`` in place of ``white_noise``."""
@@ -119,7 +115,7 @@ class Variance:
             where=where,
             evidence={"test": "F test of the blocks' log variance of paired differences on a quadratic in "
                               f"{test.against} against a constant",
-                      "f": round(test.f, 3), "p_value": float(test.p_value), "level": ALPHA / 2,
+                      "f": round(test.f, 3), "p_value": float(test.p_value), "level": self.settings.alpha / 2,
                       "blocks": self.blocks, "pairs_per_block": self.pairs_per_block,
                       "other": [{"against": t.against, "f": round(t.f, 3), "p_value": float(t.p_value)}
                                 for t in self.tests if t is not test]},
@@ -144,7 +140,7 @@ class Variance:
         if self.reason:
             return {"not_tested": self.reason}
         return {"blocks": self.blocks, "pairs_per_block": self.pairs_per_block,
-                "min_sigma_ratio": MIN_SIGMA_RATIO,
+                "min_sigma_ratio": self.settings.min_sigma_ratio,
                 "tests": {t.against: {"f": round(t.f, 3), "p_value": float(t.p_value),
                                       "sigma_ratio": round(t.sigma_band[1] / t.sigma_band[0], 4)} for t in self.tests}}
 
@@ -182,10 +178,10 @@ def _f_test(v: np.ndarray, x: np.ndarray) -> tuple[float, float, float]:
     return float(f), float(f_dist.sf(f, 2, dof)), slope
 
 
-def _band(v: np.ndarray, x: np.ndarray) -> tuple[tuple[float, float], np.ndarray, np.ndarray]:
-    """The noisiest band of ``x``, and the mean ``x`` and mean ``v`` of each of :data:`BINS` bins."""
+def _band(v: np.ndarray, x: np.ndarray, n_bins: int) -> tuple[tuple[float, float], np.ndarray, np.ndarray]:
+    """The noisiest band of ``x``, and the mean ``x`` and mean ``v`` of each of ``n_bins`` bins."""
     order = np.argsort(x, kind="stable")
-    bins = np.array_split(order, BINS)
+    bins = np.array_split(order, n_bins)
     level = np.array([v[b].mean() for b in bins])
     centre = np.array([x[b].mean() for b in bins])
     lo_x = np.array([x[b].min() for b in bins])
@@ -194,26 +190,26 @@ def _band(v: np.ndarray, x: np.ndarray) -> tuple[tuple[float, float], np.ndarray
     above = level >= 0.5 * (level.max() + level.min())
     breaks = np.flatnonzero(~above)
     left = int(breaks[breaks < top].max() + 1) if (breaks < top).any() else 0
-    right = int(breaks[breaks > top].min() - 1) if (breaks > top).any() else BINS - 1
+    right = int(breaks[breaks > top].min() - 1) if (breaks > top).any() else n_bins - 1
     return (float(lo_x[left]), float(hi_x[right])), centre, level
 
 
 def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run_id: np.ndarray,
-                  sample_rate_hz: float, *, alpha: float = ALPHA) -> Variance:
+                  sample_rate_hz: float, *, settings: VarianceSettings = DEFAULTS.screens.variance) -> Variance:
     """The variance tests of ``residual`` (output unit) against temperature ``temp_c`` (degC)
     and time ``t_s`` (s); see the module doc."""
     start, d = paired_differences(t_s, np.asarray(residual, dtype=float), run_id)
-    blocks = min(MAX_BLOCKS, d.size // MIN_PAIRS)
+    blocks = min(settings.max_blocks, d.size // settings.min_pairs)
     scale = float(MAD_TO_SIGMA * np.median(np.abs(d))) if d.size else 0.0
     sigma = scale / np.sqrt(2.0)
-    if blocks < MIN_BLOCKS or not scale > 0:
-        why = (f"too few pairs of consecutive samples ({d.size}) for {MIN_BLOCKS} blocks of {MIN_PAIRS}"
-               if blocks < MIN_BLOCKS else "the residual has no sample-to-sample scatter")
-        return Variance(None, [], blocks, 0, sigma, 0.0, sample_rate_hz, reason=why)
+    if blocks < settings.min_blocks or not scale > 0:
+        why = (f"too few pairs of consecutive samples ({d.size}) for {settings.min_blocks} blocks of "
+               f"{settings.min_pairs}" if blocks < settings.min_blocks else "the residual has no sample-to-sample scatter")
+        return Variance(None, [], blocks, 0, sigma, 0.0, sample_rate_hz, reason=why, settings=settings)
     m = d.size // blocks
     edges = (np.arange(blocks) * d.size) // blocks  # blocks of m or m + 1 pairs, every pair used
     sizes = np.diff(np.append(edges, d.size))
-    d2 = np.minimum(np.abs(d), CLIP * scale) ** 2
+    d2 = np.minimum(np.abs(d), settings.clip_sigma * scale) ** 2
     v = np.log(np.add.reduceat(d2, edges) / sizes)
     mid = 0.5 * (t_s[start] + t_s[start + 1])
     temps = 0.5 * (temp_c[start] + temp_c[start + 1])
@@ -221,11 +217,12 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
     for against, x_pairs in (("temperature", temps), ("time", mid)):
         x = np.add.reduceat(x_pairs, edges) / sizes
         f, p, slope = _f_test(v, x)
-        band, centre, level = _band(v, x)
+        band, centre, level = _band(v, x, settings.bins)
         sigma_bins = np.sqrt(np.exp(level) / 2.0)  # log mean d^2 = log(2 sigma^2) (+ a bias common to all blocks)
         tests.append(Test(against, f, p, 0.5 * slope, band, (float(sigma_bins.min()), float(sigma_bins.max())),
                           (tuple(centre.tolist()), tuple(sigma_bins.tolist()))))
-    passed = [t for t in tests if t.p_value < 0.5 * alpha and t.sigma_band[1] >= MIN_SIGMA_RATIO * t.sigma_band[0]]
+    passed = [t for t in tests if t.p_value < 0.5 * settings.alpha
+              and t.sigma_band[1] >= settings.min_sigma_ratio * t.sigma_band[0]]
     found = max(passed, key=lambda t: t.f) if passed else None
     ref, sigma_ref = 0.0, sigma
     if found is not None:
@@ -233,4 +230,4 @@ def find_variance(t_s: np.ndarray, temp_c: np.ndarray, residual: np.ndarray, run
         ref = float(np.round(np.median(x_pairs), 3))
         sigma_ref = float(np.sqrt(np.mean(d2 * np.exp(-2.0 * found.slope * (x_pairs - ref))) / 2.0))
     rms = float(np.sqrt(np.mean(d2) / 2.0))
-    return Variance(found, tests, blocks, m, sigma_ref, ref, sample_rate_hz, rms_sigma=rms)
+    return Variance(found, tests, blocks, m, sigma_ref, ref, sample_rate_hz, rms_sigma=rms, settings=settings)

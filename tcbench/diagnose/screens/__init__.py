@@ -2,10 +2,13 @@
 not an additive term of the mean model, by stage, and the order their parts take in the report.
 
 - ``prepare``: the thermometer's quantisation, which sets the smoothing window;
-- ``before`` the fit (:data:`BEFORE_FIT`): the output's quantisation and saturation (clipped samples
+- ``before`` the fit (:func:`before_fit`): the output's quantisation and saturation (clipped samples
   get zero weight), the noise level (the first variance test) and isolated outliers;
-- ``after`` the final fit (:data:`AFTER_FIT`): flicker (with the recheck of the kept effects) and
+- ``after`` the final fit (:func:`after_fit`): flicker (with the recheck of the kept effects) and
   the variance of the final residual.
+
+Each screen holds the settings it tests with (:class:`~tcbench.diagnose.settings.ScreenSettings`);
+:data:`BEFORE_FIT` and :data:`AFTER_FIT` are the stages at the defaults.
 """
 
 from __future__ import annotations
@@ -16,9 +19,22 @@ from tcbench.diagnose.screens.outliers import OutliersScreen
 from tcbench.diagnose.screens.output import QuantisationScreen, SaturationScreen
 from tcbench.diagnose.screens.thermometer import ThermometerScreen, smoothing
 from tcbench.diagnose.screens.variance import NoiseLevelScreen, VarianceScreen
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 
-BEFORE_FIT: tuple[Screen, ...] = (QuantisationScreen(), SaturationScreen(), NoiseLevelScreen(), OutliersScreen())
-AFTER_FIT: tuple[Screen, ...] = (FlickerScreen(), VarianceScreen())
+
+def before_fit(settings: DiagnoseSettings = DEFAULTS) -> tuple[Screen, ...]:
+    """The screens before the fit, in order, with ``settings``' screens section."""
+    s = settings.screens
+    return (QuantisationScreen(s), SaturationScreen(s), NoiseLevelScreen(s), OutliersScreen(s))
+
+
+def after_fit(settings: DiagnoseSettings = DEFAULTS) -> tuple[Screen, ...]:
+    """The screens after the final fit, in order, with ``settings``."""
+    return (FlickerScreen(settings), VarianceScreen(settings.screens))
+
+
+BEFORE_FIT: tuple[Screen, ...] = before_fit()
+AFTER_FIT: tuple[Screen, ...] = after_fit()
 # report.json ``effects``: after the mean model's terms, in this order
 FINDINGS_ORDER = ("bias_instability", "outliers", "saturation", "quantisation", "thermometer_quantisation", "variance")
 # model.yaml, after the fitted terms, the declared ones and the white noise: the noise's level first
@@ -27,4 +43,4 @@ FINDINGS_ORDER = ("bias_instability", "outliers", "saturation", "quantisation", 
 MODEL_ORDER = ("outliers", "variance", "quantisation", "saturation", "thermometer_quantisation")
 
 __all__ = ["AFTER_FIT", "BEFORE_FIT", "FINDINGS_ORDER", "MODEL_ORDER", "Screen", "ScreenInput", "ScreenResult",
-           "Screened", "ThermometerScreen", "run_screens", "smoothing"]
+           "Screened", "ThermometerScreen", "after_fit", "before_fit", "run_screens", "smoothing"]

@@ -3,10 +3,11 @@ white noise plus the thermometer noise the model inherits, and the recheck of th
 with that flicker in the noise model.
 
 Deterministic before stochastic: while the physics-agnostic reference beats the final model by
-more than :data:`~tcbench.diagnose.reference.REFERENCE_RATIO`, an Allan excess is the structure
+more than its ``structure_ratio``, an Allan excess is the structure
 the model leaves, not flicker; and the recheck may not hand flicker structure the reference
 shows. The Allan test reads the in-sample residual: a held-out one carries each fold's
-coefficient error, constant over its blocks, which looks like slow noise.
+coefficient error, constant over its blocks, which looks like slow noise. The test's
+false-alarm probability and the recheck's draws are :class:`~tcbench.diagnose.settings.FlickerSettings`.
 """
 
 from __future__ import annotations
@@ -22,10 +23,11 @@ from tcbench.diagnose.design import Model
 from tcbench.diagnose.evidence import Evidence
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.locate import FALSE_ALARM, AllanExcess, allan_excess, why_no_allan
+from tcbench.diagnose.locate import AllanExcess, allan_excess, why_no_allan
 from tcbench.diagnose.reference import Reference
 from tcbench.diagnose.result import Confusion, rmse
 from tcbench.diagnose.screens.base import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.terms import terms
 from tcbench.diagnose.thermometer import propagated_noise
 
@@ -85,13 +87,17 @@ class Flicker(ScreenResult):
         return [Confusion((e, ID), FLICKER_TEST) for e in found if e in TIME_EFFECTS] if self.named else []
 
 
-def flicker_test(att: Attribution, fit: Fit, model: Model) -> tuple[AllanExcess | None, float | None]:
+def flicker_test(att: Attribution, fit: Fit, model: Model,
+                 false_alarm: float = DEFAULTS.screens.flicker.false_alarm,
+                 min_samples: int = DEFAULTS.locate.min_allan_samples) -> tuple[AllanExcess | None, float | None]:
     """Allan test of the in-sample residual of ``fit`` (of ``model``) against white noise plus the
-    thermometer noise the model inherits; the flicker coefficient ``b`` when it flattens above both."""
+    thermometer noise the model inherits, at ``false_alarm`` from a tau of ``min_samples``
+    samples; the flicker coefficient ``b`` when it flattens above both."""
     designer = att.designer
     data = designer.data
     thermometer = propagated_noise(designer, model, fit.beta)
-    ex = allan_excess(data.t_s, fit.residual, data.white_sigma, FALSE_ALARM, estimated=True, coloured=thermometer)
+    ex = allan_excess(data.t_s, fit.residual, data.white_sigma, false_alarm, estimated=True, coloured=thermometer,
+                      min_samples=min_samples)
     if ex is None or ex.first_over is None:
         return ex, None
     excess = np.sqrt(np.maximum(ex.adev**2 - ex.white**2, 0.0))
@@ -103,30 +109,38 @@ def final_rmse(att: Attribution) -> float:
     return rmse(att.final_fit.sse_heldout, att.designer.data.n)
 
 
+@dataclass(frozen=True)
 class FlickerScreen(Screen):
     """The Allan test of the final residual; when it finds flicker behind kept effects, they are
     tested again with that flicker in the noise model (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`)
-    and the test is run again on what remains."""
+    and the test is run again on what remains (``settings.screens.flicker``, its shortest tau
+    ``settings.locate.min_allan_samples``)."""
 
+    settings: DiagnoseSettings = DEFAULTS
     id = ID
     stage = AFTER
 
     def skip(self, given: ScreenInput) -> str | None:
-        return why_no_allan(given.data.t_s)  # type: ignore[union-attr]
+        return why_no_allan(given.data.t_s, self.settings.locate.min_allan_samples)  # type: ignore[union-attr]
+
+    def test(self, att: Attribution) -> tuple[AllanExcess | None, float | None]:
+        """:func:`flicker_test` of the final model of ``att``."""
+        return flicker_test(att, att.final_fit, att.final, self.settings.screens.flicker.false_alarm,
+                            self.settings.locate.min_allan_samples)
 
     def run(self, given: ScreenInput) -> Flicker:
         att, reference = given.attribution, given.reference
         assert att is not None and reference is not None
-        allan, b = flicker_test(att, att.final_fit, att.final)
+        allan, b = self.test(att)
         found = Flicker(allan, b, Extent.of(att.designer.data), ID in given.declared)
         if reference.structure_remains(final_rmse(att)):  # an Allan excess made by it is not flicker
             return replace(found, b=None)
         if found.b is None or len(att.final.ids) <= len(att.base.ids):
             return found
-        rechecked = recheck_with_flicker(att, found.b)
+        rechecked = recheck_with_flicker(att, found.b, self.settings.screens.flicker)
         if rechecked is att or reference.structure_remains(final_rmse(rechecked)):
             return found
-        allan, b = flicker_test(rechecked, rechecked.final_fit, rechecked.final)
+        allan, b = self.test(rechecked)
         return replace(found, allan=allan, b=b, attribution=rechecked)
 
 

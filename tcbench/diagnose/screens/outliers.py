@@ -14,6 +14,7 @@ from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.screens.base import BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.variance import relative_sigma
+from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import DiagnosisData
 
 
@@ -34,10 +35,12 @@ class Spikes(ScreenResult):
                                  "size": [float(v) for v in self.found.size]}
 
 
+@dataclass(frozen=True)
 class OutliersScreen(Screen):
     """Outliers of the in-sample residual of the starting model, each sample judged against the
-    noise level the variance test found at it."""
+    noise level the variance test found at it (``settings.outliers``)."""
 
+    settings: ScreenSettings = DEFAULTS.screens
     id = "outliers"
     stage = BEFORE
 
@@ -46,5 +49,6 @@ class OutliersScreen(Screen):
         assert data is not None
         x = Designer(data).matrix(given.base)
         beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
-        found = find_outliers(data.t_s, data.output - x @ beta, data.white_sigma, relative_sigma=relative_sigma(given))
+        found = find_outliers(data.t_s, data.output - x @ beta, data.white_sigma, settings=self.settings.outliers,
+                              relative_sigma=relative_sigma(given))
         return Spikes(found, without(data, found.index))

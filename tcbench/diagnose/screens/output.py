@@ -4,7 +4,7 @@ white sigma is measured again, on the grid from the RMS of differences."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -14,10 +14,8 @@ from tcbench.diagnose.outliers import without
 from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
 from tcbench.diagnose.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens.base import BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
-
-CLEAR_SIGMA = 3.0  # white sigmas between a sample's fitted value and a clip level for the variance test
-CLIP_SIGMA = 8.0  # differences clipped at this many sigmas (or steps) when the output is quantised
 
 
 def _differences(data: DiagnosisData) -> np.ndarray:
@@ -37,15 +35,16 @@ def white_sigma(data: DiagnosisData) -> float:
     return sigma if sigma > 0 else data.white_sigma
 
 
-def quantised_sigma(data: DiagnosisData, step: float) -> float:
+def quantised_sigma(data: DiagnosisData, step: float,
+                    clip_sigma: float = DEFAULTS.screens.quantisation.clip_sigma) -> float:
     """The output's per-sample noise, quantisation included, on a lattice of ``step``: the
-    RMS of first differences / sqrt(2), each clipped at :data:`CLIP_SIGMA` times the larger of
+    RMS of first differences / sqrt(2), each clipped at ``clip_sigma`` times the larger of
     the MAD estimate and the step. The MAD of differences that take a few lattice values is
     not a sigma (for noise of sigma 1 on a grid of 1.5 it reads 1.57 where the truth is 1.09)."""
     d = _differences(data)
     if d.size < 10:
         return data.white_sigma
-    bound = CLIP_SIGMA * max(data.white_sigma, step)
+    bound = clip_sigma * max(data.white_sigma, step)
     return float(np.sqrt(np.mean(np.minimum(np.abs(d), bound) ** 2) / 2.0))
 
 
@@ -78,18 +77,21 @@ class Grid(ScreenResult):
         effects["quantisation"] = {"step": float(q)}
 
 
+@dataclass(frozen=True)
 class QuantisationScreen(Screen):
-    """The output's lattice; on one, the white sigma from the RMS of differences."""
+    """The output's lattice; on one, the white sigma from the RMS of differences (``settings.quantisation``)."""
 
+    settings: ScreenSettings = DEFAULTS.screens
     id = "quantisation"
     stage = BEFORE
 
     def run(self, given: ScreenInput) -> Grid:
         data = given.data
         assert data is not None
-        found = find_output_quantisation(data.output, data.white_sigma)
+        grid = self.settings.quantisation
+        found = find_output_quantisation(data.output, data.white_sigma, grid)
         if found is not None and found.step:
-            data = replace(data, white_sigma=quantised_sigma(data, found.step))
+            data = replace(data, white_sigma=quantised_sigma(data, found.step, grid.clip_sigma))
             found = replace(found, white_sigma=data.white_sigma)
         return Grid(found, data)
 
@@ -102,10 +104,12 @@ def grid_step(given: ScreenInput) -> float:
 
 @dataclass(frozen=True)
 class Clipping(ScreenResult):
-    """The saturation found (or not) and the data without the samples it gives zero weight."""
+    """The saturation found (or not), the data without the samples it gives zero weight and
+    how far inside the clip levels a sample is clear of them (``clear_sigma`` white sigmas)."""
 
     found: Saturation
     data: DiagnosisData | None
+    clear_sigma: float = field(default=DEFAULTS.screens.saturation.clear_sigma)
 
     def findings(self, unit: str) -> list[Finding]:
         return [self.found.finding(unit)] if self.found.found else []
@@ -115,14 +119,14 @@ class Clipping(ScreenResult):
             model["effects"]["saturation"] = self.found.model_params()
 
     def clear(self, data: DiagnosisData, residual: np.ndarray) -> np.ndarray:
-        """Samples whose fitted value lies more than :data:`CLEAR_SIGMA` white sigmas inside
+        """Samples whose fitted value lies more than :attr:`clear_sigma` white sigmas inside
         the clip levels: nearer, the unclipped samples kept are a truncated, less scattered part
         of their distribution, which the variance test would take for a quieter band."""
         keep = np.ones(data.n, dtype=bool)
         if not self.found.found:
             return keep
         fitted = data.output - residual
-        margin = CLEAR_SIGMA * data.white_sigma
+        margin = self.clear_sigma * data.white_sigma
         levels = self.found.model_params()
         if "upper" in levels:
             keep &= fitted < levels["upper"] - margin
@@ -131,21 +135,25 @@ class Clipping(ScreenResult):
         return keep
 
 
+@dataclass(frozen=True)
 class SaturationScreen(Screen):
-    """Clipping at the output's extremes; the clipped samples (and their episodes) get zero
-    weight and the white sigma is measured again without them."""
+    """Clipping at the output's extremes (``settings.saturation``); the clipped samples (and
+    their episodes) get zero weight and the white sigma is measured again without them."""
 
+    settings: ScreenSettings = DEFAULTS.screens
     id = "saturation"
     stage = BEFORE
 
     def run(self, given: ScreenInput) -> Clipping:
         data, step = given.data, grid_step(given)
         assert data is not None
-        found = find_saturation(data, step)
+        clip = self.settings.saturation
+        found = find_saturation(data, step, settings=clip)
         if found.index.size:
             data = without(data, found.index)
-            data = replace(data, white_sigma=quantised_sigma(data, step) if step else white_sigma(data))
-        return Clipping(found, data)
+            data = replace(data, white_sigma=quantised_sigma(data, step, self.settings.quantisation.clip_sigma)
+                           if step else white_sigma(data))
+        return Clipping(found, data, clip.clear_sigma)
 
 
 def clear_of_clipping(given: ScreenInput, residual: np.ndarray) -> np.ndarray:

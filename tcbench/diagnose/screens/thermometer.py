@@ -9,7 +9,8 @@ from typing import Any
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.quantisation import ThermometerSteps, thermometer_steps
 from tcbench.diagnose.screens.base import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
-from tcbench.diagnose.signals import DEFAULT_SMOOTH_S, fitted_window_s
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
+from tcbench.diagnose.signals import fitted_window_s
 from tcbench.sensors.recording import Recording
 
 
@@ -19,7 +20,7 @@ class Smoothing(ScreenResult):
     the profile (s); :attr:`smooth_s` the window the diagnosis smooths with."""
 
     steps: ThermometerSteps | None = None
-    default_smooth_s: float = DEFAULT_SMOOTH_S
+    default_smooth_s: float = DEFAULTS.smoothing.default_window_s
 
     @property
     def smooth_s(self) -> float:
@@ -42,9 +43,11 @@ class Smoothing(ScreenResult):
 class ThermometerScreen(Screen):
     """The thermometer's lattice and the smoothing window: an undithered staircase keeps its own
     wide window (its steps are not white noise, they would read as bias); otherwise the window
-    is fitted to the profile's time scales, or is ``window_s`` when given."""
+    is fitted to the profile's time scales, or is ``window_s`` when given. The default window,
+    the fitted window's bias-to-noise share and the staircase's numbers are ``settings``'."""
 
     window_s: float | None = None
+    settings: DiagnoseSettings = DEFAULTS
     id = "thermometer_quantisation"
     stage = PREPARE
 
@@ -54,15 +57,19 @@ class ThermometerScreen(Screen):
 
     def run(self, given: ScreenInput) -> Smoothing:
         t, temp = given.rec.time_s, given.rec.temperature_c  # type: ignore[union-attr]
-        steps = thermometer_steps(t, temp, DEFAULT_SMOOTH_S)
+        smooth, screens = self.settings.smoothing, self.settings.screens
+        default_s = smooth.default_window_s
+        steps = thermometer_steps(t, temp, default_s, screens.thermometer, screens.quantisation)
         if steps is not None and steps.staircase:
-            return Smoothing(steps, DEFAULT_SMOOTH_S)
-        window_s = self.window_s if self.window_s is not None else fitted_window_s(t, temp, DEFAULT_SMOOTH_S)
-        return Smoothing(thermometer_steps(t, temp, window_s) if steps is not None else None, window_s)
+            return Smoothing(steps, default_s)
+        window_s = self.window_s if self.window_s is not None else fitted_window_s(t, temp, default_s,
+                                                                                    smooth.bias_to_noise)
+        return Smoothing(thermometer_steps(t, temp, window_s, screens.thermometer, screens.quantisation)
+                         if steps is not None else None, window_s)
 
 
-def smoothing(rec: Recording, window_s: float | None = None) -> Smoothing:
+def smoothing(rec: Recording, window_s: float | None = None, settings: DiagnoseSettings = DEFAULTS) -> Smoothing:
     """The thermometer screen on ``rec`` (the default window where it cannot run)."""
-    screen = ThermometerScreen(window_s)
+    screen = ThermometerScreen(window_s, settings)
     found = run_screens([screen], ScreenInput(rec, None)).results.get(screen.id)
-    return found if isinstance(found, Smoothing) else Smoothing()
+    return found if isinstance(found, Smoothing) else Smoothing(default_smooth_s=settings.smoothing.default_window_s)

@@ -21,6 +21,7 @@ from tcbench.diagnose.design import Designer, Model
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.screens.base import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.output import QuantisationScreen, clear_of_clipping
+from tcbench.diagnose.settings import DEFAULTS, ScreenSettings, VarianceSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.variance import Variance, find_variance
 
@@ -37,12 +38,14 @@ def coarse_grid(given: ScreenInput) -> str | None:
     return None
 
 
-def variance_of(given: ScreenInput, residual: np.ndarray) -> Variance:
+def variance_of(given: ScreenInput, residual: np.ndarray,
+                settings: VarianceSettings = DEFAULTS.screens.variance) -> Variance:
     """The variance test of ``residual`` on the samples of ``given.data`` clear of any clip level."""
     data = given.data
     assert data is not None
     keep = clear_of_clipping(given, residual)
-    return find_variance(data.t_s[keep], data.temp_c[keep], residual[keep], data.run_id[keep], data.sample_rate_hz)
+    return find_variance(data.t_s[keep], data.temp_c[keep], residual[keep], data.run_id[keep], data.sample_rate_hz,
+                         settings=settings)
 
 
 @dataclass(frozen=True)
@@ -55,9 +58,11 @@ class NoiseLevel(ScreenResult):
     data: DiagnosisData | None
 
 
+@dataclass(frozen=True)
 class NoiseLevelScreen(Screen):
-    """The variance test on the residual of the minimal model, before any fit."""
+    """The variance test (``settings.variance``) on the residual of the minimal model, before any fit."""
 
+    settings: ScreenSettings = DEFAULTS.screens
     id = ID
     stage = BEFORE
 
@@ -69,7 +74,7 @@ class NoiseLevelScreen(Screen):
         assert data is not None
         x = Designer(data).matrix(Model())
         beta, *_ = np.linalg.lstsq(x, data.output, rcond=None)
-        found = variance_of(given, data.output - x @ beta)
+        found = variance_of(given, data.output - x @ beta, self.settings.variance)
         if found.found is None:
             return NoiseLevel(found, None, data)
         if found.rms_sigma > data.white_sigma:
@@ -107,9 +112,11 @@ class NoiseVariance(ScreenResult):
         return {} if self.found.reason else {"variance": self.found.statistics()}
 
 
+@dataclass(frozen=True)
 class VarianceScreen(Screen):
-    """The variance test on the final model's in-sample residual."""
+    """The variance test (``settings.variance``) on the final model's in-sample residual."""
 
+    settings: ScreenSettings = DEFAULTS.screens
     id = ID
     stage = AFTER
 
@@ -118,4 +125,4 @@ class VarianceScreen(Screen):
 
     def run(self, given: ScreenInput) -> NoiseVariance:
         assert given.attribution is not None
-        return NoiseVariance(variance_of(given, given.attribution.final_fit.residual))
+        return NoiseVariance(variance_of(given, given.attribution.final_fit.residual, self.settings.variance))

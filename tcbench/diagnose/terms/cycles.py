@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import DUTY_PHASES, LINE_BINS, bin_width, duty_phase, line_window, why_no_lines
+from tcbench.diagnose.detectors import bin_width, duty_phase, line_window, why_no_lines
+from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log
@@ -27,8 +28,8 @@ def windows(search: Search) -> list[tuple[float, float, float]]:
     inside :data:`GATED_MAX_PART` of the span, with where it is present
     (:func:`~tcbench.diagnose.detectors.line_window`); once per round."""
     d, r, span = search.data, search.residual, search.span_s
-    return search.shared("line_windows", lambda: [(p, *line_window(d.t_s, r, p)) for p in search.lines
-                                                  if DUTY_MIN_CYCLES * p < GATED_MAX_PART * span])
+    return search.shared("line_windows", lambda: [(p, *line_window(d.t_s, r, p, search.detectors))
+                                                  for p in search.lines if DUTY_MIN_CYCLES * p < GATED_MAX_PART * span])
 
 
 def _period_phase(data: DiagnosisData, period_s: float) -> np.ndarray:
@@ -39,13 +40,13 @@ def _log_period(value: Value) -> tuple[float, float]:
     return np.log(value[0] * PERIOD_BAND[0]), np.log(value[0] * PERIOD_BAND[1])
 
 
-def _why_no_part(t_s: np.ndarray, min_cycles: float, what: str) -> str | None:
+def _why_no_part(t_s: np.ndarray, min_cycles: float, what: str, detectors: DetectorSettings) -> str | None:
     """Why no line present in part of the record (or switched load, ``min_cycles`` apart) can be
     tested: even the shortest period the periodogram resolves needs its cycles inside less than
     the whole record."""
     span = float(t_s[-1] - t_s[0])
     longest = GATED_MAX_PART * span / min_cycles
-    shortest = 3.0 * bin_width(t_s, LINE_BINS)
+    shortest = 3.0 * bin_width(t_s, detectors.line_bins, detectors.min_bin_s)
     if longest >= shortest:
         return None
     return (f"{what} present in part of the record needs {min_cycles:g} cycles inside "
@@ -105,8 +106,9 @@ class PeriodicTerm(OpenTerm):
     def refine(self, screen: Screen, value: Value) -> Value:
         return search_log(screen, self.id, value, *_log_period(value), lambda z: (float(np.exp(z)), *value[1:]))
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        return why_no_lines(data.t_s)
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        return why_no_lines(data.t_s, detectors)
 
 
 class GatedPeriodicTerm(OpenTerm):
@@ -157,8 +159,9 @@ class GatedPeriodicTerm(OpenTerm):
         value = search_log(screen, self.id, value, *_log_period(value), lambda z: (float(np.exp(z)), *value[1:]))
         return _refine_window(screen, self.id, value, GATED_MIN_CYCLES)
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        return why_no_lines(data.t_s) or _why_no_part(data.t_s, GATED_MIN_CYCLES, "a line")
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        return why_no_lines(data.t_s, detectors) or _why_no_part(data.t_s, GATED_MIN_CYCLES, "a line", detectors)
 
 
 class DutyCycleTerm(OpenTerm):
@@ -201,7 +204,7 @@ class DutyCycleTerm(OpenTerm):
 
     def propose(self, search: Search) -> list[Value]:
         d, r, span = search.data, search.residual, search.span_s
-        return [(p, *duty_phase(d.t_s, r, p, a, b), a, b) for p, a, b in windows(search)
+        return [(p, *duty_phase(d.t_s, r, p, a, b, search.detectors.duty_phases), a, b) for p, a, b in windows(search)
                 if DUTY_MIN_CYCLES * p <= b - a < GATED_MAX_PART * span]
 
     def refine(self, screen: Screen, value: Value) -> Value:
@@ -214,7 +217,7 @@ class DutyCycleTerm(OpenTerm):
         in-sample drop: a switching edge misplaced by a few samples leaves a spike at every
         cycle, which the Allan test would take for flicker."""
         period, on_s, duty, start, end = value
-        step = period / DUTY_PHASES
+        step = period / screen.detectors.duty_phases
         grid = np.linspace(-step, step, 17)
         on_s = max((on_s + g for g in grid), key=lambda x: screen.drop(self.id, (period, x, duty, start, end)))
         off = on_s + duty * period
@@ -222,12 +225,14 @@ class DutyCycleTerm(OpenTerm):
                   key=lambda x: screen.drop(self.id, (period, on_s, (x - on_s) / period, start, end)))
         return period, float(on_s), float((off - on_s) / period), start, end
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        return why_no_lines(data.t_s) or _why_no_part(data.t_s, DUTY_MIN_CYCLES, "a switched load")
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        return why_no_lines(data.t_s, detectors) or _why_no_part(data.t_s, DUTY_MIN_CYCLES, "a switched load", detectors)
 
 
 def _refold(screen: Screen, value: Value) -> Value:
     """A switched load's ``(period_s, on_s, duty, start_s, end_s)`` with its phase and duty
     read again from the residual folded on its period and span."""
     period, _, _, start, end = value
-    return (period, *duty_phase(screen.data.t_s, screen.residual, period, start, end), start, end)
+    return (period, *duty_phase(screen.data.t_s, screen.residual, period, start, end, screen.detectors.duty_phases),
+            start, end)

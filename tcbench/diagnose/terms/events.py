@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.detectors import why_no_steps
+from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log, step_range
@@ -18,10 +19,11 @@ TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
 TAU_FACTOR = 1.6  # a time constant is refined within this factor of its grid value
 
 
-def why_no_step(t_s: np.ndarray, fold: np.ndarray | None) -> str | None:
+def why_no_step(t_s: np.ndarray, fold: np.ndarray | None, detectors: DetectorSettings = DEFAULTS.detectors
+                ) -> str | None:
     """Why no step can be tested on a record sampled at ``t_s`` with cross-validation ``fold``:
     too few bins for the change points, or no time with two folds on each side."""
-    why = why_no_steps(t_s)
+    why = why_no_steps(t_s, detectors)
     if why is None and fold is not None:
         lo, hi = step_range(t_s, fold)
         if not hi > lo:
@@ -56,8 +58,9 @@ class BiasStepTerm(OpenTerm):
     def propose(self, search: Search) -> list[Value]:
         return [(t,) for t in search.steps]
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        return why_no_step(data.t_s, fold)
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        return why_no_step(data.t_s, fold, detectors)
 
 
 class TransientTerm(OpenTerm):
@@ -92,10 +95,11 @@ class TransientTerm(OpenTerm):
     def refine(self, screen: Screen, value: Value) -> Value:
         return refine_tau(screen, self.id, value)
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
         """Why no transient can be proposed: no step can, or its shortest time constant needs
         twice its length of record after a testable step."""
-        why = why_no_step(data.t_s, fold)
+        why = why_no_step(data.t_s, fold, detectors)
         if why is not None or fold is None:
             return why
         t_s = data.t_s

@@ -29,6 +29,7 @@ from scipy.optimize import minimize_scalar
 
 from tcbench.diagnose.detectors import line_periods, step_times
 from tcbench.diagnose.findings import SHAPES, Finding
+from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import _NO_DRAW, Extent, Term, signals, term, terms
 from tcbench.sensors.effects import MAX_REPEATS, Effect
@@ -38,11 +39,13 @@ T = TypeVar("T")
 
 
 class Screen(Protocol):
-    """What a refinement reads: the record, the in-sample residual of the current model and the
-    in-sample drop of squared error of adding a term's columns at a value."""
+    """What a refinement reads: the record, the in-sample residual of the current model, the
+    detectors' settings and the in-sample drop of squared error of adding a term's columns at a
+    value."""
 
     data: DiagnosisData
     residual: np.ndarray
+    detectors: DetectorSettings
 
     def drop(self, term_id: str, value: Value) -> float: ...
 
@@ -58,13 +61,14 @@ def step_range(t_s: np.ndarray, fold: np.ndarray) -> tuple[float, float]:
 @dataclass
 class Search:
     """What the detectors read in one round: the record, the in-sample residual of the current
-    model, the model temperature and the cross-validation folds. Each detector runs once per
-    round, on first use, whichever terms read it."""
+    model, the model temperature, the cross-validation folds and the detectors' settings. Each
+    detector runs once per round, on first use, whichever terms read it."""
 
     data: DiagnosisData
     residual: np.ndarray
     temp_c: np.ndarray
     fold: np.ndarray
+    detectors: DetectorSettings = DEFAULTS.detectors
 
     _shared: dict[str, Any] = field(default_factory=dict, repr=False)
 
@@ -87,12 +91,12 @@ class Search:
     def steps(self) -> list[float]:
         """Change points of the residual (:func:`~tcbench.diagnose.detectors.step_times`) where a step is testable."""
         lo, hi = self.testable
-        return [t for t in step_times(self.data.t_s, self.residual) if lo < t < hi]
+        return [t for t in step_times(self.data.t_s, self.residual, self.detectors) if lo < t < hi]
 
     @cached_property
     def lines(self) -> list[float]:
         """Periods of the residual's spectral lines (:func:`~tcbench.diagnose.detectors.line_periods`)."""
-        return line_periods(self.data.t_s, self.residual)
+        return line_periods(self.data.t_s, self.residual, self.detectors)
 
 
 class OpenTerm(Term):
@@ -143,9 +147,10 @@ class OpenTerm(Term):
         """``value`` moved to the largest in-sample drop nearby (as proposed: nothing to refine)."""
         return value
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        """Why its detector cannot propose anything on ``data`` with cross-validation ``fold``
-        (None: unknown, not checked) whatever the residual, or None."""
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,  # type: ignore[override]
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        """Why its detector, run as ``detectors`` says, cannot propose anything on ``data`` with
+        cross-validation ``fold`` (None: unknown, not checked) whatever the residual, or None."""
         return None
 
     def where(self, extent: Extent | None = None, params: Mapping[str, float] | None = None) -> dict[str, Any]:

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.detectors import bump_centres, why_no_bumps
+from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData, lagged
 from tcbench.diagnose.terms.base import g3, term
 from tcbench.diagnose.terms.events import refine_tau
@@ -46,10 +47,11 @@ class TemperatureBumpTerm(OpenTerm):
             "(an activity dip), or a material transition of the die attach, does this.")
 
     def propose(self, search: Search) -> list[Value]:
-        return [(c, w) for c, w in bump_centres(search.temp_c, search.residual)]
+        return [(c, w) for c, w in bump_centres(search.temp_c, search.residual, search.detectors)]
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
-        return why_no_bumps(data.temp_c)
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
+        return why_no_bumps(data.temp_c, detectors)
 
 
 class SecondNodeTerm(OpenTerm):
@@ -86,7 +88,8 @@ class SecondNodeTerm(OpenTerm):
     def refine(self, screen: Screen, value: Value) -> Value:
         return refine_tau(screen, self.id, value)
 
-    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None) -> str | None:
+    def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
+             detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
         """Why no second thermal node can be proposed: thermal lag not identifiable, or a record
         shorter than :data:`NODE_SPANS` times the shortest time constant."""
         why = term("thermal_lag").skip(data)
