@@ -98,6 +98,8 @@ def test_cli_on_a_short_record_exits_0_with_the_short_report(cli_run: dict) -> N
     report = cli_run["json"]
     assert report["report"] == "short_record" and report["samples"] == 100_000 and report["unit"] == "g"
     assert [r["id"] for r in report["needs_more_time"]] == ["effect_attribution", "second_node"]
+    assert report["settings"]["short"]["alpha"] == report["level"]  # every setting it ran with, as a full report
+    assert report["settings"]["plan"]["folds"] == FOLDS
     md = cli_run["md"]
     assert "## Tests run" in md and "| level_step | significant |" in md
     assert "## Not run on this record" in md and "- **effect_attribution**: needs 1200 s (20 min)" in md
