@@ -111,7 +111,15 @@ class PeriodicTerm(OpenTerm):
         return why_no_lines(data.t_s, detectors)
 
 
-class GatedPeriodicTerm(OpenTerm):
+class _CycleInPart(OpenTerm):
+    """A cycle present from ``start_s`` to ``end_s`` only: located at its line and its span."""
+
+    def located(self, params: Mapping[str, float]) -> dict[str, Any]:
+        return {"period_s": params["period_s"], "frequency_hz": 1.0 / params["period_s"],
+                "time_s": [params["start_s"], params["end_s"]]}
+
+
+class GatedPeriodicTerm(_CycleInPart):
     """A cycle present in part of the record only: a level and sin, cos of the period and its
     harmonics to the 5th, inside ``[start_s, end_s)``. Proposed where a line of the periodogram is
     present (complex demodulation)."""
@@ -139,10 +147,6 @@ class GatedPeriodicTerm(OpenTerm):
         out["amplitude"] = float(np.hypot(coef[1], coef[2]))
         return out
 
-    def located(self, params: Mapping[str, float]) -> dict[str, Any]:
-        return {"period_s": params["period_s"], "frequency_hz": 1.0 / params["period_s"],
-                "time_s": [params["start_s"], params["end_s"]]}
-
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
         return (
             f"A line in the residual's spectrum, a cycle of {g3(params['period_s'] / 60)} min "
@@ -164,7 +168,7 @@ class GatedPeriodicTerm(OpenTerm):
         return why_no_lines(data.t_s, detectors) or _why_no_part(data.t_s, GATED_MIN_CYCLES, "a line", detectors)
 
 
-class DutyCycleTerm(OpenTerm):
+class DutyCycleTerm(_CycleInPart):
     """A load switched on and off: a level and ``1[(t - on_s) mod period_s < duty period_s]``,
     inside ``[start_s, end_s)``. Proposed where a line is present, its phase and duty read from
     the residual folded on the line's period."""
@@ -189,10 +193,6 @@ class DutyCycleTerm(OpenTerm):
     def params(self, coef: Any, value: Any, half_range_c: float = 1.0) -> dict[str, float]:
         return {"period_s": value[0], "on_s": value[1], "duty": value[2], "start_s": value[3], "end_s": value[4],
                 "offset": float(coef[0]), "size": float(coef[1])}
-
-    def located(self, params: Mapping[str, float]) -> dict[str, Any]:
-        return {"period_s": params["period_s"], "frequency_hz": 1.0 / params["period_s"],
-                "time_s": [params["start_s"], params["end_s"]]}
 
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
         return (
