@@ -141,3 +141,32 @@ def test_a_fourth_instance_or_an_unknown_suffix_is_refused() -> None:
     assert effect_class("bias_step_4") is None and effect_class("hysteresis_2") is None
     with pytest.raises(ValueError, match="unknown effect 'hysteresis_2'"):
         make_effect("hysteresis_2")
+
+
+def test_a_plugin_effect_repeats_when_its_class_says_so() -> None:
+    from dataclasses import dataclass
+    from typing import ClassVar
+
+    from tcbench.sensors.effects import PLUGINS, Effect, effect_class
+
+    @dataclass(frozen=True)
+    class Knock(Effect):
+        id: ClassVar[str] = "knock_test"
+        repeatable: ClassVar[bool] = True
+        size: float = 0.0
+
+    @dataclass(frozen=True)
+    class Hum(Effect):
+        id: ClassVar[str] = "hum_test"
+        size: float = 0.0
+
+    PLUGINS.register("knock_test", Knock)
+    PLUGINS.register("hum_test", Hum)
+    try:
+        assert effect_class("knock_test_2") is Knock and effect_class("knock_test_3") is Knock
+        assert effect_class("knock_test_4") is None
+        assert effect_class("hum_test") is Hum and effect_class("hum_test_2") is None
+        assert make_effect("knock_test_2", size=1.0) == Knock(size=1.0)
+    finally:
+        for name in ("knock_test", "hum_test"):
+            PLUGINS._entries.pop(name, None)

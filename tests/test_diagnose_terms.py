@@ -26,7 +26,7 @@ from tcbench.diagnose.terms import (
     terms,
 )
 from tcbench.diagnose.terms.base import signals
-from tcbench.sensors.effects import EFFECTS, REPEATABLE, Signals, make_effect
+from tcbench.sensors.effects import EFFECTS, Signals, make_effect, repeatable_effects
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 from tcbench.compensation.fitted_model import RIG_EFFECTS
 
@@ -55,7 +55,7 @@ def test_every_library_effect_the_diagnosis_models_has_exactly_one_term() -> Non
 
 def test_every_repeatable_effect_is_an_open_world_term_in_the_registry() -> None:
     open_ids = [t.id for t in terms(open=True)]
-    assert set(open_ids) == set(REPEATABLE)
+    assert set(open_ids) == set(repeatable_effects())
     assert open_ids == ["bias_step", "transient", "periodic", "gated_periodic", "duty_cycle", "temperature_bump",
                         "second_node"]  # the order of a round's search and of the "not tested" reasons
     assert report_order() == ("bias_step", "periodic", "gated_periodic", "duty_cycle", "transient",

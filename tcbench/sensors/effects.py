@@ -51,12 +51,14 @@ class Effect:
     """Base of all effects; subclasses set ``id`` and ``stage`` and implement one method.
     ``stochastic``: part of the recorded noise (drawn, or the quantisation of what was drawn),
     left out of the deterministic truth; ``rig``: what the test rig does to the output (a
-    compressor's, a fan's or a supply's line), not the sensor."""
+    compressor's, a fan's or a supply's line), not the sensor; ``repeatable``: a model may hold
+    further instances of it (``bias_step_2``: a second step, up to :data:`MAX_REPEATS`)."""
 
     id: ClassVar[str] = ""
     stage: ClassVar[str] = "output"
     stochastic: ClassVar[bool] = False
     rig: ClassVar[bool] = False
+    repeatable: ClassVar[bool] = False
 
     def die_temperature(self, s: Signals) -> np.ndarray:
         """Stage ``die``: the die temperature after this effect."""
@@ -239,6 +241,7 @@ class BiasStep(Effect):
     """A bias jump of ``size`` at ``time_s`` (mode hop, shock, restart; PHYSICS.md §8)."""
 
     id: ClassVar[str] = "bias_step"
+    repeatable: ClassVar[bool] = True
     time_s: float = 0.0
     size: float = 0.0
 
@@ -251,6 +254,7 @@ class Periodic(Effect):
     """``amplitude * sin(2 pi t / period_s + phase_rad)``: environmental cycling (PHYSICS.md §8)."""
 
     id: ClassVar[str] = "periodic"
+    repeatable: ClassVar[bool] = True
     rig: ClassVar[bool] = True
     period_s: float = 1800.0
     amplitude: float = 0.0
@@ -268,6 +272,7 @@ class GatedPeriodic(Effect):
     cycle, not a sinusoid); ``amplitude`` (the fundamental's) is informative."""
 
     id: ClassVar[str] = "gated_periodic"
+    repeatable: ClassVar[bool] = True
     rig: ClassVar[bool] = True
     period_s: float = 1800.0
     start_s: float = 0.0
@@ -299,6 +304,7 @@ class DutyCycle(Effect):
     while the load is on (a compressor or heater on a thermostat)."""
 
     id: ClassVar[str] = "duty_cycle"
+    repeatable: ClassVar[bool] = True
     rig: ClassVar[bool] = True
     period_s: float = 1800.0
     on_s: float = 0.0
@@ -318,6 +324,7 @@ class Transient(Effect):
     """A jump of ``amplitude`` at ``time_s`` decaying with ``tau_s`` (settling after a handling event)."""
 
     id: ClassVar[str] = "transient"
+    repeatable: ClassVar[bool] = True
     time_s: float = 0.0
     tau_s: float = 1800.0
     amplitude: float = 0.0
@@ -333,6 +340,7 @@ class TemperatureBump(Effect):
     ``width_c`` (an activity dip: a mode crossing at one temperature)."""
 
     id: ClassVar[str] = "temperature_bump"
+    repeatable: ClassVar[bool] = True
     centre_c: float = 25.0
     width_c: float = 2.0
     amplitude: float = 0.0
@@ -347,6 +355,7 @@ class SecondNode(Effect):
     with its own time constant, unseen by the thermometer."""
 
     id: ClassVar[str] = "second_node"
+    repeatable: ClassVar[bool] = True
     tau_s: float = 3600.0
     coef_per_c: float = 0.0
 
@@ -482,25 +491,38 @@ def known_effects() -> list[str]:
     return sorted({*EFFECTS, *(n for n in PLUGINS.names() if n not in EFFECTS)})
 
 
-REPEATABLE = ("bias_step", "periodic", "gated_periodic", "duty_cycle", "transient", "temperature_bump", "second_node")
 MAX_REPEATS = 3  # instances of one repeatable effect in a model: ``bias_step``, ``bias_step_2``, ``bias_step_3``
 
 
 def effect_class(effect_id: str) -> type[Effect] | None:
-    """The effect class of ``effect_id``: an id of :data:`EFFECTS`, a further instance of a
-    :data:`REPEATABLE` one (``bias_step_2``: a second step) or an installed plugin effect
-    (imported on first use); None for an unknown id or a broken plugin."""
+    """The effect class of ``effect_id``: an id of :data:`EFFECTS` or an installed plugin effect
+    (imported on first use), or a further instance of a ``repeatable`` one of either
+    (``bias_step_2``: a second step); None for an unknown id or a broken plugin."""
+    cls = _base_effect_class(effect_id)
+    if cls is not None:
+        return cls
+    base, _, k = effect_id.rpartition("_")
+    if k.isdigit() and 2 <= int(k) <= MAX_REPEATS:
+        cls = _base_effect_class(base)
+        return cls if cls is not None and cls.repeatable else None
+    return None
+
+
+def _base_effect_class(effect_id: str) -> type[Effect] | None:
+    """The class of a built-in or installed plugin effect named exactly ``effect_id``."""
     if effect_id in EFFECTS:
         return EFFECTS[effect_id]
-    base, _, k = effect_id.rpartition("_")
-    if base in REPEATABLE and k.isdigit() and 2 <= int(k) <= MAX_REPEATS:
-        return EFFECTS[base]
     if effect_id in PLUGINS.names():
         try:
             return PLUGINS.get(effect_id)
         except KeyError:
             return None
     return None
+
+
+def repeatable_effects() -> list[str]:
+    """The ids of the built-in effects a model may hold more than once."""
+    return [i for i, cls in EFFECTS.items() if cls.repeatable]
 
 
 def make_effect(effect_id: str, **params: Any) -> Effect:
@@ -511,7 +533,7 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
         if broken:
             raise ValueError(f"effect {effect_id!r}: plugin failed to load: {broken}")
         raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(known_effects())} "
-                         f"(and {REPEATABLE[0]}_2 ... _{MAX_REPEATS} for further instances of {', '.join(REPEATABLE)})")
+                         f"(and <id>_2 ... _{MAX_REPEATS} for further instances of {', '.join(repeatable_effects())})")
     known = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(params) - known)
     if unknown:
