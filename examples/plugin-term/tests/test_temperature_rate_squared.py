@@ -4,8 +4,7 @@ import numpy as np
 
 from tcbench.diagnose.terms import term, term_source
 from tcbench.sensors.effects import Signals, effect_class, make_effect
-from tcbench_rate2.effect import TemperatureRateSquared
-from tcbench_rate2.term import TemperatureRateSquaredTerm
+from tcbench_rate2.temperature_rate_squared import TemperatureRateSquared, TemperatureRateSquaredTerm
 
 
 def test_even_in_the_rate() -> None:

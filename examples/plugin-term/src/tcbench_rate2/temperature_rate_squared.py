@@ -1,16 +1,31 @@
-"""The effect as the diagnosis models, reports and explains it."""
+"""A thermal-gradient stress the output carries in the square of the temperature rate: the effect
+the simulator runs and the term the diagnosis fits, reports and explains, in one file."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import Term
 from tcbench.diagnose.terms.base import g3
-from tcbench.sensors.effects import Effect
-from tcbench_rate2.effect import TemperatureRateSquared
+from tcbench.sensors.effects import Effect, Signals
+
+
+@dataclass(frozen=True)
+class TemperatureRateSquared(Effect):
+    """Thermal-gradient stress ``coef * (dT_meas/dt in degC/min)^2`` (output unit per (degC/min)^2):
+    the same sign heating and cooling, zero at rest."""
+
+    id: ClassVar[str] = "temperature_rate_squared"
+    coef_per_c2_per_min2: float = 0.0
+
+    def term(self, s: Signals, rng: np.random.Generator) -> np.ndarray:
+        rate_c_per_min = 60.0 * s.temp_rate_c_per_s
+        return self.coef_per_c2_per_min2 * rate_c_per_min * rate_c_per_min
 
 MIN_RATE_C_PER_S = 0.05 / 60.0  # slower than this the temperature counts as still
 
