@@ -23,7 +23,7 @@ from tcbench.diagnose.quantisation import (
     thermometer_steps,
 )
 from tcbench.diagnose.report import write_report
-from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens, smoothing
+from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors.recording import Recording, read_recording
 from tcbench.sensors.simulate import simulate_recording
@@ -78,14 +78,6 @@ def test_thermometer_staircase_worked_by_hand() -> None:
     dithered = thermometer_steps(t, fine, 120.0)
     assert dithered is not None and not dithered.staircase and dithered.smooth_s == 120.0
     assert thermometer_steps(t, np.round(true + 0.005 * rng.standard_normal(t.size), 2), 120.0) is None
-
-
-@pytest.mark.parametrize(("sensor", "seed"), [("gyro", 5), ("msra", 5), ("gyro", 11), ("msra", 11)])
-def test_concealed_controls_show_no_grid(sensor: str, seed: int) -> None:
-    rec, _ = concealed_recording(sensor, None, seed)
-    steps = smoothing(rec)
-    assert steps.smooth_s == DEFAULTS.smoothing.default_window_s and not steps.staircase and not steps.findings("Hz")
-    assert lattice_step(rec.output) is None
 
 
 def test_simulate_model_file_reproduces_both_grids(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -6,10 +6,13 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+import pytest
 
-from tcbench.diagnose.screens import AFTER_FIT, BEFORE_FIT, FINDINGS_ORDER, MODEL_ORDER, ThermometerScreen
+from tcbench.datasets.concealed import concealed_recording
+from tcbench.diagnose.screens import AFTER_FIT, BEFORE_FIT, FINDINGS_ORDER, MODEL_ORDER, ThermometerScreen, smoothing
 from tcbench.diagnose.screens.base import AFTER, BEFORE, Screen, ScreenInput, ScreenResult, run_screens
-from tcbench.diagnose.signals import DiagnosisData
+from tcbench.diagnose.settings import DEFAULTS
+from tcbench.diagnose.signals import DiagnosisData, prepare
 
 
 def _data(hours: float, sigma: float = 1.0) -> DiagnosisData:
@@ -70,3 +73,18 @@ def test_the_plans_hold_one_screen_per_detector_by_stage() -> None:
     assert ids == ["quantisation", "saturation", "variance", "outliers", "bias_instability", "variance"]
     known = {*ids, ThermometerScreen.id}
     assert set(FINDINGS_ORDER) == known and set(MODEL_ORDER) == known - {"bias_instability"}
+
+
+@pytest.mark.parametrize(("sensor", "seed"), [("gyro", 5), ("msra", 5), ("gyro", 11), ("msra", 11)])
+def test_no_screen_before_the_fit_finds_anything_on_a_control(sensor: str, seed: int) -> None:
+    """Concealed controls (nothing hidden): a thermometer fine enough for the default smoothing, no output
+    grid, no clipping, a constant noise level (on the minimal model's residual) and no outlier, each
+    screen having run."""
+    rec, _ = concealed_recording(sensor, None, seed)
+    smooth = smoothing(rec)
+    assert smooth.smooth_s == DEFAULTS.smoothing.default_window_s and not smooth.staircase
+    data = prepare(rec, smooth_s=smooth.smooth_s)
+    before = run_screens(BEFORE_FIT, ScreenInput(rec, data, results={ThermometerScreen.id: smooth}))
+    assert before.not_tested == {}
+    assert list(before.results) == [ThermometerScreen.id, *(s.id for s in BEFORE_FIT)]
+    assert {i: r.findings(data.unit) for i, r in before.results.items() if r.findings(data.unit)} == {}
