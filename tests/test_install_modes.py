@@ -22,8 +22,8 @@ from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, conf_dir
 
 REPO = Path(__file__).resolve().parents[1]
 IN_CLONE = (REPO / "pyproject.toml").is_file() and (REPO / "conf" / "config.yaml").is_file()
-# What a build reads: the project file, the readme and the folders that become packages.
-SOURCES = ["pyproject.toml", "README.md", "tcbench", "conf", "hydra_plugins"]
+# What a build reads: the project file, the readme, the licence and the folders that become packages.
+SOURCES = ["pyproject.toml", "README.md", "LICENSE", "tcbench", "conf", "hydra_plugins"]
 needs_clone = pytest.mark.skipif(not IN_CLONE, reason="needs tcbench's source tree")
 
 
