@@ -39,6 +39,14 @@ def test_quickstart_end_to_end(workdir: Path, capsys: pytest.CaptureFixture[str]
     assert "Verdict: missing: thermal_lag" in out and "the hidden effect was thermal_lag: found" in out
     assert "found thermal_lag" in out and "where: temperature " in out and "in sigma" in out
     assert "Next steps" in out
+    assert "micromachined silicon resonant accelerometer (MSRA)" in out and "doi:10.3390/mi13071054" in out
+    # Hydra's lines (each job's summary, the sweep's progress) and the diagnosis job's own summary are in the
+    # log, not between the results
+    assert "[HYDRA]" not in out and "][INFO]" not in out and "logged to MLflow run" not in out
+    log = (workdir / "tcbench-quickstart" / "quickstart.log").read_text()
+    assert log.count("Launching") == 3 and "IFA-BP-gd-msra_zerobias-dev0-s1: zb_zero_start_ug" in log
+    assert "diagnosed tcbench-quickstart/recordings/concealed-msra-thermal_lag-0.csv" in log
+    assert "logged to MLflow run" in log
 
     named = [Path(p) for line in out.splitlines() if line.startswith(("Leaderboard: ", "Diagnosis report"))
              for p in line.split(": ", 1)[1].split(", ")]

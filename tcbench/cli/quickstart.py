@@ -20,19 +20,21 @@ import textwrap
 import time
 import uuid
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, redirect_stdout
 from pathlib import Path
 from typing import Any
 
 from tcbench.cli.app import hydra_string
 from tcbench.commands.schemas import QuickstartConfig
 from tcbench.errors import ConfigError
+from tcbench.papers import SEED_000
 
 HEADER = """\
 tcbench: a benchmark for temperature compensation of MEMS inertial sensors. It simulates sensors
-(MSRA accelerometer, gyroscope) in temperature chambers, compensates them (learners and their
-weight searches, against the polynomial flight stacks ship and the physical limit), and diagnoses
-what a model or simulator leaves out of a recording. Every job is a run in MLflow."""
+(a micromachined silicon resonant accelerometer, MSRA; a dual-mass MEMS gyroscope; an ordinary
+MEMS accelerometer) in temperature chambers, compensates them (learners and their weight searches,
+against the polynomial flight stacks ship and the physical limit), and diagnoses what a model or
+simulator leaves out of a recording. Every job is a run in MLflow."""
 NEXT_STEPS = """\
 Next steps (the full experiments, from the repository root; the paper's studies compare with CMA-ES
 from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
@@ -47,6 +49,7 @@ from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
 
 
 FOLDERS = ("diagnosis", "leaderboard", "recordings")  # the quickstart's, inside its out=
+LOG = "quickstart.log"  # Hydra's log lines of the quickstart's sweeps and diagnosis, inside its out=
 
 
 def _rule(title: str) -> str:
@@ -115,15 +118,22 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     started = time.monotonic()
     sweep = cfg.tracking.sweep_id or uuid.uuid4().hex[:12]
     out = Path(cfg.out)
+    log_path = out / LOG
+    out.mkdir(parents=True, exist_ok=True)
+    log_path.write_text("")  # this quickstart's log: Hydra's lines go here, not between the results
     tracked = [f"tracking.sweep_id={sweep}", f"tracking.experiment={hydra_string(cfg.tracking.experiment)}",
-               *([f"tracking.uri={hydra_string(cfg.tracking.uri)}"] if cfg.tracking.uri else [])]
+               *([f"tracking.uri={hydra_string(cfg.tracking.uri)}"] if cfg.tracking.uri else []),
+               "hydra/hydra_logging=tcbench_file",
+               f"hydra.hydra_logging.handlers.file.filename={hydra_string(str(log_path.resolve()))}"]
     print(HEADER)
 
     print(_rule("1. Compensating a sensor: MSRA zero-bias stability (seed 000 §3, Table 1)"))
+    _say(f"Seed 000 is {SEED_000.names()}.")
     n_bp = cfg.seeds
     _say(f"Sizes (a demonstration, not the paper's result): IFA-BP trained {n_bp} times (seeds 0-{n_bp - 1}; "
           f"the paper: 30), each with {cfg.budget} evaluations of IFA's weight search (population 10) and "
           f"{cfg.epochs} gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
+    _say(f"Running; each job's line and the sweep's progress go to {log_path}.")
     checked = run_sweep(["-m", "experiment=quickstart", *tracked, f"budget={cfg.budget}",
                          f"learner.epochs={cfg.epochs}", f"seed=range({n_bp})"])
     assert checked is not None
@@ -150,7 +160,8 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     print(f"Diagnosis report and plots: {', '.join(str(p.resolve()) for p in diag_paths)}")
     print("Per-run figures (the paper's Fig. 7 for each test recording), scores.json and the training curves are")
     print("  artifacts of each compensation run in MLflow.")
-    print(f"Hydra job logs and resolved configs: {Path('multirun').resolve()}/")
+    print(f"Log of the sweeps and the diagnosis: {log_path.resolve()}; each job's resolved config: "
+          f"{Path('multirun').resolve()}/")
     print(f"Took {compensation_s:.0f} s (compensation) + {diagnosis_s:.0f} s (diagnosis).")
     print()
     print(NEXT_STEPS)
@@ -254,7 +265,8 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
     # the job tcbench diagnose runs (its report, and its run in MLflow), over an earlier quickstart's report
     c = as_dict(OmegaConf.structured(DiagnoseConfig(recording=str(path), out=str(out), overwrite=True)))
     c["tracking"] |= {"uri": uri, "experiment": experiment, "sweep_id": sweep}
-    outcome = run_job(c)
+    with (out.parent / LOG).open("a") as log, redirect_stdout(log):  # its summary lines: the quickstart prints its own
+        outcome = run_job(c)
     if isinstance(outcome, JobFailure):
         if outcome.user:
             raise ConfigError(outcome.error)
