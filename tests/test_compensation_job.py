@@ -16,7 +16,7 @@ from tcbench.cli.app import expand
 from tcbench.cli.main import main
 from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
-from tcbench.runner import compensation_job
+from tcbench.runner import kept_env
 from tcbench.runner.job import JobFailure, run_job
 from tcbench.runner.kinds import kind_of
 from tcbench.tracking.store import config_hash
@@ -36,7 +36,7 @@ def builds(monkeypatch: pytest.MonkeyPatch) -> list[str]:
         return make(env_id, *args, **kwargs)
 
     monkeypatch.setattr(gymnasium, "make", counted)
-    monkeypatch.setattr(compensation_job, "_kept", {})
+    monkeypatch.setattr(kept_env, "_kept", {})
     return made
 
 
