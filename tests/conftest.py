@@ -52,3 +52,23 @@ def workdir(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
     return tmp_path
+
+
+@pytest.fixture
+def builds(monkeypatch):  # type: ignore[no-untyped-def]
+    """The ids of the envs ``gym.make`` builds from now on, in order (no env kept by a plan check
+    before: :mod:`tcbench.runner.kept_env`)."""
+    import gymnasium
+
+    from tcbench.runner import kept_env
+
+    made: list[str] = []
+    make = gymnasium.make
+
+    def counted(env_id, *args, **kwargs):  # type: ignore[no-untyped-def]
+        made.append(env_id if isinstance(env_id, str) else env_id.id)
+        return make(env_id, *args, **kwargs)
+
+    monkeypatch.setattr(gymnasium, "make", counted)
+    monkeypatch.setattr(kept_env, "_kept", {})
+    return made

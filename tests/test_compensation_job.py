@@ -8,7 +8,6 @@ import pickle
 from pathlib import Path
 from typing import Any
 
-import gymnasium
 import pytest
 import yaml
 
@@ -16,28 +15,12 @@ from tcbench.cli.app import expand
 from tcbench.cli.main import main
 from tcbench.config_dir import conf_dir
 from tcbench.errors import ConfigError
-from tcbench.runner import compensation_job
 from tcbench.runner.job import JobFailure, run_job
 from tcbench.runner.kinds import kind_of
 from tcbench.tracking.store import config_hash
 
 ZEROBIAS = "tcbench/MSRA-ZeroBias-v0"
 QUICK = ["task=msra_zerobias", "learner=poly", "optimiser=none", "tracking.enabled=false"]
-
-
-@pytest.fixture
-def builds(monkeypatch: pytest.MonkeyPatch) -> list[str]:
-    """The ids of the envs ``gym.make`` builds from now on, in order."""
-    made: list[str] = []
-    make = gymnasium.make
-
-    def counted(env_id: Any, *args: Any, **kwargs: Any) -> Any:
-        made.append(env_id if isinstance(env_id, str) else env_id.id)
-        return make(env_id, *args, **kwargs)
-
-    monkeypatch.setattr(gymnasium, "make", counted)
-    monkeypatch.setattr(compensation_job, "_kept", {})
-    return made
 
 
 def _job(*overrides: str) -> dict[str, Any]:

@@ -44,8 +44,9 @@ class LearnerConfig:
 
 @dataclass(frozen=True)
 class OptimiserConfig:
-    """A compensation job's optimiser of the learner's initial weights (``none``: a random
-    start): its name, its parameters and its leaderboard label."""
+    """A job's optimiser (a compensation job's searches the learner's initial weights, ``none``:
+    a random start; an optimisation job's minimises the task): its name, its parameters and its
+    leaderboard label."""
 
     name: str
     params: dict[str, Any]
@@ -66,7 +67,7 @@ def learner_of(c: dict[str, Any]) -> LearnerConfig:
 
 
 def optimiser_of(c: dict[str, Any]) -> OptimiserConfig:
-    """The job's optimiser of the learner's initial weights (its config's ``optimiser``)."""
+    """The job's optimiser (its config's ``optimiser``)."""
     params = dict(c["optimiser"])
     name = str(params.pop("name", None))
     label = params.pop("label", None)

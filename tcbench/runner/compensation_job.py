@@ -4,8 +4,9 @@ env's arguments, the learner and the optimiser, the job's names and the env it r
 The env is built once per job in a process: the plan check of a command line
 (:meth:`~tcbench.runner.kinds.JobKind.plan_check`, before any job starts) keeps the env it built
 and checked for the job that runs next in the same process with the same env arguments
-(:func:`keep`), which takes it instead of building another (an env is fresh until its first
-``reset``: a check reads it, never steps it). A job on a worker process is prepared there.
+(:func:`keep`, :mod:`~tcbench.runner.kept_env`), which takes it instead of building another (an
+env is fresh until its first ``reset``: a check reads it, never steps it). A job on a worker
+process is prepared there.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from tcbench.runner import kept_env
 from tcbench.runner.compensation_config import LearnerConfig, OptimiserConfig, learner_of, optimiser_of, \
     validate_compensation
 from tcbench.runner.config import checked_config
@@ -64,15 +66,10 @@ def in_sample(task: dict[str, Any]) -> list[str]:
     return shared_recordings(task["train_files"], task["test_files"])
 
 
-# The env a plan check built, by its key, for the job that runs next in this process (one at most).
-_kept: dict[str, Any] = {}
-
-
 def keep(job: CompensationJob) -> None:
     """Keep ``job``'s env for the next job prepared in this process from the same env arguments
-    (the plan check's job hands it to the job that runs); one env is kept at most."""
-    _kept.clear()
-    _kept[job.env_key] = job.env
+    (the plan check's job hands it to the job that runs; :mod:`~tcbench.runner.kept_env`)."""
+    kept_env.keep(job.env_key, job.env)
 
 
 def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) -> CompensationJob:
@@ -83,7 +80,7 @@ def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) 
     spec, task = checked_config(c)
     learner, optimiser = learner_of(c), optimiser_of(c)
     kwargs = task_kwargs(task)
-    kept = _kept.pop(env_key(spec, learner, c["budget"], kwargs), None)
+    kept = kept_env.take(env_key(spec, learner, c["budget"], kwargs))
     env = validate_compensation(c, task, kept)
     plots = (c.get("tracking") or {}).get("plots")
     return CompensationJob(spec, task, kwargs, learner, optimiser, int(c["budget"]), int(c["seed"]),

@@ -79,27 +79,43 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     """Check ranges and names of a composed job config; raise :class:`ConfigError` if wrong."""
     c = as_dict(cfg)
     spec, task = checked_config(c)
-    name = str(c["task"].get("name"))
     if spec.is_compensation:
         validate_compensation(c, task)
         return
+    validate_optimisation(c, spec, task)
+
+
+def validate_optimisation(c: dict[str, Any], spec: TaskSpec, task: dict[str, Any], env: Any = None) -> Any:
+    """The optimiser and task of an optimisation job whose config :func:`checked_config` returned
+    ``spec`` and ``task``; raise ConfigError naming the key. The env checked: ``env`` when given
+    (built from the same arguments by an earlier check of this job), else built now (unwrapped,
+    not yet reset)."""
+    name = str(c["task"].get("name"))
     if c.get("learner"):
         raise ConfigError(f"learner={c['learner'].get('name')}: learners apply to compensation tasks "
                           f"({', '.join(n for n, s in TASKS.items() if s.is_compensation)}), not to task {name}")
     kwargs = task_kwargs(task)
     if spec.sized:
         check_job_memory(c, kwargs.get("dim", 2))
-    try:
-        env = gym.make(spec.gym_id, budget=c["budget"], **kwargs).unwrapped
-    except ConfigError:
-        raise
-    except (KeyError, ValueError) as exc:
-        raise ConfigError(f"task: {exc}") from None
+    if env is None:
+        env = build_optimisation_env(spec, c["budget"], kwargs)
     ioh_dir = c.get("tracking", {}).get("ioh_dir")
     if ioh_dir and getattr(env, "n_objectives", 1) > 1:
         raise ConfigError(f"tracking.ioh_dir: IOHprofiler logs are for one objective; task {name} has "
                           f"{env.n_objectives}")
     check_optimiser(c, env, name)
+    return env
+
+
+def build_optimisation_env(spec: TaskSpec, budget: int, kwargs: dict[str, Any]) -> Any:
+    """The unwrapped env of an optimisation job (``gym.make`` of ``spec.gym_id`` with ``budget``
+    and the task's keyword arguments); a ConfigError naming the task when it refuses them."""
+    try:
+        return gym.make(spec.gym_id, budget=budget, **kwargs).unwrapped
+    except ConfigError:
+        raise
+    except (KeyError, ValueError) as exc:
+        raise ConfigError(f"task: {exc}") from None
 
 
 def check_job_memory(c: dict[str, Any], dim: Any) -> None:

@@ -167,11 +167,14 @@ def run_optimisation(
     progress: bool = False,
     ioh_folder: str | Path | None = None,
     algorithm: str | None = None,
+    env: Any = None,
 ) -> RunResult:
     """Minimise ``task`` with ``optimiser`` (configs as mappings) under ``budget`` and ``seed``;
     with ``ioh_folder``, also write the run there in IOHprofiler's format under the name
-    ``algorithm`` (default: the optimiser's name)."""
-    env = make_task(task, budget)
+    ``algorithm`` (default: the optimiser's name). ``env``: the task's env already built from
+    ``task`` and ``budget`` (unwrapped, not yet reset; an optimisation job's, built once for its
+    checks and its run); None: built here (:func:`make_task`)."""
+    env = make_task(task, budget) if env is None else env
     env_seed, rng = seed_streams(seed)
     env.reset(seed=env_seed)
     params = {k: v for k, v in optimiser.items() if k != "name"}

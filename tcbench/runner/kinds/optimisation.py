@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.runner.config import validate
 from tcbench.runner.kinds import JobKind, JobNames
 from tcbench.runner.loop import RunResult, run_optimisation
+from tcbench.runner.optimisation_job import OptimisationJob, keep, prepare_job
 from tcbench.tasks import task_spec
 
 
@@ -55,23 +55,27 @@ def ioh_folder(c: dict[str, Any]) -> Path | None:
 
 
 class OptimisationKind(JobKind):
+    """An optimisation job: checked and prepared once (:class:`~tcbench.runner.optimisation_job.OptimisationJob`,
+    its env built once per process), then run, recorded and summed up from that job."""
+
     plots_in_sweeps = False  # a convergence PNG per run costs more than the run; the leaderboard draws them
 
     def plan_check(self, c: dict[str, Any]) -> None:
-        validate(c)
+        keep(self.job(c))  # the env built for the check serves the job when it runs in this process
 
     def names(self, c: dict[str, Any]) -> JobNames:
         tkey, method = task_key(c["task"]), method_label(c["optimiser"])
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
                         {"tcbench.task_name": str(c["task"]["name"])})
 
-    def execute(self, c: dict[str, Any]) -> RunResult:
-        validate(c)
-        optimiser = {k: v for k, v in c["optimiser"].items() if k != "label"}
-        return run_optimisation(c["task"], optimiser, c["budget"], c["seed"], c["progress"],
-                                ioh_folder=ioh_folder(c), algorithm=method_label(c["optimiser"]))
+    def job(self, c: dict[str, Any]) -> OptimisationJob:
+        return prepare_job(c, self.names, ioh_folder)
 
-    def record(self, run: Any, result: RunResult, c: dict[str, Any], where: Path) -> list[Path]:
+    def execute(self, job: OptimisationJob) -> RunResult:
+        return run_optimisation(job.task, job.optimiser_config, job.budget, job.seed, job.progress,
+                                ioh_folder=job.ioh_folder, algorithm=job.names.method, env=job.env)
+
+    def record(self, run: Any, result: RunResult, job: OptimisationJob, where: Path) -> list[Path]:
         t = result.trace
         multi = result.n_objectives > 1
         run.log_series("hv_gap" if multi else "best_f", t.best_f, t.evaluations)
@@ -86,18 +90,18 @@ class OptimisationKind(JobKind):
             np.savetxt(front, result.front_f, delimiter=",", header=",".join(
                 f"f{i + 1}" for i in range(result.n_objectives)), comments="")
             files.append(front)
-        if c["tracking"]["plots"] is not False:  # null: plot (a sweep's launcher decides)
+        if job.plots is not False:  # null: plot (a sweep's launcher decides)
             from tcbench import plots  # matplotlib only when a run draws
 
-            names = self.names(c)
+            names = job.names
             files.append(plots.run_convergence(
                 where / "convergence.png", t.evaluations, t.best_f, t.mean_f, result.f_opt,
-                f"{names.method} on {names.task}, seed {c['seed']}",
+                f"{names.method} on {names.task}, seed {job.seed}",
                 labels=("hypervolume gap 1 - HV/HV*", "IGD") if multi else None,
             ))
         return files
 
-    def summary(self, result: RunResult, c: dict[str, Any]) -> str:
-        n = self.names(c)
-        return (f"{n.method} on {n.task} seed {c['seed']}: best {result.best_f:.6g} (error {result.error:.3g}) "
+    def summary(self, result: RunResult, job: OptimisationJob) -> str:
+        n = job.names
+        return (f"{n.method} on {n.task} seed {job.seed}: best {result.best_f:.6g} (error {result.error:.3g}) "
                 f"after {result.evaluations} evaluations")
