@@ -43,11 +43,20 @@ def _out(cfg: Any, root: Path) -> Path:
     return out
 
 
+_MADE: dict[tuple[str, tuple[str, ...]], Site] = {}  # the last site made: a job's check and work make it once
+
+
 def _site(cfg: Any, root: Path) -> Site:
     """The pages of the boards asked for; one line naming an unknown board."""
     select = [str(b) for b in (cfg.boards or [])]
+    key = (os.path.realpath(root), tuple(select))
+    if key in _MADE:
+        return _MADE[key]
     try:
-        return build_site(root, select)
+        site = build_site(root, select)
+        _MADE.clear()
+        _MADE[key] = site
+        return site
     except UnknownBoardError as exc:
         names = known(root)
         folders = [n for n in names if "/" not in n]

@@ -363,8 +363,8 @@ def build_site(root: Path, select: list[str] | None = None) -> Site:
     chosen: list[CompensationBoard] = []
     found: set[str] = set()
     for folder, family in FAMILIES.items():
-        if not (root / folder).is_dir():
-            continue
+        if not (root / folder).is_dir() or (wanted and not any(w.split("/")[0] == folder for w in wanted)):
+            continue  # every name of a folder's pages starts with the folder
         made, boards = family_pages(root, family)
         found |= {folder} | {p.page_id for p in made}
         keep = [p for p in made if not wanted or folder in wanted or p.page_id in wanted]
