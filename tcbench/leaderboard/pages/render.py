@@ -163,7 +163,7 @@ def devices_page(root: Path, family: Family) -> Page | None:
     table = read_csv(folder / "devices.csv")
     path = PurePosixPath(family.folder) / "devices.md"
     files: dict[PurePosixPath, Content] = {}
-    lines = _head(family, "**Across devices:** every method's median drift over the thermometer-limited oracle's, "
+    lines = WIDE + _head(family, "**Across devices:** every method's median drift over the thermometer-limited oracle's, "
                           "per simulated device (split next_run).")
     lines += _admonition("abstract", "Verdict", verdicts.devices_verdict(table))
     lines += [*[f"{p}\n" for p in md_paragraphs(folder / "devices.md")],
@@ -185,7 +185,7 @@ def claims_page(root: Path, family: Family) -> Page | None:
                 f"{int(said[claims['tier'] == tier].str.startswith('yes on').sum())} on the table only (failing "
                 "the ±0.5 g probe)." for tier in dict.fromkeys(claims["tier"])]
     path = PurePosixPath(family.folder) / "claims.md"
-    lines = _head(family, "**The paper's claims, per tier:** gains against raw, worse of the two test datasets.")
+    lines = WIDE + _head(family, "**The paper's claims, per tier:** gains against raw, worse of the two test datasets.")
     lines += _admonition("abstract", "Verdict", per_tier)
     lines += [html.table(claims, "board-claims", "every claim, tier and selection", key="tier"), ""]
     if (folder / "gd_budget.csv").is_file():
@@ -279,7 +279,7 @@ def calibration_page(root: Path, family: Family) -> Page | None:
     table = read_csv(folder / "board.csv")
     path = PurePosixPath(family.folder) / "index.md"
     files: dict[PurePosixPath, Content] = {}
-    lines = _head(family)
+    lines = WIDE + _head(family)
     lines += _admonition("abstract", "Verdict", verdicts.calibration_verdict(table, family.paper_methods))
     lines += [*[f"{p}\n" for p in md_paragraphs(folder / "board.md")],
               html.table(table, "board-real-imu", "every record, split and method",

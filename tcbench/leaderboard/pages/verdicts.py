@@ -125,10 +125,12 @@ def _claims_csv(board: CompensationBoard, table: pd.DataFrame) -> list[str]:
             verdict = "**reproduced**"
         elif yes == 0 and partly == 0:
             verdict = "**not reproduced**"
+        elif yes == 0:
+            verdict = (f"**not reproduced as a compensation**: {partly} of {n} rows reach it on the table while "
+                       "failing the ±0.5 g probe, none otherwise")
         else:
-            verdict = f"reproduced in {yes} of {n} rows" + (f", {partly} more on the table only (failing the ±0.5 g "
-                                                             "probe)" if partly else "")
-            verdict = f"**partly**: {verdict}" if yes or partly else verdict
+            verdict = f"**partly reproduced**: in {yes} of {n} rows" + (
+                f", {partly} more on the table only (failing the ±0.5 g probe)" if partly else "")
         picks = "; ".join(f"{sel}: {gain}" for sel, gain in zip(rows["selection"].head(2), rows["worst-test gain"].head(2),
                                                                  strict=True))
         out.append(f"Claim “{claim}” on this tier: {verdict} ({n} rows of claims.csv; e.g. {picks}).")
