@@ -14,7 +14,8 @@ from tcbench.cli import help as cli_help
 from tcbench.cli import COMMANDS, main
 from tcbench.commands.registry import SPECS
 
-KEYVALUE = ["simulate", "metrics", "import", "diagnose", "calibrate", "export", "leaderboard", "list", "quickstart"]
+KEYVALUE = ["simulate", "metrics", "import", "diagnose", "calibrate", "export", "leaderboard", "list", "quickstart",
+            "pages"]
 # what the help of the other commands must name: their parameters or settings
 NAMED = {
     "run": ["usage: tcbench run", "seed", "budget", "tracking", "optimiser", "examples:", "output:"],
@@ -24,6 +25,7 @@ ALSO = {
     "leaderboard": ["--experiment", "--sweep", "--out", "--tracking-uri", "--ecdf"],
     "quickstart": ["budget: 510", "seed: range(5)", "thermal_lag", "one after another"],
     "list": ["one after another"],
+    "pages": ["one after another", "(required)", "FOLDER/STEM", "nothing outside OUT"],
 }
 
 

@@ -146,6 +146,36 @@ SPECS: dict[str, CommandSpec] = {
                  "  --tracking-uri URI  tracking.uri=URI",
                  "  --ecdf              ecdf=true"),
     ),
+    "pages": CommandSpec(
+        name="pages",
+        summary="the leaderboard pages of the committed boards, for the documentation site (out=DIR)",
+        description="Write the leaderboard pages of the documentation site from the committed boards under "
+                    "leaderboards/ alone (no MLflow store): a page per compensation board (its paper and sensor, "
+                    "its split tier, its verdict, a sortable and filterable table with the limits and the "
+                    "memoriser marked, its methods against the limits as a plot, its own figures), a page per "
+                    "optimisation folder (ECDFs and tables), the real-IMU board, and a summary ranking the methods "
+                    "across the compensation tasks. `mkdocs build` makes the same pages into docs/leaderboards/.",
+        schema="tcbench.commands.schemas:PagesConfig",
+        runs_here="tcbench.leaderboard.pages.command",
+        params={
+            "out": "output folder (markdown pages for MkDocs, their plots and the boards' figures)",
+            "leaderboards": "the folder of committed boards (the repository's leaderboards/)",
+            "boards": "only these: board folders (boards=[paper-ifa-bp,bbob]) or single boards as FOLDER/STEM "
+                      "(boards=[paper-ifa-bp/msra_zerobias-dev0]); empty: every board. The summary page is "
+                      "always written, over the boards chosen",
+            "overwrite": OVERWRITE,
+        },
+        examples=(
+            "tcbench pages out=board-pages",
+            "tcbench pages out=board-pages 'boards=[paper-ifa-bp,accel-chamber/accel_chamber-dev0]'",
+            "tcbench pages out=board-pages overwrite=true      (again, replacing the pages written before)",
+        ),
+        output="OUT/index.md (the summary), OUT/<folder>/<board>.md per compensation board with its plot "
+               "OUT/<folder>/<board>.limits.svg, OUT/<folder>/index.md per optimisation folder, and the boards' "
+               "committed figures beside them; nothing outside OUT",
+        required=("out",),
+        sweep=", each writing its own out=",
+    ),
     "quickstart": CommandSpec(
         name="quickstart",
         summary="the main job in a minute: compensate a simulated MSRA, diagnose a recording",

@@ -192,6 +192,17 @@ class LeaderboardConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(enabled=False, experiment="leaderboards"))
 
 
+@dataclass
+class PagesConfig:
+    """``tcbench pages``: the leaderboard pages of the committed boards in ``leaderboards`` (all of
+    them, or the folders and boards named in ``boards``) written into ``out``."""
+
+    out: str = ""
+    leaderboards: str = "leaderboards"
+    boards: list[str] = field(default_factory=list)
+    overwrite: bool = False
+
+
 LISTS = ("all", "tasks", "optimisers", "learners", "sensors", "terms")
 
 
