@@ -223,7 +223,7 @@ def test_a_bad_argument_is_one_line_and_writes_nothing(args: list[str], words: l
 
 
 def _hook():  # type: ignore[no-untyped-def]
-    spec = importlib.util.spec_from_file_location("leaderboard_pages_hook", REPO / "hooks" / "leaderboard_pages.py")
+    spec = importlib.util.spec_from_file_location("leaderboard_pages_hook", REPO / "docs" / "hooks" / "leaderboard_pages.py")
     module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
     spec.loader.exec_module(module)  # type: ignore[union-attr]
     return module

@@ -1,4 +1,5 @@
-"""Seed 000's micro-silicon resonant accelerometer: output the resonators' frequency difference in Hz.
+"""Seed 000's micromachined silicon resonant accelerometer (MSRA): output the resonators' frequency
+difference in Hz.
 
 Protocols: ``fulltemp``, seed 000's full-temperature test (nodes -40..60 degC every 20 degC, 1 h
 soak, then +0 g, +1 g, -0 g, -1 g for 40 s each with 10 s turntable moves, at 1 Hz); ``roomtemp``,
