@@ -1,10 +1,17 @@
-"""Tables as GitHub markdown: a leaf module (numpy and pandas only), shared by the leaderboards
-and the commands that write tables of their own."""
+"""Tables as GitHub markdown: a leaf module (numpy, pandas and tabulate only), shared by the
+leaderboards and the commands that write tables of their own."""
 
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from tabulate import DataRow, TableFormat
+
+# tabulate's "github" format with cells as given (no padding to the column's width) and a rule
+# of three dashes per column: the tables tcbench has always written, byte for byte.
+_GITHUB = TableFormat(lineabove=None, linebelowheader=lambda widths, _aligns: "|" + "|".join("---" for _ in widths) + "|",
+                      linebetweenrows=None, linebelow=None, headerrow=DataRow("|", "|", "|"),
+                      datarow=DataRow("|", "|", "|"), padding=1, with_header_hide=None)
 
 
 def _fmt(value: object) -> str:
@@ -18,8 +25,7 @@ def _fmt(value: object) -> str:
 
 
 def markdown_table(table: pd.DataFrame) -> str:
-    """A pandas table as a GitHub markdown table (floats to three significant digits)."""
-    head = "| " + " | ".join(table.columns) + " |"
-    rule = "|" + "|".join("---" for _ in table.columns) + "|"
-    body = ["| " + " | ".join(_fmt(v) for v in row) + " |" for row in table.itertuples(index=False)]
-    return "\n".join([head, rule, *body])
+    """A pandas table as a GitHub markdown table (floats to three significant digits, ``inf`` as
+    ∞, NaN as –; every other cell as ``str`` gives it)."""
+    cells = table.astype(object).map(_fmt)
+    return cells.to_markdown(index=False, tablefmt=_GITHUB, disable_numparse=True, stralign=None, numalign=None)

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tcbench.leaderboard.optimisation import summarise
-from tcbench.stats import bootstrap_median_ci, paired_p_value
+from tcbench.stats import BOOTSTRAP_SEED, bootstrap_median_ci, paired_p_value, percentiles, with_failures
 
 
 def test_bootstrap_interval_covers_and_shrinks() -> None:
@@ -68,3 +72,29 @@ def test_bootstrap_interval_ignores_the_order_of_the_values() -> None:
     values = np.random.default_rng(3).lognormal(size=30)
     for seed in range(10):  # an order-dependent resampling differs on several of these
         assert bootstrap_median_ci(values) == bootstrap_median_ci(np.random.default_rng(seed).permutation(values))
+
+
+_board_values = st.integers(2, 40).flatmap(lambda n: st.tuples(
+    st.lists(st.one_of(st.floats(-1e6, 1e6), st.sampled_from([0.0, 1.0, 1.5])), min_size=n, max_size=n),
+    st.integers(0, n), st.booleans()))
+
+
+@settings(max_examples=150, deadline=None)
+@given(_board_values)
+def test_the_median_interval_is_scipys_percentile_bootstrap_up_to_the_quantile_rule(case: tuple[list[float], int, bool]) -> None:
+    """Same seed, same resampled medians as ``scipy.stats.bootstrap(method="percentile")``, so
+    the interval is ``percentiles`` of scipy's bootstrap distribution, bit for bit, ties and
+    failed runs (±inf) included. scipy's own interval is not used: its quantile rule differs in
+    the last bits and has no ±inf rule (benchmarks/RESULTS.md, bootstrap_vs_scipy.py)."""
+    pytest.importorskip("scipy", minversion="1.15")  # the rng argument
+    from scipy import stats
+
+    finished, failed, higher_is_better = case
+    x = with_failures(np.array(finished), failed, higher_is_better)
+    rng = np.random.default_rng(BOOTSTRAP_SEED)
+    sample = np.sort(x)
+    with warnings.catch_warnings():  # ±inf: scipy warns about its own interval and spread
+        warnings.simplefilter("ignore")
+        res = stats.bootstrap((sample,), np.median, method="percentile", n_resamples=2000, rng=rng, vectorized=True)
+    tail = 100.0 * (1.0 - 0.95) / 2.0  # as bootstrap_median_ci computes it (2.5000000000000022)
+    assert bootstrap_median_ci(x) == tuple(percentiles(res.bootstrap_distribution, [tail, 100.0 - tail]).tolist())

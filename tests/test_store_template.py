@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import sqlite3
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -94,3 +96,26 @@ def test_an_existing_store_is_not_replaced(workdir: Path, cache: Path) -> None:
     tracking.prepare_store(uri, "second")
     names = {e.name for e in mlflow.MlflowClient(uri).search_experiments()}
     assert {"first", "second"} <= names
+
+
+_FLOCK = ("import fcntl, sys; h = open(sys.argv[1], 'a'); print('waiting', flush=True); "
+          "fcntl.flock(h, fcntl.LOCK_EX | (fcntl.LOCK_NB if sys.argv[2] == 'try' else 0)); print('got', flush=True)")
+
+
+def test_the_store_lock_is_an_exclusive_blocking_flock_on_db_lock(workdir: Path) -> None:
+    """Held by one process, the lock on ``<db>.lock`` is refused to another's non-blocking
+    ``flock`` (so it also excludes a tcbench that locks with plain ``flock``), and another's
+    blocking ``flock`` waits until it is released."""
+    db = workdir / "mlflow.db"
+    lock = db.with_name("mlflow.db.lock")
+    with tracking.store_lock(f"sqlite:///{db}"):
+        assert lock.is_file()
+        tried = subprocess.run([sys.executable, "-c", _FLOCK, str(lock), "try"], capture_output=True, text=True)
+        assert tried.returncode != 0 and "BlockingIOError" in tried.stderr
+        waiter = subprocess.Popen([sys.executable, "-c", _FLOCK, str(lock), "wait"], stdout=subprocess.PIPE, text=True)
+        assert waiter.stdout is not None and waiter.stdout.readline() == "waiting\n"
+        time.sleep(0.5)
+        assert waiter.poll() is None  # still blocked in flock
+    assert waiter.wait(timeout=30) == 0 and waiter.stdout.read() == "got\n"
+    assert subprocess.run([sys.executable, "-c", _FLOCK, str(lock), "try"], capture_output=True).returncode == 0
+    assert lock.is_file()  # left in place for the next process, as before

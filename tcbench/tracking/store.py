@@ -75,9 +75,9 @@ def store_lock(uri: str | None = None) -> Iterator[None]:
     if db is None:
         yield
         return
-    from tcbench.tracking.filelock import locked
+    from filelock import FileLock
 
-    with locked(db):
+    with FileLock(db.with_name(db.name + ".lock")):
         yield
 
 

@@ -23,7 +23,7 @@ from collections.abc import Iterator
 from contextlib import closing, contextmanager
 from pathlib import Path
 
-from tcbench.tracking.filelock import locked
+from filelock import FileLock
 
 log = logging.getLogger(__name__)
 
@@ -104,7 +104,7 @@ def ensure_template() -> Path:
     or unreadable."""
     template = template_path()
     template.parent.mkdir(parents=True, exist_ok=True)
-    with locked(template):
+    with FileLock(template.with_name(template.name + ".lock")):
         if not (_is_store(template) and template.with_suffix(".json").is_file()):
             _build(template)
     return template
