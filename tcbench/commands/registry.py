@@ -224,7 +224,7 @@ SPECS: dict[str, CommandSpec] = {
     ),
     "simulate": CommandSpec(
         name="simulate",
-        summary="simulate a recording (sensor=msra|gyro protocol=... device_seed=N seed=N out=DIR) and its metrics",
+        summary="simulate a recording (sensor=msra|gyro|accel protocol=... device_seed=N seed=N out=DIR) and its metrics",
         description="Simulate a recording of one device under a test protocol, then compute its metrics.",
         schema="tcbench.commands.schemas:SimulateConfig",
         kinds={"simulate": "tcbench.runner.kinds.recordings:SimulateKind"},
@@ -260,7 +260,7 @@ SPECS: dict[str, CommandSpec] = {
     ),
     "import": CommandSpec(
         name="import",
-        summary="your own CSV as a recording (csv=PATH sensor=msra|gyro time=COL:unit ... out=DIR)",
+        summary="your own CSV as a recording (csv=PATH sensor=msra|gyro|accel time=COL:unit ... out=DIR)",
         description="Import your own CSV file as a tcbench recording (validated, with its sidecar).",
         schema="tcbench.commands.schemas:ImportConfig",
         kinds={"import": "tcbench.runner.kinds.recordings:ImportKind"},
