@@ -1,6 +1,7 @@
-"""The README's walkthrough of a user's own IMU (import, diagnose, calibrate, export, leaderboard,
-on the tofupilot and PAN recordings the repository carries) runs as written: every command of
-its block, in order, from a folder that holds only the repository's data."""
+"""The tutorial "Compensate your own IMU" (docs/tutorials/own-imu.md: import, diagnose, calibrate,
+export, leaderboard, on the tofupilot and PAN recordings the repository carries) runs as written:
+every command of its bash blocks, in order, from a folder that holds only the repository's data,
+and gives the files the page describes."""
 
 from __future__ import annotations
 
@@ -17,22 +18,22 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def walkthrough() -> list[list[str]]:
-    """The commands of the README's block under "Your own IMU, end to end", continuations joined."""
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("### Your own IMU, end to end"):]
-    block = re.search(r"```bash\n(.*?)```", section, re.S).group(1)  # type: ignore[union-attr]
-    return [shlex.split(line) for line in block.replace("\\\n", " ").splitlines() if line.strip()]
+    """The commands of the tutorial's bash blocks, in order, continuations joined."""
+    text = (ROOT / "docs" / "tutorials" / "own-imu.md").read_text()
+    blocks = re.findall(r"```bash\n(.*?)```", text, re.S)
+    return [shlex.split(line) for block in blocks for line in block.replace("\\\n", " ").splitlines()
+            if line.strip() and not line.lstrip().startswith("#")]
 
 
-def test_the_walkthrough_block_is_what_this_test_runs() -> None:
+def test_the_tutorial_blocks_are_what_this_test_runs() -> None:
     commands = walkthrough()
-    assert [c[1] for c in commands] == ["import", "diagnose", "calibrate", "export", "import", "calibrate",
-                                        "leaderboard"]
+    assert [c[1] for c in commands] == ["import", "diagnose", "calibrate", "export", "import", "metrics",
+                                        "calibrate", "leaderboard", "calibrate"]
     assert all(c[0] == "tcbench" for c in commands)
 
 
 @pytest.mark.slow
-def test_the_readme_walkthrough_runs(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_own_imu_tutorial_runs(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     (workdir / "data").symlink_to(ROOT / "data")
     for command in walkthrough():
         assert main(command[1:]) == 0, " ".join(command)
@@ -45,4 +46,4 @@ def test_the_readme_walkthrough_runs(workdir: Path, capsys: pytest.CaptureFixtur
     assert pan["held_out_parts"] == [1, 3] and pan["axis"] == "x"
     boards = sorted(p.name for p in (mine / "boards").glob("calibration-*.md"))
     assert len(boards) == 4, boards  # three tofupilot axes and the PAN gyro, one board each
-    assert out.count("best held out:") == 4
+    assert out.count("best held out:") == 5  # the three tofupilot axes, the PAN gyro, gyro y on two branches
