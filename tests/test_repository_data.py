@@ -15,9 +15,10 @@ from tcbench.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
 SCANNED = ("tests", "experiments", "tcbench", "benchmarks", "conf", "plugins", "examples", "hydra_plugins",
-           ".ci", "README.md", "Makefile", "pyproject.toml")
+           ".ci", "docs", "README.md", "Makefile", "mkdocs.yml", "pyproject.toml")
 TEXT_SUFFIXES = {".py", ".sh", ".md", ".yaml", ".yml", ".toml", ".cfg", ".ini", ".txt", ""}
-GENERATED = {"__pycache__", "runs", "outputs", "multirun", "mlruns", "mlartifacts", "ioh-analyzer"}
+GENERATED = {"__pycache__", "runs", "outputs", "multirun", "mlruns", "mlartifacts", "ioh-analyzer",
+             "leaderboards"}  # docs/leaderboards/: the site's board pages, made at every build
 OUTSIDE = ("../shared", '"shared" /', "'shared' /", "TCBENCH_REAL_DATA")
 MAX_FILE_BYTES = 5_000_000
 # Path(__file__).resolve().parents[k]: outside the repository when k reaches past its root
@@ -64,7 +65,7 @@ def test_every_data_real_path_named_exists() -> None:
                                                                                    errors="replace"))}
     assert {"data/real/pan_lsm6dsm_tvac_cooling/pan_lsm6dsm_tvac_cooling.csv",
             "data/real/tofupilot_imu_chamber/imu_raw_data.csv",
-            "data/real/px4_ulog_samples/sample_log_small.ulg"} <= named  # the README's commands
+            "data/real/px4_ulog_samples/sample_log_small.ulg"} <= named  # the documented commands (README, docs)
     assert not sorted(p for p in named if not (ROOT / p).exists())
 
 
