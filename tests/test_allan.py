@@ -108,7 +108,7 @@ def test_rate_random_walk_adev_and_k():
 
 
 def _gauss_markov_bank(rng: np.random.Generator, n: int, fs_hz: float, b: float) -> np.ndarray:
-    """PHYSICS.md §4: first-order Gauss-Markov processes, two per decade, sigma 0.605 B each."""
+    """docs/concepts/physics.md, metrics: first-order Gauss-Markov processes, two per decade, sigma 0.605 B each."""
     out = np.zeros(n)
     sigma = 0.605 * b
     for tc_s in 10 ** np.arange(0.0, 4.01, 0.5):
@@ -190,7 +190,7 @@ def test_unit_conversions():
     assert to_deg_per_hour(1.0) == 3600.0
     np.testing.assert_allclose(to_deg_per_hour(np.array([1e-3, 2.0])), [3.6, 7200.0])
     assert arw_to_deg_per_sqrt_hour(1.0) == 60.0
-    # PHYSICS.md §4: N[deg/sqrt(h)] = sigma(1 s)[deg/h] / 60 for white noise.
+    # docs/concepts/physics.md, metrics: N[deg/sqrt(h)] = sigma(1 s)[deg/h] / 60 for white noise.
     sigma_1s_dps = 0.01
     assert arw_to_deg_per_sqrt_hour(sigma_1s_dps) == pytest.approx(
         to_deg_per_hour(sigma_1s_dps) / 60

@@ -33,7 +33,7 @@ from tcbench.diagnose.report import write_report
 from tcbench.sensors.recording import Recording
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-# PHYSICS.md §8: the shape each library effect takes in a residual
+# docs/concepts/diagnosis-report.md, shapes: the shape each library effect takes in a residual
 EXPECTED_SHAPE = {
     "thermal_lag": "temperature_dynamics", "temperature_rate": "temperature_dynamics",
     "hysteresis": "temperature_dynamics", "temperature_cubic": "temperature_function", "warmup": "transient",

@@ -1,4 +1,4 @@
-"""Noise processes: their Allan signatures (PHYSICS.md §4)."""
+"""Noise processes: their Allan signatures (docs/concepts/physics.md, metrics)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A new run is a new power-on (PHYSICS.md §9): what differs between simulated runs of one device."""
+"""A new run is a new power-on (docs/concepts/split-tiers.md): what differs between simulated runs of one device."""
 
 from __future__ import annotations
 

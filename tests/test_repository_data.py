@@ -19,7 +19,8 @@ SCANNED = ("tests", "experiments", "tcbench", "benchmarks", "conf", "plugins", "
 TEXT_SUFFIXES = {".py", ".sh", ".md", ".yaml", ".yml", ".toml", ".cfg", ".ini", ".txt", ""}
 GENERATED = {"__pycache__", "runs", "outputs", "multirun", "mlruns", "mlartifacts", "ioh-analyzer",
              "leaderboards"}  # docs/leaderboards/: the site's board pages, made at every build
-OUTSIDE = ("../shared", '"shared" /', "'shared' /", "TCBENCH_REAL_DATA")
+OUTSIDE = ("../shared", '"shared" /', "'shared' /", "TCBENCH_REAL_DATA",
+           "PHYSICS.md", "DESIGN.md")  # documents that are not in the repository: docs/concepts/ is its own
 MAX_FILE_BYTES = 5_000_000
 # Path(__file__).resolve().parents[k]: outside the repository when k reaches past its root
 PARENTS = re.compile(r"__file__\)\.resolve\(\)\.parents\[(\d+)\]")

@@ -104,7 +104,7 @@ def test_output_effects_by_hand() -> None:
 
 
 def test_msra_core_by_hand() -> None:
-    """Differential output at rest and at +-1 g, eq. of PHYSICS.md §1 evaluated by hand."""
+    """Differential output at rest and at +-1 g, eq. of docs/concepts/physics.md, sensor kinds evaluated by hand."""
     m = MSRA(f0_hz=(30000.0, 29850.0), k_hz_per_g=(100.0, 100.0), tce_ppm_per_k=(-30.0, -30.0),
              stress_ppm_per_k=(-10.0, -8.0), c2_ppb_per_k2=(0.0, 0.0), gk_ppm_per_k=100.0,
              misalignment_rad=0.0)

@@ -54,7 +54,7 @@ def _primary(task: str, split: str, learner: str | None, baseline: str | None = 
 
 @pytest.mark.parametrize(("task", "form"), [("accel_chamber", "bias"), ("msra_fulltemp", "inverse")])
 def test_the_memoriser_loses_to_a_cubic_on_the_default_split(task: str, form: str) -> None:
-    """PHYSICS.md §9: with no physics, the training runs' mean output at the same time since the
+    """docs/concepts/split-tiers.md: with no physics, the training runs' mean output at the same time since the
     start wins on a replay of their signal, and loses to a cubic in temperature on new power-ons
     (next_run, the default). Measured: accel chamber 1 593 against 318 µg drift (replay 91.5 against
     312); full temperature 3 380 against 39.2 µg bias variation (replay 4.9 against 3.4)."""

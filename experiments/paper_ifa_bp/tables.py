@@ -39,7 +39,7 @@ BASELINES = ("raw", "memoriser", "poly3", "poly3_runs", "poly3_rate", "lagpoly",
 LIMITS = ("oracle", "oracle_thermometer")  # drawn over 30 runs: their median in the best-of-N table
 TIER_NOTE = {
     "next_run": "Tier `next_run` (the default): the test runs are new power-ons of the device (turn-on bias and "
-                "scale factor, hysteresis state, chamber timing, ageing; PHYSICS.md §9).",
+                "scale factor, hysteresis state, chamber timing, ageing; docs/concepts/split-tiers.md).",
     "replay": "Tier `replay` (a diagnostic): the test runs replay the first training run's power-on with new "
               "noise, as every board measured before tiers. A claim reproduced here only is not held out.",
 }

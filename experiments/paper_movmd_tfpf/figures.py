@@ -151,7 +151,7 @@ def _tier_table(runs: pd.DataFrame) -> list[str]:
     return ["## Tiers: next run against a replay", "",
             "Drift (°/h, median, number of runs in brackets) of the rows run on both tiers: `next_run` tests "
             "on new power-ons of the device (the default, every table above), `replay` on new noise over the "
-            "training run's power-on (PHYSICS.md §9). The oracles are drawn over 30 runs of each tier they "
+            "training run's power-on (docs/concepts/split-tiers.md). The oracles are drawn over 30 runs of each tier they "
             "were run on; every other row is one draw of the train and test runs.", "", markdown_table(wide), ""]
 
 
@@ -171,10 +171,10 @@ def main() -> None:
         "# Seed 001 Fig. 19 beside tcbench", "",
         "Simulated 14 h oven runs of gyro 0 at 10 Hz (one to train, one to test; `bash "
         "experiments/paper_movmd_tfpf/run.sh`): the device as simulated by default (flicker B ≈ 33 °/h, "
-        "PHYSICS.md §6)" + (", and the same device with 3 °/h of flicker" if runs["task"].nunique() > 1 else "")
+        "experiments/raw-sensors/README.md)" + (", and the same device with 3 °/h of flicker" if runs["task"].nunique() > 1 else "")
         + ". Medians over restarts; ARW = σ(1 s)/60 "
         "in °/√h (seed 001 prints °/h/√Hz for a value that only fits its bias stability as °/√h, "
-        "PHYSICS.md §5); bias instability = Allan minimum / 0.664 (°/h); drift = std of the 5-min soak "
+        "docs/concepts/physics.md, metrics); bias instability = Allan minimum / 0.664 (°/h); drift = std of the 5-min soak "
         "means (°/h); rms = RMS error against the true rate (°/h); bandwidth = −3 dB frequency of the "
         "whole method, measured by injecting a multi-sine rate into the test run (5 Hz = Nyquist: "
         "nothing lost). Gains are raw / method (the paper's rows: its raw / its result).", "",

@@ -21,7 +21,7 @@ seeds='range(30)'
 run() { local i=$1; shift; tcbench run -m task=gyro_driftnoise tracking.experiment=paper-movmd-tfpf \
   "hydra.sweep.dir=multirun/paper-movmd-tfpf-$stamp-$i" "$@"; }
 serial=(task.decomposition=none task.denoise=none)
-# the device as simulated by default (flicker ~33 deg/h, PHYSICS.md §6).
+# the device as simulated by default (flicker ~33 deg/h, experiments/raw-sensors/README.md).
 # the honest baselines first (this also creates the tracking store before parallel sweeps use it):
 # raw output, the oracle (true drift removed, noise untouched), a polynomial in T and dT/dt
 run 1 "${serial[@]}" learner=raw,memoriser,poly optimiser=none

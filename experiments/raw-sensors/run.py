@@ -325,9 +325,9 @@ over the six nodes (ddof=1). Gyro ARW is read in °/√h (seed 001 prints °/h/�
 as °/√h), bias stability = Allan minimum / 0.664, both over τ ≤ T/10 of the whole oven run. Drift = mean output
 over the last 10 min of the 60 °C soak minus the −40 °C soak.
 
-## How the defaults were set, and where they differ from PHYSICS.md §6
+## How the defaults were set, and where they differ from experiments/raw-sensors/README.md
 
-- **MSRA bias variation.** With PHYSICS.md §6's resonator coefficients (c1 = −40 / −38.1 ppm/K, a 5 %
+- **MSRA bias variation.** With experiments/raw-sensors/README.md's resonator coefficients (c1 = −40 / −38.1 ppm/K, a 5 %
   mismatch) the bias moves by about 310 µg/K and its variation over −40…60 °C is about 11 000 µg, a
   third of the paper's 33 000–39 000 µg. The device population therefore draws a 11–15 % mismatch of the
   resonators' frequency coefficients (dU/dT ≈ −0.13 … −0.18 Hz/K, 650–900 µg/K). The bias
@@ -335,12 +335,12 @@ over the last 10 min of the 60 °C soak minus the −40 °C soak.
   (B0 ≈ ΔF/S), so devices with large gK land above the paper's range (see the table).
 - **MSRA scale-factor variation** comes from gK drawn log-uniformly in 60–600 ppm/K, which spans the
   paper's two datasets (2 153 and 20 600 ppm).
-- **MSRA room temperature.** With the larger bias coefficient, PHYSICS.md's 2.5 °C self-heating (20 min)
+- **MSRA room temperature.** With the larger bias coefficient, the simulator's 2.5 °C self-heating (20 min)
   would give a zero-start stability of {hot_lo:.0f}–{hot_hi:.0f} µg (devices 0–4). The room-temperature protocol
   uses 1.1 °C self-heating with a 40 min time constant (instead of 20 min): the paper's stability after
   30 min is 48 % and 66 % of its zero-start value (the simulated devices: {kept_lo:.0p}–{kept_hi:.0%}), which a
   20 min settling cannot reproduce (it gives {fast_lo:.0p}–{fast_hi:.0%}).
-- **Gyro.** PHYSICS.md §6's defaults are used as they are (bias 1.10u + 4.0e-3u² + 1.5e-4u³ °/h,
+- **Gyro.** experiments/raw-sensors/README.md's defaults are used as they are (bias 1.10u + 4.0e-3u² + 1.5e-4u³ °/h,
   3 °/h per °C/min, lag 8 min, ARW 0.52 °/√h, flicker B = 33 °/h), with a few per cent spread per device.
   The noise-free drift from 60 to −40 °C is {quiet_lo:.3f}–{quiet_hi:.3f} °/s, as in the paper. The measured drift scatters
   by up to ±{scatter:.3f} °/s around it (the table's runs): flicker noise of B = 33 °/h wanders by tens of °/h over the
@@ -356,7 +356,7 @@ over the last 10 min of the 60 °C soak minus the −40 °C soak.
 
 def settling() -> dict[str, float]:
     """Room-temperature figures the prose quotes (run seed = device seed): the zero-start stability
-    with PHYSICS.md's 2.5 °C, 20 min self-heating, and the share of it left after 30 min with the
+    with the simulator's 2.5 °C, 20 min self-heating, and the share of it left after 30 min with the
     default 1.1 °C settling in 20 min instead of 40."""
     hot, fast = [], []
     for d in DEVICES:

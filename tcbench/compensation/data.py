@@ -17,7 +17,7 @@ Two tasks of seed 000 §3 on the MSRA, and one on an ordinary accelerometer:
 
 Recordings are simulated from the sensors package or read from schema-v1 files (for example
 real ones); simulated ones keep the simulator's truth for the oracle. A simulated task draws its
-test runs on one of four tiers (:data:`SPLITS`, PHYSICS.md §9), from easiest to hardest:
+test runs on one of four tiers (:data:`SPLITS`, docs/concepts/split-tiers.md), from easiest to hardest:
 
 - ``replay``: the training runs' power-on again, with new noise (the signal replayed: a
   diagnostic, not a benchmark — a memoriser of the training runs wins here);

@@ -20,7 +20,7 @@ cooling's drift from 0.325 to 0.199 deg/s). The diagnosis still reports them: th
 record; they are not compensated.
 
 A line (``periodic``, ``gated_periodic``, ``duty_cycle``) is what a chamber's compressor, a fan
-or a supply does to the test (PHYSICS.md §8), not the sensor: its phase on another day is
+or a supply does to the test (docs/concepts/diagnosis-report.md, shapes), not the sensor: its phase on another day is
 unknown, so a compensator carrying it adds the line back wherever the phase has moved. Fitted
 on the tofupilot cycle's cooling and heating branches, the lines the diagnosis found made the
 second cooling's drift 1.88 mg with them and 0.84 mg without on acc z, 0.32 and 0.23 °/s on gyro

@@ -1,6 +1,6 @@
 """Compensation methods on a static-input task (MSRA, accelerometer chamber): a learner, no
 compensation (raw), the memoriser (no physics: the training runs' mean output at the same time
-since the start, the sanity row of PHYSICS.md §9), the lag-aware polynomial (lagpoly), and the
+since the start, the sanity row of docs/concepts/split-tiers.md), the lag-aware polynomial (lagpoly), and the
 two oracles (the diagnosed model, ``model``, is fitted by the diagnosis:
 :mod:`tcbench.tasks.diagnosed`).
 
@@ -64,7 +64,7 @@ def memoriser_compensator(data: MSRAData) -> Compensator:
     start, taken from a test run's output (``inverse``: the memorised input plus the output's
     departure from the memorised output, over the scale factor). On a test run that replays the
     training signal it is near the limit; on a new power-on it should lose to a cubic in
-    temperature (PHYSICS.md §9)."""
+    temperature (docs/concepts/split-tiers.md)."""
     output, applied = memorised(data.train, "output"), memorised(data.train, "input")
 
     def compensate(tr: TaskRecording, out: np.ndarray) -> np.ndarray:

@@ -74,7 +74,7 @@ CONVENTIONS = {
         "arw_1s_deg_per_sqrt_h and bias_instability_dph: overlapping Allan deviation of the whole record; "
         "arw_1s = sigma(1 s)[deg/h] / 60, the Allan deviation at 1 s (IEEE 952's ARW, the fitted -1/2 line "
         "read at 1 s, where white noise dominates at 1 s; seed 001's unit 'deg/h/sqrt(Hz)' read as "
-        "deg/sqrt(h), PHYSICS.md §5); bias instability = Allan minimum / 0.664, a floor only where "
+        "deg/sqrt(h), docs/concepts/physics.md, metrics); bias instability = Allan minimum / 0.664, a floor only where "
         "allan_min_interior is 1 (else the minimum is an end of the curve: for a filtered output, sigma at "
         "the first tau, a function of the sample interval)",
         "rms_error_dph: RMS of output minus the applied (true) rate (deg/h)",

@@ -15,7 +15,7 @@ model:
 - device: ``unit(sensor, device_seed)`` with every effect removed (and the MSRA's
   misalignment set to zero), so its noise-free output is quadratic bias plus a scale factor
   at most quadratic in the die temperature, which equals the package temperature.
-- hidden effect: physical parameters drawn from PHYSICS.md §3; its noise-free contribution
+- hidden effect: physical parameters drawn from docs/concepts/physics.md, the effect library; its noise-free contribution
   ``d`` (output with the effect minus output without it) is projected out of the minimal
   model's columns ``[1, u, u^2, a, a u, a u^2]`` (``u`` the scaled package temperature, ``a``
   the acceleration; no ``a`` columns for the gyro) by least squares; with ``r`` the RMS of
@@ -74,7 +74,7 @@ _MAX_DRAWS = 10_000
 NOMINAL_DURATION_S = 10.0 * 3600.0  # the middle of DURATION_S: time scales are sized from it
 MAX_RAMP_C_PER_MIN = 10.0  # the fastest chamber ramp a sized programme asks for
 
-# Shape parameters drawn from PHYSICS.md §3; the amplitude parameter (if any) is set later.
+# Shape parameters drawn from docs/concepts/physics.md, the effect library; the amplitude parameter (if any) is set later.
 _AMPLITUDE = {
     "temperature_rate": "coef_per_c_per_s",
     "hysteresis": "amplitude",

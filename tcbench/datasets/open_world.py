@@ -3,7 +3,7 @@
 Each recording is a concealed recording (:mod:`tcbench.datasets.concealed`: the same 1 Hz,
 8-12 h heat-and-cool staircase, the same device with every effect removed, so that without
 the hidden mismatch it *is* the minimal model plus white noise) with one structure of
-PHYSICS.md §8 that no library effect makes. The kinds (:data:`KINDS`), with the ``shape`` and
+docs/concepts/diagnosis-report.md, shapes that no library effect makes. The kinds (:data:`KINDS`), with the ``shape`` and
 ``where`` the report must state:
 
 - ``step``: a bias jump at one instant (``time_s``);

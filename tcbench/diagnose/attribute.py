@@ -24,7 +24,7 @@ supports (the :class:`~tcbench.diagnose.significance.SignificanceTest` its plan 
 Each effect's evidence says which test decided. Its nonlinear parameter is then refined
 between its grid neighbours. After the forward pass each kept effect must still earn its place,
 and when the residual turns out to hold flicker, :func:`recheck_with_flicker` tests the kept
-effects again with that flicker in the noise model. Pairs that look alike (PHYSICS.md §3) are
+effects again with that flicker in the noise model. Pairs that look alike (docs/concepts/physics.md, the effect library) are
 tested by swapping one for the other: when the swap costs less than the threshold the
 recording cannot tell them apart, and the report says which test would.
 """

@@ -1,10 +1,10 @@
 """Design matrices: the minimal model and each effect of the library as a regressor.
 
-The minimal model (DESIGN.md "Diagnosis") is ``b(T) + input * k(T)``, with ``b`` and ``k``
+The minimal model (docs/concepts/diagnosis-report.md) is ``b(T) + input * k(T)``, with ``b`` and ``k``
 quadratic in ``u = (T - centre_c) / half_range_c``; the ``input * k(T)`` columns are dropped
 when the input never varies. ``T`` is the smoothed thermometer reading, or the die temperature
 ``lag(T, tau_s)`` once ``thermal_lag`` is part of the model. Every other effect adds the
-column(s) of its term (:mod:`tcbench.diagnose.terms`, PHYSICS.md §3); its nonlinear parameter
+column(s) of its term (:mod:`tcbench.diagnose.terms`, docs/concepts/physics.md, the effect library); its nonlinear parameter
 (a time constant, a width) is searched on the term's grid:
 
 =====================  ===============================  =====================

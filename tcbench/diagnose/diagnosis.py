@@ -6,7 +6,7 @@ the screens before the fit (:mod:`tcbench.diagnose.screens`: output grid, clippi
 outliers), forward selection (:mod:`tcbench.diagnose.attribute`), where the starting model
 misses (:mod:`tcbench.diagnose.locate`), the screens after the final fit (flicker and the recheck
 of the kept effects, the variance of the residual) and the report. The :class:`Diagnosis` it
-returns is the report: :meth:`Diagnosis.to_json` is DESIGN.md's ``report.json``. Every stage is
+returns is the report: :meth:`Diagnosis.to_json` is the ``report.json`` of docs/concepts/diagnosis-report.md. Every stage is
 given its section of the :class:`~tcbench.diagnose.settings.DiagnoseSettings` the diagnosis runs
 with.
 """

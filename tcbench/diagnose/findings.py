@@ -4,7 +4,7 @@ A finding is whatever the diagnosis located and modelled, from the effect librar
 
 - ``id``: the model term's id (the key it has in ``model.yaml`` ``effects``, or ``outliers``);
 - ``shape``: one of :data:`SHAPES`, what the structure looks like in the data;
-- ``library``: whether ``id`` is one of the effect library's (PHYSICS.md §3);
+- ``library``: whether ``id`` is one of the effect library's (docs/concepts/physics.md, the effect library);
 - ``params``: its fitted parameters (names with units, as in ``model.yaml``);
 - ``where``: whichever of :data:`WHERE_KEYS` apply: ``time_s`` (an instant or a list of them),
   ``period_s`` and ``frequency_hz``, ``temperature_c`` (a ``[low, high]`` band), ``level`` (an

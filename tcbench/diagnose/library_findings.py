@@ -1,8 +1,8 @@
-"""Effects of the library (PHYSICS.md §3) as findings of the report contract
+"""Effects of the library (docs/concepts/physics.md, the effect library) as findings of the report contract
 (:mod:`tcbench.diagnose.findings`).
 
 Each library effect's term (:mod:`tcbench.diagnose.terms`) gives the shape its signature takes
-in a residual (PHYSICS.md §8), where it shows (the recording's temperature band for a
+in a residual (docs/concepts/diagnosis-report.md, shapes), where it shows (the recording's temperature band for a
 temperature term, ``time_s`` 0 for the warm-up, nothing for the others) and its explanation;
 ``confirm_with`` names the measurement or test profile that would confirm the effect and, when
 the recording cannot tell it from another effect, the test of

@@ -1,4 +1,4 @@
-"""Where a model's residual departs from white noise (DESIGN.md "Diagnosis", the ``mismatch`` list).
+"""Where a model's residual departs from white noise (docs/concepts/diagnosis-report.md, the ``mismatch`` list).
 
 :func:`locate` runs five families of tests on a residual ``r`` (any unit) sampled at times
 ``t_s`` with thermometer temperature ``temp_c``; the family-wise false-alarm probability

@@ -2,7 +2,7 @@
 
 Every finding of ``effects`` (the contract of :mod:`tcbench.diagnose.findings`, library effect or
 not) is rendered the same way, whatever its id: a row of the findings table (id, shape, library,
-where) and a section with its shape and what that shape looks like (PHYSICS.md §8), its scalar
+where) and a section with its shape and what that shape looks like (docs/concepts/diagnosis-report.md, shapes), its scalar
 parameters with units, where (:func:`format_where`: instants in s and h from the start, periods
 in s and min, bands in degC, levels in the finding's ``params`` ``unit`` or the output unit), the
 evidence, what it cannot be told from, confirm-with, a table of its listed values (lists of one
@@ -89,7 +89,7 @@ def _value_cell(e: Evidence) -> str:
     return _g(e.value) if name is None else _param(name, e.value, "")
 
 
-SHAPE_SIGNATURE = {  # PHYSICS.md §8: what each shape looks like in the residual
+SHAPE_SIGNATURE = {  # docs/concepts/diagnosis-report.md, shapes: what each shape looks like in the residual
     "step": "a bias jump at one instant, flat before and after",
     "periodic": "a spectral line, often unrelated to temperature",
     "trend": "a slow drift against time, not temperature",

@@ -1,4 +1,4 @@
-"""The statistics of a diagnosis, sized to the recording (DESIGN.md "Diagnosis").
+"""The statistics of a diagnosis, sized to the recording (docs/concepts/diagnosis-report.md).
 
 A diagnosis scores effects by blocked cross-validation and tests them against the residual's
 slow noise. Both need time spans that fit the recording:

@@ -1,5 +1,5 @@
 """What a diagnosis found, as typed records: :class:`Diagnosis` and its parts. Only
-:meth:`Diagnosis.to_json` (DESIGN.md's ``report.json``) turns them into plain data; the arrays
+:meth:`Diagnosis.to_json` (the ``report.json`` of docs/concepts/diagnosis-report.md) turns them into plain data; the arrays
 behind the plots ride along in :class:`Series`."""
 
 from __future__ import annotations
@@ -140,7 +140,7 @@ class Confusion:
 
 @dataclass
 class Diagnosis:
-    """What the diagnosis found, in the shape of DESIGN.md's report (see :meth:`to_json`)."""
+    """What the diagnosis found, in the shape of the report of docs/concepts/diagnosis-report.md (see :meth:`to_json`)."""
 
     sensor: str
     unit: str

@@ -259,7 +259,7 @@ SPLIT_LINES = {
               "not a benchmark (a memoriser of the training signal wins here).",
     "next_run": "**Split next_run:** the test runs are new power-ons of the same device under the same programme "
                 "(turn-on bias and scale factor, hysteresis state, chamber timing and the thermometer differ; "
-                "PHYSICS.md §9).",
+                "docs/concepts/split-tiers.md).",
     "new_profile": "**Split new_profile:** the test runs are new power-ons under a programme the training never "
                    "saw (the holds in reverse order, ramps twice as fast; a room 5 °C warmer for the zero-bias test).",
     "new_device": "**Split new_device:** the training runs are of some units of the population, the test runs of "

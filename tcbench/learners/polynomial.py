@@ -14,7 +14,7 @@ Two forms, chosen by the task (``form="auto"`` is a placeholder the task must re
   gradient term constant in ``T``.
 
 ``offsets="per_run"`` fits the temperature polynomials *within* runs: each training run gets
-its own constant term (its turn-on bias, PHYSICS.md §9), and the model keeps their mean. Pooled
+its own constant term (its turn-on bias, docs/concepts/split-tiers.md), and the model keeps their mean. Pooled
 over power-ons at different ambients, a shared constant lets the run-to-run offsets bend the
 polynomial (a cubic then extrapolates them into the next run); the task passes the run of each
 training row (``fit(..., runs=)``).

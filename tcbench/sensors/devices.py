@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 
-SLOPE_REPEAT = 0.01  # the temperature slope's run-to-run change, relative std (PHYSICS.md §9: about 1 %)
+SLOPE_REPEAT = 0.01  # the temperature slope's run-to-run change, relative std (docs/concepts/split-tiers.md: about 1 %)
 AGEING_DAYS = 30.0  # a run falls uniformly within this many days of the device's first
 
 

@@ -1,6 +1,6 @@
 """The effect library: named, parametric physical effects a sensor model is composed of.
 
-Each effect has an ``id`` (PHYSICS.md §3), parameters, and a form for simulation. Effects act
+Each effect has an ``id`` (docs/concepts/physics.md, the effect library), parameters, and a form for simulation. Effects act
 at one of three stages:
 
 - ``die``: change the die temperature the physics sees (``thermal_lag``);
@@ -238,7 +238,7 @@ class Quantisation(Effect):
 
 @dataclass(frozen=True)
 class BiasStep(Effect):
-    """A bias jump of ``size`` at ``time_s`` (mode hop, shock, restart; PHYSICS.md §8)."""
+    """A bias jump of ``size`` at ``time_s`` (mode hop, shock, restart; docs/concepts/diagnosis-report.md, shapes)."""
 
     id: ClassVar[str] = "bias_step"
     repeatable: ClassVar[bool] = True
@@ -251,7 +251,7 @@ class BiasStep(Effect):
 
 @dataclass(frozen=True)
 class Periodic(Effect):
-    """``amplitude * sin(2 pi t / period_s + phase_rad)``: environmental cycling (PHYSICS.md §8)."""
+    """``amplitude * sin(2 pi t / period_s + phase_rad)``: environmental cycling (docs/concepts/diagnosis-report.md, shapes)."""
 
     id: ClassVar[str] = "periodic"
     repeatable: ClassVar[bool] = True

@@ -1,4 +1,4 @@
-"""Sensor models: a physical core plus a list of named effects (PHYSICS.md §1-3).
+"""Sensor models: a physical core plus a list of named effects (docs/concepts/physics.md).
 
 :class:`MSRA` — two double-ended tuning-fork resonators in differential configuration; output
 ``U = f1 - f2`` in Hz. :class:`Gyro` — a dual-mass vibratory gyroscope; output rate in deg/s.
@@ -87,7 +87,7 @@ class SensorModel:
 
 @dataclass(frozen=True)
 class MSRA(SensorModel):
-    """Differential resonant accelerometer (PHYSICS.md §1); pairs are (resonator 1, resonator 2).
+    """Differential resonant accelerometer (docs/concepts/physics.md, sensor kinds); pairs are (resonator 1, resonator 2).
 
     ``f_i = f0_i (1 + c1_i dT + c2_i dT^2) + s_i K_i (1 + gK dT) a_eff``, ``s = (+1, -1)``,
     with ``c1_i = tce_i + stress_i`` (Young's modulus and CTE-mismatch thermal stress) and
@@ -146,7 +146,7 @@ def msra_effects(
 
 @dataclass(frozen=True)
 class Gyro(SensorModel):
-    """Dual-mass vibratory gyroscope (PHYSICS.md §2).
+    """Dual-mass vibratory gyroscope (docs/concepts/physics.md, sensor kinds).
 
     ``w_out = (1 + sf0 + sf dT) (W + b0 + b1 dT + b2 dT^2)`` with ``dT = T_die - ref`` and the
     bias in deg/h; ``sf0`` is the scale factor's turn-on error; the cubic and rate terms, lag and
@@ -186,7 +186,7 @@ def gyro_effects(
     bias_instability_dph: float = 33.0,
     adc_step_dps: float = 0.0,
 ) -> tuple[fx.Effect, ...]:
-    """Default gyro effects from figures in deg/h units (PHYSICS.md §6)."""
+    """Default gyro effects from figures in deg/h units (experiments/raw-sensors/README.md)."""
     return (
         fx.ThermalLag(lag_tau_s),
         fx.TemperatureCubic(c3_dph_per_k3 * DPH),

@@ -1,4 +1,4 @@
-"""Sensor noise processes, vectorised and seeded (PHYSICS.md §4).
+"""Sensor noise processes, vectorised and seeded (docs/concepts/physics.md, metrics).
 
 All amplitudes are in the sensor's output unit (Hz for the MSRA, deg/s for the gyroscope).
 """

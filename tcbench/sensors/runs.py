@@ -1,4 +1,4 @@
-"""What differs between runs of one device (PHYSICS.md §9): a new run is a new power-on.
+"""What differs between runs of one device (docs/concepts/split-tiers.md): a new run is a new power-on.
 
 Two runs of one device under one chamber programme are not one signal with new noise. A run's
 *power-on* (its seed, :func:`power_on`) draws:

@@ -1,4 +1,4 @@
-"""A chamber programme as one run ran it (PHYSICS.md §9): the timing the protocols read.
+"""A chamber programme as one run ran it (docs/concepts/split-tiers.md): the timing the protocols read.
 
 :func:`running` sets the :class:`Timing` of the run being built; the protocols
 (:mod:`tcbench.sensors.protocols` and each kind's) read it with :func:`current_timing` when they

@@ -1,4 +1,4 @@
-"""Overlapping Allan deviation of a rate signal and its IEEE Std 952 read-offs (PHYSICS.md §4).
+"""Overlapping Allan deviation of a rate signal and its IEEE Std 952 read-offs (docs/concepts/physics.md, metrics).
 
 The rate ``y`` (any unit, e.g. deg/s) sampled at ``fs_hz`` is integrated to the angle
 ``theta = [0, cumsum(y - mean(y))] * tau0`` (``N + 1`` points for ``N`` samples; removing the mean

@@ -68,7 +68,7 @@ def _simulated(run: RunSpec, sample_rate: float, hold_s: float, effects_json: st
 
 
 def check_effects(effects: dict[str, dict[str, float]] | None) -> dict[str, dict[str, float]]:
-    """Effect changes ``{id: {param: value}}`` of the device (PHYSICS.md §3, output units deg/s);
+    """Effect changes ``{id: {param: value}}`` of the device (docs/concepts/physics.md, the effect library, output units deg/s);
     :class:`TaskDataError` naming an unknown effect or parameter."""
     from tcbench.sensors.kinds import unit
 

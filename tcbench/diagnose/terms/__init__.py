@@ -1,5 +1,5 @@
 """The effects the diagnosis models: one :class:`~.base.Term` per effect of the library, and one
-:class:`~.open_base.OpenTerm` per structure outside it (PHYSICS.md §8), found by id (:func:`term`).
+:class:`~.open_base.OpenTerm` per structure outside it (docs/concepts/diagnosis-report.md, shapes), found by id (:func:`term`).
 Importing the package registers every built-in term; the order of the imports below is the order
 of the forward selection and of the report's candidates (for the open-world terms: of a round's
 search, the report ordering them by shape). Installed terms (entry-point group ``tcbench.terms``)

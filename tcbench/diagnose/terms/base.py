@@ -70,7 +70,7 @@ class Term(ABC):
     """One effect of the library in the diagnosis.
 
     - ``id``, ``effect``: its id and its class in the effect library (the same id);
-    - ``shape``: the shape its signature takes in a residual (PHYSICS.md §8);
+    - ``shape``: the shape its signature takes in a residual (docs/concepts/diagnosis-report.md, shapes);
     - ``param``, ``grid``: the nonlinear parameter searched and its grid (None: none);
     - ``deterministic``: a model term of the forward selection (False: noise, judged from the
       residual's Allan deviation);

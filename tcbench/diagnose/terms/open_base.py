@@ -1,4 +1,4 @@
-"""The base of an open-world term: structure outside the effect library (PHYSICS.md §8) as
+"""The base of an open-world term: structure outside the effect library (docs/concepts/diagnosis-report.md, shapes) as
 regressors, found by the detectors of :mod:`tcbench.diagnose.detectors` and scored by
 :mod:`tcbench.diagnose.discover`.
 

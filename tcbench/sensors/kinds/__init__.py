@@ -60,7 +60,7 @@ class SensorKind:
     default_protocol: the protocol ``tcbench simulate`` runs when none is given (None: the first
         of ``protocols``).
     power_on: what a new power-on changes in a unit's model, ``(model, rng) -> (model as it runs,
-        {draw: value})`` (turn-on bias and scale factor, PHYSICS.md §9; :mod:`tcbench.sensors.runs`);
+        {draw: value})`` (turn-on bias and scale factor, docs/concepts/split-tiers.md; :mod:`tcbench.sensors.runs`);
         None: the model is the same at every power-on (the chamber timing and the thermometer
         still vary).
     """

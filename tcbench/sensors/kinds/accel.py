@@ -1,4 +1,4 @@
-"""A capacitive MEMS accelerometer, the ordinary IMU's (PHYSICS.md §7): output in g.
+"""A capacitive MEMS accelerometer, the ordinary IMU's (docs/concepts/physics.md, sensor kinds): output in g.
 
 Model (``Accel``)::
 
@@ -66,7 +66,7 @@ def accel_effects(
     flicker_ug: float = 40.0,
     lsb_mg: float = 0.061,
 ) -> tuple[fx.Effect, ...]:
-    """A consumer part's effects (PHYSICS.md §7): noise 100 µg/√Hz, flicker floor 40 µg,
+    """A consumer part's effects (docs/concepts/physics.md, sensor kinds): noise 100 µg/√Hz, flicker floor 40 µg,
     0.061 mg LSB (16 bits over ±2 g), stress hysteresis of ±0.8 mg, lag 3 min."""
     return (
         fx.ThermalLag(lag_tau_s),
@@ -81,7 +81,7 @@ def accel_effects(
 def accel_unit(device_seed: int) -> Unit:
     """One consumer accelerometer axis: zero-g offset ~15 mg, bias coefficient 0.05-0.5 mg/K
     of either sign (log-uniform), scale-factor coefficient 50-300 ppm/K, hysteresis 5-15 % of
-    the bias span over 80 K, noise 70-150 µg/√Hz, flicker 20-60 µg (PHYSICS.md §7)."""
+    the bias span over 80 K, noise 70-150 µg/√Hz, flicker 20-60 µg (docs/concepts/physics.md, sensor kinds)."""
     rng = device_rng("accel", device_seed)
     sign = rng.choice([-1.0, 1.0], size=2)
     b1 = float(sign[0] * np.exp(rng.uniform(np.log(0.05), np.log(0.5))))

@@ -20,7 +20,7 @@ from tcbench.sensors.timing import current_timing
 
 
 def gyro_unit(device_seed: int) -> Unit:
-    """One dual-mass gyroscope around PHYSICS.md §6's defaults (bias 1.10 u + 4.0e-3 u^2 +
+    """One dual-mass gyroscope around experiments/raw-sensors/README.md's defaults (bias 1.10 u + 4.0e-3 u^2 +
     1.5e-4 u^3 deg/h, ARW 0.52 deg/sqrt(h), bias instability 33 deg/h, lag 8 min)."""
     rng = device_rng("gyro", device_seed)
     draws = {

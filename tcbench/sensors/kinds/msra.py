@@ -59,7 +59,7 @@ def msra_unit(device_seed: int) -> Unit:
 def msra_power_on(model: SensorModel, rng: np.random.Generator) -> tuple[SensorModel, dict[str, float]]:
     """An MSRA's power-on: turn-on bias 100 µg (std; resonator 1's frequency moved), scale factor
     50 ppm, bias slope 0.1 %, ageing 2 µg per day over up to :data:`AGEING_DAYS` days. A resonant
-    part sits at the repeatable end of PHYSICS.md §9's ranges: seed 000's zero-bias stability is
+    part sits at the repeatable end of docs/concepts/split-tiers.md's ranges: seed 000's zero-bias stability is
     110-190 µg, and its compensated test sets' bias variation (33-37 µg over a 39 000 µg span, Table 2)
     bounds the slope's run-to-run change near 0.1 %."""
     if not isinstance(model, MSRA):
