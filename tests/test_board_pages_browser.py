@@ -46,8 +46,12 @@ def _missing() -> str | None:
     return None
 
 
-if (_reason := _missing()) is not None:
-    pytest.skip(_reason, allow_module_level=True)
+@pytest.fixture(scope="module", autouse=True)
+def _browser_at_hand() -> None:
+    """Skip, saying what is missing, where the browser test cannot run (a fixture: when CI deselects
+    the slow tests, nothing is reported as skipped)."""
+    if (reason := _missing()) is not None:
+        pytest.skip(reason)
 
 
 class _Quiet(http.server.SimpleHTTPRequestHandler):
