@@ -48,7 +48,7 @@ PAPER_OPTIMISERS = ("fa", "ifa", "fa_yang", "ifa_yang", "bas", "mopso")
 FAMILIES: dict[str, Family] = {f.folder: f for f in (
     Family(
         folder="paper-ifa-bp", kind="compensation", nav="Seed 000: IFA-BP on the MSRA",
-        title="Seed 000 — IFA-BP compensation of a micro-machined silicon resonant accelerometer (MSRA)",
+        title="Seed 000 — IFA-BP compensation of a micromachined silicon resonant accelerometer (MSRA)",
         readme="experiments/paper_ifa_bp/README.md", paper=SEED_000,
         paper_methods=("IFA-BP-gd", "IFA-BP-lm"),
         tasks={r"msra_zerobias-dev(?P<dev>\d+)": ("zero-bias stability at room temperature (Table 1), device {dev}",
