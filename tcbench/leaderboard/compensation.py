@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from tcbench.papers import SEED_000, SEED_001
 from tcbench.leaderboard.files import (
     FAILED_RULE,
     failed_as_text,
@@ -417,6 +418,20 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
     return path
 
 
+def task_line(protocol: str) -> str:
+    """The board's task in words: the paper it comes from and the sensor, spelt out."""
+    return {
+        "roomtemp": f"**Task:** zero-bias stability of a simulated micromachined silicon resonant accelerometer "
+                    f"(MSRA) at room temperature, Table 1 of seed 000: {SEED_000.cite()}.",
+        "fulltemp": f"**Task:** scale factor and bias of a simulated micromachined silicon resonant accelerometer "
+                    f"(MSRA) over -40...60 °C, Table 2 of seed 000: {SEED_000.cite()}.",
+        "chamber": "**Task:** the drift of an ordinary capacitive MEMS accelerometer at rest through temperature-"
+                   "chamber cycles, the most common real calibration record (no paper).",
+        "gyro": f"**Task:** drift and noise of a simulated dual-mass MEMS gyroscope through oven steps, Fig. 19 of "
+                f"seed 001: {SEED_001.cite()}.",
+    }[protocol]
+
+
 def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Path]:
     """Write ``<task>.md``, ``<task>.csv`` and ``<task>.png`` into ``out_dir`` (atomically)."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -445,6 +460,7 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
     }[board.protocol]
     lines = [
         f"# Compensation leaderboard: {board.task}" + (f" — split {board.split}" if board.split else ""), "",
+        task_line(board.protocol), "",
         *([SPLIT_LINES.get(board.split, ""), ""] if board.split in SPLIT_LINES else []),
         *([board.data, ""] if board.data else []),
         *([f"**In-sample:** train_files and test_files share {board.in_sample}: the test scores are in-sample, "
