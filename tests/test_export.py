@@ -64,11 +64,12 @@ def test_px4_parameters_put_every_axis_in_its_slot(calibrated: dict[str, Path], 
     probe = np.concatenate([temp, np.linspace(-40.0, 100.0, 141)])  # beyond the range: held at the edge
     for kind, si in (("gyro", np.pi / 180), ("accel", 9.80665)):
         for i, a in enumerate(AXES):
-            poly, _ = fitted(calibrated[f"{kind}-{a}"])
+            poly, about = fitted(calibrated[f"{kind}-{a}"])
             px4 = px4_offset(params, probe, kind, instance=1, axis=i).astype(np.float64)
-            want = poly.offset(probe) * si  # the fitted correction of THIS axis, in PX4's unit
+            level = about["export"]["static_level"] if kind == "accel" else 0.0  # PX4 leaves it to CAL_ACCn_*
+            want = (poly.offset(probe) - level) * si  # the fitted correction of THIS axis, in PX4's unit
             np.testing.assert_allclose(px4, want, atol=2e-6 * np.ptp(want) + 1e-9, err_msg=f"{kind} {a}")
-            others = [fitted(calibrated[f"{kind}-{b}"])[0].offset(probe) * si for b in AXES if b != a]
+            others = [(fitted(calibrated[f"{kind}-{b}"])[0].offset(probe) - level) * si for b in AXES if b != a]
             assert all(np.abs(px4 - o).max() > 100 * np.abs(px4 - want).max() for o in others), f"{kind} {a}"
 
 
@@ -116,6 +117,22 @@ def test_export_refusals_are_one_line(calibrated: dict[str, Path], workdir: Path
     assert not any((workdir / p).exists() for p in ("p1", "p2", "p3", "p4"))
 
 
+def test_an_accel_calibration_without_its_static_level_is_refused_for_px4(
+        calibrated: dict[str, Path], workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A calibration.json of an accelerometer that does not hold its static level cannot give
+    PX4's polynomial (it would carry gravity): one line, nothing written; ArduPilot's has no
+    constant and is written."""
+    path = calibrated["accel-x"] / "calibration.json"
+    about = json.loads(path.read_text())
+    del about["export"]["static_level"]
+    path.write_text(json.dumps(about))
+    code, _, err = run(capsys, "export", "calibrations=[cal/accel-x,cal/accel-y]", "device_id=3", "out=p1")
+    assert code == 2 and len(err) == 1 and "cal/accel-x: no static level" in err[0], err
+    assert not (workdir / "p1").exists()
+    code, _, err = run(capsys, "export", "calibrations=[cal/accel-x,cal/accel-y]", "formats=[ardupilot]", "out=p2")
+    assert code == 0, err
+
+
 def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Imported from a PX4 log, each recording knows its axis and the sensor's device id: the
     export needs neither axis= nor device_id=, and the id is the log's."""
@@ -160,3 +177,69 @@ def test_reexpansion_is_exact_and_the_common_range_is_the_intersection() -> None
     apart = OffsetPolynomial(b.x, 200.0, 190.0, 210.0)
     with pytest.raises(ValueError, match="do not overlap"):
         ardupilot_parameters({"gyro": {"x": a, "y": apart}})
+
+
+def px4_applied(params: dict, head: str, axis: int, temp_c: np.ndarray, reading: np.ndarray) -> np.ndarray:
+    """PX4's compensation from its documented formula, in 32-bit: the offset sum X_k dT^k, with
+    dT = clamp(T, TMIN, TMAX) - TREF, subtracted from the reading."""
+    f32 = np.float32
+    dt = np.clip(temp_c.astype(f32), f32(params[f"{head}_TMIN"]), f32(params[f"{head}_TMAX"])) - f32(params[f"{head}_TREF"])
+    offset = sum(f32(params[f"{head}_X{k}_{axis}"]) * dt ** k for k in range(4))
+    return (reading.astype(f32) - offset).astype(np.float64)
+
+
+def ardupilot_applied(params: dict, head: str, axis: str, temp_c: np.ndarray, cal_temp_c: float,
+                      reading: np.ndarray) -> np.ndarray:
+    """ArduPilot's compensation: v - p(T) + p(T_cal), p the constant-free cubic about 35 degC of
+    the INS_TCAL coefficients x 1e-6, both temperatures held to TMIN..TMAX, in 32-bit."""
+    f32 = np.float32
+    lo, hi = f32(params["INS_TCAL1_TMIN"]), f32(params["INS_TCAL1_TMAX"])
+
+    def p(t: np.ndarray) -> np.ndarray:
+        u = np.clip(np.asarray(t, dtype=f32), lo, hi) - f32(35.0)
+        return sum(f32(params[f"{head}{k}_{axis.upper()}"]) * u ** k for k in (1, 2, 3)) * f32(1e-6)
+
+    return (reading.astype(f32) - p(temp_c) + p(np.array([cal_temp_c]))[0]).astype(np.float64)
+
+
+def thermal_spread(temp_c: np.ndarray, reading: np.ndarray) -> float:
+    """The spread of the reading over temperature: the SD of its means in 2-degC bins."""
+    bins = np.floor(temp_c / 2.0).astype(int)
+    _, which = np.unique(bins, return_inverse=True)
+    return float(np.std(np.bincount(which, reading) / np.bincount(which)))
+
+
+def test_the_firmware_round_trip_removes_the_drift_and_keeps_the_static_reading(
+        calibrated: dict[str, Path], workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The real tofupilot gyro and accelerometer exported, and each file applied to the raw log as
+    its firmware applies it: on every axis most of the thermal drift goes, and the static reading
+    is what the firmware's ordinary calibration expects. An accelerometer keeps its level (z about
+    -9.6 m/s^2: PX4 leaves it to CAL_ACCn_*, ArduPilot to the reading at T_cal); PX4's gyro reads
+    its true rate, 0, at rest."""
+    import pandas as pd
+
+    cals = ",".join(f"cal/{k}" for k in calibrated)
+    code, out, err = run(capsys, "export", f"calibrations=[{cals}]", "device_id={gyro: 1, accel: 2}", "out=params",
+                         "formats=[px4,ardupilot]")
+    assert code == 0, err
+    px4 = {ln.split()[2]: float(ln.split()[3]) for ln in (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()}
+    ap = {ln.split()[0]: float(ln.split()[1]) for ln in (workdir / "params" / "ardupilot_tcal.parm").read_text().splitlines()}
+    log = pd.read_csv(TOFUPILOT_CSV, sep="\t")  # the firmware's units: rad/s and m/s^2
+    temp = log["imu.temperature"].to_numpy()
+    cal_temp_c = 35.0
+    near_cal = np.abs(temp - cal_temp_c) < 1.0
+    for kind, col, px4_head, ap_head in (("gyro", "gyro", "TC_G0", "INS_TCAL1_GYR"),
+                                         ("accel", "acc", "TC_A0", "INS_TCAL1_ACC")):
+        for i, a in enumerate(AXES):
+            raw = log[f"imu.{col}.{a}"].to_numpy()
+            spread = thermal_spread(temp, raw)
+            by_px4 = px4_applied(px4, px4_head, i, temp, raw)
+            by_ap = ardupilot_applied(ap, ap_head, a, temp, cal_temp_c, raw)
+            for firmware, corrected in (("px4", by_px4), ("ardupilot", by_ap)):
+                assert thermal_spread(temp, corrected) < 0.5 * spread, f"{kind} {a} {firmware}: drift left"
+            static = 0.0 if kind == "gyro" else np.median(raw)  # PX4: a gyro's whole offset, an accel's change
+            assert abs(np.median(by_px4) - static) < 0.25 * spread, f"{kind} {a} px4: {np.median(by_px4)} not {static}"
+            lo, hi = np.percentile(raw[near_cal], [5, 95])  # what the sensor reads at T_cal
+            assert lo <= np.median(by_ap) <= hi, f"{kind} {a} ardupilot: {np.median(by_ap)} not in {lo}..{hi}"
+    assert abs(px4["TC_A0_X0_2"]) < 0.5  # gravity left to CAL_ACC0_*: z still reads about -9.6 at rest
+    assert "accel: TC_A0_X0_* leave out the static level" in out

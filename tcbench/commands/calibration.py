@@ -481,18 +481,21 @@ def _content_hash(path: str) -> str:
 def _export_fit(whole: Any, screen: bool = True) -> dict[str, Any] | None:
     """The cubic an autopilot is given: ``poly3`` refitted on the whole record, screened as the
     training parts are (the held-out scores judged the method; the parameters use every kept
-    sample), in the recording's output unit."""
+    sample), in the recording's output unit; and ``static_level``, the median of the offset it
+    fits (the level PX4 leaves an accelerometer's ordinary calibration,
+    :func:`tcbench.compensation.px4.px4_polynomial`)."""
     from tcbench.compensation.px4 import fit_offset
     from tcbench.compensation.screening import screen as screened
 
     kept = screened(whole, screen).pieces
+    offset = np.concatenate([p.output - p.truth for p in kept])
     try:
-        cubic = fit_offset(np.concatenate([p.temp_c for p in kept]),
-                           np.concatenate([p.output - p.truth for p in kept]))
+        cubic = fit_offset(np.concatenate([p.temp_c for p in kept]), offset)
     except ValueError:
         return None
-    return {"method": "poly3", "fitted_on": "the whole record" + (", screened" if screen else ""), "x": list(cubic.x), "tref_c": cubic.tref_c,
-            "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c}
+    return {"method": "poly3", "fitted_on": "the whole record" + (", screened" if screen else ""), "x": list(cubic.x),
+            "tref_c": cubic.tref_c, "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c,
+            "static_level": float(np.median(offset))}
 
 
 def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict[str, Path]) -> None:

@@ -411,7 +411,8 @@ SPECS: dict[str, CommandSpec] = {
         description="Write the thermal-calibration parameters of one IMU for PX4 (TC_G*/TC_A*, a param-set "
                     "script) and ArduPilot (INS_TCALn_*, a .parm file) from tcbench calibrate's outputs, one per "
                     "axis and sensor kind, every axis in its slot (the axis from the recording's sidecar or "
-                    "calibrate axis=).",
+                    "calibrate axis=). As PX4's own fit, an accelerometer's TC_A* leave out its static level "
+                    "(the median reading, gravity included), which stays with CAL_ACCn_*.",
         schema="tcbench.commands.schemas:ExportConfig",
         runs_here="tcbench.commands.export",
         params={
