@@ -5,6 +5,7 @@ they give the fitted correction."""
 from __future__ import annotations
 
 import json
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -140,15 +141,51 @@ def test_a_px4_log_gives_the_axes_and_the_device_id(workdir: Path, capsys: pytes
 
     code, _, err = run(capsys, "import", f"csv={PX4_LOG}", "sensor=gyro", "out=rec", "name=log", "tracking.enabled=false")
     assert code == 0, err
+    hints = []
     for a in AXES:
-        code, _, err = run(capsys, "calibrate", f"recording=rec/log-sensor_gyro-0-{a}.csv", f"out=cal/{a}",
-                           "methods=[poly3]", "train_branches=[0]", "drift_window_s=5", "tracking.enabled=false")
+        code, out, err = run(capsys, "calibrate", f"recording=rec/log-sensor_gyro-0-{a}.csv", f"out=cal/{a}",
+                             "methods=[poly3]", "train_branches=[0]", "drift_window_s=5", "tracking.enabled=false")
         assert code == 0, err
+        hints += [ln for ln in out.splitlines() if ln.startswith("for ")]
     code, _, err = run(capsys, "export", "calibrations=[cal/x,cal/y,cal/z]", "out=params")
     assert code == 0, err
     script = (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()
     logged = read_topic(PX4_LOG, "gyro")[0].device_id
     assert script[0] == f"param set TC_G0_ID {logged}" and logged
+    # calibrate's last lines name the export with the log's id, and it runs as printed
+    assert hints[0] == f"for PX4/ArduPilot: tcbench export 'calibrations=[cal/x]' device_id={logged}", hints
+    assert main(shlex.split(hints[-1].removeprefix("for PX4/ArduPilot: "))[1:]) == 0
+    assert (workdir / "export" / "px4_tc_params.txt").read_text().startswith(f"param set TC_G0_ID {logged}")
+
+
+def test_calibrate_prints_an_export_command_that_runs(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Without a device id from a log, calibrate printed ``tcbench export calibrations=[...]``,
+    which exits 2 asking for ``device_id=``: now one command for ArduPilot that runs as printed,
+    and PX4's with ``device_id=N`` and where N is found; a recording without its axis is told to
+    name it first."""
+    code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.z:rad/s", "axes=z", "out=rec", "name=z",
+                       "tracking.enabled=false")
+    assert code == 0, err
+    code, out, err = run(capsys, "calibrate", "recording=rec/z.csv", "out=cal/z", "methods=[raw,poly3]",
+                         "tracking.enabled=false")
+    assert code == 0, err
+    hints = [ln for ln in out.splitlines() if ln.startswith("for ")]
+    assert hints == ["for ArduPilot: tcbench export 'calibrations=[cal/z]' formats=[ardupilot]",
+                     "for PX4 too: tcbench export 'calibrations=[cal/z]' device_id=N, N the gyro's device id (its "
+                     "CAL_GYRO0_ID parameter on the vehicle, or the log's)"], hints
+    assert main(shlex.split(hints[0].removeprefix("for ArduPilot: "))[1:]) == 0
+    assert (workdir / "export" / "ardupilot_tcal.parm").is_file()
+    px4 = hints[1].removeprefix("for PX4 too: ").split(",")[0].replace("device_id=N", "device_id=2293768")
+    assert main([*shlex.split(px4)[1:], "out=px4"]) == 0
+    assert (workdir / "px4" / "px4_tc_params.txt").read_text().startswith("param set TC_G0_ID 2293768")
+    code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", "sensor=gyro", "time=timestamp:us",
+                       "temperature=imu.temperature:degC", "output=imu.gyro.z:rad/s", "out=rec", "name=noaxis",
+                       "tracking.enabled=false")
+    assert code == 0, err
+    code, out, err = run(capsys, "calibrate", "recording=rec/noaxis.csv", "out=cal/noaxis", "methods=[poly3]",
+                         "tracking.enabled=false")
+    assert code == 0 and "calibrate again with axis=x|y|z, then tcbench export" in out, out
 
 
 def test_a_partial_sensor_gets_zeros_and_says_so(calibrated: dict[str, Path], workdir: Path,

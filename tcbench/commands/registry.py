@@ -372,7 +372,8 @@ SPECS: dict[str, CommandSpec] = {
             "out": "output folder",
             "overwrite": OVERWRITE,
             "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
-                              "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
+                              "null: of several branches, the fewest consecutive ones whose temperatures span the others' "
+                              "(the held-out score is then interpolation), or blocks 0, 2, 4 of five when there is one",
             "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
                       "(a record that only cools: train_branches=[0,2,4] blocks=5)",
             "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp (trained by "
