@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shlex
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -27,22 +28,32 @@ def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, list[
     return code, captured.out, captured.err.strip().splitlines()
 
 
+@pytest.fixture(scope="module")
+def calibrated_once(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The tofupilot gyro and accelerometer imported axis by axis and calibrated (poly3 only),
+    once for the module: ``rec/`` and ``cal/<kind>-<axis>`` in a folder of their own."""
+    folder = tmp_path_factory.mktemp("calibrated")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.chdir(folder)
+        patch.delenv("MLFLOW_TRACKING_URI", raising=False)
+        for kind, col, unit in (("gyro", "gyro", "rad/s"), ("accel", "acc", "m/s^2")):
+            outputs = ",".join(f"imu.{col}.{a}:{unit}" for a in AXES)
+            assert main(["import", f"csv={TOFUPILOT_CSV}", f"sensor={kind}", "time=timestamp:us",
+                         "temperature=imu.temperature:degC", f"output={outputs}", "axes=x,y,z", "out=rec",
+                         f"name={kind}", "tracking.enabled=false"]) == 0
+            for a in AXES:  # each axis from its sidecar (import axes=)
+                assert main(["calibrate", f"recording=rec/{kind}-imu.{col}.{a}.csv", f"out=cal/{kind}-{a}",
+                             "methods=[raw,poly3]", "tracking.enabled=false"]) == 0
+    return folder
+
+
 @pytest.fixture()
-def calibrated(workdir: Path, capsys: pytest.CaptureFixture[str]) -> dict[str, Path]:
-    """The tofupilot gyro and accelerometer imported axis by axis and calibrated (poly3 only)."""
-    folders = {}
-    for kind, col, unit in (("gyro", "gyro", "rad/s"), ("accel", "acc", "m/s^2")):
-        outputs = ",".join(f"imu.{col}.{a}:{unit}" for a in AXES)
-        code, _, err = run(capsys, "import", f"csv={TOFUPILOT_CSV}", f"sensor={kind}", "time=timestamp:us",
-                           "temperature=imu.temperature:degC", f"output={outputs}", "axes=x,y,z", "out=rec",
-                           f"name={kind}", "tracking.enabled=false")
-        assert code == 0, err
-        for a in AXES:  # each axis from its sidecar (import axes=)
-            code, _, err = run(capsys, "calibrate", f"recording=rec/{kind}-imu.{col}.{a}.csv", f"out=cal/{kind}-{a}",
-                               "methods=[raw,poly3]", "tracking.enabled=false")
-            assert code == 0, err
-            folders[f"{kind}-{a}"] = workdir / "cal" / f"{kind}-{a}"
-    return folders
+def calibrated(calibrated_once: Path, workdir: Path) -> dict[str, Path]:
+    """A copy of :func:`calibrated_once`'s ``rec/`` and ``cal/`` in the test's own folder: the
+    calibration folders by ``<kind>-<axis>``."""
+    for sub in ("rec", "cal"):
+        shutil.copytree(calibrated_once / sub, workdir / sub)
+    return {f"{kind}-{a}": workdir / "cal" / f"{kind}-{a}" for kind in ("gyro", "accel") for a in AXES}
 
 
 def fitted(folder: Path) -> tuple[OffsetPolynomial, dict]:
