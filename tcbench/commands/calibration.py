@@ -7,8 +7,8 @@ every part of ``test_recordings``), rank the methods on the held-out parts with 
 interval on every ratio (:mod:`tcbench.compensation.holdout`; a best whose interval against the
 next reaches 1 is a tie), say in one line when a method is worse than raw held out, and write the long table (``calibration.md`` and
 ``.csv``), the residual plots and ``calibration.json`` (the ranking, and the cubic refitted on the
-whole record with the recording's sensor, unit, axis and device id, which ``tcbench export``
-turns into PX4 and ArduPilot parameters).
+whole record with its static level and the recording's sensor, unit, axis and device id, which
+``tcbench export`` turns into PX4 and ArduPilot parameters; the last lines print that command).
 
 Something is always held out: with no ``train_branches=``, a record of several temperature
 branches is fitted on the consecutive branches whose temperatures span what the others need
