@@ -231,7 +231,8 @@ def px4_applied(params: dict, head: str, axis: int, temp_c: np.ndarray, reading:
     """PX4's compensation from its documented formula, in 32-bit: the offset sum X_k dT^k, with
     dT = clamp(T, TMIN, TMAX) - TREF, subtracted from the reading."""
     f32 = np.float32
-    dt = np.clip(temp_c.astype(f32), f32(params[f"{head}_TMIN"]), f32(params[f"{head}_TMAX"])) - f32(params[f"{head}_TREF"])
+    tmin, tmax, tref = (f32(params[f"{head}_{k}"]) for k in ("TMIN", "TMAX", "TREF"))
+    dt = np.clip(temp_c.astype(f32), tmin, tmax) - tref
     offset = sum(f32(params[f"{head}_X{k}_{axis}"]) * dt ** k for k in range(4))
     return (reading.astype(f32) - offset).astype(np.float64)
 
@@ -270,8 +271,10 @@ def test_the_firmware_round_trip_removes_the_drift_and_keeps_the_static_reading(
     code, out, err = run(capsys, "export", f"calibrations=[{cals}]", "device_id={gyro: 1, accel: 2}", "out=params",
                          "formats=[px4,ardupilot]")
     assert code == 0, err
-    px4 = {ln.split()[2]: float(ln.split()[3]) for ln in (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()}
-    ap = {ln.split()[0]: float(ln.split()[1]) for ln in (workdir / "params" / "ardupilot_tcal.parm").read_text().splitlines()}
+    script = (workdir / "params" / "px4_tc_params.txt").read_text().splitlines()
+    px4 = {ln.split()[2]: float(ln.split()[3]) for ln in script}  # as the NuttX console reads it
+    parm = (workdir / "params" / "ardupilot_tcal.parm").read_text().splitlines()
+    ap = {ln.split()[0]: float(ln.split()[1]) for ln in parm}
     log = pd.read_csv(TOFUPILOT_CSV, sep="\t")  # the firmware's units: rad/s and m/s^2
     temp = log["imu.temperature"].to_numpy()
     cal_temp_c = 35.0

@@ -167,8 +167,8 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
 
 
 def _spanning(temp_c: np.ndarray, parts: list[Any]) -> tuple[list[int], str]:
-    """The default fitted branches of a record of several (:func:`~tcbench.compensation.fitted_span.spanning_parts`)
-    and why, in words."""
+    """The default fitted branches of a record of several, and why in words
+    (:func:`~tcbench.compensation.fitted_span.spanning_parts`)."""
     from tcbench.compensation.fitted_span import beyond_share, spanning_parts
 
     choice = spanning_parts(temp_c, parts)
@@ -176,7 +176,8 @@ def _spanning(temp_c: np.ndarray, parts: list[Any]) -> tuple[list[int], str]:
     lo, hi = choice.fitted_c
     these = "these consecutive branches span" if len(choice.train) > 1 else "this branch spans"
     return choice.train, (f"why: {these} the held-out temperatures best ({lo:.1f}..{hi:.1f} degC): "
-                          f"{choice.beyond_share:.1%} of the held-out samples lie beyond{first}; train_branches= chooses")
+                          f"{choice.beyond_share:.1%} of the held-out samples lie beyond{first}; "
+                          "train_branches= chooses")
 
 
 def _check_record(path: str, rec: Any, cfg: CalibrateConfig, own: bool) -> None:

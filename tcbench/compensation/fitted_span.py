@@ -5,9 +5,9 @@ guesses beyond the fitted range.
 Among the runs of consecutive branches that leave at least one branch held out, the default is
 one with the smallest share of held-out samples beyond its temperature range (within
 :data:`SHARE_TOLERANCE`: a few samples at a turning point do not cost a branch of held-out data):
-of those, the fewest branches, then the smallest share, the widest range, the earliest. A record of an oven heating to its
-hottest level and then stepping down to its coldest is fitted on the long cooling, not on the
-first warm-up.
+of those, the fewest branches, then the smallest share, the widest range, the earliest. A record
+of an oven heating to its hottest level and then stepping down to its coldest is fitted on the
+long cooling, not on the first warm-up.
 """
 
 from __future__ import annotations
