@@ -1,5 +1,6 @@
 """``tcbench calibrate`` on the real tofupilot chamber cycle as a user imports it: fitted on the
-first cooling branch, scored on the heating and the second cooling branch, tracked in MLflow."""
+first cooling branch, scored on the heating and the second cooling branch, tracked in MLflow; by
+default fitted on the branches that span the held-out temperatures."""
 
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ def gyro_y(workdir: Path, capsys: pytest.CaptureFixture[str]) -> Path:
 
 
 def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run(capsys, "calibrate", f"recording={gyro_y}", "out=cal")
+    code, out, err = run(capsys, "calibrate", f"recording={gyro_y}", "out=cal", "train_branches=[0]")
     assert code == 0, err
     table = pd.read_csv(workdir / "cal" / "calibration.csv")
     assert sorted(set(table["method"])) == ["bp", "bp_gd", "elman", "model", "poly3", "poly3_rate", "raw"]
@@ -85,6 +86,35 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
     assert r.data.tags["tcbench.data_hash"] == summary["content_hash"]
     assert {"calibration.md", "calibration.json", "residuals.png", "model.yaml", "report.md"} <= \
         {a.path for a in client.list_artifacts(r.info.run_id)}
+
+
+def test_the_default_split_fits_the_branches_that_span_the_held_out_temperatures(
+        gyro_y: Path, workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A simulated oven record (5.2 h: a warm-up from 26 to 61 degC, then steps down to -39 degC)
+    was fitted on its warm-up by default and scored 66 % beyond the fitted range; now the branch
+    spanning the held-out temperatures is fitted, and the line under the first says why. On the
+    tofupilot cycle that is the heating (-17.6..74.0 degC), the two coolings held out inside it.
+    ``train_branches=`` still chooses, and the share beyond the fitted range is still printed."""
+    code, _, err = run(capsys, "simulate", "sensor=gyro", "protocol=oven", "protocol_params.sample_rate_hz=1",
+                       "protocol_params.hold_s=600", "metrics=false", "out=sim", "name=oven", "tracking.enabled=false")
+    assert code == 0, err
+    for rec, fitted, held in (("sim/oven.csv", [1], [0]), (str(gyro_y), [1], [0, 2])):
+        code, out, err = run(capsys, "calibrate", f"recording={rec}", "out=cal", "methods=[raw,poly3]",
+                             "overwrite=true", "tracking.enabled=false")
+        assert code == 0, err
+        about = json.loads((workdir / "cal" / "calibration.json").read_text())
+        assert (about["fitted"], about["held_out_parts"]) == (fitted, held), rec
+        assert about["range"]["beyond_share"] < 0.001 and "held out beyond the fitted" not in out, about["range"]
+        why = out.splitlines()[1]
+        assert why.startswith("  why: this branch spans the held-out temperatures best") and "0.0% of the held-out" \
+            in why and "train_branches= chooses" in why, why
+        assert about["fitted_why"] == why.strip()
+    code, out, err = run(capsys, "calibrate", "recording=sim/oven.csv", "out=cal", "methods=[raw,poly3]",
+                         "train_branches=[0]", "overwrite=true", "tracking.enabled=false")
+    assert code == 0, err
+    about = json.loads((workdir / "cal" / "calibration.json").read_text())
+    assert about["range"]["beyond_share"] > 0.6 and "held out beyond the fitted" in out  # the old default
+    assert about["fitted_why"] == "" and "  why:" not in out
 
 
 @pytest.mark.parametrize(("args", "words"), [

@@ -44,7 +44,7 @@ def test_the_leaderboard_reads_calibrations_keyed_by_content(workdir: Path, caps
     sizes = sorted(len(t) for t in tables.values())
     assert sizes == [2, 4], tables  # b: raw and poly3 once; a: raw and poly3 under two configs
     two = next(t for t in tables.values() if len(t) == 4)
-    assert two["config"].nunique() == 2 and set(two["split"]) == {"fit 0 -> score 1,2", "fit 0,1 -> score 2"}
+    assert two["config"].nunique() == 2 and set(two["split"]) == {"fit 1 -> score 0,2", "fit 0,1 -> score 2"}
     assert two.loc[0, "method"] == "poly3" and (two["x_best"] >= 1).all()
 
 

@@ -41,8 +41,9 @@ tcbench metrics -m "recording=$all" "out=$out/metrics/\${stem:recording}" hydra.
 echo "== diagnosis of each whole record"
 tcbench diagnose -m "recording=$all" "out=$out/diagnosis/\${stem:recording}"
 echo "== calibration: tofupilot fitted on its first cooling branch, PAN on every other time block"
-tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration/\${stem:recording}" "restarts=$restarts"
-tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g \
+tcbench calibrate -m "recording=${tofu_axes%,}" "out=$out/calibration/\${stem:recording}" 'train_branches=[0]' \
+    "restarts=$restarts"
+tcbench calibrate "recording=$work/rec/tofupilot-imu.acc.z.csv" true_input=-1:g 'train_branches=[0]' \
     "out=$out/calibration/tofupilot-imu.acc.z" "restarts=$restarts"
 tcbench calibrate -m "recording=${pan_axes%,}" "out=$out/calibration/\${stem:recording}" blocks=5 \
     'train_branches=[0,2,4]' drift_window_s=5 "restarts=$restarts"

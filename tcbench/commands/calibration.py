@@ -7,12 +7,14 @@ every part of ``test_recordings``), rank the methods on the held-out parts with 
 interval on every ratio (:mod:`tcbench.compensation.holdout`; a best whose interval against the
 next reaches 1 is a tie), say in one line when a method is worse than raw held out, and write the long table (``calibration.md`` and
 ``.csv``), the residual plots and ``calibration.json`` (the ranking, and the cubic refitted on the
-whole record with the recording's sensor, unit, axis and device id, which ``tcbench export``
-turns into PX4 and ArduPilot parameters).
+whole record with its static level and the recording's sensor, unit, axis and device id, which
+``tcbench export`` turns into PX4 and ArduPilot parameters; the last lines print that command).
 
 Something is always held out: with no ``train_branches=``, a record of several temperature
-branches is fitted on its first and scored on the others; a record of one branch (a single
-cooling) is cut into five time blocks, fitted on blocks 0, 2, 4 and scored on 1 and 3."""
+branches is fitted on the consecutive branches whose temperatures span what the others need
+(:mod:`tcbench.compensation.fitted_span`: the held-out score judges interpolation) and scored on
+the others; a record of one branch (a single cooling) is cut into five time blocks, fitted on
+blocks 0, 2, 4 and scored on 1 and 3."""
 
 from __future__ import annotations
 
@@ -68,6 +70,7 @@ class Split:
     train: list[int]
     noun: str
     how: str
+    why: str = ""  # why these parts are fitted, when calibrate chose them
 
     @property
     def held_out(self) -> list[int]:
@@ -145,19 +148,36 @@ def _split(path: str, cfg: CalibrateConfig, own: bool = True) -> tuple[Any, Spli
         noun, how = "time block", f"blocks={blocks}" + ("" if cfg.blocks else ", as the record has one temperature branch")
     if not own:
         return rec, Split(parts, [], noun, how)
+    why = ""
     if cfg.train_branches is not None:
         train = sorted(set(cfg.train_branches))
+    elif noun == "time block" or len(parts) == 1:
+        train = list(range(0, len(parts), 2)) if len(parts) > 1 else [0]
     else:
-        train = list(range(0, len(parts), 2)) if noun == "time block" and len(parts) > 1 else [0]
+        train, why = _spanning(rec.temperature_c, parts)
     bad = [k for k in train if not 0 <= k < len(parts)]
     if bad or not train:
         raise CommandError(f"train_branches={list(cfg.train_branches or [])}: the recording has {len(parts)} "
                            f"{noun}{'es' * (noun.endswith('branch') and len(parts) != 1)}"
                            f"{'s' * (noun.endswith('block') and len(parts) != 1)} (0..{len(parts) - 1}; {how})")
-    split = Split(parts, train, noun, how)
+    split = Split(parts, train, noun, how, why)
     rows = np.concatenate([np.arange(parts[k].start, parts[k].stop) for k in train])
     fittable(rec.temperature_c[rows], f"{path}: the fitted parts ({split.describe(train)})")
     return rec, split
+
+
+def _spanning(temp_c: np.ndarray, parts: list[Any]) -> tuple[list[int], str]:
+    """The default fitted branches of a record of several, and why in words
+    (:func:`~tcbench.compensation.fitted_span.spanning_parts`)."""
+    from tcbench.compensation.fitted_span import beyond_share, spanning_parts
+
+    choice = spanning_parts(temp_c, parts)
+    first = "" if choice.train == [0] else f", against {beyond_share(temp_c, parts, [0]):.1%} fitted on branch 0"
+    lo, hi = choice.fitted_c
+    these = "these consecutive branches span" if len(choice.train) > 1 else "this branch spans"
+    return choice.train, (f"why: {these} the held-out temperatures best ({lo:.1f}..{hi:.1f} degC): "
+                          f"{choice.beyond_share:.1%} of the held-out samples lie beyond{first}; "
+                          "train_branches= chooses")
 
 
 def _check_record(path: str, rec: Any, cfg: CalibrateConfig, own: bool) -> None:
@@ -238,6 +258,8 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
     print(f"calibrate {name} ({rec.meta.sensor}, output in {unit}): fitting {', '.join(methods)} on "
           f"{split.describe(split.train)}; scoring on {scored or 'the fitted parts only'}", flush=True)
+    if split.why:
+        print(f"  {split.why}", flush=True)
     if not split.held_out and not others:
         print("tcbench: warning: every part is fitted and no test_recordings= is given: the scores are "
               "in-sample and no method is ranked", file=sys.stderr)
@@ -467,7 +489,7 @@ def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash
     return {"recording": Path(cfg.recording).name, "content_hash": content_hash,
             "sensor": rec.meta.sensor, "unit": unit, "axis": axis,
             "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
-            "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train,
+            "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train, "fitted_why": split.why,
             "held_out_parts": split.held_out, "test_recordings": [Path(p).name for p in cfg.test_recordings],
             "drift_window_s": cfg.drift_window_s}
 
@@ -481,18 +503,21 @@ def _content_hash(path: str) -> str:
 def _export_fit(whole: Any, screen: bool = True) -> dict[str, Any] | None:
     """The cubic an autopilot is given: ``poly3`` refitted on the whole record, screened as the
     training parts are (the held-out scores judged the method; the parameters use every kept
-    sample), in the recording's output unit."""
+    sample), in the recording's output unit; and ``static_level``, the median of the offset it
+    fits (the level PX4 leaves an accelerometer's ordinary calibration,
+    :func:`tcbench.compensation.px4.px4_polynomial`)."""
     from tcbench.compensation.px4 import fit_offset
     from tcbench.compensation.screening import screen as screened
 
     kept = screened(whole, screen).pieces
+    offset = np.concatenate([p.output - p.truth for p in kept])
     try:
-        cubic = fit_offset(np.concatenate([p.temp_c for p in kept]),
-                           np.concatenate([p.output - p.truth for p in kept]))
+        cubic = fit_offset(np.concatenate([p.temp_c for p in kept]), offset)
     except ValueError:
         return None
-    return {"method": "poly3", "fitted_on": "the whole record" + (", screened" if screen else ""), "x": list(cubic.x), "tref_c": cubic.tref_c,
-            "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c}
+    return {"method": "poly3", "fitted_on": "the whole record" + (", screened" if screen else ""), "x": list(cubic.x),
+            "tref_c": cubic.tref_c, "tmin_c": cubic.tmin_c, "tmax_c": cubic.tmax_c,
+            "static_level": float(np.median(offset))}
 
 
 def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict[str, Path]) -> None:
@@ -500,8 +525,9 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     from tcbench.tables import markdown_table
 
     print("\n" + markdown_table(summary.round(6)))
-    print(f"\nlong table (every part): {written['md']}; residual plots: {written['png']}; "
-          f"for PX4/ArduPilot: tcbench export calibrations=[{Path(written['json']).parent}]")
+    print(f"\nlong table (every part): {written['md']}; residual plots: {written['png']}")
+    if hint := _export_hint(about, Path(written["json"]).parent):
+        print(hint)
     if not about.get("held_out"):
         print("nothing held out: no method is ranked")
         return
@@ -509,6 +535,29 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
         if line:
             print(line)
     print(_best_line(about, unit))
+
+
+def _export_hint(about: dict[str, Any], folder: Path) -> str | None:
+    """The ``tcbench export`` command of this calibration as it runs: with the device id the log
+    gave; else for ArduPilot, and for PX4 with ``device_id=`` spelt out (PX4 applies ``TC_*``
+    only to the sensor it names). None when neither autopilot calibrates the sensor kind."""
+    import shlex
+
+    from tcbench.compensation.px4 import px4_covers
+    from tcbench.sensors import kinds
+
+    sensor = about.get("sensor")
+    if not about.get("export") or not px4_covers(sensor):
+        return None
+    command = f"tcbench export {shlex.quote(f'calibrations=[{folder}]')}"
+    if about.get("axis") is None:
+        return (f"for PX4/ArduPilot: the recording does not say its axis; calibrate again with axis=x|y|z, then "
+                f"{command} ...")
+    if about.get("px4_device_id") is not None:
+        return f"for PX4/ArduPilot: {command} device_id={about['px4_device_id']}"
+    cal = f"CAL_{kinds.get(sensor).px4_cal}0_ID"
+    return (f"for ArduPilot: {command} formats=[ardupilot]\nfor PX4 too: {command} device_id=N, N the {sensor}'s "
+            f"device id (its {cal} parameter on the vehicle, or the log's)")
 
 
 def _best_line(about: dict[str, Any], unit: str) -> str:
@@ -588,7 +637,7 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: d
     note = "" if about.get("held_out") else "\nNothing was held out: the scores are in-sample only.\n"
     lines = [f"{rec.meta.sensor} recording, output in {unit}; {len(split.parts)} "
              f"{split.noun.replace('branch', 'branche')}s ({split.how}); "
-             f"fitted on {split.describe(split.train)}, scored on every part.",
+             f"fitted on {split.describe(split.train)}{f' ({split.why})' if split.why else ''}, scored on every part.",
              f"drift = RMS of the residual's {cfg.drift_window_s:g}-s running mean (output minus true input minus "
              "the model's offset); rms = RMS of the residual."]
     if cfg.test_recordings:

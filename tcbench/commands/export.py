@@ -8,6 +8,11 @@ a PX4 log's field) or ``calibrate axis=``; a calibration without one is refused,
 axis. PX4 applies ``TC_<t><i>_*`` only to the sensor whose device id ``TC_<t><i>_ID`` names: it
 comes from ``device_id=`` (one number, or ``{gyro: N, accel: M}``) or the log the recording was
 imported from, and PX4's file is refused without one.
+
+PX4 takes an accelerometer's polynomial without its static level (the median reading, gravity
+included, as PX4's ``process_sensor_caldata.py`` fits it): that level stays in the reading for the
+ordinary calibration ``CAL_ACCn_*``; a gyro's polynomial is its whole offset. ArduPilot's cubic
+has no constant, so its file is the same either way.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ class AxisCalibration:
     axis: str
     poly: Any  # OffsetPolynomial
     px4_device_id: int | None
+    static_level: float | None = None  # the median offset (calibration.json's export.static_level)
 
 
 def read_calibration(folder: str | Path) -> AxisCalibration:
@@ -51,6 +57,8 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
         poly = OffsetPolynomial(tuple(float(c) for c in fit["x"]), float(fit["tref_c"]),  # type: ignore[arg-type]
                                 float(fit["tmin_c"]), float(fit["tmax_c"]))
         sensor, unit, axis = about["sensor"], about["unit"], about.get("axis")
+        level = fit.get("static_level")
+        static_level = float(level) if level is not None else None
     except (ValueError, KeyError, TypeError) as exc:
         raise CommandError(f"calibrations: {path}: not a calibration tcbench export reads ({exc})") from None
     if axis not in ("x", "y", "z"):
@@ -58,7 +66,7 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
                            "or calibrate it again with axis=x|y|z")
     device = about.get("px4_device_id")
     return AxisCalibration(Path(folder), str(sensor), str(unit), str(axis), poly,
-                           int(device) if device is not None else None)
+                           int(device) if device is not None else None, static_level)
 
 
 def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
@@ -89,7 +97,22 @@ def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
     if "px4" in cfg.formats:
         for sensor in by_sensor:
             device_id(cfg, sensor, by_sensor[sensor])
+            static_levels(sensor, by_sensor[sensor])
     return by_sensor
+
+
+def static_levels(sensor: str, axes: dict[str, AxisCalibration]) -> dict[str, float]:
+    """Each axis's static level when PX4 leaves it to the ordinary calibration (an accelerometer,
+    :func:`~tcbench.compensation.px4.keeps_static_level`), else none; one line for a calibration
+    written without it."""
+    from tcbench.compensation.px4 import keeps_static_level
+
+    if not keeps_static_level(sensor):
+        return {}
+    if without := [c.folder for c in axes.values() if c.static_level is None]:
+        raise CommandError(f"calibrations: {without[0]}: no static level in its calibration.json, which PX4's {sensor} "
+                           "polynomial leaves out; calibrate it again, or formats=[ardupilot]")
+    return {a: float(c.static_level) for a, c in axes.items()}  # type: ignore[arg-type]
 
 
 def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) -> int:
@@ -113,7 +136,7 @@ def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) 
 def export(cfg: ExportConfig) -> dict[str, Path]:
     """Write the parameter files; print what each holds."""
     from tcbench.compensation.ardupilot import ardupilot_parameters, write_parm
-    from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, write_parameters
+    from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, px4_polynomial, write_parameters
 
     by_sensor = check_export(cfg)
     to_si = {s: px4_factor(s, next(iter(axes.values())).unit) for s, axes in by_sensor.items()}
@@ -139,8 +162,10 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
             if "px4" in cfg.formats:
                 params: dict[str, float | int] = {}
                 for sensor, axes in polys.items():
-                    params |= px4_parameters(axes, sensor, cfg.px4_instance, device_id(cfg, sensor, by_sensor[sensor]),
-                                             to_px4_unit=to_si[sensor])
+                    levels = static_levels(sensor, by_sensor[sensor])
+                    px4_axes = {a: px4_polynomial(p, sensor, levels.get(a, 0.0)) for a, p in axes.items()}
+                    params |= px4_parameters(px4_axes, sensor, cfg.px4_instance,
+                                             device_id(cfg, sensor, by_sensor[sensor]), to_px4_unit=to_si[sensor])
                 written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys))
             if "ardupilot" in cfg.formats:
                 try:
@@ -158,6 +183,12 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
     if "px4" in written:
         print(f"tcbench: wrote {written['px4']} (PX4 TC_* of {every}, instance {cfg.px4_instance}; "
               "paste into the NuttX console or run from the SD card)")
+        for sensor in polys:
+            if levels := static_levels(sensor, by_sensor[sensor]):
+                each = ", ".join(f"{a} {v:.6g}" for a, v in sorted(levels.items()))
+                print(f"  {sensor}: TC_{kinds.get(sensor).px4_letter}{cfg.px4_instance}_X0_* leave out the static level "
+                      f"({each} {next(iter(by_sensor[sensor].values())).unit}, gravity included), as PX4 fits it: "
+                      f"the ordinary calibration CAL_{kinds.get(sensor).px4_cal}n_* keeps it")
     if "ardupilot" in written:
         print(f"tcbench: wrote {written['ardupilot']} (ArduPilot INS_TCAL{cfg.ardupilot_imu}_* of {every}; "
               "load it in the ground station)")

@@ -372,7 +372,8 @@ SPECS: dict[str, CommandSpec] = {
             "out": "output folder",
             "overwrite": OVERWRITE,
             "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
-                              "null: the first of several branches, or blocks 0, 2, 4 of five when there is one",
+                              "null: of several branches, the fewest consecutive ones whose temperatures span the others' "
+                              "(the held-out score is then interpolation), or blocks 0, 2, 4 of five when there is one",
             "blocks": "cut the record into this many time blocks of equal duration instead of temperature branches "
                       "(a record that only cools: train_branches=[0,2,4] blocks=5)",
             "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp (trained by "
@@ -411,7 +412,8 @@ SPECS: dict[str, CommandSpec] = {
         description="Write the thermal-calibration parameters of one IMU for PX4 (TC_G*/TC_A*, a param-set "
                     "script) and ArduPilot (INS_TCALn_*, a .parm file) from tcbench calibrate's outputs, one per "
                     "axis and sensor kind, every axis in its slot (the axis from the recording's sidecar or "
-                    "calibrate axis=).",
+                    "calibrate axis=). As PX4's own fit, an accelerometer's TC_A* leave out its static level "
+                    "(the median reading, gravity included), which stays with CAL_ACCn_*.",
         schema="tcbench.commands.schemas:ExportConfig",
         runs_here="tcbench.commands.export",
         params={

@@ -142,7 +142,8 @@ class DiagnoseConfig:
 class CalibrateConfig:
     """``tcbench calibrate``: offset models of a static recording fitted on some of its parts
     (``train_branches``: temperature branches or time blocks, numbered from 0 in time order; null:
-    the first of several branches, or the even ones of five time blocks when there is one branch)
+    of several branches, the consecutive ones whose temperatures span the held-out ones', or the
+    even ones of five time blocks when there is one branch)
     and scored on the others."""
 
     kind: str = "calibrate"

@@ -8,6 +8,12 @@ TC_<t><i>_TMAX]``, ``dT = T - TC_<t><i>_TREF``, the offset is ``X0 + X1 dT + X2 
 with ``Xn = TC_<t><i>_X<n>_<a>``, and it is subtracted from the reading. PX4 keeps the values as
 32-bit floats, in its units: rad/s for a gyro, m/s^2 for an accelerometer. ``TC_<t><i>_ID`` names
 the sensor (its ``device_id``); ``TC_<t>_ENABLE`` switches the compensation on.
+
+What the offset holds follows PX4's own fit (``Tools/process_sensor_caldata.py``): a gyro's
+polynomial is its whole offset (at rest the compensated rate reads 0); an accelerometer's is the
+change of its offset with temperature, fitted after the median of the static reading is taken
+off each axis, so the static level (gravity and the bias at rest) stays in the reading and
+belongs to the ordinary calibration ``CAL_ACCn_*`` (:func:`px4_polynomial`).
 """
 
 from __future__ import annotations
@@ -107,6 +113,22 @@ def common_range(axes: Mapping[str, OffsetPolynomial]) -> dict[str, OffsetPolyno
     if not hi > lo:
         raise ValueError("the axes' fitted temperature ranges do not overlap: calibrate them on one record")
     return {a: reexpanded(p, 0.5 * (lo + hi), lo, hi) for a, p in axes.items()}
+
+
+def keeps_static_level(sensor: str) -> bool:
+    """Whether PX4 leaves ``sensor``'s static level to its ordinary calibration (an
+    accelerometer: its ``TC_A*`` polynomial is fitted about the median reading), rather than
+    taking the whole offset into ``TC_*`` (a gyro)."""
+    return px4_type(sensor)[0] == "A"
+
+
+def px4_polynomial(poly: OffsetPolynomial, sensor: str, static_level: float) -> OffsetPolynomial:
+    """``poly`` (a whole-record offset fit) as PX4 takes it for ``sensor``: unchanged for a gyro;
+    for an accelerometer less ``static_level`` (the median of the static reading, same unit), so
+    that PX4's subtraction leaves that level in the reading."""
+    if not keeps_static_level(sensor):
+        return poly
+    return OffsetPolynomial((poly.x[0] - float(static_level), *poly.x[1:]), poly.tref_c, poly.tmin_c, poly.tmax_c)
 
 
 def px4_parameters(axes: Mapping[str, OffsetPolynomial], sensor: str = "gyro", instance: int = 0,
