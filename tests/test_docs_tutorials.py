@@ -11,38 +11,15 @@ block; a few outputs of each are checked where that is cheap."""
 
 from __future__ import annotations
 
-import os
-import re
-import shutil
-import subprocess
-import sys
+import importlib.util
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+from doc_blocks import ROOT, blocks, environment, fresh_folder, run_blocks, runnable
 
-ROOT = Path(__file__).resolve().parents[1]
 TUTORIALS = ROOT / "docs" / "tutorials"
-FENCE = re.compile(r"^```([^\n]*)\n(.*?)^```\s*$", re.M | re.S)
-PIP_SHIM = """#!/usr/bin/env bash
-# pip as the tutorials call it: installs go to a throwaway folder on PYTHONPATH
-if [ "$1" = install ]; then
-  shift
-  exec "{python}" -m pip install -q --no-deps --no-build-isolation --target "{site}" "$@"
-fi
-exec "{python}" -m pip "$@"
-"""
-
-
-def blocks(page: Path) -> list[tuple[str, str]]:
-    """``(info string, body)`` of every fenced block of ``page``, in order."""
-    return [(info.strip(), body) for info, body in FENCE.findall(page.read_text(encoding="utf-8"))]
-
-
-def runnable(page: Path) -> list[str]:
-    """The bodies of the page's blocks fenced exactly ```` ```bash ````."""
-    return [body for info, body in blocks(page) if info == "bash"]
 
 
 @dataclass(frozen=True)
@@ -86,37 +63,15 @@ def test_every_tutorial_has_runnable_blocks_and_only_local_ones() -> None:
         for body in runnable(page):
             assert "submitit_slurm" not in body and "postgresql" not in body, f"{name}: a cluster block runs"
             assert "run.sh" not in body, f"{name}: a full study runs (it rewrites the committed boards)"
-
-
-def _environment(work: Path) -> dict[str, str]:
-    bin_dir = work / ".bin"
-    bin_dir.mkdir()
-    site = work / ".site"
-    site.mkdir()
-    shim = bin_dir / "pip"
-    shim.write_text(PIP_SHIM.format(python=sys.executable, site=site))
-    shim.chmod(0o755)
-    env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
-           "PYTHONPATH": str(site), "MPLBACKEND": "Agg", "MLFLOW_DISABLE_TELEMETRY": "true"}
-    env.pop("MLFLOW_TRACKING_URI", None)  # the pages' runs go to ./mlflow.db, as they say
-    return env
+            assert "hydra/launcher=ray" not in body, f"{name}: a Ray block runs without the ray extra"
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", PAGES)
 def test_tutorial_runs_as_written(name: str, tmp_path: Path) -> None:
-    work = tmp_path / "work"
-    work.mkdir()
-    (work / "data").symlink_to(ROOT / "data")
-    shutil.copytree(ROOT / "examples", work / "examples",
-                    ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
-    env = _environment(work)
-    output, start = [], time.monotonic()
-    for i, body in enumerate(runnable(TUTORIALS / name)):
-        run = subprocess.run(["bash", "-euo", "pipefail", "-c", body], cwd=work, env=env, capture_output=True,
-                             text=True, timeout=1800)
-        output.append(run.stdout + run.stderr)
-        assert run.returncode == 0, f"{name}, block {i + 1} exited {run.returncode}:\n{body}\n{output[-1][-4000:]}"
+    work = fresh_folder(tmp_path / "work")
+    start = time.monotonic()
+    output = run_blocks(name, runnable(TUTORIALS / name), work, environment(work))
     text = "\n".join(output)
     expect = EXPECT[name]
     for piece in expect.output:
@@ -125,3 +80,19 @@ def test_tutorial_runs_as_written(name: str, tmp_path: Path) -> None:
         assert (work / path).is_file(), f"{name}: {path} not written"
         assert (work / path).read_text(encoding="utf-8").startswith(first), f"{name}: {path}"
     print(f"{name}: {len(output)} blocks in {time.monotonic() - start:.0f} s")
+
+
+@pytest.mark.slow
+def test_cluster_page_ray_rehearsal_runs(tmp_path: Path) -> None:
+    """The cluster page's Ray block (shown, not run, by the test above: it needs the ``ray``
+    extra) runs a two-job sweep on a local Ray instance where Ray is installed."""
+    if not (importlib.util.find_spec("ray") and importlib.util.find_spec("hydra_plugins.hydra_ray_launcher")):
+        pytest.skip("ray and hydra-ray-launcher are not installed (pip install -e '.[ray]')")
+    (body,) = [body for info, body in blocks(TUTORIALS / "cluster-sweeps.md") if "hydra/launcher=ray" in body]
+    work = fresh_folder(tmp_path / "work")
+    env = {**environment(work), "RAY_USAGE_STATS_ENABLED": "0"}
+    start = time.monotonic()
+    (output,) = run_blocks("cluster-sweeps.md (Ray)", [body], work, env)
+    assert "Ray Launcher is launching 2 jobs" in output, output[-4000:]
+    assert "(experiment 'ray-rehearsal', sweep ray-1): 2 finished, 0 failed" in output, output[-4000:]
+    print(f"cluster-sweeps.md, Ray rehearsal: {time.monotonic() - start:.0f} s")

@@ -4,6 +4,7 @@ row, the diagnosis naming the hidden effect, the files it names, and its runs in
 from __future__ import annotations
 
 import re
+import sys
 from pathlib import Path
 
 import mlflow
@@ -11,6 +12,7 @@ import pytest
 import yaml
 
 from tcbench.cli import main
+from tcbench.cli.quickstart import activate_command
 from tcbench.commands.schemas import QuickstartConfig
 
 
@@ -35,10 +37,13 @@ def test_quickstart_end_to_end(workdir: Path, capsys: pytest.CaptureFixture[str]
     assert sorted(methods) == ["IFA-BP-gd", "lagpoly", "memoriser", "oracle", "poly3", "poly3_runs", "raw"]
     assert re.search(r"\n\s+\d+\s+oracle\s+1\s+0\s+\S+\s+–\s+1\s", table), table
     assert "physical limit" in table
+    assert "IFA-BP-gd = the paper's method" in table and "gradient descent (gd)" in table  # the legend under it
 
     assert "Verdict: missing: thermal_lag" in out and "the hidden effect was thermal_lag: found" in out
     assert "found thermal_lag" in out and "where: temperature " in out and "in sigma" in out
-    assert "Next steps" in out
+    assert "Next steps" in out and ".venv/bin/" not in out.split("Next steps")[1]
+    assert "(cluster-robust Wald: the effect's coefficients" in out
+    assert f"activate it once per shell: {activate_command(Path(sys.prefix), workdir)}" in out
     assert "micromachined silicon resonant accelerometer (MSRA)" in out and "doi:10.3390/mi13071054" in out
     # Hydra's lines (each job's summary, the sweep's progress) and the diagnosis job's own summary are in the
     # log, not between the results

@@ -16,6 +16,7 @@ link out of ``out`` is refused, as by every command.
 
 from __future__ import annotations
 
+import sys
 import textwrap
 import time
 import uuid
@@ -26,6 +27,7 @@ from typing import Any
 
 from tcbench.cli.app import hydra_string
 from tcbench.commands.schemas import QuickstartConfig
+from tcbench.diagnose.significance import ROBUST_WALD, SURROGATE
 from tcbench.errors import ConfigError
 from tcbench.papers import SEED_000
 
@@ -36,8 +38,8 @@ MEMS accelerometer) in temperature chambers, compensates them (learners and thei
 against the polynomial flight stacks ship and the physical limit), and diagnoses what a model or
 simulator leaves out of a recording. Every job is a run in MLflow."""
 NEXT_STEPS = """\
-Next steps (the full experiments, from the repository root; the paper's studies compare with CMA-ES
-from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
+Next steps (the full experiments, from the repository root with the environment active; the paper's
+studies compare with CMA-ES from the peers plugin: pip install -e plugins/tcbench-peers):
   bash experiments/paper_ifa_bp/run.sh     seed 000 Tables 1-2: 30 trainings per method on both MSRA tasks,
                                            with raw, poly, the oracle and the paper's tables
   tcbench run -m task=msra_fulltemp learner=bp optimiser=fa,ifa seed='range(30)'   the full-temperature task
@@ -46,10 +48,32 @@ from the peers plugin: .venv/bin/pip install -e plugins/tcbench-peers):
   python experiments/diagnose-concealed/run.py --workers 2   every hidden effect and controls, 80 recordings
   tcbench run -m experiment=paper_fa_ifa   FA against IFA on the paper's benchmark functions
   tcbench --help                           every command; tcbench <command> --help for its parameters"""
+# the quickstart's leaderboard: the names its table shows that the paragraph above it does not explain
+TABLE_LEGEND = """\
+  IFA-BP-gd = the paper's method: a backpropagation (BP) network whose initial weights the improved
+  firefly algorithm (IFA) searches, then trained by gradient descent (gd); raw = the uncompensated
+  output. 95% CI = bootstrap interval of the median over the trainings (– for a method run once);
+  x physical limit = median ÷ the oracle's; gain over raw = raw's median ÷ this one's."""
+# what each significance test a diagnosis names in its evidence means (tcbench.diagnose.significance)
+TEST_LEGEND = {
+    ROBUST_WALD: "the effect's coefficients against their uncertainty, estimated from blocks of the record "
+                 "(clusters) so that slow, correlated noise is not taken for an effect",
+    SURROGATE: "the gain compared with the gains of simulated records that have the residual's spectrum and "
+               "no effect",
+}
 
 
 FOLDERS = ("diagnosis", "leaderboard", "recordings")  # the quickstart's, inside its out=
 LOG = "quickstart.log"  # Hydra's log lines of the quickstart's sweeps and diagnosis, inside its out=
+
+
+def activate_command(prefix: Path, cwd: Path) -> str:
+    """``source <prefix>/bin/activate`` (relative to ``cwd`` where it lies inside it), which puts the
+    virtual environment ``prefix``'s ``tcbench`` on the path; empty when ``prefix`` has no such script."""
+    script = prefix / "bin" / "activate"
+    if not script.is_file():
+        return ""
+    return f"source {script.relative_to(cwd) if script.is_relative_to(cwd) else script}"
 
 
 def _rule(title: str) -> str:
@@ -153,6 +177,8 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
 
     uri = tracking.tracking_uri(checked.tracking_uri)
     print(_rule("Where everything is"))
+    if activate := activate_command(Path(sys.prefix), Path.cwd()):
+        print(f"The commands below run in tcbench's environment; activate it once per shell: {activate}")
     print(f"MLflow store: {uri} (experiment {checked.experiment!r}, sweep {sweep}: "
           f"{n_bp + len(baselines) + 1} compensation runs and the diagnosis run {run_id})")
     print(f"  browse: mlflow ui --backend-store-uri {uri}")
@@ -190,8 +216,8 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
         oracle = t.loc[t["method"] == "oracle", f"median_{s}"]
         limit = float(oracle.iloc[0]) if len(oracle) else float("nan")
         print()
-        _say(f"Leaderboard {board.task}: zero-bias stability from power-on ({primary}: 1σ of 10 s means of "
-              "the compensated 0 g output, mean of the 2 test recordings, µg; lower is better). "
+        _say(f"Leaderboard {board.task}: zero-bias stability from power-on (1σ of 10 s means of the compensated "
+              f"0 g output, mean of the 2 test recordings, µg; lower is better; {primary} in MLflow and the log). "
               "oracle = the simulator's own model at the true die temperature: noise alone, the physical limit; "
               "lagpoly = a straight line or low polynomial in the thermometer passed through a first-order lag "
               "(the die trails the thermometer), its lag chosen by leave-one-recording-out error; poly3 = a cubic "
@@ -203,6 +229,7 @@ def _leaderboard(experiment: str, sweep: str, uri: str | None, out: Path) -> lis
                 for r in t.itertuples(index=False)]
         _print_table(["rank", "method", "runs", "failed", "median (µg)", "95% CI (µg)", "x physical limit",
                       "gain over raw"], rows)
+        print(TABLE_LEGEND)
     return written
 
 
@@ -284,6 +311,10 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
         print(f"  found {e.id} ({e.shape}){': ' + params if params else ''}")
         print(f"    where: {_where(e.where)}")
         print(f"    evidence: {evidence}")
+    for test in dict.fromkeys(e.evidence.get("test") for e in diag.effects):
+        if test in TEST_LEGEND:
+            print(textwrap.fill(f"({test}: {TEST_LEGEND[test]})", width=100, initial_indent="  ",
+                                subsequent_indent="   "))
     hit = cfg.diagnose_effect in diag.effect_ids
     print(f"  the hidden effect was {hidden.effect}: {'found' if hit else 'NOT found'}")
     print(f"Held-out RMSE (white noise sigma {sigma:.4g} {diag.unit}; a model that misses nothing reaches ~1 sigma):")

@@ -409,8 +409,11 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
     values = done[primary].to_numpy(float) if primary in done else np.array([])
     if np.any(np.isfinite(values) & (values > 0)):  # log scale needs a positive value to show
         ax.set_yscale("log")
-    ax.set_ylabel(primary.replace("_ug", " (µg)").replace("_", " "))
-    ax.set_title(f"{board.task}: {primary} per restart (line: median)")
+    from tcbench.leaderboard.labels import METRICS as LABELS  # labels reads this module's column names
+
+    what, _, unit = LABELS.get(primary, primary).rpartition(", ")
+    ax.set_ylabel(f"{what} ({unit})" if what else unit)
+    ax.set_title(f"{board.task}: {what or unit} per restart (line: median)")
     ax.grid(True, which="both", axis="y", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

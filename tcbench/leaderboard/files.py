@@ -11,10 +11,13 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+# Why a board's p_vs_next is "–" (tcbench.stats.paired_p_value), said in its key and on its page
+P_DASH = ("p_vs_next is – where the row and the next share fewer than 6 seeds (with fewer pairs no difference "
+          "could reach p < 0.05; a method run once, such as raw or the oracle, has one seed) and on the last row.")
 # How every board counts failed runs in its statistics (:func:`tcbench.stats.with_failures`), said in its key
 FAILED_RULE = ("Every median, quartile and ci95 counts a failed run as worse than any finished one: "
                "\"failed\" where the statistic falls on failed runs (a method that failed half its runs or "
-               "more has median \"failed\"); p_vs_next pairs finished runs only.")
+               "more has median \"failed\"); p_vs_next pairs finished runs only. " + P_DASH)
 STAT_PREFIXES = ("median_", "ci95_", "iqr_", "x_")  # the columns a failed run can make "failed"
 
 

@@ -44,7 +44,8 @@ COLUMNS = {
     "runs": "runs (restarts or draws)",
     "failed": "failed runs",
     "seeds": "seeds",
-    "p_vs_next": "p-value against the next row (Wilcoxon, paired by seed)",
+    "p_vs_next": "p-value against the next row (Wilcoxon, paired by seed; – under 6 shared seeds, where no "
+                 "difference could reach p < 0.05)",
     "x_oracle": "median ÷ the oracle's (the physical limit)",
     "x_thermo": "median ÷ the thermometer-limited oracle's",
     "note": "note",

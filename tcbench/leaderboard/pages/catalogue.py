@@ -8,14 +8,12 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from tcbench import papers
+
 REPO_URL = "https://github.com/tcbench/tcbench"  # mkdocs.yml's repo_url: links to files outside the site
 
-SEED_000 = ("Huang, L.; Jiang, L.; Zhao, L.; Ding, X. Temperature Compensation Method Based on an Improved Firefly "
-            "Algorithm Optimized Backpropagation Neural Network for Micromachined Silicon Resonant Accelerometers. "
-            "Micromachines 2022, 13, 1054, [doi:10.3390/mi13071054](https://doi.org/10.3390/mi13071054)")
-SEED_001 = ("Seed 001: a parallel processing model of MOPSO-tuned variational mode decomposition with time-frequency "
-            "peak filtering (MOVMD–TFPF) and a beetle-antennae-search-initialised Elman network (BAS–Elman) for the "
-            "noise and temperature drift of a MEMS gyroscope. Micromachines, vol. 12, article 1285")
+SEED_000 = papers.SEED_000.markdown()
+SEED_001 = papers.SEED_001.markdown()
 
 
 @dataclass(frozen=True)
