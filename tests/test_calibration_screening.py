@@ -118,6 +118,16 @@ def test_the_calibration_says_when_it_is_worse_than_raw(workdir: Path, capsys: p
             assert "screened: 70 of 7200 training samples dropped (35 s): 1 burst (70 samples, 35 s)" in captured.out
             assert about["screening"]["dropped"]["burst"]["samples"] == 70 and about["best"] == "poly3"
         else:
-            assert len(worse) == 1 and worse[0].startswith("WORSE THAN RAW held out (drift over raw's): poly3 "), worse
+            assert len(worse) == 1 and worse[0].startswith("WORSE THAN RAW held out (drift over raw's, the whole interval above 1): poly3 "), worse
             assert worse[0] in md and about["worse_than_raw"] == ["poly3"] and about["best"] == "raw"
             assert "not screened (screen=false)" in captured.out
+
+
+def test_worse_than_raw_is_decided_by_the_interval_not_the_point() -> None:
+    from tcbench.commands.calibration import raw_verdicts
+
+    to_raw = {"raw": (1.0, 1.0, 1.0), "poly3": (1.15, 1.00, 1.30), "bp": (1.2, 1.05, 1.4),
+              "model": (0.5, 0.4, 0.6), "elman": (0.9, 0.7, 1.1)}
+    worse, no_better = raw_verdicts(to_raw)
+    assert worse == ["bp"]  # its whole interval above 1
+    assert no_better == ["poly3", "elman"]  # intervals reaching 1, whichever side the point is

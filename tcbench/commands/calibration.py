@@ -397,8 +397,17 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[
                     "tied": [m for m in order[1:] if not to_best[m][1] > 1.0]}
     if best != "raw":
         ranking["ratio_to_raw"] = list(to_raw[best])
-    ranking["worse_than_raw"] = [m for m in order if m != "raw" and to_raw[m][0] > 1.0]
+    ranking["worse_than_raw"], ranking["no_better_than_raw"] = raw_verdicts(to_raw)
     return summary, ranking
+
+
+def raw_verdicts(to_raw: dict[str, tuple[float, float, float]]) -> tuple[list[str], list[str]]:
+    """The methods worse than raw held out and those no better, from each one's drift ratio to
+    raw's ``(point, lo, hi)``: a verdict is its interval's, not its point's — worse when the whole
+    interval lies above 1, no better when it reaches 1 (``raw`` itself is neither)."""
+    others = [m for m in to_raw if m != "raw"]
+    worse = [m for m in others if to_raw[m][1] > 1.0]
+    return worse, [m for m in others if m not in worse and not to_raw[m][2] < 1.0]
 
 
 def _per_part(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], steps: list[float],
@@ -467,14 +476,19 @@ def _range_line(about: dict[str, Any]) -> str | None:
             "(the networks' rate input too), poly3_rate's rate term and model carry on")
 
 
-def _worse_line(about: dict[str, Any]) -> str | None:
-    """One line when a method's held-out drift is above raw's (the calibration makes it worse)."""
-    worse = about.get("worse_than_raw") or []
-    if not worse:
-        return None
-    each = ", ".join(f"{m} {about['x_raw'][m][0]:.2f}x [{about['x_raw'][m][1]:.2f}, {about['x_raw'][m][2]:.2f}]"
-                     for m in worse)
-    return f"WORSE THAN RAW held out (drift over raw's): {each}"
+def _worse_lines(about: dict[str, Any]) -> list[str]:
+    """One line when a method's held-out drift is above raw's with its whole interval (the
+    calibration makes it worse), and one when its interval reaches 1 (no better than raw)."""
+    def each(methods: list[str]) -> str:
+        return ", ".join(f"{m} {about['x_raw'][m][0]:.2f}x [{about['x_raw'][m][1]:.2f}, {about['x_raw'][m][2]:.2f}]"
+                         for m in methods)
+
+    lines = []
+    if worse := about.get("worse_than_raw") or []:
+        lines.append(f"WORSE THAN RAW held out (drift over raw's, the whole interval above 1): {each(worse)}")
+    if level := about.get("no_better_than_raw") or []:
+        lines.append(f"no better than raw held out (the interval reaches 1): {each(level)}")
+    return lines
 
 
 def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash: str) -> dict[str, Any]:
@@ -531,7 +545,7 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     if not about.get("held_out"):
         print("nothing held out: no method is ranked")
         return
-    for line in (_range_line(about), _worse_line(about)):
+    for line in (_range_line(about), *_worse_lines(about)):
         if line:
             print(line)
     print(_best_line(about, unit))
@@ -656,7 +670,7 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: d
         lines.append("\n\nTraining:\n\n" + "".join(f"- {t['line']}\n" for t in about["training"].values()))
     ranking = ""
     if about.get("held_out"):
-        verdicts = [ln for ln in (_range_line(about), _worse_line(about)) if ln]
+        verdicts = [ln for ln in (_range_line(about), *_worse_lines(about)) if ln]
         ranking = (f"\n## Held out\n\nEvery held-out sample pooled; x_best = held-out drift over the best's, x_raw = "
                    f"over raw's, each with its {about['level']:.0%} block-bootstrap interval (_lo, _hi; "
                    f"{about['blocks']} blocks of {about['block_s']:g} s, every method on the same draws). "
