@@ -105,3 +105,17 @@ def test_gyro_allan_summary_units() -> None:
     y = rng.standard_normal(200_000) * arw_deg_sqrt_h / 60 * np.sqrt(fs)
     _, _, summary = gyro.allan_summary(y, fs)
     assert summary["arw_deg_per_sqrt_h"] == pytest.approx(arw_deg_sqrt_h, rel=0.05)
+
+
+def test_a_gyro_record_with_soaks_shorter_than_the_drift_window_keeps_its_other_metrics() -> None:
+    from tcbench.metrics.report import analyse
+    from tcbench.sensors.recording import make_recording
+
+    # 60 and -40 degC soaks of 5 min at 1 Hz: too short for the 10-min drift read-off
+    t = np.arange(0.0, 1200.0)
+    temp = np.where(t < 300, 60.0, np.where(t < 900, 60.0 - (t - 300) / 6.0, -40.0))
+    out = 0.01 + 1e-3 * np.random.default_rng(0).standard_normal(t.size)
+    report = analyse(make_recording(t, temp, np.zeros_like(t), out, sensor="gyro", sample_rate_hz=1.0,
+                                     device_id="short-soaks"))
+    assert "drift_60_to_m40_dps" not in report.metrics and "arw_deg_per_sqrt_h" in report.metrics
+    assert any(c.startswith("drift (60 to -40 degC) not read") for c in report.conventions)

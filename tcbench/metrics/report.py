@@ -164,9 +164,14 @@ def _gyro(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     temp = rec.temperature_c
     hot_c, cold_c = np.quantile(temp, [0.99, 0.01])  # inside the hottest and coldest soaks
     if hot_c - cold_c >= 95.0:  # a 60 .. -40 degC test, read through the thermometer's own offset
-        metrics["drift_60_to_m40_dps"] = gyro.drift_dps(rec.time_s, temp, rec.output, hot_c, cold_c)
-        conventions.append("drift: mean output over the last 10 min of the hottest soak (60 degC) minus that of the "
-                           "coldest (-40 degC), the soaks found as read (a thermometer reads apart from the element)")
+        try:
+            metrics["drift_60_to_m40_dps"] = gyro.drift_dps(rec.time_s, temp, rec.output, hot_c, cold_c)
+            conventions.append("drift: mean output over the last 10 min of the hottest soak (60 degC) minus that of "
+                               "the coldest (-40 degC), the soaks found as read (a thermometer reads apart from the "
+                               "element)")
+        except ValueError as exc:  # soaks too short to read: the other metrics stand
+            conventions.append(f"drift (60 to -40 degC) not read: {exc} (it needs soaks of at least 10 min at both "
+                               "ends)")
     fit = gyro.rate_vs_temperature(temp, rec.output, seg)
     if fit is not None:
         metrics |= fit.metrics()
