@@ -1,0 +1,175 @@
+"""A record of more rows than a diagnosis takes: thermal terms on bin means, noise on every sample
+(:mod:`tcbench.diagnose.native_rate`), through the API, ``tcbench diagnose`` and ``calibrate``."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from tcbench.cli import main
+from tcbench.diagnose import native_rate
+from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.native_rate import bin_means, full_rate_noise, plan_bins, plan_for
+from tcbench.diagnose.settings import DEFAULTS, RateSettings
+from tcbench.sensors.recording import Recording, make_recording, write_recording
+
+OFF = "tracking.enabled=false"
+RATE_HZ, MINUTES, SIGMA = 200.0, 21.0, 0.3  # 252 000 rows, a little over the 20 min a full diagnosis needs
+BUDGET = 3000  # settings.rate.max_rows: bins of 84 samples (0.42 s)
+RATE_COEF = 2.0  # deg/s per degC/s: the temperature_rate hidden in the record
+
+
+def _record(seed: int = 0, spikes: int = 0) -> Recording:
+    """A gyro at 200 Hz through a 15 min temperature cycle, its output 0.05 deg/s per degC plus a
+    temperature_rate term and white noise of :data:`SIGMA` per sample (``spikes`` of 60 sigma)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, MINUTES * 60.0, 1.0 / RATE_HZ)
+    temp = 30.0 + 12.0 * np.sin(2.0 * np.pi * t / 900.0)
+    rate = 12.0 * 2.0 * np.pi / 900.0 * np.cos(2.0 * np.pi * t / 900.0)
+    out = 0.05 * temp + RATE_COEF * rate + SIGMA * rng.standard_normal(t.size)
+    out[rng.choice(t.size, spikes, replace=False)] += 60.0 * SIGMA
+    return make_recording(t, temp + 0.02 * rng.standard_normal(t.size), np.zeros(t.size), out, sensor="gyro",
+                          sample_rate_hz=RATE_HZ, device_id="d")
+
+
+def _by_hand(rec: Recording, k: int) -> Recording:
+    """``rec`` averaged by hand: means of ``k`` consecutive samples (a partial last bin dropped)."""
+    n = rec.time_s.size // k * k
+
+    def mean(x: np.ndarray) -> np.ndarray:
+        return x[:n].reshape(-1, k).mean(axis=1)
+
+    return make_recording(mean(rec.time_s), mean(rec.temperature_c), mean(rec.input), mean(rec.output),
+                          sensor="gyro", sample_rate_hz=RATE_HZ / k, device_id="d")
+
+
+def _intervals_meet(a: dict[str, Any], b: dict[str, Any], z: float = 3.0) -> tuple[bool, Any]:
+    """Whether two findings' amplitudes lie inside each other's intervals (``z`` standard errors,
+    the error from the cluster-robust Wald statistic: se = |coef| / sqrt(Wald))."""
+    (key, x), (_, y) = next(iter(a["params"].items())), next(iter(b["params"].items()))
+    se = [abs(v) / np.sqrt(f["evidence"]["robust_wald"]) for v, f in ((x, a), (y, b))]
+    return all(abs(x - y) <= z * s for s in se), (key, x, y, se)
+
+
+def test_the_bin_is_the_shortest_that_fits_the_budget_and_never_longer_than_max_bin_s() -> None:
+    assert plan_bins(100_000, 1000.0).bin_samples == 1 and not plan_bins(100_000, 1000.0).averaged
+    day = plan_bins(8_640_000, 100.0)  # 24 h at 100 Hz: means of 87 samples, 86 400 rows
+    assert (day.bin_samples, day.diagnosed_rows, day.capped) == (87, 99_311, False)
+    log = plan_bins(2_700_000, 1000.0)  # 45 min at 1 kHz
+    assert log.bin_samples == 27 and log.diagnosed_rows <= 100_000
+    capped = plan_bins(8_640_000, 100.0, RateSettings(max_rows=100_000, max_bin_s=0.5))
+    assert capped.bin_samples == 50 and capped.capped and "max_bin_s=0.5" in capped.why()
+
+
+def test_a_record_within_the_budget_goes_to_the_diagnosis_as_it_is(monkeypatch: pytest.MonkeyPatch) -> None:
+    seen: list[Recording] = []
+
+    class Given(Exception):
+        """Stops the front stage once it hands the diagnosis its record."""
+
+    def given(rec: Recording, **_: Any) -> None:
+        seen.append(rec)
+        raise Given
+
+    monkeypatch.setattr(native_rate, "diagnose", given)
+    rec = _record()
+    with pytest.raises(Given):
+        native_rate.diagnose_any_rate(rec, settings=replace(DEFAULTS, rate=RateSettings(max_rows=rec.time_s.size)))
+    assert seen[-1] is rec  # the same object, not a copy or a resampling
+    with pytest.raises(Given):
+        native_rate.diagnose_any_rate(rec, settings=replace(DEFAULTS, rate=RateSettings(max_rows=BUDGET)))
+    assert seen[-1].time_s.size == rec.time_s.size // 84 == BUDGET
+    assert seen[-1].meta.sample_rate_hz == pytest.approx(RATE_HZ / 84)
+
+
+def test_noise_terms_come_from_every_sample_and_outliers_enter_no_bin() -> None:
+    rec = _record(seed=1, spikes=5)
+    full = full_rate_noise(rec)
+    assert full.white_sigma == pytest.approx(SIGMA, rel=0.03)  # per sample at 200 Hz, not the bins' 0.3 / sqrt(84)
+    assert full.outliers.count == 5 and full.zero_weight.size == 5
+    binned, dropped = bin_means(rec, plan_bins(rec.time_s.size, RATE_HZ, RateSettings(max_rows=BUDGET)),
+                                full.zero_weight)
+    clean = _record(seed=1)
+    hand = _by_hand(clean, 84)
+    n = hand.time_s.size
+    # a bin holding a spike is the mean of its other 83 samples: within a few bin sigmas of the clean mean
+    assert dropped == 0 and np.max(np.abs(binned.output[:n] - hand.output)) < 5.0 * SIGMA / np.sqrt(83.0)
+
+
+def test_a_clipped_output_is_found_on_every_sample_and_its_clipped_samples_enter_no_bin() -> None:
+    rec = _record(seed=2)
+    level = float(np.quantile(rec.output, 0.9))
+    rec.data["output"] = np.minimum(rec.output, level)
+    full = full_rate_noise(rec)
+    assert full.saturation.found and full.saturation.upper.level == pytest.approx(level)
+    at = int(np.count_nonzero(rec.output >= level))  # the clip, and samples within its tolerance below it
+    assert at <= full.saturation.clipped <= 1.01 * at
+    assert np.isin(np.flatnonzero(rec.output >= level), full.zero_weight).all()
+
+
+@pytest.fixture(scope="module")
+def averaged_cli(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], str, str, Path]:
+    """``tcbench diagnose`` of the 200 Hz record with ``settings.rate.max_rows`` lowered: report.json,
+    report.md, stderr and the folder."""
+    work = tmp_path_factory.mktemp("native")
+    write_recording(_record(), work / "rec.parquet")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = main(["diagnose", f"recording={work / 'rec.parquet'}", f"out={work / 'd'}",
+                     f"settings.rate.max_rows={BUDGET}", OFF])
+    assert code == 0, err.getvalue()
+    return (json.loads((work / "d" / "report.json").read_text()), (work / "d" / "report.md").read_text(),
+            err.getvalue(), work)
+
+
+def test_the_averaged_diagnosis_names_what_the_hand_averaged_record_shows(
+        averaged_cli: tuple[dict[str, Any], str, str, Path]) -> None:
+    report = averaged_cli[0]
+    hand = diagnose(_by_hand(_record(), 84)).to_json()
+    assert [e["id"] for e in report["effects"]] == [e["id"] for e in hand["effects"]]
+    assert "temperature_rate" in [e["id"] for e in hand["effects"]]
+    for mine, theirs in zip(report["effects"], hand["effects"], strict=True):
+        if "robust_wald" in mine["evidence"]:
+            ok, said = _intervals_meet(mine, theirs)
+            assert ok, said
+    rate = next(e for e in report["effects"] if e["id"] == "temperature_rate")["params"]["coef_per_c_per_s"]
+    assert rate == pytest.approx(RATE_COEF, rel=0.05)
+
+
+def test_the_report_says_what_was_averaged_to_what_rate_and_why(
+        averaged_cli: tuple[dict[str, Any], str, str, Path]) -> None:
+    report, markdown, err, work = averaged_cli
+    said = report["native_rate"]
+    assert (said["rows"], said["bin_samples"], said["bins_diagnosed"]) == (252_000, 84, 3000)
+    assert said["bin_rate_hz"] == pytest.approx(RATE_HZ / 84)
+    assert "means of 84 samples" in said["why"] and "means of 84 samples" in err
+    assert "## Native rate" in markdown and "means of 84 samples" in markdown
+    # the noise is the full-rate stream's: per sample at 200 Hz, and the bins' is 1/sqrt(84) of it
+    assert report["noise"]["white_sigma"] == pytest.approx(SIGMA, rel=0.03)
+    assert report["noise"]["samples"] == 252_000
+    assert said["white_sigma_bins"] == pytest.approx(SIGMA / np.sqrt(84.0), rel=0.1)
+    model = yaml.safe_load((work / "d" / "model.yaml").read_text())
+    assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
+    assert "rate" not in report["statistics"]["settings"]  # the front stage's knobs are said in native_rate
+
+
+def test_bins_longer_than_max_rows_are_refused_once_known(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    write_recording(_record(), tmp_path / "rec.parquet")
+    code = main(["diagnose", f"recording={tmp_path / 'rec.parquet'}", f"out={tmp_path / 'd'}", "max_rows=1000",
+                 f"settings.rate.max_rows={BUDGET}", OFF])
+    err = capsys.readouterr().err
+    assert code == 2 and "252000 rows (bin means of 0.42 s)" in err and "max_rows=3000" in err, err
+    assert not (tmp_path / "d").exists()
+
+
+def test_plan_for_reads_the_rate_inside_segments() -> None:
+    rec = _record()
+    assert plan_for(rec, RateSettings(max_rows=BUDGET)).sample_rate_hz == pytest.approx(RATE_HZ)
