@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -116,23 +117,19 @@ def test_a_clipped_output_is_found_on_every_sample_and_its_clipped_samples_enter
 
 
 @pytest.fixture(scope="module")
-def averaged_cli(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], str, str, Path]:
-    """``tcbench diagnose`` of the 200 Hz record with ``settings.rate.max_rows`` lowered: report.json,
-    report.md, stderr and the folder."""
-    work = tmp_path_factory.mktemp("native")
-    write_recording(_record(), work / "rec.parquet")
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        code = main(["diagnose", f"recording={work / 'rec.parquet'}", f"out={work / 'd'}",
-                     f"settings.rate.max_rows={BUDGET}", OFF])
-    assert code == 0, err.getvalue()
-    return (json.loads((work / "d" / "report.json").read_text()), (work / "d" / "report.md").read_text(),
-            err.getvalue(), work)
+def averaged() -> tuple[dict[str, Any], str, dict[str, Any]]:
+    """The diagnosis of the 200 Hz record with ``settings.rate.max_rows`` lowered: report.json,
+    report.md (without plots) and model.yaml's mapping."""
+    from tcbench.diagnose.markdown import render_markdown
+    from tcbench.diagnose.report import _plain
+
+    diag = native_rate.diagnose_any_rate(_record(), settings=replace(DEFAULTS, rate=RateSettings(max_rows=BUDGET)))
+    return _plain(diag.to_json()), render_markdown(diag, {}), _plain(diag.model)
 
 
 def test_the_averaged_diagnosis_names_what_the_hand_averaged_record_shows(
-        averaged_cli: tuple[dict[str, Any], str, str, Path]) -> None:
-    report = averaged_cli[0]
+        averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
+    report = averaged[0]
     hand = diagnose(_by_hand(_record(), 84)).to_json()
     assert [e["id"] for e in report["effects"]] == [e["id"] for e in hand["effects"]]
     assert "temperature_rate" in [e["id"] for e in hand["effects"]]
@@ -145,20 +142,41 @@ def test_the_averaged_diagnosis_names_what_the_hand_averaged_record_shows(
 
 
 def test_the_report_says_what_was_averaged_to_what_rate_and_why(
-        averaged_cli: tuple[dict[str, Any], str, str, Path]) -> None:
-    report, markdown, err, work = averaged_cli
+        averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
+    report, markdown, model = averaged
     said = report["native_rate"]
     assert (said["rows"], said["bin_samples"], said["bins_diagnosed"]) == (252_000, 84, 3000)
     assert said["bin_rate_hz"] == pytest.approx(RATE_HZ / 84)
-    assert "means of 84 samples" in said["why"] and "means of 84 samples" in err
+    assert "means of 84 samples" in said["why"] and "200 Hz" in said["why"]
     assert "## Native rate" in markdown and "means of 84 samples" in markdown
-    # the noise is the full-rate stream's: per sample at 200 Hz, and the bins' is 1/sqrt(84) of it
-    assert report["noise"]["white_sigma"] == pytest.approx(SIGMA, rel=0.03)
-    assert report["noise"]["samples"] == 252_000
-    assert said["white_sigma_bins"] == pytest.approx(SIGMA / np.sqrt(84.0), rel=0.1)
-    model = yaml.safe_load((work / "d" / "model.yaml").read_text())
-    assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
     assert "rate" not in report["statistics"]["settings"]  # the front stage's knobs are said in native_rate
+
+
+def test_the_white_noise_is_the_full_rate_streams(averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
+    report, _, model = averaged
+    # per sample at 200 Hz, where the bins' is 1/sqrt(84) of it
+    assert report["noise"]["white_sigma"] == pytest.approx(SIGMA, rel=0.03)
+    assert report["noise"]["samples"] == 252_000 and report["noise"]["bins"] == 3000
+    assert report["native_rate"]["white_sigma_bins"] == pytest.approx(SIGMA / np.sqrt(84.0), rel=0.1)
+    assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
+
+
+@pytest.mark.slow
+def test_diagnose_says_it_averages_and_writes_the_report(tmp_path: Path) -> None:
+    write_recording(_record(), tmp_path / "rec.parquet")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()) as out:
+        code = main(["diagnose", f"recording={tmp_path / 'rec.parquet'}", f"out={tmp_path / 'd'}",
+                     f"settings.rate.max_rows={BUDGET}", OFF])
+    assert code == 0, err.getvalue()
+    assert "means of 84 samples" in err.getvalue()
+    said = re.search(r"white noise ([0-9.]+) deg/s per sample", out.getvalue())
+    assert said and float(said.group(1)) == pytest.approx(SIGMA, rel=0.03), out.getvalue()
+    report = json.loads((tmp_path / "d" / "report.json").read_text())
+    assert report["native_rate"]["bin_samples"] == 84
+    assert "## Native rate" in (tmp_path / "d" / "report.md").read_text()
+    model = yaml.safe_load((tmp_path / "d" / "model.yaml").read_text())
+    assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
 
 
 def test_bins_longer_than_max_rows_are_refused_once_known(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

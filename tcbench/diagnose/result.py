@@ -17,7 +17,7 @@ from tcbench.diagnose.locate import AllanExcess, Mismatch
 from tcbench.diagnose.outliers import Outliers
 from tcbench.diagnose.plan import StatsPlan
 from tcbench.diagnose.reference import Reference
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, tested_mapping
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import term
 
@@ -123,7 +123,7 @@ class Statistics:
             out["not_tested"] = self.not_tested
         if self.smooth_tried_s:
             out["thermometer_smooth_tried_s"] = self.smooth_tried_s
-        out["settings"] = tested_mapping(self.settings)
+        out["settings"] = report_mapping(self.settings)
         return out
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["DEFAULTS", "DetectorSettings", "DiagnoseSettings", "SettingsError", "differing", "documented",
-           "from_mapping", "meanings", "tested_mapping", "to_mapping", "yaml_lines"]
+           "from_mapping", "meanings", "report_mapping", "to_mapping", "yaml_lines"]
 
 
 class SettingsError(ValueError):
@@ -423,7 +423,7 @@ def to_mapping(settings: Any) -> dict[str, Any]:
     return out
 
 
-def tested_mapping(settings: Any) -> dict[str, Any]:
+def report_mapping(settings: Any) -> dict[str, Any]:
     """report.json's ``statistics.settings``: :func:`to_mapping` without the :data:`FRONT_STAGE`
     sections (the report's ``native_rate`` records them where they changed the record)."""
     return {k: v for k, v in to_mapping(settings).items() if k not in FRONT_STAGE}
