@@ -24,7 +24,7 @@ from tcbench.sensors.recording import Recording, make_recording, write_recording
 
 OFF = "tracking.enabled=false"
 RATE_HZ, MINUTES, SIGMA = 200.0, 21.0, 0.3  # 252 000 rows, a little over the 20 min a full diagnosis needs
-BUDGET = 3000  # settings.rate.max_rows: bins of 84 samples (0.42 s)
+BUDGET = 3000  # settings.rate.max_rows: the record is averaged into 1 s bins of 200 samples, 1260 rows
 RATE_COEF = 2.0  # deg/s per degC/s: the temperature_rate hidden in the record
 
 
@@ -60,14 +60,14 @@ def _intervals_meet(a: dict[str, Any], b: dict[str, Any], z: float = 3.0) -> tup
     return all(abs(x - y) <= z * s for s in se), (key, x, y, se)
 
 
-def test_the_bin_is_the_shortest_that_fits_the_budget_and_never_longer_than_max_bin_s() -> None:
+def test_the_bin_is_max_bin_s_once_a_record_is_over_the_budget() -> None:
     assert plan_bins(100_000, 1000.0).bin_samples == 1 and not plan_bins(100_000, 1000.0).averaged
-    day = plan_bins(8_640_000, 100.0)  # 24 h at 100 Hz: means of 87 samples, 86 400 rows
-    assert (day.bin_samples, day.diagnosed_rows, day.capped) == (87, 99_311, False)
-    log = plan_bins(2_700_000, 1000.0)  # 45 min at 1 kHz
-    assert log.bin_samples == 27 and log.diagnosed_rows <= 100_000
-    capped = plan_bins(8_640_000, 100.0, RateSettings(max_rows=100_000, max_bin_s=0.5))
-    assert capped.bin_samples == 50 and capped.capped and "max_bin_s=0.5" in capped.why()
+    day = plan_bins(8_640_000, 100.0)  # 24 h at 100 Hz: means of 100 samples, 86 400 rows
+    assert (day.bin_samples, day.diagnosed_rows, day.capped) == (100, 86_400, False)
+    log = plan_bins(2_700_000, 1000.0)  # 45 min at 1 kHz: 2 700 rows of 1 s
+    assert (log.bin_samples, log.diagnosed_rows, log.bin_s) == (1000, 2700, 1.0)
+    long = plan_bins(8_640_000, 100.0, RateSettings(max_rows=50_000, max_bin_s=1.0))
+    assert long.capped and "86400 bins are more than the budget" in long.why()
 
 
 def test_a_record_within_the_budget_goes_to_the_diagnosis_as_it_is(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -87,22 +87,22 @@ def test_a_record_within_the_budget_goes_to_the_diagnosis_as_it_is(monkeypatch: 
     assert seen[-1] is rec  # the same object, not a copy or a resampling
     with pytest.raises(Given):
         native_rate.diagnose_any_rate(rec, settings=replace(DEFAULTS, rate=RateSettings(max_rows=BUDGET)))
-    assert seen[-1].time_s.size == rec.time_s.size // 84 == BUDGET
-    assert seen[-1].meta.sample_rate_hz == pytest.approx(RATE_HZ / 84)
+    assert seen[-1].time_s.size == rec.time_s.size // 200 == 1260
+    assert seen[-1].meta.sample_rate_hz == pytest.approx(RATE_HZ / 200)
 
 
 def test_noise_terms_come_from_every_sample_and_outliers_enter_no_bin() -> None:
     rec = _record(seed=1, spikes=5)
     full = full_rate_noise(rec)
-    assert full.white_sigma == pytest.approx(SIGMA, rel=0.03)  # per sample at 200 Hz, not the bins' 0.3 / sqrt(84)
+    assert full.white_sigma == pytest.approx(SIGMA, rel=0.03)  # per sample at 200 Hz, not the bins' 0.3 / sqrt(200)
     assert full.outliers.count == 5 and full.zero_weight.size == 5
     binned, dropped = bin_means(rec, plan_bins(rec.time_s.size, RATE_HZ, RateSettings(max_rows=BUDGET)),
                                 full.zero_weight)
     clean = _record(seed=1)
-    hand = _by_hand(clean, 84)
+    hand = _by_hand(clean, 200)
     n = hand.time_s.size
-    # a bin holding a spike is the mean of its other 83 samples: within a few bin sigmas of the clean mean
-    assert dropped == 0 and np.max(np.abs(binned.output[:n] - hand.output)) < 5.0 * SIGMA / np.sqrt(83.0)
+    # a bin holding a spike is the mean of its other 199 samples: within a few bin sigmas of the clean mean
+    assert dropped == 0 and np.max(np.abs(binned.output[:n] - hand.output)) < 5.0 * SIGMA / np.sqrt(199.0)
 
 
 def test_a_clipped_output_is_found_on_every_sample_and_its_clipped_samples_enter_no_bin() -> None:
@@ -130,7 +130,7 @@ def averaged() -> tuple[dict[str, Any], str, dict[str, Any]]:
 def test_the_averaged_diagnosis_names_what_the_hand_averaged_record_shows(
         averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
     report = averaged[0]
-    hand = diagnose(_by_hand(_record(), 84)).to_json()
+    hand = diagnose(_by_hand(_record(), 200)).to_json()
     assert [e["id"] for e in report["effects"]] == [e["id"] for e in hand["effects"]]
     assert "temperature_rate" in [e["id"] for e in hand["effects"]]
     for mine, theirs in zip(report["effects"], hand["effects"], strict=True):
@@ -145,19 +145,19 @@ def test_the_report_says_what_was_averaged_to_what_rate_and_why(
         averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
     report, markdown, model = averaged
     said = report["native_rate"]
-    assert (said["rows"], said["bin_samples"], said["bins_diagnosed"]) == (252_000, 84, 3000)
-    assert said["bin_rate_hz"] == pytest.approx(RATE_HZ / 84)
-    assert "means of 84 samples" in said["why"] and "200 Hz" in said["why"]
-    assert "## Native rate" in markdown and "means of 84 samples" in markdown
+    assert (said["rows"], said["bin_samples"], said["bins_diagnosed"]) == (252_000, 200, 1260)
+    assert said["bin_rate_hz"] == pytest.approx(RATE_HZ / 200)
+    assert "means of 200 samples" in said["why"] and "200 Hz" in said["why"]
+    assert "## Native rate" in markdown and "means of 200 samples" in markdown
     assert "rate" not in report["statistics"]["settings"]  # the front stage's knobs are said in native_rate
 
 
 def test_the_white_noise_is_the_full_rate_streams(averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
     report, _, model = averaged
-    # per sample at 200 Hz, where the bins' is 1/sqrt(84) of it
+    # per sample at 200 Hz, where the bins' is 1/sqrt(200) of it
     assert report["noise"]["white_sigma"] == pytest.approx(SIGMA, rel=0.03)
-    assert report["noise"]["samples"] == 252_000 and report["noise"]["bins"] == 3000
-    assert report["native_rate"]["white_sigma_bins"] == pytest.approx(SIGMA / np.sqrt(84.0), rel=0.1)
+    assert report["noise"]["samples"] == 252_000 and report["noise"]["bins"] == 1260
+    assert report["native_rate"]["white_sigma_bins"] == pytest.approx(SIGMA / np.sqrt(200.0), rel=0.1)
     assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
 
 
@@ -169,11 +169,11 @@ def test_diagnose_says_it_averages_and_writes_the_report(tmp_path: Path) -> None
         code = main(["diagnose", f"recording={tmp_path / 'rec.parquet'}", f"out={tmp_path / 'd'}",
                      f"settings.rate.max_rows={BUDGET}", OFF])
     assert code == 0, err.getvalue()
-    assert "means of 84 samples" in err.getvalue()
+    assert "means of 200 samples" in err.getvalue()
     said = re.search(r"white noise ([0-9.]+) deg/s per sample", out.getvalue())
     assert said and float(said.group(1)) == pytest.approx(SIGMA, rel=0.03), out.getvalue()
     report = json.loads((tmp_path / "d" / "report.json").read_text())
-    assert report["native_rate"]["bin_samples"] == 84
+    assert report["native_rate"]["bin_samples"] == 200
     assert "## Native rate" in (tmp_path / "d" / "report.md").read_text()
     model = yaml.safe_load((tmp_path / "d" / "model.yaml").read_text())
     assert model["effects"]["white_noise"]["density"] == pytest.approx(SIGMA / np.sqrt(RATE_HZ), rel=0.03)
@@ -184,7 +184,7 @@ def test_bins_longer_than_max_rows_are_refused_once_known(tmp_path: Path, capsys
     code = main(["diagnose", f"recording={tmp_path / 'rec.parquet'}", f"out={tmp_path / 'd'}", "max_rows=1000",
                  f"settings.rate.max_rows={BUDGET}", OFF])
     err = capsys.readouterr().err
-    assert code == 2 and "252000 rows (bin means of 0.42 s)" in err and "max_rows=3000" in err, err
+    assert code == 2 and "252000 rows (bin means of 1 s)" in err and "max_rows=1260" in err, err
     assert not (tmp_path / "d").exists()
 
 

@@ -314,12 +314,11 @@ class RateSettings:
     ``statistics.settings`` leaves it out and the report's ``native_rate`` says what it did."""
 
     max_rows: int = setting(
-        100_000, "a record of more rows is diagnosed on bin means of at most this many rows: 25-50 s of one "
-                 "core and 550 MB (tcbench/diagnose/cost.py), where 2.7 M rows would take 10-20 min and 8 GB", COUNT)
+        100_000, "a record of more rows is diagnosed on bin means (25-50 s of one core and 550 MB at this many "
+                 "rows, tcbench/diagnose/cost.py, where 2.7 M rows would take 10-20 min and 8 GB)", COUNT)
     max_bin_s: float = setting(
-        1.0, "longest bin: the 1 s clock of the lag filter, a twentieth of the shortest thermal lag searched "
-             "(20 s) and a tenth of the detectors' narrowest bin (10 s); a record that needs longer bins to fit "
-             "max_rows is diagnosed on more rows")
+        1.0, "the bin of a record averaged: the 1 s clock of the lag filter, a twentieth of the shortest thermal lag "
+             "searched (20 s) and a tenth of the detectors' narrowest bin (10 s)")
 
 
 FRONT_STAGE = ("rate",)  # sections that choose the record the diagnosis is given, not how it tests
