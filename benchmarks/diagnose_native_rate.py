@@ -5,18 +5,20 @@ by hand.
 
 Each case is a simulated gyro oven run (device 0, run 0) sampled at the case's rate and cut to
 its length (``log45m1k``: 45 min at 1 kHz from 1.5 h into a run of 10-min holds, 2.7 M rows;
-``day100``: 24 h at 100 Hz of a run of 2-h holds, 8.64 M rows), written as Parquet; then, each once in a fresh process under
-``/usr/bin/time -v`` with the two thermometer windows one after the other
-(``JOBLIB_MULTIPROCESSING=0``) and one BLAS thread:
+``day100``: 24 h at 100 Hz of a run of 2-h holds, 8.64 M rows), written as Parquet; then, each
+once in a fresh process under ``/usr/bin/time -v`` with the two thermometer windows one after the
+other (``JOBLIB_MULTIPROCESSING=0``) and one BLAS thread:
 
 1. ``tcbench diagnose`` of the full-rate record at the default settings (the command's wall and
    CPU time and its peak resident memory, reading the file included);
 2. ``tcbench diagnose`` of the same record averaged by hand into means of the same number of
    samples the command chose (``settings.rate.max_rows`` lifted, so it is diagnosed as given).
 
-The two reports are compared: the effects named, and each amplitude with its interval (three
-standard errors from the cluster-robust Wald statistic, ``se = |a| / sqrt(Wald)``) inside the
-other's; a nonlinear parameter (a time constant) is listed with its relative difference.
+The two reports are compared: the effects named (in any order: the forward selection may take
+two of similar gain in either order), and each amplitude with its interval (three standard
+errors from the cluster-robust Wald statistic, ``se = |a| / sqrt(Wald)``) inside the other's; a
+nonlinear parameter (a time constant, a period, a phase) is listed with its relative difference.
+A switched load's square is compared with a positive size (on and off swapped where needed).
 
     python benchmarks/diagnose_native_rate.py --case log45m1k day100
 """
@@ -90,27 +92,41 @@ def timed_diagnose(recording: Path, out: Path, *extra: str) -> dict[str, Any]:
             "report": json.loads((out / "report.json").read_text())}
 
 
+NONLINEAR = {"tau_s", "time_s", "width_c", "period_s", "phase_rad", "on_s", "duty", "start_s", "end_s"}
+
+
+def canonical(params: dict[str, Any]) -> dict[str, Any]:
+    """A switched load's square with a positive size: ``offset + size * on`` is ``(offset + size) -
+    size * off``, the same square read with on and off swapped (duty ``1 - duty``)."""
+    if {"duty", "size", "offset"} <= params.keys() and params["size"] < 0:
+        return {**params, "offset": params["offset"] + params["size"], "size": -params["size"],
+                "duty": 1.0 - params["duty"]}
+    return params
+
+
 def compare(a: dict[str, Any], b: dict[str, Any], z: float = 3.0) -> dict[str, Any]:
-    """The effects of two reports side by side: same ids, and each parameter with whether it lies
-    inside the other's interval (amplitudes) or its relative difference (the others)."""
+    """The effects of two reports side by side: the same ids (in any order), and each parameter with
+    whether it lies inside the other's interval (amplitudes) or its relative difference (the
+    nonlinear ones: times, periods, phases, shares)."""
     ids_a, ids_b = [e["id"] for e in a["effects"]], [e["id"] for e in b["effects"]]
     rows = []
     for ea in a["effects"]:
         eb = next((e for e in b["effects"] if e["id"] == ea["id"]), None)
         if eb is None:
             continue
-        for key, va in ea["params"].items():
-            vb = eb["params"].get(key)
+        pa, pb = canonical(ea["params"]), canonical(eb["params"])
+        for key, va in pa.items():
+            vb = pb.get(key)
             if not isinstance(va, float) or not isinstance(vb, float):
                 continue
             row = {"effect": ea["id"], "param": key, "native": va, "by_hand": vb,
                    "relative": abs(va - vb) / max(abs(vb), 1e-300)}
             wald = [e["evidence"].get("robust_wald") for e in (ea, eb)]
-            if all(wald) and key not in ("tau_s", "time_s", "width_c", "period_s"):
+            if all(wald) and key not in NONLINEAR:
                 se = [abs(v) / np.sqrt(w) for v, w in zip((va, vb), wald, strict=True)]
                 row |= {"se": se, "inside": bool(all(abs(va - vb) <= z * s for s in se))}
             rows.append(row)
-    return {"same_effects": ids_a == ids_b, "native": ids_a, "by_hand": ids_b, "params": rows}
+    return {"same_effects": sorted(ids_a) == sorted(ids_b), "native": ids_a, "by_hand": ids_b, "params": rows}
 
 
 def main() -> None:

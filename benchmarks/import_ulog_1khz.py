@@ -83,7 +83,8 @@ def main() -> None:
         log_mb = log.stat().st_size / 1e6
     recordings_mb = 3 * rows * 4 * 8 / 2**20  # three axes' recordings, four float64 columns each
     print(f"Command: `{command_line()}`\n\n{environment_line(env, 'pyulog ' + str(env['pyulog']))}\n")
-    print("| rows | log (MB) | topic in memory (MiB) | recordings in memory (MiB) | wall (s) | CPU (s) | peak RSS (MiB) |")
+    print("| rows | log (MB) | topic in memory (MiB) | recordings in memory (MiB) | wall (s) | CPU (s) "
+          "| peak RSS (MiB) |")
     print("|---:|---:|---:|---:|---:|---:|---:|")
     print(f"| {rows} | {log_mb:.0f} | {topic_bytes / 2**20:.0f} | {recordings_mb:.0f} | {run['wall_s']:.1f} | "
           f"{run['cpu_s']:.1f} | {run['peak_mb']:.0f} |")

@@ -88,7 +88,7 @@ def test_a_record_within_the_budget_goes_to_the_diagnosis_as_it_is(monkeypatch: 
     with pytest.raises(Given):
         native_rate.diagnose_any_rate(rec, settings=replace(DEFAULTS, rate=RateSettings(max_rows=BUDGET)))
     assert seen[-1].time_s.size == rec.time_s.size // 200 == 1260
-    assert seen[-1].meta.sample_rate_hz == pytest.approx(RATE_HZ / 200)
+    assert seen[-1].meta.sample_rate_hz == 1.0  # the stated 200 Hz in 200-sample bins, exactly
 
 
 def test_noise_terms_come_from_every_sample_and_outliers_enter_no_bin() -> None:
@@ -188,6 +188,9 @@ def test_bins_longer_than_max_rows_are_refused_once_known(tmp_path: Path, capsys
     assert not (tmp_path / "d").exists()
 
 
-def test_plan_for_reads_the_rate_inside_segments() -> None:
+def test_plan_for_takes_the_stated_rate_else_the_clocks_inside_segments() -> None:
     rec = _record()
+    rec.data["time_s"] = rec.time_s * (1.0 + 1e-9)  # a clock a hair slow: the sidecar's 200 Hz stands
+    assert plan_for(rec, RateSettings(max_rows=BUDGET)).sample_rate_hz == RATE_HZ
+    rec.meta = replace(rec.meta, sample_rate_hz=None)
     assert plan_for(rec, RateSettings(max_rows=BUDGET)).sample_rate_hz == pytest.approx(RATE_HZ)

@@ -16,10 +16,10 @@ one keeps nothing they use (the means of a slow term over 1 s carry its whole si
 gains and Wald statistics, in units of the bins' own noise, are the same) and costs time and
 memory by the row: 45 min at 1 kHz in 0.1 s bins would be 27 000 rows where 2 700 tell the
 same. A record whose 1 s bins are still more than ``max_rows`` (over 27 h) is diagnosed on
-them all (``max_rows`` of ``tcbench diagnose`` still refuses it where it says so). Bins never straddle a gap or a change of input
-(they restart with every run of constant input inside a continuous segment), and a bin enters
-the diagnosis when at least half of its ``k`` samples carry weight, so that every row averages
-about the same noise.
+them all (``max_rows`` of ``tcbench diagnose`` still refuses it where it says so). Bins never
+straddle a gap or a change of input (they restart with every run of constant input inside a
+continuous segment), and a bin enters the diagnosis when at least half of its ``k`` samples carry
+weight, so that every row averages about the same noise.
 
 **The noise, on every sample** (:func:`full_rate_noise`), in pieces of :data:`CHUNK_ROWS` where a
 filter runs: the white sigma from first differences inside runs (as
@@ -118,15 +118,18 @@ def plan_bins(rows: int, sample_rate_hz: float, settings: RateSettings = DEFAULT
     """The bin of a record of ``rows`` samples at ``sample_rate_hz`` (see the module doc)."""
     k = 1
     if rows > settings.max_rows:
-        k = max(1, math.floor(settings.max_bin_s * sample_rate_hz + 1e-9))
+        k = max(1, math.floor(settings.max_bin_s * sample_rate_hz * (1.0 + 1e-6)))  # 999.9999 Hz is 1 kHz
     return BinPlan(int(rows), float(sample_rate_hz), int(k), settings.max_rows, settings.max_bin_s)
 
 
 def plan_for(rec: Recording, settings: RateSettings = DEFAULTS.rate) -> BinPlan:
-    """:func:`plan_bins` of ``rec`` at its rate inside its segments (gaps excluded)."""
+    """:func:`plan_bins` of ``rec`` at the rate its sidecar states (the reader checked it against
+    the clock), else at its clock's inside its segments (gaps excluded). The stated rate keeps the
+    bins' own exact (1000 Hz in 1000-sample bins is 1 Hz, not 0.99999999 Hz): the diagnosis sizes
+    windows in samples from it, and a hair's difference moves a window by a sample."""
     t = rec.time_s
-    rate_hz = within_rate_hz(t) if t.size > 1 else 1.0
-    return plan_bins(t.size, rate_hz, settings)
+    rate_hz = rec.meta.sample_rate_hz or (within_rate_hz(t) if t.size > 1 else 1.0)
+    return plan_bins(t.size, float(rate_hz), settings)
 
 
 @dataclass(frozen=True)
@@ -245,7 +248,7 @@ def full_rate_noise(rec: Recording, settings: DiagnoseSettings = DEFAULTS,
         sigma = _sigma(y, same & keep[1:] & keep[:-1], step, screens.quantisation.clip_sigma, sigma)
     spikes = _outliers(t, y, starts, sigma, settings)
     keep[spikes.index] = False
-    rate_hz = sample_rate_hz or (within_rate_hz(t) if t.size > 1 else 1.0)
+    rate_hz = sample_rate_hz or rec.meta.sample_rate_hz or (within_rate_hz(t) if t.size > 1 else 1.0)
     return FullRate(int(y.size), float(rate_hz), sigma, grid, clipped, spikes, np.flatnonzero(~keep))
 
 

@@ -78,5 +78,6 @@ def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
     out = []
     for d in found:
         ids = d.data.get("device_id")
-        out.append(TopicInstance(topic, int(d.multi_id), dict(d.data), int(ids[0]) if ids is not None and len(ids) else None))
+        device_id = int(ids[0]) if ids is not None and len(ids) else None
+        out.append(TopicInstance(topic, int(d.multi_id), dict(d.data), device_id))
     return out
