@@ -194,3 +194,16 @@ def test_plan_for_takes_the_stated_rate_else_the_clocks_inside_segments() -> Non
     assert plan_for(rec, RateSettings(max_rows=BUDGET)).sample_rate_hz == RATE_HZ
     rec.meta = replace(rec.meta, sample_rate_hz=None)
     assert plan_for(rec, RateSettings(max_rows=BUDGET)).sample_rate_hz == pytest.approx(RATE_HZ)
+
+
+def test_the_tracked_metrics_carry_the_full_rate_sigma_beside_the_bins() -> None:
+    from types import SimpleNamespace
+
+    from tcbench.runner.kinds.diagnosis import diagnosis_metrics
+
+    fit = SimpleNamespace(rmse_heldout=0.03)
+    diag = SimpleNamespace(noise=SimpleNamespace(white_sigma=0.021), baseline=fit, final=fit, effect_ids=[],
+                           native_rate=SimpleNamespace(full=SimpleNamespace(white_sigma=0.3),
+                                                       plan=SimpleNamespace(bin_samples=200)))
+    said = diagnosis_metrics(diag)
+    assert said["white_sigma_full_rate"] == 0.3 and said["bin_samples"] == 200.0 and said["white_sigma"] == 0.021
