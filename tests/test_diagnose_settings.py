@@ -28,6 +28,7 @@ from tcbench.diagnose.settings import (
     differing,
     documented,
     from_mapping,
+    report_mapping,
     to_mapping,
     yaml_lines,
 )
@@ -161,7 +162,8 @@ def test_a_setting_reaches_its_stage() -> None:
 def test_a_diagnosis_runs_with_its_settings_and_its_report_records_them() -> None:
     """The same concealed thermal lag: found at the defaults; with gain thresholds no gain
     reaches it is not kept and its candidate says against what; report.json records every setting
-    and report.md names the ones changed."""
+    of the tests (the front stage's rate section is said in native_rate where it averaged) and
+    report.md names the ones changed."""
     from tcbench.datasets.concealed import concealed_recording
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.markdown import render_markdown
@@ -173,7 +175,8 @@ def test_a_diagnosis_runs_with_its_settings_and_its_report_records_them() -> Non
     high = diagnose(rec, name="lag", settings=strict)
     assert default.effect_ids == ["thermal_lag"] and "thermal_lag" not in high.effect_ids
     report, high_report = default.to_json(), high.to_json()
-    assert report["statistics"]["settings"] == to_mapping(DEFAULTS)
+    assert report["statistics"]["settings"] == report_mapping(DEFAULTS)
+    assert set(to_mapping(DEFAULTS)) - set(report_mapping(DEFAULTS)) == {"rate"}  # said in native_rate when used
     assert high_report["statistics"]["settings"]["selection"]["detection_threshold_sigma2"] == 1e6
     lag = next(c for c in high_report["candidates"] if c["id"] == "thermal_lag")
     assert lag["status"] == "rejected" and lag["threshold_sigma2"] == 1e6

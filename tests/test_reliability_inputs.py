@@ -4,11 +4,15 @@ calibrate, sidecars that are not files, clocks before the power-on, and file nam
 names, not syntax. Each is one line and exit code 2 with nothing written, or, for a name the file
 system accepts, the command's ordinary work.
 
-Every file is made inside the test; the 10^7-row record is a cheap file refused from its row
-count, before it is read.
+Every file is made inside the test; a record of more rows than the diagnosis's budget is read (to
+be diagnosed on bin means), not refused from its row count.
 """
 
 from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
 
 from pathlib import Path
 
@@ -49,13 +53,14 @@ def gyro(path: Path, rows: int = 2000, step_s: float = 1.0, start_s: float = 0.0
 
 # -- 1. diagnose: a record is weighed against the time it will take, before any work -------------
 
-def test_diagnose_refuses_ten_million_rows_from_their_count(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """10^7 rows (no answer in 570 s before): refused up front with the figure, the estimate and
-    what to do, from the row count alone (the rows here are not even a valid clock)."""
-    (workdir / "big.csv").write_bytes(b"time_s,temperature_c,input,output\n" + b"1,20,0,0\n" * 10_000_000)
-    line = refused(capsys, workdir, ["diagnose", "recording=big.csv", "sensor=gyro", "out=d", OFF],
-                   "big.csv", "10000000 rows", "max_rows=")
-    assert " h" in line or " min" in line, line  # the estimated time
+def test_diagnose_reads_a_record_longer_than_its_row_budget_instead_of_refusing_it(
+        workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """More rows than ``settings.rate.max_rows`` are no longer refused from their count (10^7 rows
+    were): the record is read, to be diagnosed on bin means; here its clock is no clock, and the
+    reader says so."""
+    (workdir / "big.csv").write_bytes(b"time_s,temperature_c,input,output\n" + b"1,20,0,0\n" * 20_000)
+    refused(capsys, workdir, ["diagnose", "recording=big.csv", "sensor=gyro", "out=d", "max_rows=1000",
+                              "settings.rate.max_rows=1000", OFF], "big.csv", "duplicate time_s")
 
 
 def test_diagnose_max_rows_is_the_limit_and_can_be_raised(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -79,16 +84,21 @@ def test_diagnose_says_how_long_a_long_record_will_take(workdir: Path, capsys: p
     assert "diagnosing rec.csv: 1500 rows, about" in err, err
 
 
-def test_calibrate_leaves_out_a_model_too_long_to_diagnose(workdir: Path, capsys: pytest.CaptureFixture[str],
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
-    """calibrate's ``model`` method diagnoses the fitted parts: more rows than diagnose takes by
-    default (lowered here to 1000) leave it out with one line, as a record too short for it does."""
-    from tcbench.commands import schemas
+def test_calibrate_diagnoses_more_rows_than_the_budget_on_bin_means(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """calibrate's ``model`` method diagnoses the fitted parts: more rows than a diagnosis takes
+    (the budget lowered here to 3000) are diagnosed on bin means as ``tcbench diagnose`` does (they
+    left the model out before), and the diagnosis's report says so."""
+    from tcbench.diagnose import native_rate
+    from tcbench.diagnose.settings import DEFAULTS, RateSettings
 
-    monkeypatch.setattr(schemas, "DIAGNOSE_MAX_ROWS", 1000)
-    gyro(workdir / "rec.csv", rows=3000)
-    out, err = ran(capsys, ["calibrate", "recording=rec.csv", "out=c", "methods=[raw,poly3,model]", OFF])
-    assert "tcbench: model left out: the fitted parts hold 1800 rows" in err and "fitting raw, poly3 on" in out, err
+    monkeypatch.setattr(native_rate, "DEFAULTS", replace(DEFAULTS, rate=RateSettings(max_rows=3000)))
+    gyro(workdir / "rec.csv", rows=216_000, step_s=0.01)  # 36 min at 100 Hz: three of five blocks fitted, 21.6 min
+    out, err = ran(capsys, ["calibrate", "recording=rec.csv", "out=c", "methods=[raw,model]", OFF])
+    assert "model left out" not in err and "fitting raw, model on" in out, err
+    said = json.loads((workdir / "c" / "diagnosis" / "report.json").read_text())["native_rate"]
+    assert 120_000 < said["rows"] <= 129_600 and said["bin_samples"] == 100  # 1 s bins at 100 Hz
+    assert said["bins_diagnosed"] == math.ceil(said["rows"] / 100)
 
 
 # -- 2. windows and lengths against the record ----------------------------------------------------

@@ -250,7 +250,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     unit = rec.meta.units.get("output", "")
     name = Path(cfg.recording).name
     methods = list(dict.fromkeys(cfg.methods))
-    if "model" in methods and (why := _too_short_to_diagnose(rec, split) or _too_long_to_diagnose(split)):
+    if "model" in methods and (why := _too_short_to_diagnose(rec, split)):
         methods.remove("model")
         print(f"tcbench: model left out: {why}", file=sys.stderr)
     scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
@@ -599,25 +599,14 @@ def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
             "(tcbench diagnose reports what a short record can tell)")
 
 
-def _too_long_to_diagnose(split: Split) -> str | None:
-    """Why the fitted parts hold too many rows for the ``model`` method's diagnosis (more than
-    ``tcbench diagnose`` takes by default, :data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS`), or None."""
-    from tcbench.commands import schemas
-    from tcbench.diagnose.cost import duration_text, estimated_s
-
-    rows = sum(split.parts[k].stop - split.parts[k].start for k in split.train)
-    if rows <= schemas.DIAGNOSE_MAX_ROWS:
-        return None
-    return (f"the fitted parts hold {rows} rows, whose diagnosis would take about {duration_text(estimated_s(rows))} "
-            f"(tcbench diagnose takes at most max_rows={schemas.DIAGNOSE_MAX_ROWS} unless told otherwise)")
-
-
 def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | None = None) -> tuple[Any, Any]:
     """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
     kept as gaps; ``keep``: the rows screening kept, per training row) and the model it fitted,
     for the ``model`` method. The parts must be as long as any full diagnosis
-    (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min)."""
-    from tcbench.diagnose.diagnosis import diagnose
+    (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min); more rows than a diagnosis takes
+    are diagnosed on bin means, their noise measured on every row (:mod:`tcbench.diagnose.native_rate`,
+    as ``tcbench diagnose`` does)."""
+    from tcbench.diagnose import native_rate
     from tcbench.diagnose.model_file import to_sensor_model
     from tcbench.diagnose.plan import min_full_duration_s
     from tcbench.diagnose.report import model_spec
@@ -630,8 +619,8 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | 
     part = make_recording(rec.time_s[rows], rec.temperature_c[rows], rec.input[rows], rec.output[rows],
                           sensor=rec.meta.sensor, sample_rate_hz=rec.meta.sample_rate_hz, device_id=rec.meta.device_id)
     try:
-        diag = diagnose(part, name=f"{Path(cfg.recording).name} (training parts)",
-                        min_duration_s=min_full_duration_s())
+        diag = native_rate.diagnose_any_rate(part, name=f"{Path(cfg.recording).name} (training parts)",
+                                             min_duration_s=min_full_duration_s())
     except DiagnosisDataError as exc:
         raise CommandError(f"methods: model: the training parts cannot be diagnosed ({exc}); fit on more parts, "
                            "or leave model out of methods") from None

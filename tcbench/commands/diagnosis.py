@@ -66,7 +66,7 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     sensor and the effects the model file declares already modelled."""
     from tcbench.diagnose.model_file import ModelFileError, read_model
 
-    diagnose_settings(cfg)
+    settings = diagnose_settings(cfg)
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
     if cfg.sensor is not None and not kinds.known(cfg.sensor):
@@ -76,8 +76,9 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     writable_folder(cfg.out)
     free_outputs(cfg.out, list(REPORT_FILES), cfg.overwrite)
     checked_store(cfg.tracking)
-    check_size(cfg.recording, cfg.max_rows)
+    check_size(cfg.recording, cfg.max_rows, settings.rate.max_rows)
     rec = read_recording_arg(cfg.recording)
+    check_bins(cfg.recording, rec, cfg.max_rows, settings)
     sensor = cfg.sensor or rec.meta.sensor
     if sensor is None:
         raise CommandError(f"{cfg.recording}: no sidecar says which sensor this is; give sensor=" + "|".join(kinds.names()))
@@ -95,21 +96,40 @@ def check_diagnose(cfg: DiagnoseConfig) -> tuple[Any, str, dict[str, dict[str, f
     return rec, sensor, declared
 
 
-def check_size(path: str, max_rows: int | None) -> None:
-    """A record of more than ``max_rows`` rows refused from its row count, before it is read: one
-    line with the rows, the time they are estimated to take (:mod:`tcbench.diagnose.cost`) and
-    what to do."""
-    from tcbench.diagnose.cost import duration_text, estimated_bytes, estimated_s, size_text
+def check_size(path: str, max_rows: int | None, budget_rows: int | None = None) -> None:
+    """A record of more than ``max_rows`` rows that will be diagnosed as recorded (at most
+    ``budget_rows``, ``settings.rate.max_rows``: a longer one is diagnosed on bin means,
+    :func:`check_bins`) refused from its row count, before it is read: one line with the rows, the
+    time they are estimated to take (:mod:`tcbench.diagnose.cost`) and what to do."""
     from tcbench.sensors.recording_files import table_rows
 
     rows = table_rows(path)
-    if rows is None or max_rows is None or rows <= max_rows:
+    if rows is None or max_rows is None or rows <= max_rows or (budget_rows is not None and rows > budget_rows):
         return
-    raise CommandError(f"{path}: {rows} rows would take about {duration_text(estimated_s(rows))} and "
-                       f"{size_text(estimated_bytes(rows))} to diagnose (one core, estimated from the rows; "
-                       f"max_rows={max_rows}: about {duration_text(estimated_s(max_rows))}): average it into at most "
-                       f"{max_rows} rows (means of {math.ceil(rows / max_rows)} samples) or cut it into shorter "
-                       f"recordings, or give max_rows={rows} to diagnose it anyway")
+    raise _too_many(path, rows, rows, max_rows)
+
+
+def check_bins(path: str, rec: Any, max_rows: int | None, settings: Any) -> None:
+    """A record diagnosed on bin means (:mod:`tcbench.diagnose.native_rate`) whose bins would
+    still be more than ``max_rows`` rows (bins no longer than ``settings.rate.max_bin_s``) refused
+    as :func:`check_size` refuses one diagnosed as recorded."""
+    from tcbench.diagnose.native_rate import plan_for
+
+    plan = plan_for(rec, settings.rate)
+    if plan.averaged and max_rows is not None and plan.diagnosed_rows > max_rows:
+        raise _too_many(path, plan.rows, plan.diagnosed_rows, max_rows, f" (bin means of {plan.bin_s:.3g} s)")
+
+
+def _too_many(path: str, rows: int, diagnosed: int, max_rows: int, bins: str = "") -> CommandError:
+    """The one line refusing ``rows`` rows whose diagnosis would run on ``diagnosed`` rows, over ``max_rows``."""
+    from tcbench.diagnose.cost import duration_text, estimated_bytes, estimated_s, size_text
+
+    return CommandError(f"{path}: {rows} rows{bins} would take about {duration_text(estimated_s(diagnosed))} and "
+                        f"{size_text(estimated_bytes(diagnosed))} to diagnose (one core, estimated from the rows; "
+                        f"max_rows={max_rows}: about {duration_text(estimated_s(max_rows))}): average it into at most "
+                        f"{max_rows} rows (means of {math.ceil(rows / max_rows)} samples; settings.rate.max_rows="
+                        f"{max_rows} does it, its noise measured on every sample) or cut it into shorter "
+                        f"recordings, or give max_rows={diagnosed} to diagnose it anyway")
 
 
 @contextlib.contextmanager
@@ -151,7 +171,7 @@ def progress(name: str, rows: int) -> Iterator[None]:
 
 def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     """Diagnose the recording, write its report and print the verdict."""
-    from tcbench.diagnose.diagnosis import diagnose
+    from tcbench.diagnose.native_rate import diagnose_any_rate, plan_for, white_sigma
     from tcbench.diagnose.plan import min_full_duration_s
     from tcbench.diagnose.report import write_report
     from tcbench.diagnose.signals import DiagnosisDataError
@@ -160,15 +180,21 @@ def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     settings = diagnose_settings(cfg)
     if rec.time_s[-1] - rec.time_s[0] < min_full_duration_s(settings):
         return _short_record(cfg, rec, sensor, settings)
+    plan = plan_for(rec, settings.rate)
+    if plan.averaged:
+        print(f"tcbench: {Path(cfg.recording).name}: {plan.why()}", file=sys.stderr, flush=True)
     try:
-        with progress(Path(cfg.recording).name, rec.time_s.size):
-            diag = diagnose(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name, settings=settings)
+        with progress(Path(cfg.recording).name, plan.diagnosed_rows):
+            diag = diagnose_any_rate(rec, sensor=sensor, declared=declared, name=Path(cfg.recording).name,
+                                     settings=settings)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
+    del rec
     written = _written(write_report, diag, cfg)
     print(f"tcbench: {diag.verdict}")
     print(f"  baseline RMSE held-out {diag.baseline.rmse_heldout:.4g} {diag.unit}, final "
-          f"{diag.final.rmse_heldout:.4g} {diag.unit}, white noise {diag.noise.white_sigma:.4g} {diag.unit}")
+          f"{diag.final.rmse_heldout:.4g} {diag.unit}" + (" (of the bin means)" if plan.averaged else "")
+          + f", white noise {white_sigma(diag):.4g} {diag.unit}" + (" per sample" if plan.averaged else ""))
     print(f"  wrote {', '.join(str(p) for p in written.values())}")
     return DiagnosisOutcome(diag, written)
 

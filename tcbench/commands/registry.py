@@ -339,10 +339,12 @@ SPECS: dict[str, CommandSpec] = {
             "overwrite": OVERWRITE,
             "sensor": "the sensor kind (msra, gyro, accel), for a recording without a sidecar (null: from the sidecar)",
             "model": "model file of the effects already modelled (null: none)",
-            "max_rows": "the most rows diagnosed (null: no limit). Measured on one core (benchmarks/"
-                        "diagnose_scaling.py), a diagnosis takes about 49 s and 550 MB at 100 000 rows, 8 min and "
-                        "3.2 GB at the default 1 000 000, 1.2 h and 30 GB at 10^7: a longer record is refused before "
-                        "it is read, with its estimate; one estimated over 30 s says so when it starts and shows the "
+            "max_rows": "the most rows diagnosed (null: no limit). A record of more rows than settings.rate.max_rows "
+                        "is diagnosed on bin means (its noise terms on every sample); this refuses what would still "
+                        "be longer. Measured on one core (benchmarks/diagnose_scaling.py), a diagnosis takes about "
+                        "49 s and 550 MB at 100 000 rows, 8 min and 3.2 GB at the default 1 000 000, 1.2 h and 30 GB "
+                        "at 10^7: a longer record is refused before it is read (or, averaged, once its bins are "
+                        "known), with its estimate; one estimated over 30 s says so when it starts and shows the "
                         "time spent on a terminal",
             **TRACKING,
         },

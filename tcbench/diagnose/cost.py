@@ -10,8 +10,10 @@ of two or three about that line with what the record holds; :data:`SECONDS_PER_1
 slowest measurement on the fitted slope), so the estimate errs long. The peak memory of one
 diagnosis grows by :data:`BYTES_PER_ROW` per row.
 
-:data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS` is the most rows ``tcbench diagnose`` takes
-unless ``max_rows=`` says otherwise: about 8 min of one core and 3 GB, where 10^7 rows would
+A record of more rows than ``settings.rate.max_rows`` (10^5) is diagnosed on 1 s bin means, its
+noise measured on every sample (:mod:`tcbench.diagnose.native_rate`), so these figures apply to
+the bins. :data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS` is the most rows ``tcbench diagnose``
+runs on unless ``max_rows=`` says otherwise: about 8 min of one core and 3 GB, where 10^7 rows would
 take 1.2 h and 30 GB (more than most machines have; the two thermometer windows a diagnosis may
 try run at once, each with its own memory).
 """

@@ -266,7 +266,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     settings = d.statistics.settings
     t0 = float(d.series.t_s[0]) if len(d.series.t_s) else 0.0
     out = [f"# Diagnosis of {d.recording or 'recording'} ({d.sensor})", "",
-           f"**Verdict:** {d.verdict}", ""]
+           f"**Verdict:** {d.verdict}", "", *d.preface()]
 
     out += ["## Fit", "",
             (f"White noise sigma {_g(sigma)} {d.unit} per sample, {int(d.noise.samples)} samples, "

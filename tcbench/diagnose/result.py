@@ -17,7 +17,7 @@ from tcbench.diagnose.locate import AllanExcess, Mismatch
 from tcbench.diagnose.outliers import Outliers
 from tcbench.diagnose.plan import StatsPlan
 from tcbench.diagnose.reference import Reference
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, to_mapping
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import term
 
@@ -123,7 +123,7 @@ class Statistics:
             out["not_tested"] = self.not_tested
         if self.smooth_tried_s:
             out["thermometer_smooth_tried_s"] = self.smooth_tried_s
-        out["settings"] = to_mapping(self.settings)
+        out["settings"] = report_mapping(self.settings)
         return out
 
 
@@ -197,6 +197,11 @@ class Diagnosis:
             out += (f"; deterministic temperature structure remains: a generic temperature model reaches "
                     f"{self.final.rmse_heldout / self.reference.rmse_heldout:.3g}x lower held-out RMSE")
         return out + spikes
+
+    def preface(self) -> list[str]:
+        """report.md's lines after the verdict, before the fit: none for a record diagnosed as it
+        was recorded (:mod:`tcbench.diagnose.native_rate` says what it averaged there)."""
+        return []
 
     def to_json(self) -> dict[str, Any]:
         """``report.json``: plain JSON data."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = ["DEFAULTS", "DetectorSettings", "DiagnoseSettings", "SettingsError", "differing", "documented",
-           "from_mapping", "meanings", "to_mapping", "yaml_lines"]
+           "from_mapping", "meanings", "report_mapping", "to_mapping", "yaml_lines"]
 
 
 class SettingsError(ValueError):
@@ -307,6 +307,24 @@ class ShortSettings:
 
 
 @dataclass(frozen=True)
+class RateSettings:
+    """A record of more rows than a diagnosis takes in time and memory: its thermal terms fitted on
+    bin means, its noise terms measured on every sample (:mod:`tcbench.diagnose.native_rate`). Not a
+    statistic of the tests: it decides which record they are given, so report.json's
+    ``statistics.settings`` leaves it out and the report's ``native_rate`` says what it did."""
+
+    max_rows: int = setting(
+        100_000, "a record of more rows is diagnosed on bin means (25-50 s of one core and 550 MB at this many "
+                 "rows, tcbench/diagnose/cost.py, where 2.7 M rows would take 10-20 min and 8 GB)", COUNT)
+    max_bin_s: float = setting(
+        1.0, "the bin of a record averaged: the 1 s clock of the lag filter, a twentieth of the shortest thermal lag "
+             "searched (20 s) and a tenth of the detectors' narrowest bin (10 s)")
+
+
+FRONT_STAGE = ("rate",)  # sections that choose the record the diagnosis is given, not how it tests
+
+
+@dataclass(frozen=True)
 class DiagnoseSettings:
     """Every statistic of a diagnosis, by section (see the module doc); checked when made."""
 
@@ -320,6 +338,8 @@ class DiagnoseSettings:
     detectors: DetectorSettings = section(DetectorSettings, "the detectors of the open-world terms")
     screens: ScreenSettings = section(ScreenSettings, "the screens")
     short: ShortSettings = section(ShortSettings, "the tests of a record too short for a full diagnosis")
+    rate: RateSettings = section(RateSettings, "a record longer than a diagnosis takes: bin means for the thermal "
+                                               "terms, every sample for the noise")
 
     def __post_init__(self) -> None:
         check(self)
@@ -402,6 +422,12 @@ def to_mapping(settings: Any) -> dict[str, Any]:
     return out
 
 
+def report_mapping(settings: Any) -> dict[str, Any]:
+    """report.json's ``statistics.settings``: :func:`to_mapping` without the :data:`FRONT_STAGE`
+    sections (the report's ``native_rate`` records them where they changed the record)."""
+    return {k: v for k, v in to_mapping(settings).items() if k not in FRONT_STAGE}
+
+
 def differing(settings: Any, defaults: Any = None) -> dict[str, Any]:
     """``{dotted key: value}`` of the settings that differ from ``defaults`` (:data:`DEFAULTS`)."""
     base = {k: v for k, _, v in _walk(DEFAULTS if defaults is None else defaults, "")}
@@ -414,7 +440,7 @@ def documented(settings: Any = None, prefix: str = "settings.") -> list[tuple[st
 
 
 # the unit a setting's name ends in, longest first; a name without one takes its check's word
-UNITS = (("_sigma2_per_param", "white-noise variances per parameter"), ("_c_per_min", "degC/min"),
+UNITS = (("_rows", "rows"), ("_sigma2_per_param", "white-noise variances per parameter"), ("_c_per_min", "degC/min"),
          ("_sigma2", "white-noise variances"), ("_sigma", "white sigmas"), ("_samples", "samples"),
          ("_steps", "lattice steps"), ("_windows", "smoothing windows"), ("_s", "s"), ("_c", "degC"))
 WORDS = {POSITIVE.says: "number", NONNEGATIVE.says: "number", PROBABILITY.says: "probability", SHARE.says: "share",

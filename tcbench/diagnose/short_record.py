@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.plan import min_full_duration_s
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, to_mapping
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.short_tests import (
     NOT_RUN,
     SIGNIFICANT,
@@ -98,7 +98,7 @@ class ShortRecordReport:
             "thermometer_smooth_s": self.smooth_s, "ramp_starts_s": self.ramp_starts_s,
             "full_diagnosis_needs_s": self.full_duration_s, "level": self.settings.short.alpha,
             "tests": [t.to_json() for t in self.tests], "needs_more_time": self.needs_more_time,
-            "settings": to_mapping(self.settings),
+            "settings": report_mapping(self.settings),
         }
 
     def tags(self) -> dict[str, str]:

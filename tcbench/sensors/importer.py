@@ -357,7 +357,8 @@ def _recording(raw: Mapping[str, np.ndarray], empty: np.ndarray, spec: Mapping[s
         keep = ~_dropped(raw, drop, empty.shape[0])
         _check_filled(empty, used, keep)
         rows = np.flatnonzero(keep) + 1
-        table = {c.target: c.convert.to_schema(raw[c.name][keep]) for c in spec.values()}
+        kept = (lambda x: x) if keep.all() else (lambda x: x[keep])  # nothing dropped: no copy of a column
+        table = {c.target: c.convert.to_schema(kept(raw[c.name])) for c in spec.values()}
     except RecordingError as err:
         raise err.located(name) from None
     table.setdefault("input", np.zeros(rows.size))

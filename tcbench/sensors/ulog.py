@@ -23,7 +23,8 @@ from tcbench.sensors.recording import AXES, RecordingError
 
 @dataclass(frozen=True)
 class TopicInstance:
-    """One instance of a sensor topic: its fields as float64 arrays, and the ``device_id`` PX4 logged."""
+    """One instance of a sensor topic: its fields as pyulog read them (each in its logged type: the
+    import converts the columns it uses, so no field is held twice), and the ``device_id`` PX4 logged."""
 
     topic: str
     instance: int
@@ -77,6 +78,6 @@ def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
     out = []
     for d in found:
         ids = d.data.get("device_id")
-        out.append(TopicInstance(topic, int(d.multi_id), {k: np.asarray(v, dtype=np.float64) for k, v in d.data.items()},
-                                 int(ids[0]) if ids is not None and len(ids) else None))
+        device_id = int(ids[0]) if ids is not None and len(ids) else None
+        out.append(TopicInstance(topic, int(d.multi_id), dict(d.data), device_id))
     return out

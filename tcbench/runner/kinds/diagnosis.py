@@ -16,13 +16,17 @@ from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
 def diagnosis_metrics(diag: Any) -> dict[str, float]:
-    """The held-out RMSEs of the baseline and final models, in the unit and in white-noise sigmas."""
+    """The held-out RMSEs of the baseline and final models, in the unit and in white-noise sigmas
+    (of the bin means for a record averaged into bins, with the full-rate sigma beside them)."""
     sigma = float(diag.noise.white_sigma)
     before, after = float(diag.baseline.rmse_heldout), float(diag.final.rmse_heldout)
     out = {"rmse_heldout_before": before, "rmse_heldout_after": after, "white_sigma": sigma,
            "effects_found": float(len(diag.effect_ids))}
     if sigma > 0:
         out |= {"rmse_heldout_before_sigma": before / sigma, "rmse_heldout_after_sigma": after / sigma}
+    native = getattr(diag, "native_rate", None)  # a record averaged into bins: the RMSEs and sigma are the bins'
+    if native is not None:
+        out |= {"white_sigma_full_rate": float(native.full.white_sigma), "bin_samples": float(native.plan.bin_samples)}
     return out
 
 
