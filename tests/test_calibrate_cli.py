@@ -89,7 +89,8 @@ def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytes
 
 @pytest.mark.parametrize(("args", "words"), [
     (("train_branches=[5]",), "the recording has 3 temperature branches"),
-    (("methods=[elman_magic]",), "methods: unknown 'elman_magic'"),
+    (("methods=[elman_magic]",), "methods: unknown method 'elman_magic'; known: raw, poly3, poly3_rate, bp, bp_gd, "
+                                 "elman, model; did you mean 'elman'?"),
     (("min_swing_c=0",), "must be > 0"),
     (("seed=-1",), "seed must be a non-negative integer"),
     (("restarts=0",), "restarts must be 1..1000"),

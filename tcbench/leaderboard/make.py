@@ -55,7 +55,7 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
         comp = comp_board.load_runs(client, experiments, sweep)
         cals = cal_board.load_runs(client, experiments, sweep)
     except LookupError as exc:
-        raise ConfigError(f"{exc} in {resolved}") from None
+        raise ConfigError(str(exc)) from None
     if runs.empty and comp.empty and cals.empty:
         where = f", sweep {sweep}" if sweep else ""
         raise ConfigError(f"no tcbench runs in experiment {', '.join(experiments)}{where}")
