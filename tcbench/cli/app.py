@@ -133,7 +133,8 @@ def _explain(exc: Exception, config_name: str = CONFIG_NAME) -> str:
         group, name = exc.missing_cfg_file.split("/", 1)
         from tcbench.plugins import group_aliases
 
-        return unknown_name(group, name, exc.options or _known_options(group), aliases=group_aliases(f"tcbench.{group}s"))
+        options = exc.options or _known_options(group)
+        return unknown_name(group, name, options, aliases=group_aliases(f"tcbench.{group}s"))
     cause = exc.__cause__
     if isinstance(cause, OmegaConfBaseException):
         key = str(getattr(cause, "full_key", None) or "config")

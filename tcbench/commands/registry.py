@@ -55,7 +55,8 @@ class CommandSpec:
     params: dict[str, str] = field(default_factory=dict)
     examples: tuple[str, ...] = ()
     output: str = ""  # where its output goes, for its --help
-    positional: str | None = None  # ``tcbench metrics PATH`` means ``recording=PATH`` (None: ``recording`` if it reads one)
+    # ``tcbench metrics PATH`` means ``recording=PATH``; None: ``recording`` for every command reading one
+    positional: str | None = None
     required: tuple[str, ...] = ()
     options: tuple[str, ...] = ()  # further lines of the options section (flags kept as aliases)
     sweep: str = ""  # what the -m line of its --help adds about its sweeps
