@@ -36,13 +36,15 @@ def british(name: str) -> str:
 
 def did_you_mean(name: str, known: Iterable[str], aliases: Mapping[str, str] | None = None) -> str | None:
     """The known name ``name`` was probably meant to be: its British spelling when that is known,
-    else the closest by :mod:`difflib`, else the name whose alias (a longer name it goes by,
+    else the known name that differs from it in case only, else the closest by :mod:`difflib`, else the name whose alias (a longer name it goes by,
     ``firefly`` for ``fa``: :func:`class_aliases`) is closest; None when nothing is close."""
     import difflib
 
     known = [str(k) for k in known]
     if (spelt := british(name)) != name and spelt in known:
         return spelt
+    if folded := [k for k in known if k.casefold() == name.casefold()]:  # degc: degC
+        return folded[0]
     close = difflib.get_close_matches(name, known, n=1)
     if close:
         return close[0]
@@ -57,9 +59,14 @@ def unknown_name(what: str, name: object, known: Iterable[str], where: str = "",
     ...; did you mean 'fa'?``. ``where`` follows the name (`` for gyro``); every lookup of a name
     the user gives says it this way."""
     known = [str(k) for k in known]
-    meant = did_you_mean(str(name), known, aliases) if isinstance(name, str) else None
-    return (f"unknown {what} {name!r}{where}; known: {', '.join(known) or 'none'}"
-            + (f"; did you mean {meant!r}?" if meant else ""))
+    return f"unknown {what} {name!r}{where}; known: {', '.join(known) or 'none'}" + meant(name, known, aliases)
+
+
+def meant(name: object, known: Iterable[str], aliases: Mapping[str, str] | None = None) -> str:
+    """``; did you mean 'x'?`` for the known name ``name`` probably meant (:func:`did_you_mean`),
+    or nothing: the end of every line naming something unknown."""
+    close = did_you_mean(name, known, aliases) if isinstance(name, str) else None
+    return f"; did you mean {close!r}?" if close else ""
 
 
 def class_aliases(paths: Mapping[str, str]) -> dict[str, str]:

@@ -56,6 +56,15 @@ def test_every_unknown_name_says_the_one_it_probably_meant(argv: list[str], mean
     assert list(workdir.iterdir()) == []
 
 
+@pytest.mark.parametrize(("temperature", "meant"), [("temp:degC", "temp_c"), ("temp_c:degc", "degC")])
+def test_an_unknown_column_or_unit_of_import_says_the_one_it_probably_meant(
+        temperature: str, meant: str, workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    line = _refused(capsys, ["import", str(PAN_CSV), "sensor=gyro", "time=time_s:s", f"temperature={temperature}",
+                             "output=gyro_x_dps:deg/s", "out=rec", "tracking.enabled=false"])
+    assert f"did you mean {meant!r}?" in line, line
+    assert list(workdir.iterdir()) == []
+
+
 @pytest.mark.parametrize(("args", "line"), [
     (["methods=[poly33]"], "methods: unknown method 'poly33'; known: raw, poly3, poly3_rate, bp, bp_gd, elman, "
                            "model; did you mean 'poly3'?"),
@@ -135,3 +144,13 @@ def test_every_command_with_out_takes_the_out_flag(command: str, workdir: Path,
 def test_a_command_without_out_refuses_the_out_flag(capsys: pytest.CaptureFixture[str]) -> None:
     assert _refused(capsys, ["list", "--out", "x"]) == ("tcbench: error: unknown option '--out' for tcbench list; "
                                                         "see `tcbench list --help`")
+
+
+def test_a_name_is_matched_across_case_and_by_the_longer_name_its_class_goes_by() -> None:
+    from tcbench.errors import class_aliases, did_you_mean
+
+    assert did_you_mean("degc", ["degF", "degC"]) == "degC"  # difflib alone ties degF with degC
+    aliases = class_aliases({"fa": "m:FireflyAlgorithm", "ifa": "m:ImprovedFireflyAlgorithm", "pso": "m:ParticleSwarm"})
+    assert aliases["firefly"] == "fa" and aliases["improved_firefly"] == "ifa" and aliases["particle_swarm"] == "pso"
+    assert did_you_mean("fireflyy", ["fa", "ifa", "pso"], aliases) == "fa"
+    assert did_you_mean("swarm", ["fa", "ifa", "pso"], aliases) is None  # a later word alone is no name
