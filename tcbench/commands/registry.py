@@ -17,7 +17,8 @@ from typing import Any
 # meanings of keys several commands share, for their --help
 TRACKING = {
     "tracking.enabled": "log the results to MLflow (false: files only)",
-    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
+    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd); a SQLite store "
+                    "keeps the runs' files in mlartifacts/ and its lock file <db>.lock beside its database",
     "tracking.experiment": "MLflow experiment the run is filed under",
     "tracking.sweep_id": "the sweep's id in MLflow (null: a new one per command)",
     "tracking.resume": "skip a job whose config already FINISHED in the experiment (re-run a killed sweep)",
