@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.cli.app import hydra_string
-from tcbench.commands.schemas import QuickstartConfig, literal
-from tcbench.errors import ConfigError, unknown_name
+from tcbench.commands.schemas import QuickstartConfig
+from tcbench.errors import ConfigError
 from tcbench.papers import SEED_000
 
 HEADER = """\
@@ -78,6 +78,7 @@ def check(cfg: QuickstartConfig) -> None:
     """The quickstart's own parameters, checked before anything runs (the compensation sweep's
     are checked by ``tcbench run``): ConfigError with one line."""
     from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
+    from tcbench.errors import unknown_name
 
     for key in ("seeds", "budget", "epochs"):
         if getattr(cfg, key) < 1:
@@ -137,6 +138,8 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
           f"{cfg.epochs} gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
     _say(f"Running; each job's line and the sweep's progress go to {log_path}.")
     def sweep_dir(name: str) -> str:  # Hydra's record of each of its sweeps, under out=
+        from tcbench.commands.schemas import literal
+
         return f"hydra.sweep.dir={hydra_string(literal(str(out / 'multirun' / name)))}"
 
     checked = run_sweep(["-m", "experiment=quickstart", *tracked, sweep_dir("ifa-bp"), f"budget={cfg.budget}",
