@@ -89,7 +89,7 @@ def check(cfg: QuickstartConfig) -> None:
     if cfg.diagnose_effect not in EFFECTS_BY_SENSOR[cfg.diagnose_sensor]:
         raise ConfigError(f"diagnose_effect={cfg.diagnose_effect}: " + unknown_name(
             "effect", cfg.diagnose_effect, EFFECTS_BY_SENSOR[cfg.diagnose_sensor],
-            f" (none tcbench hides in a {cfg.diagnose_sensor} recording)"))
+            f" to hide in a {cfg.diagnose_sensor} recording"))
     if cfg.diagnose_seed < 0:
         raise ConfigError(f"diagnose_seed={cfg.diagnose_seed}: must be a non-negative integer")
     if not str(cfg.tracking.experiment).strip():
