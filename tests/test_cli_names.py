@@ -16,6 +16,8 @@ from tcbench.cli.help import usage
 from tcbench.commands.registry import SPECS
 from tcbench.sensors.recording import make_recording, write_recording
 
+LEADERBOARDS = Path(__file__).resolve().parents[1] / "leaderboards"  # the committed boards
+
 
 def _gyro(path: Path, rows: int = 400) -> Path:
     """A small gyro recording with its sidecar."""
@@ -47,6 +49,7 @@ def _refused(capsys: pytest.CaptureFixture[str], argv: list[str]) -> str:
     (["quickstart", "diagnose_effect=hysteresiss"], "hysteresis"),
     (["import", f"csv={PAN_CSV}", "sensor=gyroo", "time=time_s:s", "temperature=temp_c:degC",
       "output=gyro_x_dps:deg/s", "out=rec"], "gyro"),
+    (["pages", "out=pg", f"leaderboards={LEADERBOARDS}", "boards=[paper-ifa-bpp]"], "paper-ifa-bp"),
 ])
 def test_every_unknown_name_says_the_one_it_probably_meant(argv: list[str], meant: str, workdir: Path,
                                                            capsys: pytest.CaptureFixture[str]) -> None:
