@@ -101,6 +101,10 @@ def test_an_unknown_experiment_lists_the_experiments_of_the_store(workdir: Path,
     # one of several unknown: named too, not silently left out of the board
     line = _refused(capsys, ["leaderboard", "experiments=[calibrations,diagnosis]", f"tracking.uri={uri}", "out=lb"])
     assert "unknown experiment 'diagnosis'" in line and line.endswith("did you mean 'diagnoses'?"), line
+    # a sweep over experiments: refused before its first board
+    line = _refused(capsys, ["leaderboard", "-m", "experiments=calibrations,diagnosis", f"tracking.uri={uri}",
+                             "out=lb/${experiments}"])
+    assert "unknown experiment 'diagnosis'" in line, line
     assert not (workdir / "lb").exists()
 
 
