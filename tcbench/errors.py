@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 
 
 class ConfigError(ValueError):
@@ -34,13 +34,52 @@ def british(name: str) -> str:
     return name
 
 
-def did_you_mean(name: str, known: Iterable[str]) -> str | None:
+def did_you_mean(name: str, known: Iterable[str], aliases: Mapping[str, str] | None = None) -> str | None:
     """The known name ``name`` was probably meant to be: its British spelling when that is known,
-    else the closest by :mod:`difflib`; None when nothing is close."""
+    else the known name that differs from it in case only, else the closest by :mod:`difflib`, else the name whose alias (a longer name it goes by,
+    ``firefly`` for ``fa``: :func:`class_aliases`) is closest; None when nothing is close."""
     import difflib
 
     known = [str(k) for k in known]
     if (spelt := british(name)) != name and spelt in known:
         return spelt
+    if folded := [k for k in known if k.casefold() == name.casefold()]:  # degc: degC
+        return folded[0]
     close = difflib.get_close_matches(name, known, n=1)
-    return close[0] if close else None
+    if close:
+        return close[0]
+    usable = {alias: target for alias, target in (aliases or {}).items() if target in known}
+    close = difflib.get_close_matches(name.lower(), list(usable), n=1)
+    return usable[close[0]] if close else None
+
+
+def unknown_name(what: str, name: object, known: Iterable[str], where: str = "",
+                 aliases: Mapping[str, str] | None = None) -> str:
+    """The one line for a name that names nothing: ``unknown optimiser 'fireflyy'; known: bas, fa,
+    ...; did you mean 'fa'?``. ``where`` follows the name (`` for gyro``); every lookup of a name
+    the user gives says it this way."""
+    known = [str(k) for k in known]
+    return f"unknown {what} {name!r}{where}; known: {', '.join(known) or 'none'}" + meant(name, known, aliases)
+
+
+def meant(name: object, known: Iterable[str], aliases: Mapping[str, str] | None = None) -> str:
+    """``; did you mean 'x'?`` for the known name ``name`` probably meant (:func:`did_you_mean`),
+    or nothing: the end of every line naming something unknown."""
+    close = did_you_mean(name, known, aliases) if isinstance(name, str) else None
+    return f"; did you mean {close!r}?" if close else ""
+
+
+def class_aliases(paths: Mapping[str, str]) -> dict[str, str]:
+    """The longer names each name goes by, from the class it names (``{"fa":
+    "tcbench.optimisers.fa:FireflyAlgorithm"}``: ``firefly`` and ``firefly_algorithm`` for ``fa``),
+    nothing imported: the leading words of the class name, lower case, joined by ``_``. A word
+    sequence two names share goes to the one whose class name it covers most of."""
+    best: dict[str, tuple[int, str]] = {}
+    for name, path in paths.items():
+        words = [w.lower() for w in re.findall(r"[A-Z]+(?![a-z])|[A-Z]?[a-z]+|\d+", path.rpartition(":")[2])]
+        for n in range(1, len(words) + 1):
+            alias = "_".join(words[:n])
+            left = len(words) - n
+            if alias != name and (alias not in best or left < best[alias][0]):
+                best[alias] = (left, name)
+    return {alias: name for alias, (_, name) in best.items()}

@@ -104,7 +104,25 @@ class PluginRegistry(Generic[T]):
         """The class registered as ``name``; :class:`UnknownPluginError` naming the known ones."""
         entry = self._load_one(name)
         if entry is None:
-            known = ", ".join(n for n in self.names() if n not in self._broken) or "none"
+            from tcbench.errors import unknown_name
+
+            known = [n for n in self.names() if n not in self._broken]
             hint = f" (plugin failed to load: {self._broken[name]})" if name in self._broken else ""
-            raise self.unknown_error(f"unknown {self.kind} {name!r}{hint}; known: {known}")
+            raise self.unknown_error(unknown_name(self.kind, name, known, hint, self.aliases()))
         return entry.cls
+
+    def aliases(self) -> dict[str, str]:
+        """The longer names the registered names go by, from their classes' names (``firefly`` for
+        ``fa``), for "did you mean" (no plugin imported)."""
+        from tcbench.errors import class_aliases
+
+        paths = {name: ep.value for name, ep in self._entry_points().items()}
+        paths.update({name: f"{e.cls.__module__}:{e.cls.__name__}" for name, e in self._entries.items()})
+        return class_aliases(paths)
+
+
+def group_aliases(group: str) -> dict[str, str]:
+    """:meth:`PluginRegistry.aliases` of the entry-point group ``group`` (``tcbench.optimisers``)."""
+    from tcbench.errors import class_aliases
+
+    return class_aliases({ep.name: ep.value for ep in entry_points(group=group)})

@@ -113,7 +113,8 @@ def test_unknown_command(workdir: Path) -> None:
 def test_leaderboard_without_runs(workdir: Path) -> None:
     assert tcbench("run", "budget=20", cwd=workdir).returncode == 0
     out = tcbench("leaderboard", "--experiment", "none", cwd=workdir)
-    assert out.returncode == 2 and "no MLflow experiment named none" in out.stderr
+    assert out.returncode == 2 and "unknown experiment 'none' in sqlite:///" in out.stderr
+    assert out.stderr.strip().endswith("; known: Default, tcbench")
 
 
 def test_help_and_import_load_no_heavy_library() -> None:

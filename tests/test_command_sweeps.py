@@ -33,7 +33,8 @@ def test_simulate_sweeps_a_population(workdir: Path, capsys: pytest.CaptureFixtu
     assert {r.data.tags["tcbench.kind"] for r in runs} == {"simulation"}
     assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1
     assert sorted(r.data.tags["tcbench.device_seed"] for r in runs) == ["0", "1", "2"]
-    assert (workdir / "multirun").is_dir()  # Hydra's sweep folder, as for tcbench run
+    assert (workdir / "population" / "multirun").is_dir()  # Hydra's sweep folder, under out=
+    assert not (workdir / "multirun").exists()
 
 
 def test_a_sweep_whose_jobs_would_share_an_output_runs_nothing(workdir: Path,

@@ -223,7 +223,7 @@ ARGS = ("sensor=gyro", "time=clock_ms:ms", "temperature=temp_c:degC", "output=ra
                                                "not an angular rate (e.g. deg/s, rad/s"),
         (GOOD, ("output=rate_dps:wibble",), "column 'rate_dps': unknown unit 'wibble': not a unit pint knows"),
         (None, (), "log.csv: no such file"),
-        (GOOD, ("sensor=imu",), "unknown sensor 'imu' (expected one of 'msra', 'gyro', 'accel')"),
+        (GOOD, ("sensor=imu",), "unknown sensor 'imu'; known: msra, gyro, accel"),
         (GOOD.replace("20,25.0,0.2", "20,25.0,abc"), (), "log.csv: row 2, column 'rate_dps': 'abc' is not a number"),
         (GOOD.replace("20,25.0,0.2,0\n", "20,25.0,,0\n"), (), "log.csv: row 2, column 'rate_dps': empty cell"),
         (GOOD.replace("20,25.0,0.2,0\n", "\n"), (), "log.csv: row 2: blank line"),

@@ -83,11 +83,11 @@ def test_cli_simulate_then_metrics(workdir: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["sensor=imu"], "unknown sensor 'imu' (known: msra, gyro, accel)"),
+        (["sensor=imu"], "unknown sensor 'imu'; known: msra, gyro, accel"),
         (["sensor=msra", "protocol=oven"], "unknown protocol 'oven' for msra"),
         (["device_seed=-1"], "non-negative"),
         (["device_seed=abc"], "device_seed: Value 'abc'"),
-        (["format=xls"], "format must be csv or parquet"),
+        (["format=xls"], "format=xls: unknown format 'xls'; known: csv, parquet"),
         (["colour=red"], "colour"),
         (["sensor=gyro", "protocol=static", "protocol_params.nope=1"], "no parameter nope"),
         (["justaword"], "expected key=value"),

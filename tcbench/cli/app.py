@@ -29,7 +29,7 @@ from tcbench.cli.flags import VALUE_FLAGS
 from tcbench.commands import schemas as command_schemas
 from tcbench.commands.registry import by_config
 from tcbench.config_dir import CONFIG_MODULE, CONFIG_NAME, SEARCH_PATH, conf_dir
-from tcbench.errors import ConfigError, did_you_mean
+from tcbench.errors import ConfigError, did_you_mean, unknown_name
 from tcbench.runner.schema import as_dict, register_schema
 
 SLURM_LAUNCHER = "hydra_plugins.hydra_submitit_launcher.submitit_launcher.SlurmLauncher"
@@ -69,6 +69,25 @@ class Plan:
     tracking_uri: str | None
     experiment: str
     sweep_id: str
+    outs: tuple[str | None, ...] = ()  # each job's out= (None: a job without one)
+
+
+def sweep_dir(outs: tuple[str | None, ...]) -> str | None:
+    """Where Hydra's record of a sweep goes (its ``multirun.yaml`` and each job's ``.hydra/``
+    folder): ``multirun/<date>/<time>`` in the folder every job's ``out=`` lies under
+    (``out=cal/${stem:recording}``: ``cal/multirun/...``), as an override value; None when a job
+    has no ``out=`` or the outputs share no folder but the file system's root (Hydra's default,
+    ``multirun/`` in the working folder, then)."""
+    from tcbench.commands.schemas import literal
+
+    if not outs or any(not o for o in outs):
+        return None
+    common = Path(os.path.commonpath([os.path.abspath(str(o)) for o in outs]))
+    if common == Path(common.anchor):
+        return None
+    cwd = Path.cwd()
+    shown = common.relative_to(cwd) if common.is_relative_to(cwd) else common
+    return hydra_string(literal(str(shown / "multirun")) + "/${now:%Y-%m-%d}/${now:%H-%M-%S}")
 
 
 def hydra_string(value: str) -> str:
@@ -112,10 +131,10 @@ def _explain(exc: Exception, config_name: str = CONFIG_NAME) -> str:
     (an unknown key or option with the known one it probably meant)."""
     if isinstance(exc, MissingConfigException) and exc.missing_cfg_file and "/" in exc.missing_cfg_file:
         group, name = exc.missing_cfg_file.split("/", 1)
+        from tcbench.plugins import group_aliases
+
         options = exc.options or _known_options(group)
-        meant = did_you_mean(name, options)
-        return f"unknown {group} {name!r}; known: {', '.join(options)}" + (f"; did you mean {meant!r}?"
-                                                                              if meant else "")
+        return unknown_name(group, name, options, aliases=group_aliases(f"tcbench.{group}s"))
     cause = exc.__cause__
     if isinstance(cause, OmegaConfBaseException):
         key = str(getattr(cause, "full_key", None) or "config")
@@ -415,21 +434,24 @@ def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
         combos = list(itertools.product(*sweeps.values())) or [()]
         last: dict[str, Any] = {}
         written: dict[Path, int] = {}
+        outs: list[str | None] = []
         for combo in combos:
             chosen = fixed + [f"{k}={v}" for k, v in zip(keys, combo, strict=True)]
             cfg = compose_job(chosen, config_name)
             if not seeds:
                 last = check_job(cfg, written)
+                outs.append(last.get("out"))
                 continue
             last = check_job(cfg)
+            outs.append(last.get("out"))
             if kind_of(last).outputs(last):  # a kind that writes files: each seed's own (out=x/${seed})
                 for s in seeds:
-                    check_job(compose_job([*chosen, f"seed={s}"], config_name), written)
+                    outs.append(check_job(compose_job([*chosen, f"seed={s}"], config_name), written).get("out"))
         for s in seeds or []:
             if not s.lstrip("-").isdigit() or int(s) < 0:
                 raise ConfigError(f"seed must be a non-negative integer, got {s!r}")
     jobs = len(combos) * (len(seeds) if seeds else 1)
     track = last["tracking"]
     return Plan(jobs, track["enabled"], track["resume"], track.get("uri"), track["experiment"],
-                str(track["sweep_id"]))
+                str(track["sweep_id"]), tuple(outs))
 

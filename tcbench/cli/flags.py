@@ -15,3 +15,5 @@ HELP_FLAGS = {"-h", "--help"}
 VALUE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "-p", "--package", "--experimental-rerun"}
 CONFIG_SOURCE_FLAGS = {"-cp", "--config-path", "-cn", "--config-name", "-cd", "--config-dir", "--experimental-rerun"}
 CFG_CHOICES = ("job", "hydra", "all")  # the values of Hydra's --cfg
+# flags every key=value command takes for a key of its schema: ``--out DIR`` is ``out=DIR``
+KEY_FLAGS = {"--out": ("out", "DIR")}

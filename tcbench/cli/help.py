@@ -9,6 +9,7 @@ import dataclasses
 import textwrap
 from typing import Any
 
+from tcbench.cli.flags import KEY_FLAGS
 from tcbench.commands.registry import SPECS, by_config
 
 # keys of the shared schema that these commands accept and ignore (``tcbench run`` uses them)
@@ -16,7 +17,8 @@ IGNORED = ("tracking.plots", "tracking.ioh_dir")
 HIDDEN = ("kind",)  # the job kind the primary config names, not a parameter
 # what -m does, by where a command's jobs run (its spec's ``kinds`` or ``runs_here``)
 ON_LAUNCHER = ("the jobs run on tcbench run's launcher (hydra.launcher.n_jobs=2 for two workers) and "
-               "the sweep is reported at the end")
+               "the sweep is reported at the end; Hydra's log lines go to stderr and its record of the sweep "
+               "to multirun/<date>/<time>/ in the folder every job's out= lies in")
 IN_TURN = "the jobs run one after another in this process"
 
 
@@ -57,7 +59,10 @@ def usage(name: str) -> str:
     schema = spec.schema_class()
     sweep = (IN_TURN if spec.runs_here else ON_LAUNCHER) + spec.sweep
     first = f" [{spec.positional.upper()}]" if spec.positional else ""
-    lines = [f"usage: tcbench {name}{first} [-m] [key=value ...] [--cfg job] [-h]", "",
+    fields = {f.name for f in dataclasses.fields(schema)}
+    flags = {flag: (key, value) for flag, (key, value) in KEY_FLAGS.items() if key in fields}
+    shown = "".join(f" [{flag} {value}]" for flag, (_, value) in flags.items())
+    lines = [f"usage: tcbench {name}{first} [-m] [key=value ...]{shown} [--cfg job] [-h]", "",
              textwrap.fill(spec.description, width=100), "",
              "parameters (key=value, default after =):"]
     meanings = spec.meanings()
@@ -75,6 +80,7 @@ def usage(name: str) -> str:
                              "range(...), in Hydra's override grammar (quote a path holding , ( ) [ ] { } or "
                              f"quotes: \"recording='run (1).csv'\"); {sweep}", width=98,
                              initial_indent="  -m           ", subsequent_indent=" " * 15),
+              *(f"  {flag + ' ' + value:{12}s} {key}={value}" for flag, (key, value) in flags.items()),
               *spec.options,
               "", "examples:", *(f"  {e}" for e in spec.examples),
               "", textwrap.fill(f"output: {spec.output}", width=100, subsequent_indent="  ")]

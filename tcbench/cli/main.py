@@ -19,6 +19,7 @@ from tcbench.cli.flags import (
     HELP_FLAGS,
     HYDRA_FLAGS,
     HYDRA_INFO_FLAGS,
+    KEY_FLAGS,
     VALUE_FLAGS,
 )
 from tcbench.commands.registry import SPECS, CommandSpec, load
@@ -39,6 +40,9 @@ def _usage() -> str:
 
 
 USAGE = _usage()
+# Hydra's own log lines (a sweep's launch, each job's line, its progress) go to stderr, never between
+# the results a command prints on stdout (conf/hydra/hydra_logging/); the quickstart's go to its log
+HYDRA_LOGGING = "tcbench_stderr"
 
 
 class UserError(Exception):
@@ -87,6 +91,13 @@ def _open_key(arg: str, command: str) -> str:
         return arg
     open_dicts = {f.name for f in dataclasses.fields(SPECS[command].schema_class()) if str(f.type).startswith("dict")}
     return f"++{arg}" if arg.split("=", 1)[0].split(".", 1)[0] in open_dicts and "." in arg.split("=", 1)[0] else arg
+
+
+def _schema_keys(command: str) -> set[str]:
+    """The top-level keys of ``command``'s schema."""
+    import dataclasses
+
+    return {f.name for f in dataclasses.fields(SPECS[command].schema_class())}
 
 
 def _first_input_key(command: str) -> str:
@@ -164,13 +175,20 @@ def _app_command(command: str, argv: list[str]) -> int:
         print(cli_help.usage(command))
         return 0
     args: list[str] = []
+    flagged: list[str] = []  # key=value of KEY_FLAGS, after the positional argument is read
     cfg: str | None = None
     multirun = False
+    keys = _schema_keys(command)
     it = iter(argv)
     for a in it:
         flag = _flag_name(a)
         if flag is None:
             args.append(a)
+        elif flag in KEY_FLAGS and KEY_FLAGS[flag][0] in keys:
+            value = a.split("=", 1)[1] if "=" in a else next(it, None)
+            if value is None:
+                raise UserError(f"{flag} needs a value ({flag} {KEY_FLAGS[flag][1]}); see `tcbench {command} --help`")
+            flagged.append(f"{KEY_FLAGS[flag][0]}={value}")
         elif flag in {"--cfg", "-c"}:
             cfg = a.split("=", 1)[1] if "=" in a else next(it, None)
             if cfg != "job":
@@ -184,6 +202,7 @@ def _app_command(command: str, argv: list[str]) -> int:
     positional = spec.positional
     if positional and args and "=" not in args[0]:
         args = [f"{positional}={args[0]}", *args[1:]]
+    args += flagged
     if bad := [a for a in args if "=" not in a or a.startswith("=")]:
         raise UserError(f"expected key=value, got {bad[0]!r}")
     if named := [a for a in args if _file_not_key(a, command)]:
@@ -262,14 +281,17 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     from hydra.errors import HydraException
     from omegaconf.errors import OmegaConfBaseException
 
-    from tcbench.cli.app import hydra_app, plan, with_overrides
+    from tcbench.cli.app import hydra_app, plan, sweep_dir, with_overrides
     from tcbench.errors import ConfigError
 
     info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
     if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
         args = with_overrides(args, [f"tracking.sweep_id={uuid.uuid4().hex[:12]}"])
+    elsewhere = any(a in CONFIG_SOURCE_FLAGS for a in args)
+    if not elsewhere and not _given(args, "hydra/hydra_logging"):  # Hydra's lines never between the results
+        args = with_overrides(args, [f"hydra/hydra_logging={HYDRA_LOGGING}"])
     checked: Plan | None = None
-    if any(a in CONFIG_SOURCE_FLAGS for a in args):
+    if elsewhere:
         from tcbench.cli.app import check_command_line_size
 
         try:  # counted from the overrides alone: Hydra would list every job first
@@ -296,6 +318,8 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
                       "process that is gone marked KILLED; their jobs run again", file=sys.stderr)
         n = checked.jobs
         print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
+        if (where := sweep_dir(checked.outs)) is not None and not _given(args, "hydra.sweep.dir"):
+            args = with_overrides(args, [f"hydra.sweep.dir={where}"])  # Hydra's record of the sweep under out=
     saved, full_error = sys.argv, os.environ.get("HYDRA_FULL_ERROR")
     sys.argv = ["tcbench", *args]
     os.environ["HYDRA_FULL_ERROR"] = "1"  # Hydra's errors reach us whole instead of as its traceback
@@ -317,6 +341,11 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         else:
             os.environ["HYDRA_FULL_ERROR"] = full_error
     return checked
+
+
+def _given(args: list[str], key: str) -> bool:
+    """Whether the command line sets ``key`` (``hydra.sweep.dir=...``, ``hydra/hydra_logging=...``)."""
+    return any(a.split("=", 1)[0].lstrip("+~").removeprefix("override ").strip() == key for a in args)
 
 
 def _mark_interrupted(checked: Plan) -> None:
@@ -474,12 +503,13 @@ def _runs_here(spec: CommandSpec) -> tuple[Callable[[dict[str, Any]], None], Cal
 
 
 # ``tcbench leaderboard``'s flags, kept as aliases of its keys
-LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--out": "out", "--tracking-uri": "tracking.uri"}
+LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--tracking-uri": "tracking.uri"}
 
 
 def cmd_leaderboard(argv: list[str]) -> int:
     """``tcbench leaderboard``: its key=value (``conf/leaderboard.yaml``), or the flags
-    ``--experiment`` (repeatable), ``--sweep``, ``--out``, ``--tracking-uri`` and ``--ecdf``."""
+    ``--experiment`` (repeatable), ``--sweep``, ``--tracking-uri`` and ``--ecdf`` (``--out``: as
+    every command's, :data:`~tcbench.cli.flags.KEY_FLAGS`)."""
     args: list[str] = []
     experiments: list[str] = []
     it = iter(argv)
@@ -542,7 +572,9 @@ def _main(argv: list[str]) -> int:
         return 0 if argv else 2
     command, rest = argv[0], argv[1:]
     if command not in COMMANDS:
-        return _fail(f"unknown command {command!r}; known: {', '.join(COMMANDS)}")
+        from tcbench.errors import unknown_name
+
+        return _fail(unknown_name("command", command, COMMANDS))
     try:
         return COMMANDS[command](rest)
     except UserError as exc:

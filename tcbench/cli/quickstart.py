@@ -63,7 +63,7 @@ TEST_LEGEND = {
 }
 
 
-FOLDERS = ("diagnosis", "leaderboard", "recordings")  # the quickstart's, inside its out=
+FOLDERS = ("diagnosis", "leaderboard", "recordings", "multirun")  # the quickstart's, inside its out=
 LOG = "quickstart.log"  # Hydra's log lines of the quickstart's sweeps and diagnosis, inside its out=
 
 
@@ -102,15 +102,18 @@ def check(cfg: QuickstartConfig) -> None:
     """The quickstart's own parameters, checked before anything runs (the compensation sweep's
     are checked by ``tcbench run``): ConfigError with one line."""
     from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
+    from tcbench.errors import unknown_name
 
     for key in ("seeds", "budget", "epochs"):
         if getattr(cfg, key) < 1:
             raise ConfigError(f"{key}={getattr(cfg, key)}: must be at least 1")
     if cfg.diagnose_sensor not in EFFECTS_BY_SENSOR:
-        raise ConfigError(f"diagnose_sensor={cfg.diagnose_sensor}: unknown; known: {', '.join(EFFECTS_BY_SENSOR)}")
+        raise ConfigError(f"diagnose_sensor={cfg.diagnose_sensor}: "
+                          + unknown_name("sensor", cfg.diagnose_sensor, EFFECTS_BY_SENSOR))
     if cfg.diagnose_effect not in EFFECTS_BY_SENSOR[cfg.diagnose_sensor]:
-        raise ConfigError(f"diagnose_effect={cfg.diagnose_effect}: not an effect tcbench hides in a "
-                          f"{cfg.diagnose_sensor} recording; known: {', '.join(EFFECTS_BY_SENSOR[cfg.diagnose_sensor])}")
+        raise ConfigError(f"diagnose_effect={cfg.diagnose_effect}: " + unknown_name(
+            "effect", cfg.diagnose_effect, EFFECTS_BY_SENSOR[cfg.diagnose_sensor],
+            f" to hide in a {cfg.diagnose_sensor} recording"))
     if cfg.diagnose_seed < 0:
         raise ConfigError(f"diagnose_seed={cfg.diagnose_seed}: must be a non-negative integer")
     if not str(cfg.tracking.experiment).strip():
@@ -158,13 +161,19 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
           f"the paper: 30), each with {cfg.budget} evaluations of IFA's weight search (population 10) and "
           f"{cfg.epochs} gradient-descent epochs; one simulated device, 4 recordings to train and 2 to test.")
     _say(f"Running; each job's line and the sweep's progress go to {log_path}.")
-    checked = run_sweep(["-m", "experiment=quickstart", *tracked, f"budget={cfg.budget}",
+    def sweep_dir(name: str) -> str:  # Hydra's record of each of its sweeps, under out=
+        from tcbench.commands.schemas import literal
+
+        return f"hydra.sweep.dir={hydra_string(literal(str(out / 'multirun' / name)))}"
+
+    checked = run_sweep(["-m", "experiment=quickstart", *tracked, sweep_dir("ifa-bp"), f"budget={cfg.budget}",
                          f"learner.epochs={cfg.epochs}", f"seed=range({n_bp})"])
     assert checked is not None
     baselines = ("raw", "memoriser", "poly", "lagpoly", "oracle")
-    run_sweep(["-m", "experiment=quickstart", f"learner={','.join(baselines)}", "optimiser=none", "seed=0", *tracked])
+    run_sweep(["-m", "experiment=quickstart", f"learner={','.join(baselines)}", "optimiser=none", "seed=0", *tracked,
+               sweep_dir("baselines")])
     run_sweep(["-m", "experiment=quickstart", "learner=poly", "learner.offsets=per_run", "optimiser=none", "seed=0",
-               *tracked])
+               *tracked, sweep_dir("poly-per-run")])
     status = sweep_report(sweep, checked.experiment, checked.tracking_uri)
     board_paths = _leaderboard(checked.experiment, sweep, checked.tracking_uri, out / "leaderboard")
     compensation_s = time.monotonic() - started
@@ -187,7 +196,7 @@ def run(run_sweep: Callable[[list[str]], Any], sweep_report: Callable[..., int],
     print("Per-run figures (the paper's Fig. 7 for each test recording), scores.json and the training curves are")
     print("  artifacts of each compensation run in MLflow.")
     print(f"Log of the sweeps and the diagnosis: {log_path.resolve()}; each job's resolved config: "
-          f"{Path('multirun').resolve()}/")
+          f"{(out / 'multirun').resolve()}/")
     print(f"Took {compensation_s:.0f} s (compensation) + {diagnosis_s:.0f} s (diagnosis).")
     print()
     print(NEXT_STEPS)

@@ -37,6 +37,7 @@ from tcbench.commands.errors import (
     writable_folder,
 )
 from tcbench.commands.schemas import CalibrateConfig
+from tcbench.errors import unknown_name
 from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
 
 
@@ -94,7 +95,7 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, A
     if not cfg.recording:
         raise CommandError("recording=PATH is required")
     if unknown := [m for m in cfg.methods if m not in METHODS]:
-        raise CommandError(f"methods: unknown {unknown[0]!r}; known: {', '.join(METHODS)}")
+        raise CommandError(f"methods: {unknown_name('method', unknown[0], METHODS)}")
     if not cfg.methods:
         raise CommandError("methods: give at least one (known: " + ", ".join(METHODS) + ")")
     if not (cfg.min_swing_c > 0 and cfg.drift_window_s > 0):

@@ -24,6 +24,7 @@ from typing import Any
 
 from tcbench.commands.errors import CommandError, cannot_write, free_outputs, refused_output, say_replaced, writable_folder
 from tcbench.commands.schemas import ExportConfig
+from tcbench.errors import unknown_name
 from tcbench.sensors import kinds
 from tcbench.staging import OutputRefusedError, moved, staged_dir
 
@@ -76,7 +77,7 @@ def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
     if not cfg.calibrations:
         raise CommandError("calibrations=[DIR,...] is required: the out= folders of tcbench calibrate")
     if bad := [f for f in cfg.formats if f not in FORMATS]:
-        raise CommandError(f"formats: unknown {bad[0]!r}; known: {', '.join(FORMATS)}")
+        raise CommandError(f"formats: {unknown_name('format', bad[0], FORMATS)}")
     if not cfg.formats:
         raise CommandError(f"formats: give at least one of {', '.join(FORMATS)}")
     if not 0 <= cfg.px4_instance <= 3:

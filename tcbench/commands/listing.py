@@ -6,13 +6,13 @@ from __future__ import annotations
 import re
 
 from tcbench.commands.schemas import LISTS, ListConfig
-from tcbench.errors import ConfigError
+from tcbench.errors import ConfigError, unknown_name
 
 
 def check(cfg: ListConfig) -> None:
     """A ConfigError for a ``what`` that is none of :data:`~tcbench.commands.schemas.LISTS`."""
     if cfg.what not in LISTS:
-        raise ConfigError(f"what={cfg.what}: expected one of {', '.join(LISTS)}")
+        raise ConfigError(f"what={cfg.what}: {unknown_name('list', cfg.what, LISTS)}")
 
 
 def work(cfg: ListConfig) -> int:

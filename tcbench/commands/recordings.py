@@ -23,6 +23,7 @@ from tcbench.commands.errors import (
     say_replaced,
     writable_folder,
 )
+from tcbench.errors import unknown_name
 from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
 
 
@@ -104,9 +105,9 @@ def check_simulate(cfg: SimulateConfig) -> Any:
     if cfg.protocol is None:
         cfg.protocol = kind.default_protocol
     if cfg.protocol not in names:
-        raise CommandError(f"unknown protocol {cfg.protocol!r} for {cfg.sensor}; known: {', '.join(names)}")
+        raise CommandError(unknown_name("protocol", cfg.protocol, names, f" for {cfg.sensor}"))
     if cfg.format not in {"csv", "parquet"}:
-        raise CommandError(f"format must be csv or parquet, got {cfg.format!r}")
+        raise CommandError(f"format={cfg.format}: {unknown_name('format', cfg.format, ('csv', 'parquet'))}")
     if cfg.device_seed < 0 or cfg.seed < 0 or (cfg.power_on is not None and cfg.power_on < 0):
         raise CommandError("device_seed, seed and power_on must be non-negative integers")
     writable_folder(cfg.out)

@@ -17,7 +17,8 @@ from typing import Any
 # meanings of keys several commands share, for their --help
 TRACKING = {
     "tracking.enabled": "log the results to MLflow (false: files only)",
-    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd)",
+    "tracking.uri": "MLflow store (null: $MLFLOW_TRACKING_URI, else sqlite:///mlflow.db in the cwd); a SQLite store "
+                    "keeps the runs' files in mlartifacts/ and its lock file <db>.lock beside its database",
     "tracking.experiment": "MLflow experiment the run is filed under",
     "tracking.sweep_id": "the sweep's id in MLflow (null: a new one per command)",
     "tracking.resume": "skip a job whose config already FINISHED in the experiment (re-run a killed sweep)",
@@ -55,7 +56,8 @@ class CommandSpec:
     params: dict[str, str] = field(default_factory=dict)
     examples: tuple[str, ...] = ()
     output: str = ""  # where its output goes, for its --help
-    positional: str | None = None  # ``tcbench metrics PATH`` means ``recording=PATH``
+    # ``tcbench metrics PATH`` means ``recording=PATH``; None: ``recording`` for every command reading one
+    positional: str | None = None
     required: tuple[str, ...] = ()
     options: tuple[str, ...] = ()  # further lines of the options section (flags kept as aliases)
     sweep: str = ""  # what the -m line of its --help adds about its sweeps
@@ -70,6 +72,8 @@ class CommandSpec:
     def __post_init__(self) -> None:
         object.__setattr__(self, "config", self.config or self.name)
         object.__setattr__(self, "schema_node", self.schema_node or f"{self.config}_schema")
+        if self.positional is None and "recording" in self.inputs:  # one rule: a recording is also the first argument
+            object.__setattr__(self, "positional", "recording")
         if bool(self.kinds) == bool(self.runs_here):
             raise ValueError(f"command {self.name}: give its job kinds or the module that runs it here, one of them")
 
@@ -142,7 +146,6 @@ SPECS: dict[str, CommandSpec] = {
                "nothing to it unless tracking.enabled=true",
         options=("  --experiment NAME   experiments=NAME (repeatable: experiments=[a,b])",
                  "  --sweep ID          sweep=ID",
-                 "  --out DIR           out=DIR",
                  "  --tracking-uri URI  tracking.uri=URI",
                  "  --ecdf              ecdf=true"),
     ),
@@ -207,7 +210,7 @@ SPECS: dict[str, CommandSpec] = {
                   "tcbench run -m experiment=quickstart 'seed=range(30)' learner.epochs=3000   the sweep alone"),
         output="runs in MLflow (./mlflow.db, experiment quickstart: one per compensation job and one for the "
                "diagnosis), the leaderboard in OUT/leaderboard/, the diagnosis report and plots in "
-               "OUT/diagnosis/, Hydra job logs and resolved configs in multirun/",
+               "OUT/diagnosis/, Hydra's log lines in OUT/quickstart.log and each job's resolved config in OUT/multirun/",
         sweep=" (each quickstart runs its own sweeps on tcbench run's launcher)",
     ),
     "list": CommandSpec(
@@ -323,7 +326,6 @@ SPECS: dict[str, CommandSpec] = {
         ),
         output="OUT/ (metrics.json, overview and Allan deviation plots, nodes.csv for a four-position "
                "test); MLflow experiment 'recordings' when tracking is on",
-        positional="recording",
         required=("recording",),
     ),
     "diagnose": CommandSpec(
@@ -334,7 +336,7 @@ SPECS: dict[str, CommandSpec] = {
         kinds={"diagnose": "tcbench.runner.kinds.diagnosis:DiagnoseKind"},
         inputs=("recording", "model"),
         params={
-            "recording": "the recording to diagnose",
+            "recording": "the recording to diagnose; also the first argument",
             "out": "output folder",
             "overwrite": OVERWRITE,
             "sensor": "the sensor kind (msra, gyro, accel), for a recording without a sidecar (null: from the sidecar)",
@@ -350,7 +352,7 @@ SPECS: dict[str, CommandSpec] = {
         },
         more_params="tcbench.diagnose.settings:meanings",  # settings.<section>.<key>: the statistics
         examples=(
-            "tcbench diagnose recording=recordings/msra-fulltemp-dev0-seed0.csv out=diagnosis",
+            "tcbench diagnose recordings/msra-fulltemp-dev0-seed0.csv --out diagnosis",
             "tcbench diagnose recording=run.csv out=diag2 model=diagnosis/model.yaml",
             "tcbench diagnose recording=run.csv settings.selection.wald_threshold=30 settings.locate.false_alarm=0.05",
             "tcbench diagnose -m recording=a.csv,b.csv 'out=diagnoses/${stem:recording}' hydra.launcher.n_jobs=2",
@@ -370,7 +372,8 @@ SPECS: dict[str, CommandSpec] = {
         kinds={"calibrate": "tcbench.runner.kinds.calibration:CalibrateKind"},
         inputs=("recording", "test_recordings"),
         params={
-            "recording": "the static recording (its true input in the input column: 0 for a gyro at rest)",
+            "recording": "the static recording (its true input in the input column: 0 for a gyro at rest); also the "
+                         "first argument",
             "out": "output folder",
             "overwrite": OVERWRITE,
             "train_branches": "the temperature branches (or time blocks) to fit on, numbered from 0 in time order; "
@@ -397,7 +400,7 @@ SPECS: dict[str, CommandSpec] = {
             **TRACKING,
         },
         examples=(
-            "tcbench calibrate recording=recordings/tofupilot/imu-imu.gyro.y.csv out=cal/gyro-y",
+            "tcbench calibrate recordings/tofupilot/imu-imu.gyro.y.csv --out cal/gyro-y",
             "tcbench calibrate recording=run.csv 'train_branches=[0,1]' 'methods=[poly3]'",
             "tcbench calibrate -m recording=a.csv,b.csv 'out=cal/${stem:recording}'",
             "tcbench calibrate recording=recordings/tofupilot/imu-imu.acc.z.csv true_input=-1:g out=cal/acc-z",
@@ -405,7 +408,6 @@ SPECS: dict[str, CommandSpec] = {
         output="the held-out ranking (printed); OUT/calibration.md and .csv (one row per method and part: drift and "
                "RMS), OUT/residuals.png, OUT/calibration.json (the ranking and the cubic for tcbench export); MLflow "
                "experiment 'calibrations' when tracking is on",
-        positional="recording",
         required=("recording",),
     ),
     "export": CommandSpec(

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.errors import unknown_name
 from tcbench.compensation.features import running_mean, temperature_rate_c_per_s
 from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 from tcbench.compensation.record import Record
@@ -129,7 +130,7 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     on 5-s bins differ by less than the seeds' spread on every gyro axis, either way (coarser
     bins began to cost both networks on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``)."""
     if method not in METHODS:
-        raise ValueError(f"unknown calibration method {method!r}; known: {', '.join(METHODS)}")
+        raise ValueError(unknown_name("calibration method", method, METHODS))
     if method == "raw":
         return OffsetModel("raw")
     if method == "model":

@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from tcbench.compensation.features import temperature_rate_c_per_s
+from tcbench.errors import unknown_name
 from tcbench.metrics.accelerometer import four_position
 from tcbench.sensors import kinds
 from tcbench.sensors.data_hash import shared_recordings
@@ -141,7 +142,7 @@ def recording_seed(recordings_seed: int, index: int) -> int:
 def check_tier(split: object) -> None:
     """A :class:`TaskDataError` unless ``split`` is one of :data:`SPLITS`."""
     if split not in SPLITS:
-        raise TaskDataError(f"unknown split {split!r}; known: {', '.join(SPLITS)} (default {DEFAULT_TIER})")
+        raise TaskDataError(unknown_name("split", split, SPLITS) + f" (default {DEFAULT_TIER})")
 
 
 @dataclass(frozen=True)
@@ -208,7 +209,7 @@ def simulated_data(protocol: str, device_seed: int, recordings_seed: int, n_trai
 def check_split(protocol: str, n_train: int, n_test: int, train_on: str, rate_window_s: float) -> None:
     """Raise :class:`TaskDataError` for an impossible split or setting."""
     if protocol not in PROTOCOLS:
-        raise TaskDataError(f"unknown compensation protocol {protocol!r}; known: {', '.join(PROTOCOLS)}")
+        raise TaskDataError(unknown_name("compensation protocol", protocol, PROTOCOLS))
     if int(n_train) != n_train or n_train < 1 or int(n_test) != n_test or n_test < 1:
         raise TaskDataError(f"n_train and n_test must be integers >= 1, got {n_train} and {n_test}")
     if n_train + n_test > 100:

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors import noise
+from tcbench.errors import unknown_name
 from tcbench.sensors.kinds import get as sensor_kind
 from tcbench.sensors.kinds import profile_input, unit
 from tcbench.sensors.models import MSRA, SensorModel
@@ -116,7 +117,7 @@ class _Parts:
 
 def _check_sensor(sensor: str) -> None:
     if sensor not in EFFECTS_BY_SENSOR:
-        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(EFFECTS_BY_SENSOR)}")
+        raise ValueError(unknown_name("sensor", sensor, EFFECTS_BY_SENSOR))
 
 
 def device_without_effects(sensor: str, device_seed: int, rate_hz: float = SAMPLE_RATE_HZ,
@@ -269,8 +270,7 @@ def _build(sensor: str, effect: str | None, seed: int) -> _Parts:
     """Draw everything of one concealed recording from ``SeedSequence(seed)``."""
     _check_sensor(sensor)
     if effect is not None and effect not in EFFECTS_BY_SENSOR[sensor]:
-        raise ValueError(f"unknown effect {effect!r} for sensor {sensor!r}; known: "
-                         f"{', '.join(EFFECTS_BY_SENSOR[sensor])}")
+        raise ValueError(unknown_name("effect", effect, EFFECTS_BY_SENSOR[sensor], f" for sensor {sensor!r}"))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     streams = np.random.SeedSequence(int(seed)).spawn(7)

@@ -72,6 +72,7 @@ from tcbench.datasets.concealed import (
     minimal_columns,
     unexplained,
 )
+from tcbench.errors import unknown_name
 from tcbench.sensors import noise
 from tcbench.sensors.effects import (
     BiasStep,
@@ -309,9 +310,9 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
     (``None``: a control) and its truth. Raises ``ValueError`` for an unknown sensor or kind or
     a negative seed."""
     if sensor not in SENSORS:
-        raise ValueError(f"unknown sensor {sensor!r}; known: {', '.join(SENSORS)}")
+        raise ValueError(unknown_name("sensor", sensor, SENSORS))
     if kind is not None and kind not in SHAPE:
-        raise ValueError(f"unknown kind {kind!r}; known: {', '.join(KINDS)}")
+        raise ValueError(unknown_name("kind", kind, KINDS))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     streams = np.random.SeedSequence(int(seed)).spawn(8)  # the eighth is kept for a new kind

@@ -46,6 +46,7 @@ from typing import Any
 
 import yaml
 
+from tcbench.errors import unknown_name
 from tcbench.outputs import temp_name
 from tcbench.sensors import effects as fx
 from tcbench.sensors import kinds
@@ -115,7 +116,7 @@ def _effects(value: Any, where: str) -> dict[str, dict[str, float]]:
     for effect_id, params in value.items():
         cls = fx.effect_class(effect_id)
         if cls is None:
-            raise ModelFileError(f"{where}: unknown effect {effect_id!r}; known: {', '.join(fx.known_effects())}")
+            raise ModelFileError(f"{where}: {unknown_name('effect', effect_id, fx.known_effects())}")
         params = {} if params is None else params
         if not isinstance(params, dict):
             raise ModelFileError(f"{where}: effect {effect_id!r} needs a mapping of parameters, got {params!r}")
@@ -163,7 +164,7 @@ def parse_model(data: Any, where: str) -> ModelSpec:
     if sensor is None:
         raise ModelFileError(f"{where}: sensor is missing; known: {', '.join(kinds.names())}")
     if not kinds.known(sensor):
-        raise ModelFileError(f"{where}: unknown sensor {sensor!r}; known: {', '.join(kinds.names())}")
+        raise ModelFileError(f"{where}: {unknown_name('sensor', sensor, kinds.names())}")
     core = data.get("core")
     if not isinstance(core, dict):
         raise ModelFileError(f"{where}: core is missing or not a mapping")

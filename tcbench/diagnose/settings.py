@@ -28,6 +28,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from tcbench.errors import did_you_mean
+
 __all__ = ["DEFAULTS", "DetectorSettings", "DiagnoseSettings", "SettingsError", "differing", "documented",
            "from_mapping", "meanings", "report_mapping", "to_mapping", "yaml_lines"]
 
@@ -396,7 +398,9 @@ def from_mapping(given: Mapping[str, Any] | None, cls: type | None = None, prefi
     hints = typing.get_type_hints(cls)
     names = [f.name for f in dataclasses.fields(cls)]
     if unknown := [k for k in given if k not in names]:
-        raise SettingsError(f"{prefix}{unknown[0]}: no such setting (known: {', '.join(names)})")
+        meant = did_you_mean(unknown[0], names)
+        raise SettingsError(f"{prefix}{unknown[0]}: no such setting (known: {', '.join(names)})"
+                            + (f"; did you mean {prefix + meant!r}?" if meant else ""))
     values: dict[str, Any] = {}
     for name, value in given.items():
         kind = hints[name]

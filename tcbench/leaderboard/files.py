@@ -21,12 +21,23 @@ FAILED_RULE = ("Every median, quartile and ci95 counts a failed run as worse tha
 STAT_PREFIXES = ("median_", "ci95_", "iqr_", "x_")  # the columns a failed run can make "failed"
 
 
+def experiment_ids(client, experiments: list[str]) -> list[str]:  # type: ignore[no-untyped-def]
+    """The ids of the experiments; ``LookupError`` naming the first the store does not hold, and
+    those it does."""
+    found = {name: client.get_experiment_by_name(name) for name in experiments}
+    if missing := [name for name, e in found.items() if e is None]:
+        from tcbench.errors import unknown_name
+
+        held = sorted(e.name for e in client.search_experiments())
+        raise LookupError(unknown_name("experiment", missing[0], held, f" in {client.tracking_uri}"))
+    return [e.experiment_id for e in found.values()]
+
+
 def search_runs(client, experiments: list[str], kind: str | None, sweep: str | None = None) -> Iterator[Any]:  # type: ignore[no-untyped-def]
     """Every MLflow run of ``kind`` (``optimisation``, ``compensation``; None: every tcbench run)
-    in the experiments, optionally of one sweep, page by page; ``LookupError`` if no experiment exists."""
-    ids = [e.experiment_id for name in experiments if (e := client.get_experiment_by_name(name))]
-    if not ids:
-        raise LookupError(f"no MLflow experiment named {', '.join(experiments)}")
+    in the experiments, optionally of one sweep, page by page; ``LookupError`` naming the first
+    experiment the store does not hold, and those it does."""
+    ids = experiment_ids(client, experiments)
     terms = [f"tags.`tcbench.kind` = '{kind}'" if kind else "tags.`tcbench.kind` != ''"]
     if sweep:
         terms.append(f"tags.`tcbench.sweep_id` = '{sweep}'")

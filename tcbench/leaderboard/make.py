@@ -20,18 +20,25 @@ def experiments_of(experiment: Any) -> list[str]:
 
 
 def check_leaderboard(experiment: Any, out: str, uri: str | None) -> str:
-    """The checks made before reading anything: the experiment names, the output folder and an
-    existing store; the store's resolved URI."""
+    """The checks made before reading any run: the experiment names, the output folder, an
+    existing store holding every experiment named; the store's resolved URI."""
+    from tcbench.leaderboard.files import experiment_ids
     from tcbench.outputs import folder_problem
     from tcbench.tracking import store as tracking
 
-    experiments_of(experiment)
+    experiments = experiments_of(experiment)
     if problem := folder_problem(out):
         raise ConfigError(f"out={out}: {problem}")
     try:
-        return tracking.check_store(uri, create=False)
+        resolved = tracking.check_store(uri, create=False)
+        experiment_ids(tracking.client(resolved), experiments)
     except tracking.StoreError as exc:
         raise ConfigError(str(exc)) from None
+    except LookupError as exc:
+        raise ConfigError(str(exc)) from None
+    except Exception as exc:  # noqa: BLE001 - a store that cannot be read: one line, as every store problem
+        raise ConfigError(f"tracking store {resolved} cannot be read ({tracking.first_line(exc)})") from None
+    return resolved
 
 
 def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | None,
@@ -55,7 +62,7 @@ def make_leaderboards(experiment: Any, sweep: str | None, out: str, uri: str | N
         comp = comp_board.load_runs(client, experiments, sweep)
         cals = cal_board.load_runs(client, experiments, sweep)
     except LookupError as exc:
-        raise ConfigError(f"{exc} in {resolved}") from None
+        raise ConfigError(str(exc)) from None
     if runs.empty and comp.empty and cals.empty:
         where = f", sweep {sweep}" if sweep else ""
         raise ConfigError(f"no tcbench runs in experiment {', '.join(experiments)}{where}")

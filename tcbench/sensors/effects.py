@@ -23,6 +23,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tcbench.plugins import PluginRegistry
+from tcbench.errors import unknown_name
 from tcbench.sensors import noise
 from tcbench.sensors.thermal import first_order_lag
 
@@ -532,8 +533,8 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
         broken = PLUGINS.broken().get(effect_id) if effect_id in PLUGINS.names() else None
         if broken:
             raise ValueError(f"effect {effect_id!r}: plugin failed to load: {broken}")
-        raise ValueError(f"unknown effect {effect_id!r}; known: {', '.join(known_effects())} "
-                         f"(and <id>_2 ... _{MAX_REPEATS} for further instances of {', '.join(repeatable_effects())})")
+        raise ValueError(unknown_name("effect", effect_id, known_effects()) + f" (and <id>_2 ... _{MAX_REPEATS} for "
+                         f"further instances of {', '.join(repeatable_effects())})")
     known = {f.name for f in dataclasses.fields(cls)}
     unknown = sorted(set(params) - known)
     if unknown:

@@ -32,6 +32,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pcsv
 
+from tcbench.errors import meant
 from tcbench.sensors.recording import (
     NUMERIC_COLUMNS,
     Recording,
@@ -134,7 +135,7 @@ def parse_column(target: str, spec: str, sensor: str, available: Sequence[str],
         name, unit = spec.rsplit(":", 1)
     if name not in available:
         raise RecordingError(f"no column {name!r} (for {target}); the file has: "
-                             f"{', '.join(map(str, available))}")
+                             f"{', '.join(map(str, available))}" + meant(name, map(str, available)))
     unit = _stated_unit(target, spec, name, unit, sensor, stated or StatedUnits())
     try:
         convert = conversion(unit, schema_unit)
@@ -343,7 +344,8 @@ def _spec(columns: Mapping[str, str], drop: Sequence[str], sensor: str, header: 
     spec = {k: parse_column(k, v, sensor, header, stated) for k, v in columns.items() if v}
     for flag in drop:
         if flag not in header:
-            raise RecordingError(f"no column {flag!r} (for drop); the file has: {', '.join(header)}")
+            raise RecordingError(f"no column {flag!r} (for drop); the file has: {', '.join(header)}"
+                                 + meant(flag, header))
     return spec, list(dict.fromkeys([c.name for c in spec.values()] + list(drop)))
 
 

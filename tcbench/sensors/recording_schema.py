@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from tcbench.errors import unknown_name
 from tcbench.sensors import kinds
 
 SCHEMA_VERSION = 1
@@ -197,7 +198,7 @@ def _meta_from_dict(doc: Any) -> RecordingMeta:
 def check_sensor(sensor: Any) -> None:
     """A known sensor kind, or one line naming the known ones."""
     if not kinds.known(sensor):
-        raise RecordingError(f"unknown sensor {sensor!r} (expected one of {', '.join(map(repr, kinds.names()))})")
+        raise RecordingError(unknown_name("sensor", sensor, kinds.names()))
 
 
 def standard_units(sensor: str) -> dict[str, str]:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.sensors import effects as fx
+from tcbench.errors import unknown_name
 from tcbench.sensors import kinds
 from tcbench.sensors.models import SensorModel, Unit
 from tcbench.sensors.noise import quantise
@@ -38,7 +39,7 @@ def build_profile(
     """The protocol's profile; ``params`` override its keyword arguments (None = default)."""
     names = protocol_names(sensor)
     if protocol not in names:
-        raise ValueError(f"unknown protocol {protocol!r} for {sensor}; known: {', '.join(names)}")
+        raise ValueError(unknown_name("protocol", protocol, names, f" for {sensor}"))
     fn: Callable[..., Profile] = kinds.get(sensor).protocols[protocol]
     accepted = inspect.signature(fn).parameters
     given = {k: v for k, v in params.items() if v is not None}

@@ -17,6 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.errors import meant
+
 # schema unit -> pint expression and the quantity it measures (for messages)
 SCHEMA = {"s": ("second", "time"), "degC": ("degC", "temperature"), "deg/s": ("degree / second", "angular rate"),
           "Hz": ("hertz", "frequency"), "g": ("gee", "acceleration")}
@@ -71,7 +73,9 @@ def conversion(unit: str, schema_unit: str) -> Conversion:
     try:
         given = ureg.Unit(_expression(unit, schema_unit))
     except Exception:  # noqa: BLE001 - pint's parser raises many kinds for text that is not a unit
-        raise UnitError(f"unknown unit {unit!r}: not a unit pint knows (e.g. {_examples(schema_unit)})") from None
+        examples = _examples(schema_unit)
+        raise UnitError(f"unknown unit {unit!r}: not a unit pint knows (e.g. {examples}"
+                        f"{meant(unit, examples.split(', '))})") from None
     if given.dimensionality != ureg.Unit(target).dimensionality:
         article = "an" if what[0] in "aeiou" else "a"
         raise UnitError(f"unit {unit!r} is a {_dimension(given)}, not {article} {what} (e.g. {_examples(schema_unit)})")

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.errors import unknown_name
+
 Array = np.ndarray
 
 
@@ -139,4 +141,4 @@ def get_function(key: str) -> ObjectiveFunction:
     try:
         return FUNCTIONS[key]
     except KeyError:
-        raise KeyError(f"unknown function {key!r}; known: {', '.join(sorted(FUNCTIONS))}") from None
+        raise KeyError(unknown_name("function", key, sorted(FUNCTIONS))) from None

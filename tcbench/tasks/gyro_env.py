@@ -35,6 +35,7 @@ from tcbench.compensation.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.compensation.methods import memorised
 from tcbench.compensation.oracle import oracle_inverse
 from tcbench.compensation.scoring import Score
+from tcbench.errors import unknown_name
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.gyro_vmd_env import load_gyro_data
 from tcbench.tasks.ids import GYRO_DRIFTNOISE_ID
@@ -245,7 +246,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                                  bandwidth) for tr in self.data.test]
             return Score("gyro", recs)
         if which not in ("oracle", "oracle_thermometer"):
-            raise ValueError(f"unknown baseline {which!r}; known: {', '.join(BASELINES)}")
+            raise ValueError(unknown_name("baseline", which, BASELINES))
         if not self.data.has_truth:
             raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
         thermometer = which == "oracle_thermometer"

@@ -36,6 +36,7 @@ from tcbench.compensation.data import (
     simulated_data,
 )
 from tcbench.compensation.scoring import Score, score_outputs
+from tcbench.errors import unknown_name
 from tcbench.learners import registry as learners
 from tcbench.learners.base import FitHistory, Learner
 from tcbench.tasks.checks import is_integer
@@ -101,7 +102,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         split: str = DEFAULT_TIER,
     ) -> None:
         if task not in TASKS:
-            raise ValueError(f"unknown static-input task {task!r}; known: {', '.join(TASKS)}")
+            raise ValueError(unknown_name("static-input task", task, TASKS))
         self.task, self.protocol = task, TASKS[task]
         self.baselines = tuple(b for b in methods.BASELINES if b != "model" or self.protocol in MODEL_PROTOCOLS)
         if not is_integer(budget) or budget < 1:
@@ -210,7 +211,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if self.data is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which not in self.baselines:
-            raise ValueError(f"unknown baseline {which!r} of task {self.task}; known: {', '.join(self.baselines)}")
+            raise ValueError(unknown_name("baseline", which, self.baselines, f" of task {self.task}"))
         if which == "raw":
             return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
         if which == "memoriser":

@@ -53,6 +53,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from tcbench.errors import unknown_name
+
 Array = np.ndarray
 
 DTLZ_K = 10  # distance variables of DTLZ2 (Deb et al. recommend k = 10)
@@ -337,7 +339,7 @@ def get_problem(key: str) -> MultiObjectiveProblem:
     try:
         return PROBLEMS[key.lower()]
     except (KeyError, AttributeError):
-        raise KeyError(f"unknown problem {key!r}; known: {', '.join(sorted(PROBLEMS))}") from None
+        raise KeyError(unknown_name("problem", key, sorted(PROBLEMS))) from None
 
 
 __all__ = [

@@ -142,7 +142,9 @@ def task_spec(name: str) -> TaskSpec:
     naming the known ones otherwise."""
     spec = TASKS.get(str(name).lower())
     if spec is None:
-        raise UnknownTaskError(f"unknown task {name!r}; known: {', '.join(sorted(TASKS))}")
+        from tcbench.errors import unknown_name
+
+        raise UnknownTaskError(unknown_name("task", name, sorted(TASKS)))
     return spec
 
 

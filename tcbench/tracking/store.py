@@ -1,9 +1,10 @@
 """MLflow tracking of tcbench jobs: one run per job, embedded store by default.
 
 The store is ``sqlite:///mlflow.db`` in the working directory unless ``MLFLOW_TRACKING_URI`` (or
-the ``tracking.uri`` config key) says otherwise; artifacts go to ``./mlartifacts/<experiment>``
-(set explicitly when the experiment is created, so they never land relative to another
-directory). MLflow's telemetry is off unless ``MLFLOW_DISABLE_TELEMETRY`` is set by the user.
+the ``tracking.uri`` config key) says otherwise; artifacts go to ``mlartifacts/<experiment>`` beside
+a SQLite store's database (its lock file ``<db>.lock`` too), in the working directory for any
+other local store (set explicitly when the experiment is created, so they never land relative to
+another directory). MLflow's telemetry is off unless ``MLFLOW_DISABLE_TELEMETRY`` is set by the user.
 """
 
 from __future__ import annotations
@@ -56,7 +57,7 @@ def experiment_id(c: MlflowClient, name: str) -> str:
     # A local store gets an explicit artifact folder; a tracking server keeps its own default
     # (proxied artifacts), which every machine of a shared sweep can reach.
     remote = str(c.tracking_uri).startswith(("http://", "https://"))
-    location = None if remote else (Path.cwd() / "mlartifacts" / name).resolve().as_uri()
+    location = None if remote else (artifact_root(str(c.tracking_uri)) / name).resolve().as_uri()
     try:
         return c.create_experiment(name, artifact_location=location)
     except mlflow.exceptions.MlflowException:  # created meanwhile by a concurrent job
@@ -64,6 +65,14 @@ def experiment_id(c: MlflowClient, name: str) -> str:
         if found is None:
             raise
         return found.experiment_id
+
+
+def artifact_root(uri: str | None = None) -> Path:
+    """The folder a local store's experiments keep their artifacts in: ``mlartifacts/`` beside a
+    SQLite store's database (``sqlite:///my-imu/mlflow.db``: ``my-imu/mlartifacts``), else in the
+    working directory."""
+    db = sqlite_path(uri)
+    return (db.parent if db is not None else Path.cwd()) / "mlartifacts"
 
 
 @contextmanager

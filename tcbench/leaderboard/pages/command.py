@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from tcbench.errors import ConfigError
+from tcbench.errors import ConfigError, meant
 from tcbench.leaderboard.pages.catalogue import FAMILIES
 from tcbench.leaderboard.pages.render import Site, UnknownBoardError, build_site, known
 
@@ -61,7 +61,8 @@ def _site(cfg: Any, root: Path) -> Site:
         names = known(root)
         folders = [n for n in names if "/" not in n]
         raise ConfigError(f"boards: unknown {exc.args[0]!r}; known: {', '.join(folders)} (a folder), or one board "
-                          f"as FOLDER/STEM, e.g. {next((n for n in names if '/' in n), 'paper-ifa-bp/claims')}") from None
+                          f"as FOLDER/STEM, e.g. {next((n for n in names if '/' in n), 'paper-ifa-bp/claims')}"
+                          + meant(exc.args[0], names)) from None
     except (OSError, ValueError, KeyError) as exc:
         raise ConfigError(f"leaderboards={cfg.leaderboards}: a committed board cannot be read ({exc})") from None
 

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.commands.registry import job_kinds, load
-from tcbench.errors import ConfigError
+from tcbench.errors import ConfigError, unknown_name
 
 
 @dataclass(frozen=True)
@@ -130,5 +130,5 @@ def kind_of(c: dict[str, Any]) -> JobKind:
     name = kind_name(c)
     paths = job_kinds()
     if name not in paths:
-        raise ConfigError(f"kind: unknown job kind {name!r}; known: {', '.join(paths)}")
+        raise ConfigError("kind: " + unknown_name("job kind", name, paths))
     return _kind(name, paths[name])

@@ -166,7 +166,9 @@ def get(name: str) -> SensorKind:
     """The kind ``name``, or a ``ValueError`` listing the known ones."""
     kinds = registry()
     if name not in kinds:
-        raise ValueError(f"unknown sensor {name!r} (known: {', '.join(kinds)})")
+        from tcbench.errors import unknown_name
+
+        raise ValueError(unknown_name("sensor", name, kinds))
     return kinds[name]
 
 
