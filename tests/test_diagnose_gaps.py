@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tcbench.datasets.concealed import concealed_recording
+from tcbench.datasets.real import tofupilot_gyro
 from tcbench.diagnose import lomb
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
 from tcbench.diagnose.glitches import find_glitches, repaired
@@ -149,6 +151,17 @@ def test_thermometer_glitches_are_found_with_their_times_and_values() -> None:
     finding = found.finding().to_json()
     assert finding["params"]["count"] == 6 and finding["where"]["time_s"] == t[index].tolist()
     assert "-40 degC at 3599 s" in finding["explanation"]
+
+
+def test_no_glitch_on_the_concealed_controls_or_the_real_records() -> None:
+    """The concealed thermometers read on a 0.0625 degC lattice with noise about half a step: a
+    reading three steps off its neighbours' median is their noise, not a glitch (7 of 60 gyro
+    controls showed one when the scale was half the step; 0 of 400 with the lattice's RMS)."""
+    for seed in range(30):
+        rec, _ = concealed_recording("gyro", None, seed)
+        assert find_glitches(rec.time_s, rec.temperature_c).count == 0, seed
+    rec = tofupilot_gyro("x")  # a clean real chamber cycle whose cooling turns sharply at its end
+    assert find_glitches(rec.time_s, rec.temperature_c).count == 0
 
 
 def test_a_ramp_or_a_corner_is_not_a_glitch() -> None:

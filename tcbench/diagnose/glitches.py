@@ -6,15 +6,16 @@ driven by would carry it over a whole smoothing window, and the thermometer's no
 would grow with its square. :func:`find_glitches` finds them the way
 :mod:`tcbench.diagnose.outliers` finds output spikes, on the raw reading: the reading minus the
 median of its ``window_samples`` - 1 neighbours (past the ends, the readings reflected through a
-robust line, so a ramp's last readings are judged against the ramp), over a robust scale (1.4826 MAD of that
-difference, at least half the thermometer's typical non-zero step, so a staircase whose MAD
-reads 0 is judged against its step), above the Bonferroni bound of the record's length
-(:func:`~tcbench.diagnose.outliers.z_bound`), in runs of at most ``max_run_samples``. A
-thermometer with little noise bends at a ramp's corner by many times its noise, so a glitch
-must also lie outside the band its neighbours span (their ``max_run_samples`` most extreme
-readings on either side left out, so a run's own readings do not widen it) by more than the
-band is wide: a reading the sensor could have gone through is never called a glitch. The
-numbers are the outliers' (:class:`~tcbench.diagnose.settings.OutlierSettings`).
+robust line, so a ramp's last readings are judged against the ramp), over a robust scale
+(1.4826 MAD of that difference; on a lattice, where the MAD reads 0, the RMS of the departures
+without their largest 1 %, and at least half the typical non-zero step), above the Bonferroni
+bound of the record's length (:func:`~tcbench.diagnose.outliers.z_bound`), in runs of at most
+``max_run_samples``. A thermometer with little noise bends at a ramp's corner by many times its
+noise, so a glitch must also lie outside the band its neighbours span (their
+``max_run_samples`` most extreme readings on either side left out, so a run's own readings do
+not widen it) by more than the band is wide: a reading the sensor could have gone through is
+never called a glitch. The numbers are the outliers'
+(:class:`~tcbench.diagnose.settings.OutlierSettings`).
 
 A glitch gets zero weight: before the thermometer is smoothed its reading is replaced by the
 previous good one (:func:`repaired`, so it moves neither the smoothing nor the lattice), and
@@ -35,6 +36,7 @@ from tcbench.diagnose.signals import MAD_TO_SIGMA
 from tcbench.sensors.recording import Recording
 
 ID = "thermometer_glitches"
+TRIM_QUANTILE = 0.99  # the robust scale's RMS leaves out the largest 1 % of the departures
 EXPLANATION = ("thermometer readings far off their neighbours: a bus or logging glitch (a read that returned zero, "
                "the converter's floor or full scale, a corrupted frame), not a temperature the sensor went through; "
                "they are given zero weight (the smoothed temperature never sees them, their samples are left out "
@@ -90,6 +92,13 @@ def _step_floor_c(temp_c: np.ndarray) -> float:
     return 0.5 * float(np.median(d)) if d.size else 0.0
 
 
+def _trimmed_rms(high: np.ndarray) -> float:
+    """RMS of ``high`` without its largest 1 % (the glitches among them): the noise of a reading
+    on a lattice, where most readings equal their neighbours' median and the MAD reads 0."""
+    a = np.abs(high)
+    return float(np.sqrt(np.mean(np.square(a[a <= np.quantile(a, TRIM_QUANTILE)]))))
+
+
 def _end_value(x: np.ndarray) -> float:
     """The reading at ``x[0]`` on a robust line through ``x``: the median slope of its steps, the
     median level about it (a glitch among them moves neither)."""
@@ -125,7 +134,7 @@ def find_glitches(t_s: np.ndarray, temp_c: np.ndarray,
     high_c = rank_filter(extended, -skip - 1, footprint=footprint, mode="nearest")[half:half + n]
     outside = np.maximum(low - x, x - high_c) > high_c - low  # off the band by more than the band is wide
     high = x - level
-    scale = max(float(MAD_TO_SIGMA * np.median(np.abs(high - np.median(high)))), _step_floor_c(x))
+    scale = max(float(MAD_TO_SIGMA * np.median(np.abs(high - np.median(high)))), _trimmed_rms(high), _step_floor_c(x))
     if not scale > 0:  # a constant reading has nothing to be off from
         return Glitches(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
                         bound, settings)
