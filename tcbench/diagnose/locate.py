@@ -23,7 +23,10 @@ number of tests:
   the white-FM equivalent degrees of freedom of the overlapping estimator
   ``edf = (3 (N - 1) / (2 m) - 2 (N - 2) / N) 4 m^2 / (4 m^2 + 5)``, Bonferroni over the taus.
   When sigma is estimated from the data, its own relative variance (about 7 / N for the MAD of
-  first differences) widens the bound.
+  first differences) widens the bound. A record with gaps (bursts, a logging gap, samples given
+  zero weight) is tested inside its continuous segments: second differences never span a gap,
+  they are pooled over the segments and the degrees of freedom summed, and the taus stop at what
+  the longest segment holds.
 
 ``sigma`` (per-sample white-noise standard deviation, unit of ``r``) is ``white_sigma`` when given,
 otherwise ``1.4826 MAD(diff(r)) / sqrt(2)``, which drift and steps barely move. The false-alarm
