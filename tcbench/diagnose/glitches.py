@@ -92,10 +92,16 @@ def _step_floor_c(temp_c: np.ndarray) -> float:
     return 0.5 * float(np.median(d)) if d.size else 0.0
 
 
-def _trimmed_rms(high: np.ndarray) -> float:
-    """RMS of ``high`` without its largest 1 % (the glitches among them): the noise of a reading
-    on a lattice, where most readings equal their neighbours' median and the MAD reads 0."""
-    a = np.abs(high)
+def _none(bound: float, settings: OutlierSettings) -> Glitches:
+    """No glitch found."""
+    empty = np.zeros(0)
+    return Glitches(np.zeros(0, dtype=np.int64), empty, empty, empty, empty, 0.0, bound, settings)
+
+
+def _trimmed_rms(departure: np.ndarray) -> float:
+    """RMS of ``departure`` without its largest 1 % (the glitches among them): the noise of a
+    reading on a lattice, where most readings equal their neighbours' median and the MAD reads 0."""
+    a = np.abs(departure)
     return float(np.sqrt(np.mean(np.square(a[a <= np.quantile(a, TRIM_QUANTILE)]))))
 
 
@@ -122,23 +128,22 @@ def find_glitches(t_s: np.ndarray, temp_c: np.ndarray,
     n, window = x.size, settings.window_samples
     bound = z_bound(n, settings)
     if n < window:
-        empty = np.zeros(0)
-        return Glitches(np.zeros(0, dtype=np.int64), empty, empty, empty, empty, 0.0, bound, settings)
+        return _none(bound, settings)
     footprint = np.ones(window, dtype=bool)
     half = window // 2
     footprint[half] = False  # the level a reading is judged against does not contain it
     extended = _extended(x, half)
     level = median_filter(extended, footprint=footprint, mode="nearest")[half:half + n]
     skip = min(settings.max_run_samples, half - 1)  # the other samples of a glitch run are left out of the band
-    low = rank_filter(extended, skip, footprint=footprint, mode="nearest")[half:half + n]
-    high_c = rank_filter(extended, -skip - 1, footprint=footprint, mode="nearest")[half:half + n]
-    outside = np.maximum(low - x, x - high_c) > high_c - low  # off the band by more than the band is wide
-    high = x - level
-    scale = max(float(MAD_TO_SIGMA * np.median(np.abs(high - np.median(high)))), _trimmed_rms(high), _step_floor_c(x))
+    band_low = rank_filter(extended, skip, footprint=footprint, mode="nearest")[half:half + n]
+    band_high = rank_filter(extended, -skip - 1, footprint=footprint, mode="nearest")[half:half + n]
+    outside = np.maximum(band_low - x, x - band_high) > band_high - band_low  # off by more than the band is wide
+    departure = x - level
+    mad = float(MAD_TO_SIGMA * np.median(np.abs(departure - np.median(departure))))
+    scale = max(mad, _trimmed_rms(departure), _step_floor_c(x))
     if not scale > 0:  # a constant reading has nothing to be off from
-        return Glitches(np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), 0.0,
-                        bound, settings)
-    z = high / scale
+        return _none(bound, settings)
+    z = departure / scale
     edges = np.diff(np.concatenate(([0], ((np.abs(z) > bound) & outside).astype(np.int8), [0])))
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     short = (ends - starts) <= settings.max_run_samples
