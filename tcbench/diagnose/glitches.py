@@ -77,9 +77,10 @@ class Glitches:
                     "level_c": [round(float(v), 4) for v in self.level_c[keep]], "unit": "degC"},
             where={"time_s": times},
             evidence={"robust_z": [round(float(z), 2) for z in self.z[keep]], "bound_z": round(self.bound, 3),
-                      "robust_sigma_c": self.scale_c, "false_alarm": self.settings.alpha,
-                      "test": f"|reading - running median of {self.settings.window_samples}| / (1.4826 MAD) above "
-                              "the Bonferroni bound for the record's samples, on the raw thermometer"},
+                      "robust_sigma": self.scale_c, "false_alarm": self.settings.alpha,
+                      "test": f"|reading - running median of {self.settings.window_samples}| / robust sigma (degC) "
+                              "above the Bonferroni bound for the record's samples, and off its neighbours' band by "
+                              "more than the band is wide, on the raw thermometer"},
             explanation=f"{self.count} thermometer reading(s) off the local level ({said}): " + EXPLANATION,
             confirm_with=CONFIRM_WITH,
         )
