@@ -10,7 +10,8 @@ import pytest
 
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.screens import AFTER_FIT, BEFORE_FIT, FINDINGS_ORDER, MODEL_ORDER, ThermometerScreen, smoothing
-from tcbench.diagnose.screens.base import AFTER, BEFORE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.base import AFTER, BEFORE, PREPARE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.glitches import GlitchScreen, glitches
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.diagnose.signals import DiagnosisData, prepare
 
@@ -71,16 +72,19 @@ def test_the_plans_hold_one_screen_per_detector_by_stage() -> None:
     assert all(s.stage == BEFORE for s in BEFORE_FIT) and all(s.stage == AFTER for s in AFTER_FIT)
     ids = [s.id for s in (*BEFORE_FIT, *AFTER_FIT)]
     assert ids == ["quantisation", "saturation", "variance", "outliers", "bias_instability", "variance"]
-    known = {*ids, ThermometerScreen.id}
-    assert set(FINDINGS_ORDER) == known and set(MODEL_ORDER) == known - {"bias_instability"}
+    known = {*ids, ThermometerScreen.id, GlitchScreen.id}
+    assert GlitchScreen.stage == ThermometerScreen.stage == PREPARE
+    # thermometer glitches are reported, not simulated: model.yaml carries no term for them
+    assert set(FINDINGS_ORDER) == known and set(MODEL_ORDER) == known - {"bias_instability", GlitchScreen.id}
 
 
 @pytest.mark.parametrize(("sensor", "seed"), [("gyro", 5), ("msra", 5), ("gyro", 11), ("msra", 11)])
 def test_no_screen_before_the_fit_finds_anything_on_a_control(sensor: str, seed: int) -> None:
     """Concealed controls (nothing hidden): a thermometer fine enough for the default smoothing, no output
-    grid, no clipping, a constant noise level (on the minimal model's residual) and no outlier, each
-    screen having run."""
+    grid, no clipping, a constant noise level (on the minimal model's residual), no outlier and no
+    thermometer glitch, each screen having run."""
     rec, _ = concealed_recording(sensor, None, seed)
+    assert glitches(rec).found.count == 0
     smooth = smoothing(rec)
     assert smooth.smooth_s == DEFAULTS.smoothing.default_window_s and not smooth.staircase
     data = prepare(rec, smooth_s=smooth.smooth_s)

@@ -106,8 +106,13 @@ def test_detector_requirements_name_the_record_value() -> None:
         "a temperature bump of width 1 degC needs a temperature span of 4 degC; this record spans 2.5 degC")
     assert why_no_allan(np.arange(50.0)) == (
         "the Allan deviation needs clusters of 10 samples at a tenth of the record (100 samples); this record has 50")
-    bursts = np.concatenate([np.arange(500.0), 1e4 + np.arange(500.0)])
-    assert "this one has 1 gap(s)" in why_no_allan(bursts)  # type: ignore[operator]
+    halves = np.concatenate([np.arange(500.0), 1e4 + np.arange(500.0)])
+    assert why_no_allan(halves) is None  # tested inside each segment
+    bursts = np.concatenate([k * 600.0 + np.arange(15.0) for k in range(40)])
+    assert why_no_allan(bursts) == (
+        "the Allan deviation needs clusters of 10 samples inside a continuous segment; the longest of this "
+        "record's 40 segments (gaps of more than five sample intervals: bursts, or samples given zero weight) "
+        "holds 15")
     assert why_no_steps(np.arange(3600.0)) is None and why_no_lines(np.arange(3600.0)) is None
 
 

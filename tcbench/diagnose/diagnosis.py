@@ -25,8 +25,10 @@ from tcbench.diagnose.crossval import Fit
 from tcbench.diagnose.design import DETERMINISTIC, Designer, Model
 from tcbench.diagnose.discover import why_untestable
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.glitches import repaired
 from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.locate import Mismatch, locate
+from tcbench.diagnose.outliers import without
 from tcbench.diagnose.plan import min_full_duration_s
 from tcbench.diagnose.reference import reference_fit
 from tcbench.diagnose.result import (
@@ -52,6 +54,7 @@ from tcbench.diagnose.screens import (
 )
 from tcbench.diagnose.screens.flicker import ID as FLICKER
 from tcbench.diagnose.screens.flicker import Flicker, flicker_evidence, flicker_test
+from tcbench.diagnose.screens.glitches import GlitchScreen, ThermometerGlitches, glitches
 from tcbench.diagnose.screens.outliers import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
 from tcbench.diagnose.screens.variance import relative_sigma
@@ -135,15 +138,22 @@ def diagnose(
     profile's corners can leave the output's model with less to work on (on the tofupilot chamber
     cycle, 7.5 s against 120 s made the final model 1.5x worse), while on a short record with
     nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
-    paid for like a term, is the judge the diagnosis uses for everything else."""
+    paid for like a term, is the judge the diagnosis uses for everything else.
+
+    Thermometer glitches (:mod:`~tcbench.diagnose.glitches`) are found first on the raw reading:
+    held at the previous reading before anything is smoothed, their samples given zero weight and
+    reported (``thermometer_glitches``)."""
     settings = DEFAULTS if settings is None else settings
     min_duration_s = min_full_duration_s(settings) if min_duration_s is None else min_duration_s
     default_s = settings.smoothing.default_window_s
+    glitch = glitches(rec, settings.screens)  # thermometer glitches: held at the previous reading, zero weight
+    rec = repaired(rec, glitch.found.index)
     fitted = smoothing(rec, settings=settings)  # a coarse thermometer staircase widens the smoothing window
     if fitted.default_smooth_s >= default_s:
-        return _diagnose(rec, fitted, sensor, declared or {}, name, settings, min_duration_s)
+        return _diagnose(rec, fitted, glitch, sensor, declared or {}, name, settings, min_duration_s)
     # the two diagnoses are independent: one per core (same results as in turn, in about half the time)
-    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, s, sensor, declared or {}, name, settings, min_duration_s)
+    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, s, glitch, sensor, declared or {}, name, settings,
+                                                  min_duration_s)
                                for s in (fitted, smoothing(rec, default_s, settings)))
     # the default window is a model choice like a term: it must pay the open-world gain threshold
     sse = [d.final.rmse_heldout ** 2 * d.noise.samples for d in tried]
@@ -154,13 +164,18 @@ def diagnose(
     return best
 
 
-def _diagnose(rec: Recording, smooth: Smoothing, sensor: str | None, declared: dict[str, dict[str, float]],
-              name: str, settings: DiagnoseSettings, min_duration_s: float) -> Diagnosis:
-    """:func:`diagnose` with the thermometer smoothed as ``smooth`` says, stage by stage."""
+def _diagnose(rec: Recording, smooth: Smoothing, glitch: ThermometerGlitches, sensor: str | None,
+              declared: dict[str, dict[str, float]], name: str, settings: DiagnoseSettings,
+              min_duration_s: float) -> Diagnosis:
+    """:func:`diagnose` with the thermometer smoothed as ``smooth`` says, stage by stage; the
+    samples of the thermometer glitches found (``glitch``) are left out of every fit and test."""
     data = prepare(rec, sensor, smooth_s=smooth.smooth_s, min_duration_s=min_duration_s,
                    min_span_c=settings.data.min_span_c, min_samples=settings.data.min_samples)
-    start = ScreenInput(rec, data, base_model(declared), frozenset(declared),
-                        {ThermometerScreen.id: smooth})
+    prepared: dict[str, ScreenResult] = {ThermometerScreen.id: smooth}
+    if glitch.found.count:
+        prepared[GlitchScreen.id] = glitch
+    start = ScreenInput(rec, without(data, glitch.found.index), base_model(declared), frozenset(declared),
+                        prepared)
     before = run_screens(before_fit(settings), start)  # output grid, clipping, noise level, outliers: zero weight
     log.info("diagnosing %s: %d samples, white sigma %.4g %s", name or "recording", before.data.n,
              before.data.white_sigma, before.data.unit)

@@ -23,7 +23,10 @@ number of tests:
   the white-FM equivalent degrees of freedom of the overlapping estimator
   ``edf = (3 (N - 1) / (2 m) - 2 (N - 2) / N) 4 m^2 / (4 m^2 + 5)``, Bonferroni over the taus.
   When sigma is estimated from the data, its own relative variance (about 7 / N for the MAD of
-  first differences) widens the bound.
+  first differences) widens the bound. A record with gaps (bursts, a logging gap, samples given
+  zero weight) is tested inside its continuous segments: second differences never span a gap,
+  they are pooled over the segments and the degrees of freedom summed, and the taus stop at what
+  the longest segment holds.
 
 ``sigma`` (per-sample white-noise standard deviation, unit of ``r``) is ``white_sigma`` when given,
 otherwise ``1.4826 MAD(diff(r)) / sqrt(2)``, which drift and steps barely move. The false-alarm
@@ -39,7 +42,7 @@ import numpy as np
 from scipy.stats import chi2, norm
 
 from tcbench.diagnose.settings import DEFAULTS, LocateSettings
-from tcbench.sensors.segments import segments
+from tcbench.sensors.segments import bounds, segments, within_rate_hz
 from tcbench.signal.allan import allan_deviation
 
 N_FAMILIES = 5  # time spans, temperature bands, heating/cooling, soak/ramp, frequency band
@@ -269,19 +272,51 @@ class AllanExcess:
     first_over: int | None
 
 
+def _longest_run(t: np.ndarray) -> tuple[int, int]:
+    """Samples of the longest continuous segment of ``t`` and the number of gaps."""
+    if t.size == 0:
+        return 0, 0
+    seg = segments(t)
+    starts, stops = bounds(seg)
+    return int(np.max(stops - starts)), int(seg[-1])
+
+
 def why_no_allan(t: np.ndarray, min_samples: int = DEFAULTS.locate.min_allan_samples) -> str | None:
     """Why :func:`allan_excess` cannot test a residual sampled at ``t`` (its shortest tau
-    ``min_samples`` samples), or None."""
+    ``min_samples`` samples, inside one continuous segment), or None."""
     n = t.size
-    m_max = min(n // 10, (n - 1) // 2)
-    gaps = int(segments(t)[-1]) if n else 0
-    if gaps:
-        return (f"the Allan deviation needs a record without gaps; this one has {gaps} gap(s) of more than "
-                "five sample intervals (bursts, or samples given zero weight)")
-    if m_max < min_samples:
-        return (f"the Allan deviation needs clusters of {min_samples} samples at a tenth of the record "
-                f"({10 * min_samples} samples); this record has {n}")
-    return None
+    longest, gaps = _longest_run(t)
+    if min(n // 10, (longest - 1) // 2) >= min_samples:
+        return None
+    if gaps and (n - 1) // 2 >= min_samples and n // 10 >= min_samples:
+        return (f"the Allan deviation needs clusters of {min_samples} samples inside a continuous segment; the "
+                f"longest of this record's {gaps + 1} segments (gaps of more than five sample intervals: bursts, "
+                f"or samples given zero weight) holds {longest}")
+    return (f"the Allan deviation needs clusters of {min_samples} samples at a tenth of the record "
+            f"({10 * min_samples} samples); this record has {n}")
+
+
+def _edf(n: np.ndarray | int, m: np.ndarray) -> np.ndarray:
+    """White-FM equivalent degrees of freedom of the overlapping Allan variance of ``n`` samples at ``m``."""
+    return (3.0 * (n - 1) / (2.0 * m) - 2.0 * (n - 2) / n) * 4.0 * m**2 / (4.0 * m**2 + 5.0)
+
+
+def _pooled_allan(t: np.ndarray, r: np.ndarray, fs: float, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Allan deviation of ``r`` at ``m`` samples with the second differences taken inside each
+    continuous segment of ``t`` and pooled over them (never across a gap), and its degrees of
+    freedom (the segments' summed); a segment shorter than ``2 m + 1`` samples skips that ``m``."""
+    starts, stops = bounds(segments(t))
+    sums, terms, edf = np.zeros(m.size), np.zeros(m.size), np.zeros(m.size)
+    for a, b in zip(starts, stops, strict=True):
+        fits = np.flatnonzero(2 * m + 1 <= b - a)
+        if fits.size == 0:
+            continue
+        ad = allan_deviation(r[a:b], fs, m[fits] / fs)
+        sums[fits] += ad.adev**2 * 2.0 * ad.tau_s**2 * ad.n_terms
+        terms[fits] += ad.n_terms
+        edf[fits] += _edf(b - a, m[fits])
+    tau_s = m / fs
+    return np.sqrt(sums / (2.0 * tau_s**2 * terms)), edf
 
 
 def allan_excess(
@@ -289,27 +324,37 @@ def allan_excess(
     coloured: np.ndarray | None = None, min_samples: int = DEFAULTS.locate.min_allan_samples,
 ) -> AllanExcess | None:
     """The frequency-band test (module doc) at level ``alpha``; None when the residual is too
-    short for tau >= ``min_samples`` samples at N / 10, or made of bursts (an Allan deviation
-    across gaps means nothing). ``coloured`` is a known non-white noise (one
+    short for tau >= ``min_samples`` samples at N / 10. A record with gaps (bursts, a logging
+    gap, samples given zero weight) is tested inside its continuous segments, the second
+    differences pooled over them (an Allan deviation across a gap means nothing), its taus up to
+    what its longest segment holds. ``coloured`` is a known non-white noise (one
     realisation, per sample) whose Allan variance is added to the white line."""
     n = r.size
-    fs = (n - 1) / (t[-1] - t[0])
-    m_max = min(n // 10, (n - 1) // 2)
     if why_no_allan(t, min_samples) is not None:
         return None
+    longest, gaps = _longest_run(t)
+    m_max = min(n // 10, (longest - 1) // 2)
     m = min_samples * 2 ** np.arange(int(np.log2(m_max / min_samples)) + 1)
-    ad = allan_deviation(r, fs, m / fs)
-    m = np.round(ad.tau_s * fs)
-    edf = (3.0 * (n - 1) / (2.0 * m) - 2.0 * (n - 2) / n) * 4.0 * m**2 / (4.0 * m**2 + 5.0)
+    if gaps:
+        fs = within_rate_hz(t)
+        tau_s, (adev, edf) = m / fs, _pooled_allan(t, r, fs, m)
+        coloured_adev = _pooled_allan(t, coloured, fs, m)[0] if coloured is not None else None
+    else:
+        fs = (n - 1) / (t[-1] - t[0])
+        ad = allan_deviation(r, fs, m / fs)
+        tau_s, adev = ad.tau_s, ad.adev
+        m = np.round(ad.tau_s * fs)
+        edf = _edf(n, m)
+        coloured_adev = allan_deviation(coloured, fs, ad.tau_s).adev if coloured is not None else None
     a = alpha / m.size
     bound = chi2.isf(a, edf) / edf
     if estimated:
         bound = bound * np.exp(norm.isf(a) * np.sqrt(SIGMA2_REL_VAR / n))
     white = sigma / np.sqrt(m)
-    if coloured is not None:
-        white = np.sqrt(white**2 + allan_deviation(coloured, fs, ad.tau_s).adev ** 2)
-    over = np.flatnonzero(ad.adev**2 / white**2 > bound)
-    return AllanExcess(ad.tau_s, ad.adev, white, np.sqrt(bound), int(over[0]) if over.size else None)
+    if coloured_adev is not None:
+        white = np.sqrt(white**2 + coloured_adev**2)
+    over = np.flatnonzero(adev**2 / white**2 > bound)
+    return AllanExcess(tau_s, adev, white, np.sqrt(bound), int(over[0]) if over.size else None)
 
 
 def _frequency_band(

@@ -6,7 +6,7 @@ temperature, with the located mismatch shaded), :func:`plot_allan` (Allan deviat
 residuals against the white-noise line and the flagging bound) and :func:`plot_evidence` (each
 candidate effect's penalised held-out gain against the detection threshold) and
 :func:`plot_spectrum` (spectrum of both residuals: ``scipy.signal.periodogram``
-for a continuous record, Lomb-Scargle for one made of bursts). :func:`plot_output` (the output
+for a continuous record or one with a few gaps, Lomb-Scargle for one made of bursts). :func:`plot_output` (the output
 and the thermometer against time) is written when the diagnosis's series carries the output.
 
 Every finding of ``report.json`` ``effects`` is marked from its ``where``, whatever its id:
@@ -27,11 +27,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from scipy.signal import lombscargle, periodogram
+from scipy.signal import periodogram
 
 from tcbench.diagnose.attribute import Evidence
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.locate import AllanExcess
+from tcbench.diagnose.lomb import lombscargle_chunked
 from tcbench.sensors.segments import segments, within_rate_hz
 
 BEFORE_COLOUR, AFTER_COLOUR = "tab:red", "tab:blue"
@@ -49,6 +50,7 @@ FINDING_COLOURS = ("tab:green", "tab:purple", "tab:orange", "tab:brown", "tab:pi
 SPECTRUM_POINTS = 4000  # faint points per spectrum (every k-th frequency)
 SPECTRUM_BINS = 160  # log-spaced frequency bins of the averaged periodogram
 LS_FREQUENCIES = 3000  # frequencies of the Lomb-Scargle periodogram of a burst record
+GAP_FILL_MAX = 2.0  # a gapped record whose clock holds at most this many slots per sample is zero-filled
 NARROW_BAND = 0.8  # a temperature band narrower than this share of the range is also shaded
 
 
@@ -153,9 +155,13 @@ def mark_levels(ax: plt.Axes, d: Diagnosis, unit: str) -> int:
 
 def residual_spectrum(t_s: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
     """One-sided spectrum of a residual: ``(frequency Hz, power, method)``. A continuous record
-    takes ``scipy.signal.periodogram`` (density, unit^2/Hz, at its median sample interval); a
-    record of bursts takes the Lomb-Scargle periodogram on log-spaced frequencies from one over
-    its span to half its within-burst rate, scaled to the same density for white noise."""
+    takes ``scipy.signal.periodogram`` (density, unit^2/Hz, at its median sample interval). A
+    record whose gaps hold a small part of its span (a logging gap, samples given zero weight)
+    takes the same periodogram on its within-segment clock with zeros in the gaps, scaled by the
+    share of the clock it fills: memory and time of the span, not of samples x frequencies. A
+    record of bursts (gaps over :data:`GAP_FILL_MAX` of the samples) takes the Lomb-Scargle
+    periodogram on log-spaced frequencies from one over its span to half its within-burst rate,
+    scaled to the same density for white noise, evaluated in chunks of bounded memory."""
     t = np.asarray(t_s, dtype=np.float64)
     x = np.asarray(r, dtype=np.float64) - float(np.mean(r))
     if segments(t)[-1] == 0:
@@ -163,8 +169,13 @@ def residual_spectrum(t_s: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.nd
         f, p = periodogram(x, fs=fs, detrend="constant")
         return f[1:], p[1:], "periodogram"
     fs = within_rate_hz(t)
+    slot = np.rint((t - t[0]) * fs).astype(np.int64)
+    if slot[-1] + 1 <= GAP_FILL_MAX * t.size:
+        filled = np.bincount(slot, weights=x, minlength=int(slot[-1]) + 1)
+        f, p = periodogram(filled, fs=fs, detrend=False)
+        return f[1:], p[1:] * (filled.size / t.size), "periodogram, gaps zero-filled"
     f = np.geomspace(1.0 / float(t[-1] - t[0]), 0.5 * fs, LS_FREQUENCIES)
-    power = lombscargle(t, x, 2.0 * np.pi * f)  # about the variance at every frequency for white noise
+    power = lombscargle_chunked(t, x, 2.0 * np.pi * f)  # about the variance at every frequency for white noise
     return f, power * (2.0 / fs), "Lomb-Scargle"
 
 

@@ -179,8 +179,10 @@ class Diagnosis:
                 f"({len(self.remaining)} region(s) or band(s), see remaining_mismatch)")
         spikes = (f"; {self.outliers.count} isolated outlier sample(s) given zero weight (see outliers)"
                   if self.outliers is not None and self.outliers.count else "")
+        spikes += "".join(f"; {e.params['count']} thermometer glitch(es) given zero weight (see {e.id})"
+                          for e in self.effects if e.id == "thermometer_glitches")
         library = [e.id for e in self.effects if e.library]
-        beyond = [f"{e.id} ({e.shape})" for e in self.effects if not e.library and e.id != "outliers"]
+        beyond = [f"{e.id} ({e.shape})" for e in self.effects if not e.library and e.shape != "outliers"]
         if beyond:
             spikes = f"; beyond the library: {', '.join(beyond)}{spikes}"
         if not library:

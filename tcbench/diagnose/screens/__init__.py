@@ -1,7 +1,8 @@
 """The screens of a diagnosis (:mod:`~tcbench.diagnose.screens.base`): the tests whose structure is
 not an additive term of the mean model, by stage, and the order their parts take in the report.
 
-- ``prepare``: the thermometer's quantisation, which sets the smoothing window;
+- ``prepare``: thermometer glitches (held at the previous reading, their samples given zero
+  weight) and the thermometer's quantisation, which sets the smoothing window;
 - ``before`` the fit (:func:`before_fit`): the output's quantisation and saturation (clipped samples
   get zero weight), the noise level (the first variance test) and isolated outliers;
 - ``after`` the final fit (:func:`after_fit`): flicker (with the recheck of the kept effects) and
@@ -36,7 +37,7 @@ def after_fit(settings: DiagnoseSettings = DEFAULTS) -> tuple[Screen, ...]:
 BEFORE_FIT: tuple[Screen, ...] = before_fit()
 AFTER_FIT: tuple[Screen, ...] = after_fit()
 # report.json ``effects``: after the mean model's terms, in this order
-FINDINGS_ORDER = ("bias_instability", "outliers", "saturation", "quantisation", "thermometer_quantisation", "variance")
+FINDINGS_ORDER = ("bias_instability", "outliers", "thermometer_glitches", "saturation", "quantisation", "thermometer_quantisation", "variance")
 # model.yaml, after the fitted terms, the declared ones and the white noise: the noise's level first
 # (a changing one replaces white_noise), then the converter's grid (which takes its q^2/12 out of
 # the white noise), the clip levels (the final stage, as simulate applies them) and the thermometer
