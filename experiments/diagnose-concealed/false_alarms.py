@@ -1,7 +1,8 @@
 """False alarms of ``tcbench diagnose`` on controls of every form: minutes to days, 0.5-100 Hz,
 continuous and in bursts.
 
-Each control is the minimal model plus white noise (:func:`tcbench.datasets.controls.control_recording`:
+Each control, diagnosed as ``tcbench diagnose`` does (a record over the row budget on its bin means,
+:mod:`tcbench.diagnose.native_rate`), is the minimal model plus white noise (:func:`tcbench.datasets.controls.control_recording`:
 the open-world controls' staircase, device and thermometer, sized to the record's length and
 sampled at its rate), so any finding in ``report.json`` ``effects`` is a false alarm (the rule of
 :func:`tcbench.datasets.open_world_scoring.score` for a control). A diagnosis that raises is a crash,
@@ -27,7 +28,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from tcbench.datasets.controls import Form, bursts_for, control_recording
-from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.native_rate import diagnose_any_rate
 from tcbench.diagnose.signals import DiagnosisDataError
 
 PROOF_SEED = 45_300_000  # 45 000 000 + i was the first proof run (README), before the thermometer window rule
@@ -82,7 +83,7 @@ def one(sensor: str, form: Form, seed: int) -> dict[str, Any]:
     }
     t0 = time.perf_counter()
     try:
-        report = diagnose(rec, sensor=sensor, name=f"{sensor}-control-{seed}").to_json()
+        report = diagnose_any_rate(rec, sensor=sensor, name=f"{sensor}-control-{seed}").to_json()
     except DiagnosisDataError as exc:
         short = truth["span_s"] < MIN_DURATION_S or truth["samples"] < 200
         return row | {"outcome": "refused" if short else "crash", "found": "", "seconds": time.perf_counter() - t0,
