@@ -22,9 +22,10 @@ from pathlib import Path
 
 import numpy as np
 from common import add_json, command_line, environment, environment_line, parser_for, write_json
+from tcbench.data_paths import REAL_DATA
 
 DEFAULT_JSON = Path(__file__).with_name("import_ulog_1khz.json")
-SAMPLE = Path(__file__).resolve().parents[1] / "data" / "real" / "px4_ulog_samples" / "sample_log_small.ulg"
+SAMPLE = REAL_DATA / "px4_ulog_samples" / "sample_log_small.ulg"
 
 
 def make_log(path: Path, rows: int) -> int:

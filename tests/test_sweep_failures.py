@@ -114,7 +114,7 @@ def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, 
     assert run.returncode == 1, run.stdout + run.stderr
     assert "Traceback" not in run.stderr
     assert statuses(tmp_path) == {"sphere-7d": ["FAILED"], "sphere-2d": ["FINISHED"]}
-    assert "MemoryError" in run.stdout and "TCBENCH_JOB_MEMORY_MB" in run.stdout
+    assert "MemoryError" in run.stdout and "TCBENCH_JOB_MEMORY_MB" in run.stdout + run.stderr  # the log line: stderr
 
 
 def running_now(cwd: Path) -> dict[str, int]:
