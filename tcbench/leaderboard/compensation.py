@@ -42,14 +42,10 @@ from tcbench.tables import markdown_table
 from tcbench.compensation.data import DEFAULT_TIER
 from tcbench.compensation.scoring import FLAGS, METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.stats import bootstrap_median_ci, paired_p_value, with_failures
+from tcbench.leaderboard.labels import FLAG_SHORT, SHORT
+from tcbench.leaderboard.labels import METRICS as METRIC_LABELS
 
 METRICS = METRIC_NAMES
-SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
-         "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug", "drift_dph": "drift_dph",
-         "arw_1s_deg_per_sqrt_h": "arw_1s", "bias_instability_dph": "bi_dph", "rms_error_dph": "rms_dph",
-         "bandwidth_hz": "bw_hz", "drift_ug": "drift_ug", "hysteresis_ug": "hyst_ug",
-         "temp_slope_ug_per_c": "slope_ug_per_c"}
-FLAG_SHORT = {"allan_min_interior": "bi_is_floor"}  # the share of runs (mean over their test records)
 NO_GAIN = ("halfg_error_ug", "bandwidth_hz")  # no raw value (probe), or not a figure to improve
 HIGHER_IS_BETTER = ("bandwidth_hz",)  # a failed run counts as the lowest value here, the highest elsewhere
 
@@ -409,9 +405,7 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
     values = done[primary].to_numpy(float) if primary in done else np.array([])
     if np.any(np.isfinite(values) & (values > 0)):  # log scale needs a positive value to show
         ax.set_yscale("log")
-    from tcbench.leaderboard.labels import METRICS as LABELS  # labels reads this module's column names
-
-    what, _, unit = LABELS.get(primary, primary).rpartition(", ")
+    what, _, unit = METRIC_LABELS.get(primary, primary).rpartition(", ")
     ax.set_ylabel(f"{what} ({unit})" if what else unit)
     ax.set_title(f"{board.task}: {what or unit} per restart (line: median)")
     ax.grid(True, which="both", axis="y", alpha=0.3)

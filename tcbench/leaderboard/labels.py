@@ -7,7 +7,14 @@ of the optimisation boards, the BBOB tables and the real-IMU board. The board pa
 from __future__ import annotations
 
 from tcbench.compensation.scoring import METRIC_NAMES, TRAIN_RMSE
-from tcbench.leaderboard.compensation import FLAG_SHORT, SHORT
+
+# the board's short column name of each metric and flag (tcbench.leaderboard.compensation)
+SHORT = {"sf_variation_ppm": "sf_ppm", "bias_variation_ug": "bias_ug", "halfg_error_ug": "halfg_ug", "zb_after_30min_ug": "zb30_ug",
+         "zb_after_20min_ug": "zb20_ug", "zb_zero_start_ug": "zb0_ug", "drift_dph": "drift_dph",
+         "arw_1s_deg_per_sqrt_h": "arw_1s", "bias_instability_dph": "bi_dph", "rms_error_dph": "rms_dph",
+         "bandwidth_hz": "bw_hz", "drift_ug": "drift_ug", "hysteresis_ug": "hyst_ug",
+         "temp_slope_ug_per_c": "slope_ug_per_c"}
+FLAG_SHORT = {"allan_min_interior": "bi_is_floor"}  # the share of runs (mean over their test records)
 
 # every metric of METRIC_NAMES and the training RMSEs: what it measures, its unit
 METRICS = {
