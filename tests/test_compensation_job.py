@@ -8,6 +8,7 @@ import pickle
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 
@@ -101,3 +102,23 @@ def test_a_job_without_a_learner_fails_with_one_line(workdir: Path) -> None:
     c = {**_job(*QUICK), "learner": None}
     failure = run_job(c)
     assert isinstance(failure, JobFailure) and failure.user and failure.error.startswith("learner: ")
+
+
+def test_a_null_recordings_seed_makes_restart_i_meet_draw_i(builds: list[str]) -> None:
+    """``task.recordings_seed=null``: the job trains and tests on draw ``seed`` — the very runs a job
+    with ``task.recordings_seed=<seed>`` meets — and tags its draw, so a board pairs it with its limits
+    on the same draw (:mod:`tcbench.leaderboard.paired`); a fixed seed tags that draw whatever the seed."""
+    kind = kind_of(_job(*QUICK))
+    drawn = kind.job(_job(*QUICK, "task.recordings_seed=null", "seed=4"))
+    fixed = kind.job(_job(*QUICK, "task.recordings_seed=4", "seed=0"))
+    other = kind.job(_job(*QUICK, "task.recordings_seed=null", "seed=5"))
+    assert drawn.names.tags["tcbench.draw"] == "4" and fixed.names.tags["tcbench.draw"] == "4"
+    assert other.names.tags["tcbench.draw"] == "5"
+    for job in (drawn, fixed, other):
+        job.env.reset(seed=0)
+    same = [np.array_equal(a.recording.output, b.recording.output)
+            for a, b in zip(drawn.env.data.train + drawn.env.data.test, fixed.env.data.train + fixed.env.data.test,
+                            strict=True)]
+    assert all(same)
+    assert not np.array_equal(drawn.env.data.test[0].recording.output, other.env.data.test[0].recording.output)
+    assert drawn.names.task == fixed.names.task == "msra_zerobias-dev0"  # one board: the draws pair on it

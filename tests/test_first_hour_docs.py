@@ -79,6 +79,6 @@ def test_a_board_says_why_p_vs_next_is_a_dash_and_labels_its_plot(tmp_path: Path
     monkeypatch.setattr(Axes, "set_ylabel", lambda self, label, *a, **k: said.append(label))
     paths = comp.write(board, tmp_path, "a test")
     text = paths["md"].read_text(encoding="utf-8")
-    assert "| – |" in text and "p_vs_next is – where the row and the next share fewer than 6 seeds" in text
+    assert "| – |" in text and "p_vs_next is – where the row and the next share fewer than 6 pairs" in text
     assert "6" in column_label("p_vs_next") and "–" in column_label("p_vs_next")
     assert said == ["zero-bias stability from power-on (µg)"]

@@ -35,7 +35,9 @@ def test_quickstart_end_to_end(workdir: Path, capsys: pytest.CaptureFixture[str]
     table = out.split("Leaderboard msra_zerobias-dev0")[1].split("== 2.")[0]
     methods = [ln.split()[1] for ln in table.splitlines() if re.match(r"\s+\d+\s", ln)]
     assert sorted(methods) == ["IFA-BP-gd", "lagpoly", "memoriser", "oracle", "poly3", "poly3_runs", "raw"]
-    assert re.search(r"\n\s+\d+\s+oracle\s+1\s+0\s+\S+\s+–\s+1\s", table), table
+    assert re.search(r"\n\s+\d+\s+oracle\s+2\s+0\s+\S+\s+\S+–\S+\s+1\s", table), table  # its own draws' ratio: 1
+    runs = [ln.split()[2] for ln in table.splitlines() if re.match(r"\s+\d+\s", ln)]
+    assert runs == ["2"] * 7  # every row on the trainings' two draws
     assert "physical limit" in table
     assert "IFA-BP-gd = the paper's method" in table and "gradient descent (gd)" in table  # the legend under it
 
@@ -65,7 +67,7 @@ def test_quickstart_end_to_end(workdir: Path, capsys: pytest.CaptureFixture[str]
     runs = client.search_runs([exp.experiment_id])
     assert all(r.info.status == "FINISHED" for r in runs)
     kinds = sorted(r.data.tags["tcbench.kind"] for r in runs)
-    assert kinds == ["compensation"] * 8 + ["diagnosis"]
+    assert kinds == ["compensation"] * 14 + ["diagnosis"]  # seven rows on two draws each
     trained = [r for r in runs if r.data.tags["tcbench.method"] == "IFA-BP-gd"]
     assert {r.data.params["budget"] for r in trained} == {"60"} and {r.data.params["learner.epochs"] for r in trained} == {"100"}
     assert len({r.data.tags["tcbench.sweep_id"] for r in runs}) == 1

@@ -26,7 +26,8 @@ LIMITS = ("oracle", "oracle_thermometer")
 
 
 def device_table(boards: Path) -> pd.DataFrame:
-    """One row per device: the drawn physics, then each method's median drift over the limit's."""
+    """One row per device: the drawn physics, then each method's drift over the thermometer-limited
+    oracle's on the same draws (the board's ``x_thermo``)."""
     rows = []
     next_run = [p for p in boards.glob("accel_chamber-dev*.csv") if "." not in p.stem]  # tier boards: <task>.<tier>
     for path in sorted(next_run, key=lambda p: int(re.findall(r"dev(\d+)", p.stem)[0])):
@@ -38,11 +39,11 @@ def device_table(boards: Path) -> pd.DataFrame:
                                   "hysteresis_mg": draws["hysteresis_mg"],
                                   "raw_ug": drift.get("raw"), "thermo_limit_ug": drift.get("oracle_thermometer")}
         methods = [m for m in drift.index if m not in LIMITS and m != "raw"]
-        for m in methods:
-            row[f"x_{m}"] = drift[m] / drift["oracle_thermometer"]
+        for m in methods:  # the board's ratio, taken draw by draw (tcbench.leaderboard.paired)
+            row[f"x_{m}"] = board.loc[m, "x_thermo"]
         best = drift[methods].idxmin()
         row["best"] = best
-        row["best_x_thermo"] = drift[best] / drift["oracle_thermometer"]
+        row["best_x_thermo"] = board.loc[best, "x_thermo"]
         rows.append(row)
     return pd.DataFrame(rows)
 

@@ -18,22 +18,22 @@ tcbench run -m experiment=accel_chamber "${common[@]}"
 tcbench run -m task=accel_chamber learner=elman optimiser=bas 'seed=range(10)' budget=510 \
   tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=raw,memoriser,lagpoly,model optimiser=none \
-  tracking.experiment=accel-chamber "${common[@]}"
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=poly learner.form=bias,bias_rate \
-  optimiser=none tracking.experiment=accel-chamber "${common[@]}"
-# The limits over 30 draws of the cycles (recordings drawn from the run seed), each device.
+  optimiser=none 'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
+# The limits on the same 30 draws of the cycles (restart i on draw i), each device.
 tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=oracle,oracle_thermometer optimiser=none \
-  'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
 # The replay tier on device 0, the diagnostic the boards stood on before power-ons: the test cycles
 # replay the training cycles' power-on with new noise.
 tcbench run -m task=accel_chamber task.split=replay learner=raw,memoriser,lagpoly,model optimiser=none \
-  tracking.experiment=accel-chamber "${common[@]}"
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber task.split=replay learner=poly learner.form=bias,bias_rate optimiser=none \
-  tracking.experiment=accel-chamber "${common[@]}"
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber task.split=replay learner=bp learner.training=lm optimiser=ifa 'seed=range(4)' \
   tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber task.split=replay learner=oracle,oracle_thermometer optimiser=none \
-  'seed=range(30)' task.recordings_seed=null tracking.experiment=accel-chamber "${common[@]}"
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment accel-chamber --sweep "$sweep" --out "$out" overwrite=true
 python "$here/devices.py" --boards "$out"

@@ -16,15 +16,15 @@ tcbench run -m experiment=paper_ifa_bp "${common[@]}"
 # the baselines on the default tier (next_run) and on the replay (the test runs replay the training runs'
 # power-on with new noise: what the boards measured before power-ons, for the seed claims' contrast)
 tcbench run -m task=msra_zerobias,msra_fulltemp task.split=next_run,replay learner=raw,memoriser,lagpoly,poly \
-  optimiser=none tracking.experiment=paper-ifa-bp "${common[@]}"
+  optimiser=none 'seed=range(30)' tracking.experiment=paper-ifa-bp "${common[@]}"
 # the cubic fitted within runs (a constant per power-on: its turn-on bias), on both tiers
 tcbench run -m task=msra_zerobias,msra_fulltemp task.split=next_run,replay learner=poly learner.offsets=per_run \
-  optimiser=none tracking.experiment=paper-ifa-bp "${common[@]}"
-# the limits over 30 draws of the runs (recordings drawn from the run seed), on both tiers; one task per
-# command: Hydra refuses a task.* override that does not sweep beside a sweep of task=
+  optimiser=none 'seed=range(30)' tracking.experiment=paper-ifa-bp "${common[@]}"
+# the limits on the same 30 draws (restart i on draw i: task.recordings_seed null, the default), on both tiers;
+# one task per command: Hydra refuses a task.* override that does not sweep beside a sweep of task=
 for task in msra_zerobias msra_fulltemp; do
   tcbench run -m task=$task task.split=next_run,replay learner=oracle,oracle_thermometer optimiser=none 'seed=range(30)' \
-    task.recordings_seed=null tracking.experiment=paper-ifa-bp "${common[@]}"
+    tracking.experiment=paper-ifa-bp "${common[@]}"
 done
 # IFA-BP on the replay tier
 for task in msra_zerobias msra_fulltemp; do
@@ -32,8 +32,8 @@ for task in msra_zerobias msra_fulltemp; do
     budget=510 tracking.experiment=paper-ifa-bp "${common[@]}"
 done
 # the cubic with the networks' inputs on zero bias: [T, dT/dt] (poly3_rate)
-tcbench run task=msra_zerobias learner=poly learner.form=bias_rate optimiser=none tracking.experiment=paper-ifa-bp \
-  "${common[@]}"
+tcbench run -m task=msra_zerobias learner=poly learner.form=bias_rate optimiser=none 'seed=range(30)' \
+  tracking.experiment=paper-ifa-bp "${common[@]}"
 # Table 2 against the gradient-descent budget: one 300 000-epoch training per seed, scored after
 # 1e3, 3e3, 1e4, 3e4, 1e5 epochs on the way (learner.checkpoints); IFA's search at the default
 # 1 000 evaluations (the sweep above uses 510)

@@ -98,20 +98,31 @@ def median_table(runs: pd.DataFrame, task: str, methods: list[str]) -> pd.DataFr
     return pd.DataFrame(rows)
 
 
-def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:  # noqa: C901
-    """The paper's claims, each judged on the best-of-N run and on the median over restarts."""
+def worst_test_gains(runs: pd.DataFrame, task: str, metric: str, method: str) -> pd.Series:
+    """Each restart's gain against raw on its own test runs (raw as the run logged it, on the same
+    draw), the worse of the two test datasets; indexed by seed."""
+    g = runs[(runs["task_name"] == task) & (runs["method"] == method)]
+    cols = [(f"test{i}.raw_{metric}", f"test{i}.{metric}") for i in (1, 2)]
+    if g.empty or any(c not in g for pair in cols for c in pair):
+        return pd.Series(dtype=float)
+    gains = np.column_stack([g[raw].to_numpy(float) / g[after].to_numpy(float) for raw, after in cols])
+    return pd.Series(gains.min(axis=1), index=g["seed"].to_numpy())
+
+
+def _interval_verdict(low: float, high: float, need: float) -> str:
+    """A target met when its interval says so: "yes" when the whole interval is at or above it, "no"
+    when it is all below, "undecided" when it spans it."""
+    if not np.isfinite(low):
+        return "not run"
+    return "yes" if low >= need else "no" if high < need else f"undecided (interval spans {need:g}x)"
+
+
+def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:
+    """The paper's claims: each gain judged on the median over restarts (each restart's gain on its
+    own draw, with a bootstrap interval: met when the interval says so) and, for the record, on the
+    paper's pick (best of N by training RMSE: one run, not a test); "IFA better than FA" by a
+    paired Wilcoxon test over the seeds (the draws) both ran."""
     out = []
-
-    def gain(task: str, metric: str, method: str, how: str) -> float:
-        g = runs[(runs["task_name"] == task) & (runs["method"] == method)]
-        r = runs[(runs["task_name"] == task) & (runs["method"] == "raw")]
-        if g.empty or r.empty:
-            return float("nan")
-        after = [float(_best(g)[f"test{i}.{metric}"]) if how == "best" else float(np.median(g[f"test{i}.{metric}"]))
-                 for i in (1, 2)]
-        before = [float(r[f"test{i}.raw_{metric}"].iloc[0]) for i in (1, 2)]
-        return float(min(b / a for a, b in zip(after, before, strict=True)))
-
     for claim, task, metric, need in [
         (">10x zero-bias stability (each row of Table 1)", "msra_zerobias", "zb_after_30min_ug", 10.0),
         (">10x zero-bias stability (each row of Table 1)", "msra_zerobias", "zb_after_20min_ug", 10.0),
@@ -119,15 +130,20 @@ def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:  # noqa: C901
         (">70x scale-factor variation", "msra_fulltemp", "sf_variation_ppm", 70.0),
         ("~1000x bias variation (>= 300x)", "msra_fulltemp", "bias_variation_ug", 300.0),
     ]:
-        for how in ("best", "median"):
-            g = gain(task, metric, ifa, how)
-            verdict = "yes" if g >= need else ("no" if np.isfinite(g) else "not run")
-            sel = runs[(runs["task_name"] == task) & (runs["method"] == ifa)]
-            if verdict == "yes" and task == "msra_fulltemp" and not sel.empty:
-                probe = float(_best(sel)["halfg_error_ug"]) if how == "best" else float(sel["halfg_error_ug"].median())
-                verdict += f" on Table 2, but ±0.5 g error {_fmt(probe)} µg"
-            out.append({"claim": claim, "metric": metric, "selection": f"{ifa} {how}", "worst-test gain": _fmt(g),
-                        "reproduced": verdict})
+        gains = worst_test_gains(runs, task, metric, ifa)
+        sel = runs[(runs["task_name"] == task) & (runs["method"] == ifa)]
+        low, high = bootstrap_median_ci(gains.to_numpy())
+        median = float(np.median(gains)) if gains.size else float("nan")
+        verdict = _interval_verdict(low, high, need) if gains.size > 1 else ("not run" if gains.empty else "one run")
+        if verdict == "yes" and task == "msra_fulltemp":
+            verdict += f" on Table 2, but ±0.5 g error {_fmt(float(sel['halfg_error_ug'].median()))} µg"
+        out.append({"claim": claim, "metric": metric, "selection": f"{ifa} median over {gains.size} restarts",
+                    "worst-test gain": f"{_fmt(median)} [{_fmt(low)}, {_fmt(high)}]", "reproduced": verdict})
+        if not sel.empty:
+            pick = float(gains.loc[int(_best(sel)["seed"])]) if int(_best(sel)["seed"]) in gains.index else float("nan")
+            out.append({"claim": claim, "metric": metric, "selection": f"{ifa} best of N by training RMSE",
+                        "worst-test gain": _fmt(pick),
+                        "reproduced": f"a pick, not a test ({'reaches' if pick >= need else 'short of'} {need:g}x)"})
     for task in ("msra_zerobias", "msra_fulltemp"):
         metric = board.PRIMARY[protocols()[task]]
         a = runs[(runs["task_name"] == task) & (runs["method"] == ifa)]
@@ -146,7 +162,7 @@ def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:  # noqa: C901
         out.append({"claim": f"IFA-BP better than FA-BP ({task})", "metric": metric,
                     "selection": f"{ifa} vs {fa}: best of N by training RMSE",
                     "worst-test gain": f"{_fmt(best_a)} vs {_fmt(best_b)}",
-                    "reproduced": "yes" if best_a < best_b else "no"})
+                    "reproduced": "a pick each, not a test"})
     return pd.DataFrame(out)
 
 

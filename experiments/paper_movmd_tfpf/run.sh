@@ -24,30 +24,30 @@ serial=(task.decomposition=none task.denoise=none)
 # the device as simulated by default (flicker ~33 deg/h, experiments/raw-sensors/README.md).
 # the honest baselines first (this also creates the tracking store before parallel sweeps use it):
 # raw output, the oracle (true drift removed, noise untouched), a polynomial in T and dT/dt
-run 1 "${serial[@]}" learner=raw,memoriser,poly optimiser=none
-run 15 "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds" task.recordings_seed=null
-run 16 "${serial[@]}" task.split=replay learner=raw,memoriser,poly optimiser=none
-run 18 "${serial[@]}" task.split=replay learner=oracle,oracle_thermometer optimiser=none "seed=$seeds" task.recordings_seed=null
+run 1 "${serial[@]}" learner=raw,memoriser,poly optimiser=none "seed=$seeds"
+run 15 "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds"
+run 16 "${serial[@]}" task.split=replay learner=raw,memoriser,poly optimiser=none "seed=$seeds"
+run 18 "${serial[@]}" task.split=replay learner=oracle,oracle_thermometer optimiser=none "seed=$seeds"
 # the paper's method over 30 restarts, beside wavelet denoising alone and BP on temperature
 run 2 learner=elman optimiser=bas "seed=$seeds" &
-run 3 task.decomposition=none task.denoise=wavelet learner=raw optimiser=none
+run 3 task.decomposition=none task.denoise=wavelet learner=raw optimiser=none "seed=$seeds"
 run 4 "${serial[@]}" task.inputs=t learner=bp optimiser=none "seed=$seeds"
 wait
 # seed 001's strongest rival: EMD + wavelet threshold + simulated-annealing-initialised BP; and
 # the pipeline's stages swapped by Hydra: MOVMD-TFPF alone, and with PSO-initialised BP
 run 5 task.decomposition=emd task.denoise=wavelet learner=bp optimiser=sa "seed=$seeds" &
-run 6 learner=raw optimiser=none
+run 6 learner=raw optimiser=none "seed=$seeds"
 run 7 learner=bp optimiser=pso 'seed=range(5)'
 wait
 run 14 learner=elman optimiser=cmaes "seed=$seeds"  # CMA-ES (plugins/tcbench-peers) in BAS's place
 # the same device with 3 deg/h of flicker instead of ~33: where temperature drift, not flicker,
 # dominates the soak means, what does each method compensate?
 low=('task.effects={bias_instability:{b:8.3e-4}}')
-run 8 "${low[@]}" "${serial[@]}" learner=raw,memoriser,poly optimiser=none
-run 17 "${low[@]}" "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds" task.recordings_seed=null
+run 8 "${low[@]}" "${serial[@]}" learner=raw,memoriser,poly optimiser=none "seed=$seeds"
+run 17 "${low[@]}" "${serial[@]}" learner=oracle,oracle_thermometer optimiser=none "seed=$seeds"
 run 9 "${low[@]}" learner=elman optimiser=bas "seed=$seeds" &
-run 10 "${low[@]}" task.decomposition=none task.denoise=wavelet learner=raw optimiser=none
-run 11 "${low[@]}" learner=raw optimiser=none
+run 10 "${low[@]}" task.decomposition=none task.denoise=wavelet learner=raw optimiser=none "seed=$seeds"
+run 11 "${low[@]}" learner=raw optimiser=none "seed=$seeds"
 run 12 "${low[@]}" "${serial[@]}" task.inputs=t learner=bp optimiser=none "seed=$seeds"
 wait
 run 13 "${low[@]}" task.decomposition=emd task.denoise=wavelet learner=bp optimiser=sa 'seed=range(10)'

@@ -63,8 +63,9 @@ def memoriser_compensator(data: MSRAData) -> Compensator:
     """No physics: the training runs' mean output (and applied input) at the same time since their
     start, taken from a test run's output (``inverse``: the memorised input plus the output's
     departure from the memorised output, over the scale factor). On a test run that replays the
-    training signal it is near the limit; on a new power-on it should lose to a cubic in
-    temperature (docs/concepts/split-tiers.md)."""
+    training signal it is near the limit; on a new power-on it loses to a cubic in temperature where
+    the drift follows temperature, and wins where it follows the time since power-on (a warm-up;
+    docs/concepts/split-tiers.md)."""
     output, applied = memorised(data.train, "output"), memorised(data.train, "input")
 
     def compensate(tr: TaskRecording, out: np.ndarray) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Per method: runs (one per seed), failed runs, for each metric the median over restarts with a
 bootstrap 95 % interval, the value of the run with the smallest training RMSE ("best of N by
-training RMSE", the paper's selection) and the improvement over the raw output (raw / median).
+training RMSE", the paper's selection) and the improvement over the raw output (median over runs of raw ÷ the method, on each run's own test runs).
 Rows are ordered by the median of the task's primary metric (bias variation for full
 temperature, zero-start stability for zero bias). Every median and interval counts a failed run as
 worse than any finished one (:func:`tcbench.stats.with_failures`; "failed" where it falls on
@@ -42,6 +42,9 @@ from tcbench.tables import markdown_table
 from tcbench.compensation.data import DEFAULT_TIER
 from tcbench.compensation.scoring import FLAGS, METRIC_NAMES, PRIMARY, TRAIN_RMSE
 from tcbench.stats import bootstrap_median_ci, paired_p_value, with_failures
+from tcbench.leaderboard.paired import (
+    draw_column, limit_by_draw, n_draws, paired_gain, paired_ratios, pairing_index, ratio_summary,
+)
 from tcbench.leaderboard.labels import FLAG_SHORT, SHORT
 from tcbench.leaderboard.labels import METRICS as METRIC_LABELS
 
@@ -81,6 +84,7 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
             "task_name": t.get("tcbench.task_name"), "data_hash": t.get("tcbench.data_hash", ""),
             "train_files": t.get("tcbench.train_files", ""), "test_files": t.get("tcbench.test_files", ""),
             "in_sample": t.get("tcbench.in_sample", ""), "split": _split_of(dict(r.data.params)),
+            "draw_tag": t.get("tcbench.draw", ""),
             "params": dict(r.data.params), **r.data.metrics,
         })
     return pd.DataFrame(rows)
@@ -97,11 +101,14 @@ def _split_of(params: dict[str, str]) -> str:
 def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     """Leaderboard table of one task's compensation runs."""
     metrics, primary = METRICS[protocol], PRIMARY[protocol]
+    if "draw" not in runs:
+        runs = runs.assign(draw=draw_column(runs))
+    limits = {column: limit_by_draw(runs, limit, primary) for column, limit in LIMITS.items()}
     rows, values = [], {}
     for method, g in runs.groupby("method", sort=True):
         ok = g[g["status"] == "FINISHED"]
         failed = int(len(g) - len(ok))
-        row: dict[str, object] = {"method": method, "runs": len(g), "failed": failed}
+        row: dict[str, object] = {"method": method, "runs": len(g), "draws": n_draws(g), "failed": failed}
         train = TRAIN_RMSE[protocol]
         best = ok.loc[ok[train].idxmin()] if train in ok and ok[train].notna().any() else None
         for m in metrics:
@@ -109,21 +116,22 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             low, high = bootstrap_median_ci(x)
             s = SHORT[m]
             median = row[f"median_{s}"] = float(np.median(x)) if x.size else np.nan
-            row[f"ci95_{s}"] = f"{_shown(low)}–{_shown(high)}" if not np.isnan(low) else "–"
+            row[f"ci95_{s}"] = _interval(low, high)
             if m == primary:
                 row["ci_high_primary"], row["ci_low_primary"] = high, low
             row[f"best_by_train_{s}"] = float(best[m]) if best is not None else np.nan
-            raw = ok[f"raw_{m}"].to_numpy(float) if f"raw_{m}" in ok else np.array([])
             if m not in NO_GAIN:
-                row[f"gain_{s}"] = float(np.median(raw) / median) if raw.size and median and np.isfinite(median) \
-                    else np.nan
+                row[f"gain_{s}"] = paired_gain(ok, m, failed)
         for flag in FLAGS.get(protocol, ()):
             row[FLAG_SHORT[flag]] = float(ok[flag].mean()) if flag in ok else np.nan
         trained = with_failures(ok[train].to_numpy(float), failed) if train in ok else np.array([])
         row[f"median_{train}"] = float(np.median(trained)) if trained.size else np.nan
+        for column, limit in limits.items():
+            ratio, low, high = ratio_summary(paired_ratios(g, limit, primary))
+            row[column], row[f"ci95_{column}"], row[f"_high_{column}"] = ratio, _interval(low, high), high
         row["_rank"] = row[f"median_{SHORT[primary]}"]
         rows.append(row)
-        values[method] = pd.Series(ok[primary].to_numpy(float), index=ok["seed"].to_numpy()) if primary in ok else pd.Series(dtype=float)
+        values[method] = pd.Series(ok[primary].to_numpy(float), index=pairing_index(ok)) if primary in ok else pd.Series(dtype=float)
     table = pd.DataFrame(rows)
     if table.empty:
         return table
@@ -132,13 +140,18 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     names = table["method"].tolist()
     table["p_vs_next"] = [paired_p_value(values[a], values[b]) for a, b in zip(names, names[1:], strict=False)] + [np.nan]
-    for column, limit in LIMITS.items():
-        table[column] = _ratio_to(table, protocol, limit)
+    table = table[[c for c in table.columns if not c.startswith(("x_", "ci95_x_", "_high_x_"))]
+                  + [c for column in LIMITS for c in (column, f"ci95_{column}", f"_high_{column}")]]
     table["note"] = _notes(table, protocol)
-    return table.drop(columns=["ci_high_primary", "ci_low_primary"])
+    return table.drop(columns=["ci_high_primary", "ci_low_primary", *(f"_high_{c}" for c in LIMITS)])
 
 
 LIMITS = {"x_oracle": "oracle", "x_thermo": "oracle_thermometer"}  # ratio column -> the limit row it divides by
+
+
+def _interval(low: float, high: float) -> str:
+    """A 95 % interval as the board shows it ("–" without one)."""
+    return f"{_shown(low)}–{_shown(high)}" if not np.isnan(low) else "–"
 
 
 def _shown(value: float) -> str:
@@ -146,62 +159,64 @@ def _shown(value: float) -> str:
     return "failed" if np.isinf(value) else f"{value:.3g}"
 
 
-def _ratio_to(table: pd.DataFrame, protocol: str, limit: str) -> np.ndarray:
-    """Each method's median primary metric over that of the ``limit`` row (NaN without one)."""
-    primary = table[f"median_{SHORT[PRIMARY[protocol]]}"].to_numpy(float)
-    row = table.loc[table["method"] == limit, f"median_{SHORT[PRIMARY[protocol]]}"]
-    return primary / float(row.iloc[0]) if not row.empty and float(row.iloc[0]) > 0 else np.full(len(table), np.nan)
-
-
-def _limit_low(table: pd.DataFrame, limit: str, primary: str) -> float:
-    """The low end of a limit row's interval (its median for a single run; NaN without the row):
-    a method is below a limit only when its own interval ends under it."""
-    row = table.loc[table["method"] == limit]
-    if row.empty:
-        return float("nan")
-    low = float(row["ci_low_primary"].iloc[0])
-    return low if np.isfinite(low) else float(row[primary].iloc[0])
-
-
 PROBE_FAILS = 10.0  # a ±0.5 g error this many times the oracle's: the method learned the trained levels
 
 
 def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
-    """Flag what a median alone hides. Below the physical limit: the upper end of the median's
-    95 % interval is under the low end of the oracle's (over its run draws; its value when it ran once);
-    below the thermometer-limited oracle likewise.
+    """Flag what a median alone hides. Below the physical limit: the upper end of the 95 % interval
+    of the method's paired ratio to the oracle (each run over the oracle on its own draw,
+    :mod:`tcbench.leaderboard.paired`) is under 1; below the thermometer-limited oracle likewise.
+    One draw: a method's runs all met one draw of power-ons, so its interval is over restarts only.
     Fails the ±0.5 g probe (fulltemp): its error is over :data:`PROBE_FAILS` times the oracle's —
     a model of the trained acceleration levels, not of the sensor, whatever its Table 2 figure.
     And (fulltemp) when the paper's pick, the best of the restarts by training RMSE, fails the
     probe worse than the median restart."""
-    primary = f"median_{SHORT[PRIMARY[protocol]]}"
-    oracle = table.loc[table["method"] == "oracle"]
-    if oracle.empty:
-        return [""] * len(table)
+    if table.loc[table["method"] == "oracle"].empty:
+        return [_one_draw(row) for row in table.to_dict("records")]
     if protocol == "gyro":
         return _gyro_notes(table)
-    limit = _limit_low(table, "oracle", primary)
-    thermo = _limit_low(table, "oracle_thermometer", primary)
+    oracle = table.loc[table["method"] == "oracle"]
     probe_limit = float(oracle["median_halfg_ug"].iloc[0]) if "median_halfg_ug" in oracle else np.nan
     notes = []
-    for row in table.itertuples(index=False):
-        if row.method in LIMITS.values():
+    for row in table.to_dict("records"):
+        if row["method"] in LIMITS.values():
             notes.append("")
             continue
-        parts = []
-        if row.ci_high_primary < limit:  # NaN (a single run) compares False
-            parts.append(f"below the physical limit (ci95 up to {row.ci_high_primary:.3g} < the oracle's from "
-                         f"{limit:.3g})")
-        elif row.ci_high_primary < thermo:
-            parts.append(f"below the thermometer-limited oracle (ci95 up to {row.ci_high_primary:.3g} < its from "
-                         f"{thermo:.3g}): it knows this power-on, which no compensator fitted on other runs can")
-        probe, picked = getattr(row, "median_halfg_ug", np.nan), getattr(row, "best_by_train_halfg_ug", np.nan)
+        parts = [_below_limit(row)]
+        probe, picked = row.get("median_halfg_ug", np.nan), row.get("best_by_train_halfg_ug", np.nan)
         if probe > PROBE_FAILS * probe_limit:
             parts.append(f"fails the ±0.5 g probe ({probe:.2g} µg, oracle {probe_limit:.2g})")
         if picked > probe > PROBE_FAILS * probe_limit:
             parts.append(f"the best-by-train pick fails it worse ({picked:.2g} µg)")
-        notes.append("; ".join(parts))
+        notes.append("; ".join(p for p in (*parts, _one_draw(row)) if p))
     return notes
+
+
+def _below_limit(row: dict[str, object]) -> str:
+    """The paired verdict against the limits: below the oracle, else below the thermometer-limited
+    oracle, when the whole interval of the ratio on the same draws is under 1 (empty otherwise)."""
+    for column, what in (("x_oracle", "the physical limit"), ("x_thermo", "the thermometer-limited oracle")):
+        high = float(row.get(f"_high_{column}", np.nan))  # type: ignore[arg-type]
+        if high < 1.0:  # NaN (no pairs) compares False
+            why = "" if column == "x_oracle" else ": it knows this power-on, which no compensator fitted on other runs can"
+            return (f"below {what} (paired on its draws: {float(row[column]):.3g}× the limit on the same draw, "  # type: ignore[arg-type]
+                    f"ci95 up to {high:.3g} < 1){why}")
+    return ""
+
+
+MIN_RESTARTS = 30  # a claim is reproduced over at least this many restarts; fewer is said on the row
+
+
+def _one_draw(row: dict[str, object]) -> str:
+    """Said of a method restarted on one draw of power-ons (its interval leaves the draws out), and
+    of one run fewer than :data:`MIN_RESTARTS` times (its n said on the row)."""
+    runs, draws = int(row.get("runs", 0)), int(row.get("draws", 0))  # type: ignore[call-overload]
+    parts = []
+    if 1 < runs < MIN_RESTARTS:
+        parts.append(f"n = {runs} < {MIN_RESTARTS} restarts")
+    if draws == 1 and runs > 1:
+        parts.append("one draw: restarts on one set of power-ons, the interval leaves out the variation between draws")
+    return "; ".join(parts)
 
 
 MSRA_KEY = (
@@ -213,9 +228,8 @@ MSRA_KEY = (
     "factor cubic in temperature (least squares); poly3_runs = the same fitted within runs (a constant per power-on, "
     "its turn-on bias; learner.offsets=per_run); poly3_rate = the bias cubic plus a cubic times the temperature rate; "
     "lagpoly = the cubic in the thermometer passed through a "
-    "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
-    "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
-    "signed-rank p-value of the primary metric against the next row, paired by seed.")
+    "first-order lag, the lag and the degree chosen by leave-one-recording-out error. "
+    "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw).")
 FULLTEMP_NOTE = (
     " note: \"below the physical limit\" when even the upper end of the median's 95 % interval is under the "
     "low end of the oracle's (over its run draws); a method below it is not better physics but has learned the "
@@ -234,9 +248,8 @@ CHAMBER_KEY = (
     "a cubic times the temperature rate (the inputs the networks get); lagpoly = cubic in the thermometer passed "
     "through a first-order lag, lag and degree by leave-one-recording-out error; model = the physics tcbench "
     "diagnose fitted on the first training cycle (lag, hysteresis, warm-up ...), run noise-free on the test "
-    "thermometer. Networks get [T, dT/dt]. x_oracle, x_thermo = the median drift over the oracle's and over "
-    "oracle_thermometer's. p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, "
-    "paired by seed.")
+    "thermometer. Networks get [T, dT/dt]. "
+    "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw).")
 GYRO_KEY = (
     "Methods are named by their pipeline: MOVMD = MOPSO-tuned VMD with sample-entropy classes (noise modes "
     "dropped), TFPF/WTD = denoiser of the mixed part (or of the whole output without a decomposition; WTD = "
@@ -245,9 +258,8 @@ GYRO_KEY = (
     "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
     "limit); oracle_thermometer = the device's drift model (not this power-on's) fed the package temperature "
     "its thermometer's reading implies (smoothed over 60 s); memoriser = no physics, the training run's mean "
-    "output at the same time since the start subtracted; x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
-    "signed-rank p-value of the primary metric against the next row, paired by "
-    "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
+    "output at the same time since the start subtracted; "
+    "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw). note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
 
 
@@ -269,19 +281,25 @@ KEYS = {"gyro": GYRO_KEY, "chamber": CHAMBER_KEY, "fulltemp": MSRA_KEY + FULLTEM
 
 def _gyro_notes(table: pd.DataFrame) -> list[str]:
     """Flag a gyro method whose ARW is below the oracle's (noise untouched): it smooths the
-    output, and its bandwidth kept says how much of a real rate input it throws away."""
+    output, and its bandwidth kept says how much of a real rate input it throws away; and one whose
+    drift is below the oracle's on the same draws (paired interval under 1)."""
     oracle = table.loc[table["method"] == "oracle"].iloc[0]
     notes = []
-    for row in table.itertuples(index=False):
+    for row in table.to_dict("records"):
         parts = []
-        if row.method in LIMITS.values():
+        if row["method"] in LIMITS.values():
             notes.append("")
             continue
-        if row.median_arw_1s < 0.9 * oracle["median_arw_1s"]:
-            parts.append(f"ARW below the physical limit by filtering: bandwidth {row.median_bw_hz:.3g} Hz")
-        if row.median_drift_dph < 0.9 * oracle["median_drift_dph"]:
-            parts.append("drift below the oracle's: the flicker of the soak means is smoothed too")
-        notes.append("; ".join(parts))
+        filters = row["median_arw_1s"] < 0.9 * oracle["median_arw_1s"]
+        if filters:
+            parts.append(f"ARW below the physical limit by filtering: bandwidth {row['median_bw_hz']:.3g} Hz")
+        if float(row.get("_high_x_oracle", np.nan)) < 1.0:
+            why = ("the flicker of the soak means is smoothed too" if filters else
+                   "with the noise untouched (no filtering), its fit follows this draw's flicker of the soak means, "
+                   "not better physics")
+            parts.append(f"drift below the oracle's on the same draws ({row['x_oracle']:.3g}×, ci95 up to "
+                         f"{row['_high_x_oracle']:.3g}): {why}")
+        notes.append("; ".join(p for p in (*parts, _one_draw(row)) if p))
     return notes
 
 
@@ -465,7 +483,7 @@ def write(board: CompensationBoard, out_dir: Path, source: str) -> dict[str, Pat
         f"Source: {source}. Metrics are means over the test recordings; {conv}.",
         f"Rows are ordered by the median of {primary} over restarts (seeds); ci95 = bootstrap 95 % "
         "interval of that median; best_by_train = the run with the smallest training RMSE (the paper's "
-        "\"best of 30\" selection); gain = raw / median. " + FAILED_RULE + " " + KEYS.get(board.protocol, MSRA_KEY), "",
+        "\"best of 30\" selection); gain = the median over runs of raw ÷ the method on the run's own test runs. " + FAILED_RULE + " " + KEYS.get(board.protocol, MSRA_KEY), "",
         markdown_table(failed_as_text(board.table)), "", f"![{primary} per restart]({paths['png'].name})", "",
     ]
     write_board_files(lines + failed_lines(failed), board.table, paths)

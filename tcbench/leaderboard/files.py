@@ -12,8 +12,10 @@ import numpy as np
 import pandas as pd
 
 # Why a board's p_vs_next is "–" (tcbench.stats.paired_p_value), said in its key and on its page
-P_DASH = ("p_vs_next is – where the row and the next share fewer than 6 seeds (with fewer pairs no difference "
-          "could reach p < 0.05; a method run once, such as raw or the oracle, has one seed) and on the last row.")
+P_DASH = ("p_vs_next is – where the row and the next share fewer than 6 pairs (runs paired by seed; on a "
+          "compensation board by draw of power-ons, by seed within one draw): with fewer no difference could reach "
+          "p < 0.05, a method run once has one, and one over draws shares at most one with one restarted on a single "
+          "draw; and on the last row.")
 # How every board counts failed runs in its statistics (:func:`tcbench.stats.with_failures`), said in its key
 FAILED_RULE = ("Every median, quartile and ci95 counts a failed run as worse than any finished one: "
                "\"failed\" where the statistic falls on failed runs (a method that failed half its runs or "

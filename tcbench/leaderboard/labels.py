@@ -42,7 +42,7 @@ STATS = {
     "median_": "median {metric}",
     "ci95_": "95 % interval of the median {metric}",
     "best_by_train_": "{metric} of the restart with the smallest training RMSE",
-    "gain_": "gain over raw in {what} (raw ÷ median)",
+    "gain_": "gain over raw in {what} (median over runs of raw ÷ the method)",
 }
 # columns that are no statistic of one metric, on every kind of board
 COLUMNS = {
@@ -51,10 +51,13 @@ COLUMNS = {
     "runs": "runs (restarts or draws)",
     "failed": "failed runs",
     "seeds": "seeds",
-    "p_vs_next": "p-value against the next row (Wilcoxon, paired by seed; – under 6 shared seeds, where no "
+    "p_vs_next": "p-value against the next row (Wilcoxon, paired by draw, by seed on one draw; – under 6 shared pairs, where no "
                  "difference could reach p < 0.05)",
-    "x_oracle": "median ÷ the oracle's (the physical limit)",
-    "x_thermo": "median ÷ the thermometer-limited oracle's",
+    "draws": "draws of power-ons the runs met",
+    "x_oracle": "median over runs of the ratio to the oracle on the same draw (the physical limit)",
+    "x_thermo": "median over runs of the ratio to the thermometer-limited oracle on the same draw",
+    "ci95_x_oracle": "95 % interval of x_oracle",
+    "ci95_x_thermo": "95 % interval of x_thermo",
     "note": "note",
     # optimisation boards (tcbench.leaderboard.optimisation)
     "median_best": "median final best value",

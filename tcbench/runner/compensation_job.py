@@ -72,6 +72,16 @@ def keep(job: CompensationJob) -> None:
     kept_env.keep(job.env_key, job.env)
 
 
+def draw_of(c: dict[str, Any]) -> int | None:
+    """The draw of power-ons a simulated compensation job trains and tests on: ``task.recordings_seed``,
+    or the run seed where it is null (restart *i* on draw *i*: a method and its limits meet the same
+    draws, :mod:`tcbench.leaderboard.paired`); None on the user's recordings or a task without draws."""
+    task = c["task"]
+    if task.get("train_files") or "recordings_seed" not in task:
+        return None
+    return int(c["seed"]) if task["recordings_seed"] is None else int(task["recordings_seed"])
+
+
 def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) -> CompensationJob:
     """The compensation job of config ``c``, checked as :func:`validate
     <tcbench.runner.config.validate>` checks it (one-line ConfigErrors naming the key), then named
@@ -79,6 +89,8 @@ def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) 
     else built now."""
     spec, task = checked_config(c)
     learner, optimiser = learner_of(c), optimiser_of(c)
+    if (draw := draw_of(c)) is not None:
+        task = {**task, "recordings_seed": draw}
     kwargs = task_kwargs(task)
     kept = kept_env.take(env_key(spec, learner, c["budget"], kwargs))
     env = validate_compensation(c, task, kept)

@@ -38,7 +38,7 @@ class MSRATaskConfig:
 
     name: str = MISSING
     device_seed: int = 0
-    recordings_seed: int | None = 0
+    recordings_seed: int | None = None  # restart i on draw i
     n_train: int | None = None
     n_test: int | None = None
     train_files: list | None = None
@@ -69,7 +69,7 @@ class GyroTaskConfig(GyroTuningTaskConfig):
     ``tuner_params`` and ``tuning_budget`` set the multi-objective search of VMD's ``[k, alpha]``
     when they are null."""
 
-    recordings_seed: int | None = 0
+    recordings_seed: int | None = None  # restart i on draw i
     n_train: int = 1
     n_test: int = 1
     split: str = "next_run"

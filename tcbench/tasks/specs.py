@@ -42,8 +42,8 @@ def bbob_key(task: dict[str, Any]) -> str:
 
 
 def device_key(task: dict[str, Any]) -> str:
-    """``msra_fulltemp-dev0`` (``-rec<N>`` for other fixed recordings; none for recordings drawn from
-    the run seed, which put a row over draws, e.g. the limits, on the device's board; ``-<effect>.<param>=<v>`` for
+    """``msra_fulltemp-dev0``, whatever the draw of its runs (a board pairs every run with its limits on the
+    run's own draw, :mod:`tcbench.leaderboard.paired`); ``-<effect>.<param>=<v>`` for
     changed effects; ``<task>-files-<hash>`` on the user's recordings, the hash of their content,
     training files then test files (:func:`tcbench.sensors.data_hash.content_hash`), so runs on
     other data never share a key). :class:`~tcbench.sensors.data_hash.DataHashError` when a file
@@ -53,8 +53,6 @@ def device_key(task: dict[str, Any]) -> str:
 
         return f"{task['name']}-files-{content_hash(task['train_files'], task.get('test_files') or [])}"
     key = f"{task['name']}-dev{task.get('device_seed', 0)}"
-    if task.get("recordings_seed", 0) not in (0, None):  # None: drawn per run seed, the device's board over draws
-        key += f"-rec{task.get('recordings_seed')}"
     for effect, params in sorted((task.get("effects") or {}).items()):
         key += "-" + "-".join(f"{effect}.{p}={v:g}" for p, v in sorted(params.items()))
     return key

@@ -14,7 +14,7 @@ from tcbench.compensation.methods import BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.errors import ConfigError
 from tcbench.runner.compensation_config import learner_of
-from tcbench.runner.compensation_job import CompensationJob, in_sample, keep, prepare_job
+from tcbench.runner.compensation_job import CompensationJob, draw_of, in_sample, keep, prepare_job
 from tcbench.runner.kinds import JobKind, JobNames
 from tcbench.runner.loop import CompensationResult, VMDTuning, compensate
 from tcbench.sensors.data_hash import DataHashError, content_hash
@@ -152,8 +152,10 @@ class CompensationKind(JobKind):
         except DataHashError as exc:
             raise ConfigError(str(exc)) from None
         method = compensation_label(c["learner"], c["optimiser"], c["task"])
+        draw = draw_of(c)
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
-                        {"tcbench.task_name": str(c["task"]["name"]), **data})
+                        {"tcbench.task_name": str(c["task"]["name"]), **data,
+                         **({"tcbench.draw": str(draw)} if draw is not None else {})})
 
     def job(self, c: dict[str, Any]) -> CompensationJob:
         return prepare_job(c, self.names)

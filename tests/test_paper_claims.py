@@ -1,0 +1,54 @@
+"""Seed 000's claims judged as the benchmark judges a target (experiments/paper_ifa_bp/tables.py):
+each restart's gain on its own draw, the median's interval deciding, the paper's best-of-N pick
+reported but never a verdict."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+spec = importlib.util.spec_from_file_location("paper_tables", ROOT / "experiments/paper_ifa_bp/tables.py")
+assert spec is not None and spec.loader is not None
+tables = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(tables)
+
+METRICS = ("zb_after_30min_ug", "zb_after_20min_ug", "zb_zero_start_ug")
+
+
+def _runs(gain_low: float, gain_high: float, seed: int) -> pd.DataFrame:
+    """IFA-BP and FA-BP restarts on 30 draws whose raw differs per draw; IFA's gains in [low, high]."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    for method in ("IFA-BP-gd", "FA-BP-gd"):
+        for s in range(30):
+            raw = rng.uniform(100.0, 400.0)  # raw differs from draw to draw
+            after = raw / rng.uniform(gain_low, gain_high)
+            row = {"task_name": "msra_zerobias", "method": method, "seed": s, "train_rmse_ug": rng.uniform(),
+                   "zb_zero_start_ug": after}
+            for k in METRICS:
+                row |= {f"test1.{k}": after, f"test2.{k}": after * 0.9, f"test1.raw_{k}": raw, f"test2.raw_{k}": raw}
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def test_a_gain_claim_is_met_only_when_its_interval_says_so() -> None:
+    met = tables.claims(_runs(12.0, 14.0, 0), "FA-BP-gd", "IFA-BP-gd")
+    spans = tables.claims(_runs(8.5, 11.5, 1), "FA-BP-gd", "IFA-BP-gd")
+    short = tables.claims(_runs(3.0, 5.0, 2), "FA-BP-gd", "IFA-BP-gd")
+    median = met["selection"].str.contains("median over 30 restarts")
+    assert (met.loc[median & met["metric"].isin(METRICS), "reproduced"] == "yes").all()
+    assert (short.loc[median & short["metric"].isin(METRICS), "reproduced"] == "no").all()
+    assert spans.loc[median & spans["metric"].isin(METRICS), "reproduced"].str.startswith("undecided").any()
+    picks = met[met["selection"].str.contains("best of N")]
+    assert len(picks) and picks["reproduced"].str.startswith("a pick").all()  # never a yes or a no
+
+
+def test_each_restart_is_divided_by_raw_on_its_own_draw() -> None:
+    runs = _runs(12.0, 12.0, 3)  # every restart gains exactly 12x on its own draw
+    gains = tables.worst_test_gains(runs, "msra_zerobias", "zb_zero_start_ug", "IFA-BP-gd")
+    np.testing.assert_allclose(gains.to_numpy(), 12.0)  # the worse test (test1) of each draw
+    assert list(gains.index) == list(range(30))
