@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,9 +35,10 @@ import pyarrow.csv as pcsv
 from tcbench.errors import meant
 from tcbench.sensors.recording import (
     NUMERIC_COLUMNS,
-    Recording,
     AXES,
+    Recording,
     RecordingError,
+    RecordingMeta,
     check_axis,
     check_sensor,
     make_recording,
@@ -403,7 +404,30 @@ def save_all(recs: Mapping[str, Recording], out: str | Path, inputs: Sequence[st
              replaced: list[Path] | None = None) -> list[Path]:
     """Write each recording as ``out/<stem>.csv`` with its sidecar, all of them or none; files
     already there are replaced only with ``overwrite`` (their paths appended to ``replaced``)."""
+    return [w.path for w in save_each(recs.items(), out, inputs, overwrite, replaced)]
+
+
+@dataclass(frozen=True)
+class Written:
+    """A recording once written: its file, its metadata and its number of samples (the table is
+    on disk, no longer in memory)."""
+
+    path: Path
+    meta: RecordingMeta
+    samples: int
+
+
+def save_each(recs: Iterable[tuple[str, Recording]], out: str | Path, inputs: Sequence[str | Path] = (),
+              overwrite: bool = True, replaced: list[Path] | None = None) -> list[Written]:
+    """Write each recording ``recs`` gives as ``out/<stem>.csv`` with its sidecar, and let it go
+    before taking the next: given a generator that builds each recording when asked, one recording
+    at a time is in memory. All of them are written or none (a build or write that raises leaves
+    ``out`` as it was); files already there are replaced only with ``overwrite``. A stem given
+    twice is written once, the later recording replacing the earlier."""
+    written: dict[str, Written] = {}
     with staged_dir(out, inputs, overwrite, replaced) as tmp:
-        for stem, rec in recs.items():
+        for stem, rec in recs:
             write_recording(rec, tmp / f"{stem}.csv")
-    return [Path(out) / f"{stem}.csv" for stem in recs]
+            written[stem] = Written(Path(out) / f"{stem}.csv", rec.meta, len(rec.data))
+            del rec  # the table goes before the next one is built
+    return list(written.values())
