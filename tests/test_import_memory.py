@@ -58,7 +58,8 @@ def _thermal_log(path: Path, rows: int) -> int:
     return int(sum(v.nbytes for v in topic.data.values()))
 
 
-def _import(log: Path, out: Path, **given: str) -> RecordingOutcome:
+def _import(log: Path, out: Path, **given: object) -> RecordingOutcome:
+    """``tcbench import csv=LOG sensor=gyro out=OUT`` with ``given``, untracked, its output not shown."""
     cfg = ImportConfig(csv=str(log), sensor="gyro", out=str(out), **given)
     cfg.tracking.enabled = False
     with contextlib.redirect_stdout(io.StringIO()):
@@ -83,9 +84,9 @@ def test_a_logs_import_holds_one_axis_beside_the_topic(tmp_path: Path) -> None:
         peak_bytes = tracemalloc.get_traced_memory()[1] - base
     finally:
         tracemalloc.stop()
-    axis_bytes = 4 * 8 * rows
-    assert peak_bytes <= topic_bytes + axis_bytes + 3 * 8 * rows, \
-        f"peak {peak_bytes / 2**20:.1f} MiB: the topic {topic_bytes / 2**20:.1f} MiB + {(peak_bytes - topic_bytes) / axis_bytes:.2f} axes"
+    axis_bytes = 4 * 8 * rows  # one axis's recording: four float64 columns
+    axes = (peak_bytes - topic_bytes) / axis_bytes
+    assert peak_bytes <= topic_bytes + axis_bytes + 3 * 8 * rows, f"peak: the topic and {axes:.2f} axes"
     assert [o.rec.samples for o in [outcome, *outcome.also]] == [rows] * 3
     assert not isinstance(outcome.rec, Recording)  # the outcome keeps no table
 
