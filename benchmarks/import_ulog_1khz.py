@@ -5,8 +5,11 @@ The log is made here: the formats and header of the repository's sample log
 (``data/real/px4_ulog_samples/sample_log_small.ulg``) with one ``sensor_gyro`` instance of
 ``--minutes`` (45) at 1 kHz in PX4's own field types (``uint64`` clocks, ``float32`` axes and
 temperature), written with pyulog's writer. ``tcbench import csv=LOG sensor=gyro`` then runs once in
-a fresh process under ``/usr/bin/time -v`` (wall, CPU, peak resident memory); with ``--tcbench
-PATH`` the tcbench found at ``PATH`` is the one run (a checkout to compare with).
+a fresh process under ``/usr/bin/time -v`` (wall, CPU, peak resident memory), after the import of a
+``--base-rows`` log of the same kind (the process's own peak without the data: modules, pint's
+registry); with ``--tcbench PATH`` the tcbench found at ``PATH`` is the one run (a checkout to
+compare with). The peak above the small log's is set against the topic (pyulog's arrays, the
+one full copy of the data) and one axis's recording (four float64 columns).
 
     python benchmarks/import_ulog_1khz.py --minutes 45
 """
@@ -71,27 +74,36 @@ def timed_import(log: Path, out: Path, tcbench_path: Path | None) -> dict[str, f
 def main() -> None:
     parser = parser_for(__doc__)
     parser.add_argument("--minutes", type=float, default=45.0)
+    parser.add_argument("--base-rows", type=int, default=12_000,
+                        help="rows of a second, small log: its import's peak is the process without the data")
     parser.add_argument("--tcbench", type=Path, default=None, help="run the tcbench found at this path")
     add_json(parser, DEFAULT_JSON)
     args = parser.parse_args()
     env = environment("pyulog")
     rows = int(args.minutes * 60 * 1000)
     with tempfile.TemporaryDirectory() as tmp:
+        small = Path(tmp) / "small-1khz.ulg"
+        make_log(small, args.base_rows)
+        base = timed_import(small, Path(tmp) / "out-small", args.tcbench)
         log = Path(tmp) / "thermal-1khz.ulg"
         topic_bytes = make_log(log, rows)
         run = timed_import(log, Path(tmp) / "out", args.tcbench)
         written = sum(p.stat().st_size for p in (Path(tmp) / "out").iterdir())
         log_mb = log.stat().st_size / 1e6
-    recordings_mb = 3 * rows * 4 * 8 / 2**20  # three axes' recordings, four float64 columns each
+    axis_mib = rows * 4 * 8 / 2**20  # one axis's recording: four float64 columns
+    recordings_mb = 3 * axis_mib
+    above = run["peak_mb"] - base["peak_mb"]
     print(f"Command: `{command_line()}`\n\n{environment_line(env, 'pyulog ' + str(env['pyulog']))}\n")
-    print("| rows | log (MB) | topic in memory (MiB) | recordings in memory (MiB) | wall (s) | CPU (s) "
-          "| peak RSS (MiB) |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
-    print(f"| {rows} | {log_mb:.0f} | {topic_bytes / 2**20:.0f} | {recordings_mb:.0f} | {run['wall_s']:.1f} | "
-          f"{run['cpu_s']:.1f} | {run['peak_mb']:.0f} |")
+    print("| rows | log (MB) | topic in memory (MiB) | one axis (MiB) | recordings in memory (MiB) | wall (s) "
+          "| CPU (s) | peak RSS (MiB) | small log's peak (MiB) | above it (MiB) | (above - topic) / one axis |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print(f"| {rows} | {log_mb:.0f} | {topic_bytes / 2**20:.0f} | {axis_mib:.0f} | {recordings_mb:.0f} | "
+          f"{run['wall_s']:.1f} | {run['cpu_s']:.1f} | {run['peak_mb']:.0f} | {base['peak_mb']:.0f} | {above:.0f} | "
+          f"{(above - topic_bytes / 2**20) / axis_mib:.2f} |")
     write_json(args.json, {"command": command_line(), "environment": env, "rows": rows, "log_mb": log_mb,
-                           "topic_mib": topic_bytes / 2**20, "recordings_mib": recordings_mb,
-                           "written_mb": written / 1e6, **run})
+                           "topic_mib": topic_bytes / 2**20, "axis_mib": axis_mib, "recordings_mib": recordings_mb,
+                           "written_mb": written / 1e6, **run, "base_rows": args.base_rows,
+                           "base_peak_mb": base["peak_mb"]})
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@ wrote. They run as jobs of :mod:`tcbench.runner.kinds.recordings` through :func:
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -32,7 +33,7 @@ class RecordingOutcome:
     """A recording a command wrote or read, and its metrics report (None when not computed)."""
 
     path: Path
-    rec: Any
+    rec: Any  # the Recording; for an import, what is kept of it once written (metadata and samples)
     report: Any = None
     also: list[RecordingOutcome] = field(default_factory=list)  # further recordings of the command (axes)
 
@@ -315,17 +316,19 @@ def column_summary(rec: Any) -> str:
 
 def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     """Import a table as validated recordings with their sidecars, one per ``output=`` axis
-    (sharing the clock and temperature columns), all written or none; print what was written."""
-    from tcbench.sensors.importer import save_all
+    (sharing the clock and temperature columns), all written or none; print what was written.
+    A PX4 log's recordings are built and written one at a time: the outcomes hold each one's
+    metadata and length (:class:`~tcbench.sensors.importer.Written`), not its table."""
+    from tcbench.sensors.importer import save_each
     from tcbench.sensors.recording import RecordingError
 
     check_import(cfg)
     drop = [c.strip() for c in (cfg.drop or "").split(",") if c.strip()]
     csv = Path(cfg.csv)
-    recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else _table_recordings(cfg, drop)
+    recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else _table_recordings(cfg, drop).items()
     replaced: list[Path] = []
     try:
-        paths = save_all(recs, cfg.out, inputs=[csv], overwrite=cfg.overwrite, replaced=replaced)
+        written = save_each(recs, cfg.out, inputs=[csv], overwrite=cfg.overwrite, replaced=replaced)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
     except InputOverwriteError as exc:
@@ -334,13 +337,13 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
         raise refused_output(exc, "out= or name=") from None
     except OSError as exc:
         raise cannot_write(cfg.out, exc) from None
-    outcomes = [RecordingOutcome(path, rec) for path, rec in zip(paths, recs.values(), strict=True)]
+    outcomes = [RecordingOutcome(w.path, w) for w in written]
     for o in outcomes:
         source, seg = o.rec.meta.extra["source"], o.rec.meta.extra["segments"]
         n_drop = source["rows_dropped"]
         dropped = f", {n_drop} row{'s' * (n_drop != 1)} dropped where {' or '.join(drop)} is nonzero" if drop else ""
         kind = f"in {seg['count']} segments " if seg["count"] > 1 else ""
-        print(f"tcbench: wrote {o.path} ({len(o.rec.data)} samples {kind}at {o.rec.meta.sample_rate_hz:g} Hz{dropped}) "
+        print(f"tcbench: wrote {o.path} ({o.rec.samples} samples {kind}at {o.rec.meta.sample_rate_hz:g} Hz{dropped}) "
               f"and its sidecar {o.path.with_suffix('.json')}")
         print(f"  {column_summary(o.rec)}")
     say_replaced(replaced)
@@ -385,22 +388,30 @@ def _ulog_axes(cfg: ImportConfig) -> list[tuple[str, str | None]]:
     return out
 
 
-def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
+def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> Iterator[tuple[str, Any]]:
     """One recording per instance and axis of the sensor's topic in a PX4 log, named
     ``NAME-<topic>-<instance>-<field>``, its axis (the field x, y, z) in the sidecar;
-    ``time=``, ``temperature=``, ``output=`` name other fields."""
-    from tcbench.sensors.importer import import_table
+    ``time=``, ``temperature=``, ``output=`` name other fields. The log is read here; each
+    recording is built only when the next one is asked for (:func:`~tcbench.sensors.importer.save_each`
+    writes and drops it first), so one axis's columns are in memory beside the log's topic."""
     from tcbench.sensors.recording import RecordingError
-    from tcbench.sensors.ulog import default_columns, read_topic
+    from tcbench.sensors.ulog import read_topic
 
     path = Path(cfg.csv)
     try:
         instances = read_topic(path, cfg.sensor)
     except RecordingError as exc:
         raise CommandError(str(exc)) from None
-    outputs = _ulog_axes(cfg)
-    units = import_units(cfg)
-    recs = {}
+    return _ulog_axis_recordings(cfg, drop, path, instances, _ulog_axes(cfg), import_units(cfg))
+
+
+def _ulog_axis_recordings(cfg: ImportConfig, drop: list[str], path: Path, instances: list[Any],
+                          outputs: list[tuple[str, str | None]], units: dict[str, str]) -> Iterator[tuple[str, Any]]:
+    """``(stem, recording)`` of each instance and ``outputs`` field of a log's topic, in turn."""
+    from tcbench.sensors.importer import import_table
+    from tcbench.sensors.recording import RecordingError
+    from tcbench.sensors.ulog import default_columns
+
     for inst in instances:
         columns = default_columns(list(inst.fields))
         columns |= {k: v for k, v in (("time_s", cfg.time), ("temperature_c", cfg.temperature),
@@ -411,14 +422,13 @@ def _ulog_recordings(cfg: ImportConfig, drop: list[str]) -> dict[str, Any]:
             field_name = output.rsplit(":", 1)[0] if ":" in output else output
             stem = file_stem(f"{import_stem(cfg)}-{inst.topic}-{inst.instance}-{field_name}", "output", ".json")
             try:
-                recs[stem] = import_table(
+                yield stem, import_table(
                     inst.fields, cfg.sensor, {**columns, "output": output}, units=units, axis=axis, drop=drop,
                     source=f"{path} ({inst.topic} instance {inst.instance})", about=about,
                     device_id=cfg.device_id or f"{path.stem}-{inst.topic}-{inst.instance}",
                     sample_rate_hz=cfg.sample_rate_hz)
             except RecordingError as exc:
                 raise CommandError(str(exc)) from None
-    return recs
 
 
 # -- shared --------------------------------------------------------------------------------------

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,9 +35,10 @@ import pyarrow.csv as pcsv
 from tcbench.errors import meant
 from tcbench.sensors.recording import (
     NUMERIC_COLUMNS,
-    Recording,
     AXES,
+    Recording,
     RecordingError,
+    RecordingMeta,
     check_axis,
     check_sensor,
     make_recording,
@@ -56,7 +57,7 @@ from tcbench.sensors.recording_files import (
     sniff_delimiter,
 )
 from tcbench.sensors.recording_schema import _meta_from_dict
-from tcbench.sensors.segments import GAP_FACTOR, bounds, segments, within_rate_hz
+from tcbench.sensors.segments import GAP_FACTOR, gap_bounds, gaps, within_rate_hz
 from tcbench.sensors.units import Conversion, UnitError, conversion
 from tcbench.staging import staged_dir
 
@@ -202,6 +203,8 @@ def _read(path: Path, used: Sequence[str], header: Sequence[str], delimiter: str
 
 def _check_filled(empty: np.ndarray, used: Sequence[str], keep: np.ndarray) -> None:
     """Raise at the first empty cell (rows x ``used`` mask) of the kept rows."""
+    if not empty.any():
+        return
     kept = empty[keep]
     if kept.any():
         i, j = divmod(int(np.argmax(kept)), kept.shape[1])
@@ -311,7 +314,7 @@ def import_table(table: Mapping[str, np.ndarray], sensor: str, columns: Mapping[
     try:
         spec, used = _spec(columns, drop, sensor, list(table), StatedUnits(dict(units or {})))
         raw = {c: np.asarray(table[c], dtype=np.float64) for c in used}
-        empty = np.zeros((len(next(iter(raw.values()))), len(used)), dtype=bool)
+        empty = np.broadcast_to(False, (len(next(iter(raw.values()))), len(used)))  # a log has no empty cells
     except RecordingError as err:
         raise err.located(source) from None
     return _recording(raw, empty, spec, drop, sensor, source, dict(about or {}), device_id or source,
@@ -349,29 +352,42 @@ def _spec(columns: Mapping[str, str], drop: Sequence[str], sensor: str, header: 
     return spec, list(dict.fromkeys([c.name for c in spec.values()] + list(drop)))
 
 
-def _recording(raw: Mapping[str, np.ndarray], empty: np.ndarray, spec: Mapping[str, Column], drop: Sequence[str],
+def _recording(raw: dict[str, np.ndarray], empty: np.ndarray, spec: Mapping[str, Column], drop: Sequence[str],
                sensor: str, name: str, source: dict[str, object], device_id: str,
                sample_rate_hz: float | None, axis: str | None = None) -> Recording:
     """The recording of the columns ``raw`` read from ``name`` (rows to drop, units, segments,
-    every check of the schema, the ``axis`` when known), its errors in the source's terms."""
+    every check of the schema, the ``axis`` when known), its errors in the source's terms.
+    ``raw`` is emptied as its columns are converted, so that a column the caller does not keep
+    elsewhere is let go once the recording's own is made: the columns in memory are at most those
+    read and those of the recording, never both in full."""
     used = list(raw)
     try:
         keep = ~_dropped(raw, drop, empty.shape[0])
         _check_filled(empty, used, keep)
-        rows = np.flatnonzero(keep) + 1
-        kept = (lambda x: x) if keep.all() else (lambda x: x[keep])  # nothing dropped: no copy of a column
-        table = {c.target: c.convert.to_schema(kept(raw[c.name])) for c in spec.values()}
+        n_kept = int(np.count_nonzero(keep))
+        kept = (lambda x: x) if n_kept == keep.size else (lambda x: x[keep])  # nothing dropped: no copy of a column
+        uses = {c: sum(col.name == c for col in spec.values()) for c in used}
+        table = {}
+        for col in spec.values():
+            table[col.target] = col.convert.to_schema(kept(raw[col.name]))
+            uses[col.name] -= 1
+            if not uses[col.name]:
+                del raw[col.name]
+        raw.clear()
     except RecordingError as err:
         raise err.located(name) from None
-    table.setdefault("input", np.zeros(rows.size))
-    if rows.size < 2:
+    table.setdefault("input", np.zeros(n_kept))
+    if n_kept < 2:
         after = f" left after dropping {int((~keep).sum())}" if (~keep).any() else ""
-        raise RecordingError(f"{rows.size} data row{'s' * (rows.size != 1)}{after}; a recording needs at least two",
+        raise RecordingError(f"{n_kept} data row{'s' * (n_kept != 1)}{after}; a recording needs at least two",
                              file=name)
     t = table["time_s"]
     clock_ok = bool(np.isfinite(t).all() and (np.diff(t) > 0).all())  # else the schema's check names the row
-    seg = segments(t) if clock_ok else np.zeros(t.size, dtype=np.int64)
-    starts, stops = bounds(seg)
+    gap = gaps(t) if clock_ok else np.zeros(t.size - 1, dtype=bool)  # a flag per step, not a number per sample
+    starts, stops = gap_bounds(gap)
+    rate = float(sample_rate_hz) if sample_rate_hz is not None else (
+        float(f"{within_rate_hz(t, gap=gap):.6g}") if clock_ok else math.nan)
+    del gap
     extra = {
         "source": {**source, "columns": {k: c.describe() for k, c in spec.items()},
                    **({"input": "0 (no column given)"} if "input" not in spec else {}),
@@ -382,12 +398,10 @@ def _recording(raw: Mapping[str, np.ndarray], empty: np.ndarray, spec: Mapping[s
         **({"axis": axis} if axis is not None else {}),
     }
     try:
-        rate = float(sample_rate_hz) if sample_rate_hz is not None else (
-            float(f"{within_rate_hz(t, seg):.6g}") if clock_ok else math.nan)
         return make_recording(table["time_s"], table["temperature_c"], table["input"], table["output"],
                               sensor=sensor, sample_rate_hz=rate, device_id=device_id, extra=extra)
     except RecordingError as err:
-        raise _in_csv(err, name, rows, spec, table, sensor) from None
+        raise _in_csv(err, name, np.flatnonzero(keep) + 1, spec, table, sensor) from None
 
 
 def save(rec: Recording, out: str | Path, stem: str, inputs: Sequence[str | Path] = (), overwrite: bool = True,
@@ -403,7 +417,30 @@ def save_all(recs: Mapping[str, Recording], out: str | Path, inputs: Sequence[st
              replaced: list[Path] | None = None) -> list[Path]:
     """Write each recording as ``out/<stem>.csv`` with its sidecar, all of them or none; files
     already there are replaced only with ``overwrite`` (their paths appended to ``replaced``)."""
+    return [w.path for w in save_each(recs.items(), out, inputs, overwrite, replaced)]
+
+
+@dataclass(frozen=True)
+class Written:
+    """A recording once written: its file, its metadata and its number of samples (the table is
+    on disk, no longer in memory)."""
+
+    path: Path
+    meta: RecordingMeta
+    samples: int
+
+
+def save_each(recs: Iterable[tuple[str, Recording]], out: str | Path, inputs: Sequence[str | Path] = (),
+              overwrite: bool = True, replaced: list[Path] | None = None) -> list[Written]:
+    """Write each recording ``recs`` gives as ``out/<stem>.csv`` with its sidecar, and let it go
+    before taking the next: given a generator that builds each recording when asked, one recording
+    at a time is in memory. All of them are written or none (a build or write that raises leaves
+    ``out`` as it was); files already there are replaced only with ``overwrite``. A stem given
+    twice is written once, the later recording replacing the earlier."""
+    written: dict[str, Written] = {}
     with staged_dir(out, inputs, overwrite, replaced) as tmp:
-        for stem, rec in recs.items():
+        for stem, rec in recs:
             write_recording(rec, tmp / f"{stem}.csv")
-    return [Path(out) / f"{stem}.csv" for stem in recs]
+            written[stem] = Written(Path(out) / f"{stem}.csv", rec.meta, len(rec.data))
+            del rec  # the table goes before the next one is built
+    return list(written.values())

@@ -92,6 +92,11 @@ class Recording:
     meta: RecordingMeta = field(default_factory=RecordingMeta)
 
     @property
+    def samples(self) -> int:
+        """Number of rows (samples)."""
+        return len(self.data)
+
+    @property
     def time_s(self) -> np.ndarray:
         """Sample times in s."""
         return self.data["time_s"].to_numpy(dtype=np.float64)

@@ -32,7 +32,7 @@ class RecordingKind(JobKind):
         run.set_tag("tcbench.device_id", str(rec.meta.device_id))
         run.set_tag("tcbench.recording", str(outcome.path.resolve()))
         run.log_params({"recording.sample_rate_hz": str(rec.meta.sample_rate_hz),
-                        "recording.samples": str(len(rec.data))})
+                        "recording.samples": str(rec.samples)})
         files = []
         if report is not None:
             run.log_metrics({k: v for k, v in report.metrics.items() if not math.isnan(v)})
