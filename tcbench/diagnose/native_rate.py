@@ -277,16 +277,32 @@ def bin_means(rec: Recording, plan: BinPlan, zero_weight: np.ndarray) -> tuple[R
     return Recording(pd.DataFrame(columns), meta), int(np.count_nonzero(~enough))
 
 
+# what a diagnosis reads from the bin means (report.json's ``native_rate.what``; report.md's sentence)
+OF_BINS = ("the thermal terms, the mismatch, the reference fit, bias instability and every RMSE and gain of this "
+           "report", "The fit, the mismatch, the reference and bias instability below")
+
+
 @dataclass(frozen=True)
 class NativeRate:
     """What the front stage did: the plan, the full-rate noise, the bins diagnosed and dropped,
-    and the white sigma of the bin means the diagnosis measured."""
+    the white sigma of the bin means the diagnosis measured, what the report read from the bin
+    means (``of_bins``: the phrase in report.json, the sentence's subject in report.md) and the
+    thermometer glitches given zero weight with the clipped samples and outliers."""
 
     plan: BinPlan
     full: FullRate
     bins: int
     dropped_bins: int
     bin_white_sigma: float
+    of_bins: tuple[str, str] = OF_BINS
+    glitch_samples: int = 0
+
+    def _zero_weight(self) -> str:
+        """The samples given zero weight, in words."""
+        if not self.glitch_samples:
+            return f"{self.full.zero_weight.size} samples given zero weight as clipped or outliers"
+        return (f"{self.full.zero_weight.size} samples given zero weight as clipped or outliers and "
+                f"{self.glitch_samples} as thermometer glitches")
 
     def to_json(self) -> dict[str, Any]:
         """report.json's ``native_rate``."""
@@ -294,10 +310,11 @@ class NativeRate:
         return {
             **self.plan.to_json(), "averaged": True, "bins_diagnosed": self.bins, "bins_dropped": self.dropped_bins,
             "zero_weight_samples": int(self.full.zero_weight.size),
+            **({"glitch_samples": self.glitch_samples} if self.glitch_samples else {}),
             "why": self.plan.why(),
-            "what": "the thermal terms, the mismatch, the reference fit, bias instability and every RMSE and gain "
-                    "of this report are of the bin means; white noise, quantisation, saturation and outliers are "
-                    "measured on every sample, and clipped samples and outliers enter no bin",
+            "what": f"{self.of_bins[0]} are of the bin means; white noise, quantisation, saturation and outliers are "
+                    "measured on every sample, and clipped samples and outliers"
+                    + (" and thermometer glitches" if self.glitch_samples else "") + " enter no bin",
             "white_sigma_full_rate": self.full.white_sigma, "white_sigma_bins": self.bin_white_sigma,
             "white_sigma_bins_expected": float(expected),
             "bins_over_expected": float(self.bin_white_sigma / expected) if expected > 0 else None,
@@ -309,8 +326,8 @@ class NativeRate:
         return ["## Native rate", "",
                 f"{self.plan.why()}.", "",
                 (f"{self.bins} bins diagnosed ({self.dropped_bins} dropped for holding fewer than half a bin of "
-                 f"kept samples; {self.full.zero_weight.size} samples given zero weight as clipped or outliers). "
-                 "The fit, the mismatch, the reference and bias instability below are of the bin means; white "
+                 f"kept samples; {self._zero_weight()}). "
+                 f"{self.of_bins[1]} are of the bin means; white "
                  "noise, quantisation, saturation and outliers are measured on every sample."), "",
                 (f"White noise: {self.full.white_sigma:.4g} {unit} per sample at {self.full.sample_rate_hz:.4g} Hz; "
                  f"the bin means' {self.bin_white_sigma:.4g} {unit} (white noise alone would give "

@@ -14,6 +14,13 @@ step found, when significant, is a column of the slope's fit and both are remove
 residual the noise test reads. The numbers are the settings' ``short`` section
 (:class:`~tcbench.diagnose.settings.ShortSettings`), with the plan's and the smoothing's for what a
 full diagnosis needs.
+
+A record of more rows than ``settings.rate.max_rows`` (15 min at 1 kHz is 900 000) is tested as a
+diagnosis takes it (:mod:`tcbench.diagnose.native_rate`): the slope, the step and the Allan
+deviation on bin means of the same plan, the noise terms on every sample (white sigma and
+density, the output's lattice, clipping and isolated outliers, reported as findings; clipped
+samples and outliers enter no bin), and report.json's ``native_rate`` (report.md's section
+"Native rate") says what was averaged, to what rate and why.
 """
 
 from __future__ import annotations
@@ -23,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
 from tcbench.diagnose.plan import min_full_duration_s
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.short_tests import (
@@ -43,6 +52,9 @@ from tcbench.sensors.segments import segments
 DRIFT = ("a drift in time (ageing, warm-up, a random walk): the temperature moves one way on this record; "
          "one that heats and cools tells them apart")
 _WORDS = {1: "one", 2: "two", 3: "three", 4: "four"}  # a small count in words
+# what a short record's report reads from the bin means (:class:`~tcbench.diagnose.native_rate.NativeRate`'s ``of_bins``)
+OF_BINS = ("the temperature slope, the level step and the Allan deviation of this report",
+           "The temperature slope, the level step and the Allan deviation below")
 
 
 @dataclass
@@ -62,6 +74,8 @@ class ShortRecordReport:
     tests: list[ShortTest]
     needs_more_time: list[dict[str, Any]]
     settings: DiagnoseSettings = field(default=DEFAULTS, repr=False)
+    findings: list[Finding] = field(default_factory=list)
+    native_rate: NativeRate | None = None
 
     @property
     def full_duration_s(self) -> float:
@@ -86,11 +100,13 @@ class ShortRecordReport:
                 parts.append(f"temperature_slope {t.status} ({t.values['slope_per_c']:.4g} {self.unit}/degC)")
             else:
                 parts.append(f"{t.id} {t.status}")
+        if self.findings:
+            parts.append(f"found: {', '.join(f.id for f in self.findings)}")
         return (f"short record ({self.duration_s:.4g} s of the {self.full_duration_s:.4g} s a full diagnosis "
                 f"needs): {'; '.join(parts)}")
 
     def to_json(self) -> dict[str, Any]:
-        """``report.json`` of a short record."""
+        """``report.json`` of a short record (``findings`` and ``native_rate`` only when there are any)."""
         return {
             "report": "short_record", "sensor": self.sensor, "unit": self.unit, "recording": self.recording,
             "verdict": self.verdict, "duration_s": self.duration_s, "samples": self.samples,
@@ -98,6 +114,8 @@ class ShortRecordReport:
             "thermometer_smooth_s": self.smooth_s, "ramp_starts_s": self.ramp_starts_s,
             "full_diagnosis_needs_s": self.full_duration_s, "level": self.settings.short.alpha,
             "tests": [t.to_json() for t in self.tests], "needs_more_time": self.needs_more_time,
+            **({"findings": [f.to_json() for f in self.findings]} if self.findings else {}),
+            **({"native_rate": self.native_rate.to_json()} if self.native_rate is not None else {}),
             "settings": report_mapping(self.settings),
         }
 
@@ -157,7 +175,30 @@ def _white_sigma(y: np.ndarray, same: np.ndarray) -> float:
 
 def short_record(rec: Recording, sensor: str | None = None, name: str = "",
                  settings: DiagnoseSettings = DEFAULTS) -> ShortRecordReport:
-    """The tests ``rec`` supports (see module doc), whatever its length, with ``settings``."""
+    """The tests ``rec`` supports (see module doc), whatever its length, with ``settings``: on its
+    samples within ``settings.rate.max_rows``, else on bin means with the noise terms of every sample."""
+    plan = plan_for(rec, settings.rate)
+    if not plan.averaged:
+        return _tested(rec, sensor, name, settings)
+    full = full_rate_noise(rec, settings, plan.sample_rate_hz)
+    binned, dropped = bin_means(rec, plan, full.zero_weight)
+    report = _tested(binned, sensor, name, settings)
+    noise = next(t for t in report.tests if t.id == "white_noise")
+    bin_sigma = float(noise.values["white_sigma"])
+    noise.values |= {"white_sigma": full.white_sigma,
+                     "density_per_sqrt_hz": full.white_sigma / float(np.sqrt(plan.sample_rate_hz)),
+                     "white_sigma_bins": bin_sigma}
+    found = full.findings(report.unit)
+    report.findings = [found[key] for key in ("outliers", "saturation", "quantisation") if key in found]
+    report.native_rate = NativeRate(plan, full, int(binned.data.shape[0]), dropped, bin_sigma, OF_BINS)
+    report.samples, report.sample_rate_hz = plan.rows, plan.sample_rate_hz
+    report.duration_s = float(rec.time_s[-1] - rec.time_s[0])
+    report.needs_more_time = needs_more_time(report.duration_s, settings)
+    return report
+
+
+def _tested(rec: Recording, sensor: str | None, name: str, settings: DiagnoseSettings) -> ShortRecordReport:
+    """The tests ``rec`` supports, on its samples as they are."""
     short, default_s = settings.short, settings.smoothing.default_window_s
     kind = str(sensor or rec.meta.sensor)
     unit = str((rec.meta.units or {}).get("output", kinds.get(kind).output_unit))
