@@ -29,6 +29,10 @@ full-rate output) and isolated outliers (:func:`~tcbench.diagnose.outliers.find_
 the output against its running median, the Bonferroni bound taken over every sample of the
 record). Clipped samples and outliers get zero weight: they never enter a bin mean, where a
 50-sigma spike would become a step of 50/k sigma the thermal terms would have to explain.
+Thermometer glitches (:mod:`tcbench.diagnose.glitches`) are found on every sample too, before
+binning (a 0.0 degC reading is a 200th of its size in a 200-sample mean, below any bound there):
+held at the previous reading, their samples entering no bin, reported as the
+``thermometer_glitches`` finding.
 Bias instability (flicker) is judged as before on the bin means' residual: the Allan deviation of
 ``k``-sample means at ``tau >= k / rate`` is the full-rate stream's own, and the flicker floor
 lies at taus of minutes, far above one bin.
@@ -51,11 +55,14 @@ import pandas as pd
 
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.glitches import ID as GLITCHES
+from tcbench.diagnose.glitches import Glitches, repaired
 from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
 from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens import FINDINGS_ORDER
+from tcbench.diagnose.screens.glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError
 from tcbench.sensors.recording import Recording
@@ -359,11 +366,14 @@ def white_sigma(diag: Diagnosis) -> float:
     return native.full.white_sigma if native is not None else diag.noise.white_sigma
 
 
-def merged(diag: Diagnosis, native: NativeRate) -> AveragedDiagnosis:
-    """``diag`` (of the bin means) with the full-rate noise findings, model terms and ``native``."""
+def merged(diag: Diagnosis, native: NativeRate, glitch: Glitches | None = None) -> AveragedDiagnosis:
+    """``diag`` (of the bin means) with the full-rate noise findings, model terms and ``native``,
+    and the thermometer glitches found on every sample (``glitch``)."""
     full = native.full
     own = full.findings(diag.unit)
-    kept = {e.id: e for e in diag.effects if e.id in FINDINGS_ORDER and e.id not in FULL_RATE_IDS}
+    if glitch is not None and glitch.count:
+        own[GLITCHES] = glitch.finding()
+    kept = {e.id: e for e in diag.effects if e.id in FINDINGS_ORDER and e.id not in (*FULL_RATE_IDS, GLITCHES)}
     effects = [e for e in diag.effects if e.id not in FINDINGS_ORDER]
     effects += [own.get(key) or kept[key] for key in FINDINGS_ORDER if key in own or key in kept]
     model = dict(diag.model)
@@ -381,6 +391,8 @@ def merged(diag: Diagnosis, native: NativeRate) -> AveragedDiagnosis:
         model["outliers"] = {"time_s": [float(t) for t in full.outliers.time_s],
                              "size": [float(v) for v in full.outliers.size]}
     fields = {f: getattr(diag, f) for f in Diagnosis.__dataclass_fields__}
+    if glitch is not None and glitch.count:
+        fields["statistics"] = replace(diag.statistics, screens={**diag.statistics.screens, GLITCHES: glitch.count})
     return AveragedDiagnosis(**(fields | {"effects": effects, "model": model, "outliers": full.outliers}),
                              native_rate=native)
 
@@ -396,9 +408,12 @@ def diagnose_any_rate(rec: Recording, *, sensor: str | None = None, declared: di
     if not plan.averaged:
         return diagnose(rec, sensor=sensor, declared=declared, name=name, min_duration_s=min_duration_s,
                         settings=settings)
+    glitch = glitches(rec, settings.screens).found  # on every sample: a bin mean would hide them
+    rec = repaired(rec, glitch.index)
     full = full_rate_noise(rec, settings, plan.sample_rate_hz)
-    binned, dropped = bin_means(rec, plan, full.zero_weight)
+    binned, dropped = bin_means(rec, plan, np.union1d(full.zero_weight, glitch.index))
     diag = diagnose(binned, sensor=sensor, declared=declared, name=name, min_duration_s=min_duration_s,
                     settings=settings)
-    native = NativeRate(plan, full, int(binned.data.shape[0]), dropped, float(diag.noise.white_sigma))
-    return merged(diag, native)
+    native = NativeRate(plan, full, int(binned.data.shape[0]), dropped, float(diag.noise.white_sigma),
+                        glitch_samples=glitch.count)
+    return merged(diag, native, glitch)
