@@ -215,3 +215,29 @@ def test_thermometer_glitches_get_zero_weight_and_are_reported(clean: tuple[Reco
     assert "6 thermometer glitch(es) given zero weight" in report["verdict"]
     assert glitched.noise.samples == clean.noise.samples - 6
     assert glitched.noise.thermometer_sigma_c == pytest.approx(clean.noise.thermometer_sigma_c, rel=0.05)
+
+
+def test_a_few_samples_between_two_gaps_are_smoothed_across_their_own_gaps() -> None:
+    """A continuous 1 Hz oven record (60 degC down to -40 and back every 3 h) with three short holes, as
+    dropped bins leave them around a clip: 8 samples stand between two holes of 30 and 20 s. Their
+    smoothed temperature follows the ramp, and the thermometer noise read from the spread about it
+    is the reading's own (the record's mean segment spacing, 5 h, made it a line over 15 h that
+    missed the ramp by degrees: 0.2 degC of thermometer noise read where 0.02 was put in)."""
+    from tcbench.diagnose.design import Designer
+    from tcbench.diagnose.signals import prepare, smooth_temperature
+    from tcbench.diagnose.thermometer import thermometer_sigma
+
+    rng = np.random.default_rng(12)
+    t = np.arange(0.0, 6 * 3600.0)
+    true = 10.0 + 50.0 * (2.0 * np.abs((t / 10800.0) % 1.0 - 0.5) * 2.0 - 1.0)  # -40..60 degC, 3 h period
+    keep = ~(((t >= 3000) & (t < 3030)) | ((t >= 3038) & (t < 3058)) | ((t >= 15000) & (t < 15100)))
+    t, true = t[keep], true[keep]
+    reading = true + rng.normal(0.0, 0.02, t.size)
+    fragment = (t >= 3030) & (t < 3038)
+    assert np.count_nonzero(fragment) == 8 and np.unique(segments(t)).size == 4
+    value, rate = smooth_temperature(t, reading, 120.0)
+    assert np.max(np.abs(value[fragment] - true[fragment])) < 0.1
+    assert np.max(np.abs(rate[fragment] + 100.0 / 5400.0)) < 0.2 * 100.0 / 5400.0  # cooling at 1.1 degC/min
+    rec = make_recording(t, reading, np.zeros(t.size), 0.01 * true + rng.normal(0.0, 0.01, t.size),
+                         sensor="gyro", sample_rate_hz=1.0, device_id="clip")
+    assert thermometer_sigma(Designer(prepare(rec, smooth_s=120.0))) == pytest.approx(0.02, rel=0.1)

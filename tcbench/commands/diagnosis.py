@@ -222,10 +222,18 @@ def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
 def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str, settings: Any) -> DiagnosisOutcome:
     """The short-record report of ``rec`` (its tests at ``settings``), written to ``out``; prints
     what ran and what needs more time."""
+    from tcbench.diagnose.native_rate import plan_for
     from tcbench.diagnose.short_record import short_record
     from tcbench.diagnose.short_report import write_short_report
+    from tcbench.diagnose.signals import DiagnosisDataError
 
-    report = short_record(rec, sensor, name=Path(cfg.recording).name, settings=settings)
+    plan = plan_for(rec, settings.rate)
+    if plan.averaged:
+        print(f"tcbench: {Path(cfg.recording).name}: {plan.why()}", file=sys.stderr, flush=True)
+    try:
+        report = short_record(rec, sensor, name=Path(cfg.recording).name, settings=settings)
+    except DiagnosisDataError as exc:
+        raise CommandError(f"{cfg.recording}: {exc}") from None
     written = _written(write_short_report, report, cfg)
     print(f"tcbench: {report.verdict}")
     ran = [f"{t.id} ({t.status})" for t in report.tests if t.ran]

@@ -29,6 +29,10 @@ full-rate output) and isolated outliers (:func:`~tcbench.diagnose.outliers.find_
 the output against its running median, the Bonferroni bound taken over every sample of the
 record). Clipped samples and outliers get zero weight: they never enter a bin mean, where a
 50-sigma spike would become a step of 50/k sigma the thermal terms would have to explain.
+Thermometer glitches (:mod:`tcbench.diagnose.glitches`) are found on every sample too, before
+binning (a 0.0 degC reading is a 200th of its size in a 200-sample mean, below any bound there):
+held at the previous reading, their samples entering no bin, reported as the
+``thermometer_glitches`` finding.
 Bias instability (flicker) is judged as before on the bin means' residual: the Allan deviation of
 ``k``-sample means at ``tau >= k / rate`` is the full-rate stream's own, and the flicker floor
 lies at taus of minutes, far above one bin.
@@ -51,11 +55,14 @@ import pandas as pd
 
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.glitches import ID as GLITCHES
+from tcbench.diagnose.glitches import Glitches, repaired
 from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
 from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens import FINDINGS_ORDER
+from tcbench.diagnose.screens.glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError
 from tcbench.sensors.recording import Recording
@@ -277,16 +284,32 @@ def bin_means(rec: Recording, plan: BinPlan, zero_weight: np.ndarray) -> tuple[R
     return Recording(pd.DataFrame(columns), meta), int(np.count_nonzero(~enough))
 
 
+# what a diagnosis reads from the bin means (report.json's ``native_rate.what``; report.md's sentence)
+OF_BINS = ("the thermal terms, the mismatch, the reference fit, bias instability and every RMSE and gain of this "
+           "report", "The fit, the mismatch, the reference and bias instability below")
+
+
 @dataclass(frozen=True)
 class NativeRate:
     """What the front stage did: the plan, the full-rate noise, the bins diagnosed and dropped,
-    and the white sigma of the bin means the diagnosis measured."""
+    the white sigma of the bin means the diagnosis measured, what the report read from the bin
+    means (``of_bins``: the phrase in report.json, the sentence's subject in report.md) and the
+    thermometer glitches given zero weight with the clipped samples and outliers."""
 
     plan: BinPlan
     full: FullRate
     bins: int
     dropped_bins: int
     bin_white_sigma: float
+    of_bins: tuple[str, str] = OF_BINS
+    glitch_samples: int = 0
+
+    def _zero_weight(self) -> str:
+        """The samples given zero weight, in words."""
+        if not self.glitch_samples:
+            return f"{self.full.zero_weight.size} samples given zero weight as clipped or outliers"
+        return (f"{self.full.zero_weight.size} samples given zero weight as clipped or outliers and "
+                f"{self.glitch_samples} as thermometer glitches")
 
     def to_json(self) -> dict[str, Any]:
         """report.json's ``native_rate``."""
@@ -294,10 +317,11 @@ class NativeRate:
         return {
             **self.plan.to_json(), "averaged": True, "bins_diagnosed": self.bins, "bins_dropped": self.dropped_bins,
             "zero_weight_samples": int(self.full.zero_weight.size),
+            **({"glitch_samples": self.glitch_samples} if self.glitch_samples else {}),
             "why": self.plan.why(),
-            "what": "the thermal terms, the mismatch, the reference fit, bias instability and every RMSE and gain "
-                    "of this report are of the bin means; white noise, quantisation, saturation and outliers are "
-                    "measured on every sample, and clipped samples and outliers enter no bin",
+            "what": f"{self.of_bins[0]} are of the bin means; white noise, quantisation, saturation and outliers are "
+                    "measured on every sample, and clipped samples and outliers"
+                    + (" and thermometer glitches" if self.glitch_samples else "") + " enter no bin",
             "white_sigma_full_rate": self.full.white_sigma, "white_sigma_bins": self.bin_white_sigma,
             "white_sigma_bins_expected": float(expected),
             "bins_over_expected": float(self.bin_white_sigma / expected) if expected > 0 else None,
@@ -309,8 +333,8 @@ class NativeRate:
         return ["## Native rate", "",
                 f"{self.plan.why()}.", "",
                 (f"{self.bins} bins diagnosed ({self.dropped_bins} dropped for holding fewer than half a bin of "
-                 f"kept samples; {self.full.zero_weight.size} samples given zero weight as clipped or outliers). "
-                 "The fit, the mismatch, the reference and bias instability below are of the bin means; white "
+                 f"kept samples; {self._zero_weight()}). "
+                 f"{self.of_bins[1]} are of the bin means; white "
                  "noise, quantisation, saturation and outliers are measured on every sample."), "",
                 (f"White noise: {self.full.white_sigma:.4g} {unit} per sample at {self.full.sample_rate_hz:.4g} Hz; "
                  f"the bin means' {self.bin_white_sigma:.4g} {unit} (white noise alone would give "
@@ -342,11 +366,14 @@ def white_sigma(diag: Diagnosis) -> float:
     return native.full.white_sigma if native is not None else diag.noise.white_sigma
 
 
-def merged(diag: Diagnosis, native: NativeRate) -> AveragedDiagnosis:
-    """``diag`` (of the bin means) with the full-rate noise findings, model terms and ``native``."""
+def merged(diag: Diagnosis, native: NativeRate, glitch: Glitches | None = None) -> AveragedDiagnosis:
+    """``diag`` (of the bin means) with the full-rate noise findings, model terms and ``native``,
+    and the thermometer glitches found on every sample (``glitch``)."""
     full = native.full
     own = full.findings(diag.unit)
-    kept = {e.id: e for e in diag.effects if e.id in FINDINGS_ORDER and e.id not in FULL_RATE_IDS}
+    if glitch is not None and glitch.count:
+        own[GLITCHES] = glitch.finding()
+    kept = {e.id: e for e in diag.effects if e.id in FINDINGS_ORDER and e.id not in (*FULL_RATE_IDS, GLITCHES)}
     effects = [e for e in diag.effects if e.id not in FINDINGS_ORDER]
     effects += [own.get(key) or kept[key] for key in FINDINGS_ORDER if key in own or key in kept]
     model = dict(diag.model)
@@ -364,6 +391,8 @@ def merged(diag: Diagnosis, native: NativeRate) -> AveragedDiagnosis:
         model["outliers"] = {"time_s": [float(t) for t in full.outliers.time_s],
                              "size": [float(v) for v in full.outliers.size]}
     fields = {f: getattr(diag, f) for f in Diagnosis.__dataclass_fields__}
+    if glitch is not None and glitch.count:
+        fields["statistics"] = replace(diag.statistics, screens={**diag.statistics.screens, GLITCHES: glitch.count})
     return AveragedDiagnosis(**(fields | {"effects": effects, "model": model, "outliers": full.outliers}),
                              native_rate=native)
 
@@ -379,9 +408,12 @@ def diagnose_any_rate(rec: Recording, *, sensor: str | None = None, declared: di
     if not plan.averaged:
         return diagnose(rec, sensor=sensor, declared=declared, name=name, min_duration_s=min_duration_s,
                         settings=settings)
+    glitch = glitches(rec, settings.screens).found  # on every sample: a bin mean would hide them
+    rec = repaired(rec, glitch.index)
     full = full_rate_noise(rec, settings, plan.sample_rate_hz)
-    binned, dropped = bin_means(rec, plan, full.zero_weight)
+    binned, dropped = bin_means(rec, plan, np.union1d(full.zero_weight, glitch.index))
     diag = diagnose(binned, sensor=sensor, declared=declared, name=name, min_duration_s=min_duration_s,
                     settings=settings)
-    native = NativeRate(plan, full, int(binned.data.shape[0]), dropped, float(diag.noise.white_sigma))
-    return merged(diag, native)
+    native = NativeRate(plan, full, int(binned.data.shape[0]), dropped, float(diag.noise.white_sigma),
+                        glitch_samples=glitch.count)
+    return merged(diag, native, glitch)

@@ -269,13 +269,11 @@ class VarianceSettings:
 
 @dataclass(frozen=True)
 class FlickerSettings:
-    """Flicker (``bias_instability``): the Allan test of the final residual and the recheck of
-    the kept effects (:mod:`tcbench.diagnose.screens.flicker`)."""
+    """Flicker (``bias_instability``): the Allan test of the final residual, whose flicker the
+    kept effects are then rechecked against (:mod:`tcbench.diagnose.screens.flicker`; the recheck
+    takes the exact variance of their scores under it, no draws)."""
 
     false_alarm: float = setting(0.01, "false-alarm probability of the Allan test over its taus", PROBABILITY)
-    recheck_draws: int = setting(16, "flicker realisations the recheck of the kept effects averages over",
-                                 COUNT)
-    recheck_seed: int = setting(0, "their generator: same recording, same diagnosis", SEED)
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,18 @@ step found, when significant, is a column of the slope's fit and both are remove
 residual the noise test reads. The numbers are the settings' ``short`` section
 (:class:`~tcbench.diagnose.settings.ShortSettings`), with the plan's and the smoothing's for what a
 full diagnosis needs.
+
+A record of more rows than ``settings.rate.max_rows`` (15 min at 1 kHz is 900 000) is tested as a
+diagnosis takes it (:mod:`tcbench.diagnose.native_rate`): the slope, the step and the Allan
+deviation on bin means of the same plan, the noise terms on every sample (white sigma and
+density, the output's lattice, clipping and isolated outliers, reported as findings; clipped
+samples and outliers enter no bin), and report.json's ``native_rate`` (report.md's section
+"Native rate") says what was averaged, to what rate and why.
+
+Thermometer glitches (a bus sample of 0.0 or -40 degC) are found on the raw reading of every
+sample as a diagnosis finds them (:mod:`tcbench.diagnose.glitches`), reported as its
+``thermometer_glitches`` finding and given zero weight: held at the previous reading before the
+thermometer is smoothed, their samples left out of every test (and of every bin).
 """
 
 from __future__ import annotations
@@ -23,7 +35,13 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.glitches import ID as GLITCHES
+from tcbench.diagnose.glitches import repaired
+from tcbench.diagnose.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
 from tcbench.diagnose.plan import min_full_duration_s
+from tcbench.diagnose.screens import FINDINGS_ORDER
+from tcbench.diagnose.screens.glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.short_tests import (
     NOT_RUN,
@@ -43,6 +61,9 @@ from tcbench.sensors.segments import segments
 DRIFT = ("a drift in time (ageing, warm-up, a random walk): the temperature moves one way on this record; "
          "one that heats and cools tells them apart")
 _WORDS = {1: "one", 2: "two", 3: "three", 4: "four"}  # a small count in words
+# what a short record's report reads from the bin means (:class:`~tcbench.diagnose.native_rate.NativeRate`'s ``of_bins``)
+OF_BINS = ("the temperature slope, the level step and the Allan deviation of this report",
+           "The temperature slope, the level step and the Allan deviation below")
 
 
 @dataclass
@@ -62,6 +83,8 @@ class ShortRecordReport:
     tests: list[ShortTest]
     needs_more_time: list[dict[str, Any]]
     settings: DiagnoseSettings = field(default=DEFAULTS, repr=False)
+    findings: list[Finding] = field(default_factory=list)
+    native_rate: NativeRate | None = None
 
     @property
     def full_duration_s(self) -> float:
@@ -86,11 +109,13 @@ class ShortRecordReport:
                 parts.append(f"temperature_slope {t.status} ({t.values['slope_per_c']:.4g} {self.unit}/degC)")
             else:
                 parts.append(f"{t.id} {t.status}")
+        if self.findings:
+            parts.append(f"found: {', '.join(f.id for f in self.findings)}")
         return (f"short record ({self.duration_s:.4g} s of the {self.full_duration_s:.4g} s a full diagnosis "
                 f"needs): {'; '.join(parts)}")
 
     def to_json(self) -> dict[str, Any]:
-        """``report.json`` of a short record."""
+        """``report.json`` of a short record (``findings`` and ``native_rate`` only when there are any)."""
         return {
             "report": "short_record", "sensor": self.sensor, "unit": self.unit, "recording": self.recording,
             "verdict": self.verdict, "duration_s": self.duration_s, "samples": self.samples,
@@ -98,6 +123,8 @@ class ShortRecordReport:
             "thermometer_smooth_s": self.smooth_s, "ramp_starts_s": self.ramp_starts_s,
             "full_diagnosis_needs_s": self.full_duration_s, "level": self.settings.short.alpha,
             "tests": [t.to_json() for t in self.tests], "needs_more_time": self.needs_more_time,
+            **({"findings": [f.to_json() for f in self.findings]} if self.findings else {}),
+            **({"native_rate": self.native_rate.to_json()} if self.native_rate is not None else {}),
             "settings": report_mapping(self.settings),
         }
 
@@ -157,7 +184,37 @@ def _white_sigma(y: np.ndarray, same: np.ndarray) -> float:
 
 def short_record(rec: Recording, sensor: str | None = None, name: str = "",
                  settings: DiagnoseSettings = DEFAULTS) -> ShortRecordReport:
-    """The tests ``rec`` supports (see module doc), whatever its length, with ``settings``."""
+    """The tests ``rec`` supports (see module doc), whatever its length, with ``settings``: on its
+    samples within ``settings.rate.max_rows``, else on bin means with the noise terms of every sample."""
+    glitch = glitches(rec, settings.screens).found  # thermometer glitches: held at the previous reading, zero weight
+    rec = repaired(rec, glitch.index)
+    plan = plan_for(rec, settings.rate)
+    if not plan.averaged:
+        report = _tested(rec, sensor, name, settings, glitch.index)
+        report.findings = [glitch.finding()] if glitch.count else []
+        return report
+    full = full_rate_noise(rec, settings, plan.sample_rate_hz)
+    binned, dropped = bin_means(rec, plan, np.union1d(full.zero_weight, glitch.index))
+    report = _tested(binned, sensor, name, settings)
+    noise = next(t for t in report.tests if t.id == "white_noise")
+    bin_sigma = float(noise.values["white_sigma"])
+    noise.values |= {"white_sigma": full.white_sigma,
+                     "density_per_sqrt_hz": full.white_sigma / float(np.sqrt(plan.sample_rate_hz)),
+                     "white_sigma_bins": bin_sigma}
+    found = full.findings(report.unit) | ({GLITCHES: glitch.finding()} if glitch.count else {})
+    report.findings = [found[key] for key in FINDINGS_ORDER if key in found]
+    report.native_rate = NativeRate(plan, full, int(binned.data.shape[0]), dropped, bin_sigma, OF_BINS,
+                                    glitch.count)
+    report.samples, report.sample_rate_hz = plan.rows, plan.sample_rate_hz
+    report.duration_s = float(rec.time_s[-1] - rec.time_s[0])
+    report.needs_more_time = needs_more_time(report.duration_s, settings)
+    return report
+
+
+def _tested(rec: Recording, sensor: str | None, name: str, settings: DiagnoseSettings,
+            zero_weight: np.ndarray | None = None) -> ShortRecordReport:
+    """The tests ``rec`` supports, on its samples as they are, those at ``zero_weight`` left out
+    after the thermometer is smoothed."""
     short, default_s = settings.short, settings.smoothing.default_window_s
     kind = str(sensor or rec.meta.sensor)
     unit = str((rec.meta.units or {}).get("output", kinds.get(kind).output_unit))
@@ -167,6 +224,11 @@ def short_record(rec: Recording, sensor: str | None = None, name: str = "",
     rate_hz = float(rec.meta.sample_rate_hz or (1.0 / np.median(np.diff(t)) if n > 1 else 1.0))
     window_s = fitted_window_s(t, temp, default_s, settings.smoothing.bias_to_noise) if n > 1 else default_s
     temp_s, rate = smooth_temperature(t, temp, window_s) if n > 1 else (temp, np.zeros(n))
+    if zero_weight is not None and zero_weight.size:
+        keep = np.ones(n, dtype=bool)
+        keep[zero_weight] = False
+        t, temp_s, rate, u, y = t[keep], temp_s[keep], rate[keep], u[keep], y[keep]
+        n = t.size
     span_c = float(np.ptp(temp_s)) if n else 0.0
     moves = n > 1 and np.ptp(u) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
     same = (np.diff(segments(t)) == 0) & (np.abs(np.diff(u)) <= 1e-9 * max(1.0, float(np.max(np.abs(u)))))
@@ -195,6 +257,6 @@ def short_record(rec: Recording, sensor: str | None = None, name: str = "",
     residual = y - q @ (q.T @ y)
     noise = white_noise(t, residual, sigma, rate_hz, short.alpha, settings.locate.min_allan_samples)
     return ShortRecordReport(
-        sensor=kind, unit=unit, recording=name, duration_s=duration_s, samples=int(n), sample_rate_hz=rate_hz,
+        sensor=kind, unit=unit, recording=name, duration_s=duration_s, samples=int(rec.time_s.size), sample_rate_hz=rate_hz,
         temperature_span_c=span_c, smooth_s=float(window_s), ramp_starts_s=[float(s) for s in starts],
         tests=[slope, step, noise], needs_more_time=needs_more_time(duration_s, settings), settings=settings)

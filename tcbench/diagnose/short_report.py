@@ -50,9 +50,16 @@ def render_short_markdown(report: ShortRecordReport) -> str:
              f"(thermometer smoothed over {_g(report.smooth_s, 3)} s).", "",
              f"A full diagnosis needs {_g(report.full_duration_s)} s; this record gets the tests its length allows, "
              f"each at level {report.to_json()['level']:g}.", "",
-             f"**Verdict**: {report.verdict}", "", "## Tests run", ""]
+             f"**Verdict**: {report.verdict}", ""]
+    if report.native_rate is not None:
+        lines += report.native_rate.markdown(report.unit)
+    lines += ["## Tests run", ""]
     rows = [(t.id, t.status, _numbers(t, report.unit), t.what) for t in report.tests if t.ran]
     lines += _table(["test", "verdict", "statistic", "what"], rows) if rows else ["None."]
+    if report.findings:
+        lines += ["", "## Found", ""]
+        lines += [f"- **{f.id}**: {f.explanation.rstrip('.')}; confirm with {f.confirm_with.rstrip('.')}."
+                  for f in report.findings]
     lines += ["", "## Not run on this record", ""]
     missing = [f"- **{t.id}**: {t.reason}." for t in report.tests if not t.ran]
     missing += [f"- **{r['id']}**: needs {_g(r['needs_s'])} s ({_g(r['needs_s'] / 60.0, 3)} min): {r['what']}."

@@ -31,9 +31,10 @@ class DiagnosisDataError(ValueError):
     """A recording that cannot be diagnosed (too short, constant temperature, ...)."""
 
 
-def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float) -> tuple[np.ndarray, np.ndarray]:
+def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Value and slope (per s) of a least-squares line through ``x`` over ``t ± window_s / 2``
-    at every sample, by cumulative sums (O(n)); a window holding one sample keeps it."""
+    at every sample (``window_s`` one for all, or one per sample), by cumulative sums (O(n)); a
+    window holding one sample keeps it."""
     t0 = t_s - t_s.mean()
     lo = np.searchsorted(t_s, t_s - 0.5 * window_s, side="left")
     hi = np.searchsorted(t_s, t_s + 0.5 * window_s, side="right")
@@ -81,7 +82,12 @@ def smooth_temperature(t_s: np.ndarray, temp_c: np.ndarray, window_s: float) -> 
     line reaching across gaps of minutes misses the profile's bends between bursts by degrees
     (2 degC RMS on an 8 h staircase sampled 100 s of every 10 min), far more than the noise
     averaging gains. Sparser segments take the local line over ``window_s`` or, if wider, three
-    segment spacings, which reaches across the gaps.
+    times their own spacing, which reaches across the gaps to their neighbours: the span from the
+    segment's first sample to its last plus the wider of the gaps on either side (on a regularly
+    sparse record, the interval between segment starts). A few samples between two gaps of a
+    continuous record (kept samples between clipped ones) are so bridged over their own gaps, not
+    over the record's mean segment spacing (hours, where a line through an oven ramp misses by
+    degrees).
     """
     value, rate = _smoothed(t_s, temp_c, window_s, with_rate=True)
     assert rate is not None
@@ -101,8 +107,7 @@ def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
     rate = np.empty_like(temp_c) if with_rate else None
     starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
     bounds = np.append(starts, t_s.size)
-    spacing = (t_s[-1] - t_s[0]) / max(starts.size, 1)
-    short_window = max(window_s, 3.0 * spacing) if starts.size > 1 else window_s
+    short_window = _sparse_window_s(t_s, bounds, window_s)
     wide: tuple[np.ndarray, np.ndarray] | None = None  # the local line, computed if a segment needs it
     for a, b in pairwise(bounds):
         n = b - a
@@ -120,6 +125,19 @@ def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
             if rate is not None:
                 rate[a:b] = wide[1][a:b]
     return value, rate
+
+
+def _sparse_window_s(t_s: np.ndarray, bounds: np.ndarray, window_s: float) -> np.ndarray:
+    """Per sample, the local line's window of a sparse segment (see :func:`smooth_temperature`):
+    ``window_s`` or, if wider, three times the segment's own spacing (its span plus the wider of
+    the gaps on either side); ``window_s`` for a record of one segment."""
+    first, last = t_s[bounds[:-1]], t_s[bounds[1:] - 1]
+    if first.size < 2:
+        return np.full(t_s.size, float(window_s))
+    gap = first[1:] - last[:-1]
+    wider = np.maximum(np.concatenate(([gap[0]], gap)), np.concatenate((gap, [gap[-1]])))
+    per_segment = np.maximum(window_s, 3.0 * (last - first + wider))
+    return np.repeat(per_segment, np.diff(bounds))
 
 
 def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,

@@ -6,6 +6,7 @@ All amplitudes are in the sensor's output unit (Hz for the MSRA, deg/s for the g
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import lfilter
 
 from tcbench.sensors.thermal import gauss_markov
 
@@ -29,6 +30,29 @@ def random_walk(n: int, dt_s: float, k_per_sqrt_s: float, rng: np.random.Generat
     return np.cumsum(rng.standard_normal(n) * (k_per_sqrt_s * np.sqrt(dt_s)))
 
 
+def flicker_bank(n: int, dt_s: float, b: float, tau_max_s: float | None = None) -> tuple[np.ndarray, float]:
+    """The Gauss-Markov bank :func:`flicker` sums for ``n`` samples ``dt_s`` apart: the
+    correlation times (s) and the std of each process (output unit)."""
+    t_hi = 10.0 * (tau_max_s or n * dt_s)
+    t_lo = max(1.0, 2.0 * dt_s)
+    count = max(1, int(np.ceil(_PER_DECADE * np.log10(t_hi / t_lo))) + 1)
+    return np.logspace(np.log10(t_lo), np.log10(t_hi), count), FLICKER_SIGMA_PER_B * b
+
+
+def flicker_score_variance(z: np.ndarray, dt_s: float, b: float, tau_max_s: float | None = None) -> float:
+    """``E[(z' f)^2]`` for ``f`` the flicker of :func:`flicker` (coefficient ``b``) on ``z.size``
+    samples ``dt_s`` apart: the variance of a score ``z' f`` over infinitely many draws, exactly.
+    Each process of the bank has covariance ``sigma^2 exp(-|i - j| dt_s / tc)``, whose quadratic
+    form ``z' K z = 2 z' s - z' z`` takes one first-order recursion ``s_i = z_i + a s_(i-1)``,
+    ``a = exp(-dt_s / tc)`` (O(n) per process). The draws' slow processes, drawn coarser and
+    interpolated, have this covariance to within 1 %."""
+    z = np.asarray(z, dtype=float)
+    tcs, sigma = flicker_bank(z.size, dt_s, b, tau_max_s)
+    zz = float(z @ z)
+    total = sum(2.0 * float(z @ lfilter([1.0], [1.0, -np.exp(-dt_s / tc)], z)) - zz for tc in tcs)
+    return float(sigma**2 * total)
+
+
 def flicker(
     n: int, dt_s: float, b: float, rng: np.random.Generator, tau_max_s: float | None = None
 ) -> np.ndarray:
@@ -39,12 +63,7 @@ def flicker(
     are drawn on a coarser grid and linearly interpolated chunk by chunk into the output, which
     keeps 24 h at 100 Hz fast and its memory at one full-length array (the output) plus chunks.
     """
-    duration_s = n * dt_s
-    t_hi = 10.0 * (tau_max_s or duration_s)
-    t_lo = max(1.0, 2.0 * dt_s)
-    count = max(1, int(np.ceil(_PER_DECADE * np.log10(t_hi / t_lo))) + 1)
-    tcs = np.logspace(np.log10(t_lo), np.log10(t_hi), count)
-    sigma = FLICKER_SIGMA_PER_B * b
+    tcs, sigma = flicker_bank(n, dt_s, b, tau_max_s)
     out = np.zeros(n)
     for tc in tcs:
         step = max(1, int(tc / dt_s / _MAX_STEPS_PER_TC))

@@ -7,7 +7,8 @@ more than its ``structure_ratio``, an Allan excess is the structure
 the model leaves, not flicker; and the recheck may not hand flicker structure the reference
 shows. The Allan test reads the in-sample residual: a held-out one carries each fold's
 coefficient error, constant over its blocks, which looks like slow noise. The test's
-false-alarm probability and the recheck's draws are :class:`~tcbench.diagnose.settings.FlickerSettings`.
+false-alarm probability is :class:`~tcbench.diagnose.settings.FlickerSettings`; the recheck takes
+each kept effect's score variance under the flicker found exactly (no draws, so no seed).
 """
 
 from __future__ import annotations
@@ -137,7 +138,7 @@ class FlickerScreen(Screen):
             return replace(found, b=None)
         if found.b is None or len(att.final.ids) <= len(att.base.ids):
             return found
-        rechecked = recheck_with_flicker(att, found.b, self.settings.screens.flicker)
+        rechecked = recheck_with_flicker(att, found.b)
         if rechecked is att or reference.structure_remains(final_rmse(rechecked)):
             return found
         allan, b = self.test(rechecked)
