@@ -204,6 +204,9 @@ def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
     return notes
 
 
+DIAGNOSED_KEY = (
+    "diagnosed = the models tcbench diagnose fits to each training run (learner=model), averaged and run "
+    "noise-free on the test thermometer without the terms keyed to a training run's clock")
 MSRA_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
     "physical limit); oracle_thermometer = the device's model (not this power-on's) fed the package temperature its "
@@ -213,7 +216,9 @@ MSRA_KEY = (
     "factor cubic in temperature (least squares); poly3_runs = the same fitted within runs (a constant per power-on, "
     "its turn-on bias; learner.offsets=per_run); poly3_rate = the bias cubic plus a cubic times the temperature rate; "
     "lagpoly = the cubic in the thermometer passed through a "
-    "first-order lag, the lag and the degree chosen by leave-one-recording-out error. x_oracle, x_thermo = the "
+    "first-order lag, the lag and the degree chosen by leave-one-recording-out error; "
+    + DIAGNOSED_KEY + " (the input solved from "
+    "the models' output on the full-temperature task). x_oracle, x_thermo = the "
     "median primary metric over the oracle's and over oracle_thermometer's. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by seed.")
 FULLTEMP_NOTE = (
@@ -232,9 +237,9 @@ CHAMBER_KEY = (
     "device exactly, not this power-on; memoriser = no physics, the training runs' mean output at the same time "
     "since the start; poly3 = bias cubic in the thermometer, as flight stacks ship it (least squares); poly3_rate = the same plus "
     "a cubic times the temperature rate (the inputs the networks get); lagpoly = cubic in the thermometer passed "
-    "through a first-order lag, lag and degree by leave-one-recording-out error; model = the physics tcbench "
-    "diagnose fitted on the first training cycle (lag, hysteresis, warm-up ...), run noise-free on the test "
-    "thermometer. Networks get [T, dT/dt]. x_oracle, x_thermo = the median drift over the oracle's and over "
+    "through a first-order lag, lag and degree by leave-one-recording-out error; "
+    + DIAGNOSED_KEY + " (lag, hysteresis, ...). "
+    "Networks get [T, dT/dt]. x_oracle, x_thermo = the median drift over the oracle's and over "
     "oracle_thermometer's. p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, "
     "paired by seed.")
 GYRO_KEY = (
@@ -245,7 +250,9 @@ GYRO_KEY = (
     "raw = the recorded output; oracle = the simulator's true drift removed, noise untouched (the physical "
     "limit); oracle_thermometer = the device's drift model (not this power-on's) fed the package temperature "
     "its thermometer's reading implies (smoothed over 60 s); memoriser = no physics, the training run's mean "
-    "output at the same time since the start subtracted; x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
+    "output at the same time since the start subtracted; "
+    + DIAGNOSED_KEY + ", their bias subtracted (no pipeline); "
+    "x_oracle, x_thermo = the median drift over theirs. p_vs_next = Wilcoxon "
     "signed-rank p-value of the primary metric against the next row, paired by "
     "seed. note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
