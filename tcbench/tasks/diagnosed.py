@@ -6,11 +6,12 @@ lag, hysteresis, second node ...) to each training run, and the compensator is t
 models run as a shipped compensator runs them
 (:func:`tcbench.compensation.fitted_model.deterministic_output` with ``clock_terms=False``: the
 thermometer and time as read, no term keyed to a training run's clock, no rig lines, no noise).
-Each training run is diagnosed on its own and the models' outputs averaged, because a diagnosis
-fits one record's time line (its turn-on bias, its steps) and the training runs are separate
-power-ons, so no joint fit could share one time line across them; the mean uses every run, and
-averages away each run's turn-on bias and the terms only one run's noise or events called for.
-The test recordings are never read by the fit: :func:`diagnose_runs` takes the training runs only.
+Each training run is diagnosed on its own and the models' outputs averaged: a diagnosis fits one
+record's time line (its turn-on bias, its steps, its warm-up), and the training runs are separate
+power-ons that share none. The mean uses every run and averages away each run's turn-on bias and
+the terms only one run's noise or events called for, where refitting the first run's terms on the
+others would keep that one run's choice of terms. The test recordings are never read by the fit:
+:func:`diagnose_runs` takes the training runs only.
 
 The room-temperature runs hold less than the diagnosis's least temperature span; they are
 diagnosed with a smaller one (:data:`MIN_SPAN_C`).
