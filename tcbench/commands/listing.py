@@ -46,8 +46,8 @@ def work(cfg: ListConfig) -> int:
             print(f"  {name:10s} BROKEN: {err}")
         print("  raw, memoriser, oracle, oracle_thermometer, lagpoly, model  baselines: no compensation; the training "
               "runs' mean output at the same time (no physics); the simulator's truth (the physical limit); its model "
-              "fed the thermometer (the limit of what a compensator reads); the lag-aware polynomial; the model "
-              "tcbench diagnose fits (accel_chamber)")
+              "fed the thermometer (the limit of what a compensator reads); the lag-aware polynomial; the models "
+              "tcbench diagnose fits to the training runs (the board row diagnosed)")
     if what in {"all", "sensors"}:
         from tcbench.sensors import kinds as sensor_kinds
 

@@ -1,8 +1,8 @@
 """Compensation methods on a static-input task (MSRA, accelerometer chamber): a learner, no
 compensation (raw), the memoriser (no physics: the training runs' mean output at the same time
 since the start, the sanity row of docs/concepts/split-tiers.md), the lag-aware polynomial (lagpoly), and the
-two oracles (the diagnosed model, ``model``, is fitted by the diagnosis:
-:mod:`tcbench.tasks.diagnosed`).
+two oracles (the diagnosed model, ``learner=model`` and the board row ``diagnosed``, is fitted by
+the diagnosis: :mod:`tcbench.tasks.diagnosed`).
 
 Each method is a *compensator*: a function of a test recording and an output array (the
 recorded one, or a probe of it) returning the compensated output (g for fulltemp, Hz for
@@ -21,6 +21,7 @@ from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.learners.base import Learner
 
 BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer", "lagpoly", "model")
+BASELINE_LABELS = {"model": "diagnosed"}  # a board row named apart from its learner: the diagnosed model
 Compensator = Callable[[TaskRecording, np.ndarray], np.ndarray]
 
 

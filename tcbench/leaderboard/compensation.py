@@ -219,6 +219,9 @@ def _one_draw(row: dict[str, object]) -> str:
     return "; ".join(parts)
 
 
+DIAGNOSED_KEY = (
+    "diagnosed = the models tcbench diagnose fits to each training run (learner=model), averaged and run "
+    "noise-free on the test thermometer without the terms keyed to a training run's clock")
 MSRA_KEY = (
     "raw = no compensation; oracle = the simulator's own model at the true die temperature (noise alone: the "
     "physical limit); oracle_thermometer = the device's model (not this power-on's) fed the package temperature its "
@@ -228,7 +231,8 @@ MSRA_KEY = (
     "factor cubic in temperature (least squares); poly3_runs = the same fitted within runs (a constant per power-on, "
     "its turn-on bias; learner.offsets=per_run); poly3_rate = the bias cubic plus a cubic times the temperature rate; "
     "lagpoly = the cubic in the thermometer passed through a "
-    "first-order lag, the lag and the degree chosen by leave-one-recording-out error. "
+    "first-order lag, the lag and the degree chosen by leave-one-recording-out error; "
+    + DIAGNOSED_KEY + " (the input solved from the models' output on the full-temperature task). "
     "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw).")
 FULLTEMP_NOTE = (
     " note: \"below the physical limit\" when even the upper end of the median's 95 % interval is under the "
@@ -246,9 +250,8 @@ CHAMBER_KEY = (
     "device exactly, not this power-on; memoriser = no physics, the training runs' mean output at the same time "
     "since the start; poly3 = bias cubic in the thermometer, as flight stacks ship it (least squares); poly3_rate = the same plus "
     "a cubic times the temperature rate (the inputs the networks get); lagpoly = cubic in the thermometer passed "
-    "through a first-order lag, lag and degree by leave-one-recording-out error; model = the physics tcbench "
-    "diagnose fitted on the first training cycle (lag, hysteresis, warm-up ...), run noise-free on the test "
-    "thermometer. Networks get [T, dT/dt]. "
+    "through a first-order lag, lag and degree by leave-one-recording-out error; "
+    + DIAGNOSED_KEY + " (lag, hysteresis, ...). Networks get [T, dT/dt]. "
     "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw).")
 GYRO_KEY = (
     "Methods are named by their pipeline: MOVMD = MOPSO-tuned VMD with sample-entropy classes (noise modes "
@@ -259,6 +262,7 @@ GYRO_KEY = (
     "limit); oracle_thermometer = the device's drift model (not this power-on's) fed the package temperature "
     "its thermometer's reading implies (smoothed over 60 s); memoriser = no physics, the training run's mean "
     "output at the same time since the start subtracted; "
+    + DIAGNOSED_KEY + ", their bias subtracted (no pipeline); "
     "x_oracle, x_thermo = the median over runs of the primary metric ÷ the limit's on the run's own draw of power-ons (paired; ci95_x_* its interval; a run on a draw the limit did not meet has none); draws = the draws of power-ons the runs met (restart i trains and tests on draw i; 1: every restart on one draw). p_vs_next = Wilcoxon signed-rank p-value of the primary metric against the next row, paired by draw (by seed when both met one draw). note: an ARW below the oracle's is not compensation but filtering — the bandwidth kept (bw_hz) "
     "says how much of a real rate input the method throws away with the noise.")
 

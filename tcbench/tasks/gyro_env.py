@@ -44,7 +44,7 @@ from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
-BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer")
+BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer", "model")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
@@ -233,8 +233,10 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     def score_baseline(self, which: str, bandwidth: bool = True) -> Score:
         """``raw`` (the pipeline without drift compensation: the recorded output itself for the
         serial pipeline without a denoiser), ``memoriser`` (the training runs' mean output at the
-        same time since the start subtracted: no physics), ``oracle`` (the simulator's truth) or
-        ``oracle_thermometer`` (the simulator's model fed the thermometer reading)."""
+        same time since the start subtracted: no physics), ``oracle`` (the simulator's truth),
+        ``oracle_thermometer`` (the simulator's model fed the thermometer reading) or ``model`` (the
+        models ``tcbench diagnose`` fits to the training runs, their mean bias subtracted:
+        :mod:`tcbench.tasks.diagnosed`)."""
         if self.data is None or self.pipeline is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which == "raw":
@@ -245,6 +247,13 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             recs = [score_record(tr, lambda y, tr=tr: y - memo(tr.recording.time_s), self.amplitude_dps, None,
                                  bandwidth) for tr in self.data.test]
             return Score("gyro", recs)
+        if which == "model":
+            from tcbench.tasks.diagnosed import diagnose_runs, gyro_method
+
+            fitted = diagnose_runs(self.data.train)
+            recs = [score_record(tr, gyro_method(fitted, tr.recording.time_s, tr.recording.temperature_c),
+                                 self.amplitude_dps, None, bandwidth) for tr in self.data.test]
+            return Score("gyro", recs, extra={"diagnosed": fitted})
         if which not in ("oracle", "oracle_thermometer"):
             raise ValueError(unknown_name("baseline", which, BASELINES))
         if not self.data.has_truth:

@@ -46,8 +46,6 @@ from tcbench.tasks.ids import MSRA_ENV_IDS
 TASKS = {"msra_zerobias": "roomtemp", "msra_fulltemp": "fulltemp", "accel_chamber": "chamber"}
 ENV_IDS = MSRA_ENV_IDS
 BIAS_FORMS = ("plus", "printed")
-# the diagnosed model needs a record with a temperature span to diagnose: the chamber cycle's
-MODEL_PROTOCOLS = ("chamber",)
 
 
 def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.random.Generator,
@@ -104,7 +102,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if task not in TASKS:
             raise ValueError(unknown_name("static-input task", task, TASKS))
         self.task, self.protocol = task, TASKS[task]
-        self.baselines = tuple(b for b in methods.BASELINES if b != "model" or self.protocol in MODEL_PROTOCOLS)
+        self.baselines = methods.BASELINES
         if not is_integer(budget) or budget < 1:
             raise ValueError(f"budget must be a positive integer, got {budget}")
         if not is_integer(device_seed) or device_seed < 0:
@@ -207,7 +205,8 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         """``raw`` (no compensation), ``memoriser`` (the training runs' mean output at the same time
         since the start: no physics), ``oracle`` (the simulator's truth: noise alone),
         ``oracle_thermometer`` (the simulator's model fed the thermometer reading), ``lagpoly``
-        or (chamber) ``model``, the model diagnosed on the first training recording."""
+        or ``model``, the mean of the models diagnosed on each training recording
+        (:mod:`tcbench.tasks.diagnosed`)."""
         if self.data is None:
             raise RuntimeError("call reset() before score_baseline()")
         if which not in self.baselines:
@@ -221,9 +220,9 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         if which == "model":
             from tcbench.tasks.diagnosed import diagnosed_compensator
 
-            fn, diag = diagnosed_compensator(self.data)
+            fn, fitted = diagnosed_compensator(self.data)
             score = score_outputs(self.data, fn, self.bias_form)
-            score.extra["diagnosis"] = diag
+            score.extra["diagnosed"] = fitted
             return score
         fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
         return score_outputs(self.data, fn, self.bias_form)

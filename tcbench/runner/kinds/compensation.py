@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.compensation.methods import BASELINES
+from tcbench.compensation.methods import BASELINE_LABELS, BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.errors import ConfigError
 from tcbench.runner.compensation_config import learner_of
@@ -25,13 +25,14 @@ TAG_FILES_CHARS = 1000  # the file lists in a run's tags, cut beyond this
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
-    the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``."""
+    """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
+    the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``
+    (not the rows that run without it: the oracles and ``diagnosed``)."""
     if learner.get("label"):
         return str(learner["label"])
     name = str(learner["name"])
     if name in BASELINES or name == "poly":
-        label = f"poly{learner.get('degree', 3)}" if name == "poly" else name
+        label = f"poly{learner.get('degree', 3)}" if name == "poly" else BASELINE_LABELS.get(name, name)
         label += "_rate" if name == "poly" and learner.get("form") == "bias_rate" else ""
         label += "_runs" if name == "poly" and learner.get("offsets") == "per_run" else ""
     else:
@@ -40,7 +41,7 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
         label = f"{prefix}-{name.upper() if name == 'bp' else name}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
     pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
-    if pipeline is None or name.startswith("oracle"):
+    if pipeline is None or name.startswith("oracle") or name == "model":
         return label
     front = pipeline(task)  # type: ignore[arg-type]
     back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
