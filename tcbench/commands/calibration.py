@@ -77,9 +77,14 @@ class Split:
     def held_out(self) -> list[int]:
         return [k for k in range(len(self.parts)) if k not in self.train]
 
+    @property
+    def plural(self) -> str:
+        """``temperature branches``, ``time blocks``."""
+        return self.noun.replace("branch", "branches") if self.noun.endswith("branch") else self.noun + "s"
+
     def describe(self, ks: list[int]) -> str:
         """``temperature branch 0 (cooling 51.6 -> -17.5 degC)`` or ``time blocks 1, 3``."""
-        plural = self.noun.replace("branch", "branches") if self.noun.endswith("branch") else self.noun + "s"
+        plural = self.plural
         if len(ks) == 1:
             b = self.parts[ks[0]]
             return f"{self.noun} {ks[0]} ({b.direction} {b.from_c:.1f} -> {b.to_c:.1f} degC)"
@@ -543,7 +548,7 @@ def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash
     return {"recording": Path(cfg.recording).name, "content_hash": content_hash,
             "sensor": rec.meta.sensor, "unit": unit, "axis": axis,
             "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
-            "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train, "fitted_why": split.why,
+            "parts": f"{len(split.parts)} {split.plural} ({split.how})", "fitted": split.train, "fitted_why": split.why,
             "held_out_parts": split.held_out, "test_recordings": [Path(p).name for p in cfg.test_recordings],
             "drift_window_s": cfg.drift_window_s}
 
