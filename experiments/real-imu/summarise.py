@@ -74,6 +74,16 @@ def _floor_columns(about: dict[str, Any], method: str) -> dict[str, Any]:
             "at_floor": method in about["at_floor"]}
 
 
+def _pooled_columns(about: dict[str, Any], method: str) -> dict[str, Any]:
+    """The ranking tcbench calibrate made (``calibration.json``): on every held-out sample pooled,
+    the method's drift over the best's and over raw's with their block-bootstrap intervals, and
+    whether it is the best or tied with it. Named ``pooled_*``: the drifts above are RMS over parts."""
+    best, raw = about["x_best"][method], about["x_raw"][method]
+    return {"pooled_best": method == about["best"], "pooled_tied": method in about.get("tied", []),
+            "pooled_over_best": best[0], "pooled_over_best_lo": best[1], "pooled_over_best_hi": best[2],
+            "pooled_over_raw": raw[0], "pooled_over_raw_lo": raw[1], "pooled_over_raw_hi": raw[2]}
+
+
 def board(calibrations: list[Path], diagnoses: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The long table (axis, split and its kind, method, drift, the floor and the ratios to it and
     to raw) and the wide board."""
@@ -96,8 +106,8 @@ def board(calibrations: list[Path], diagnoses: Path) -> tuple[pd.DataFrame, pd.D
         for method, value in scores.items():
             long_rows.append({"record": folder.name, "split": split, "split_kind": kind, "method": method,
                               "held_out_drift": value, "unit": unit, **_floor_columns(about, method),
-                              "ratio_to_raw": value / raw, "restarts": int(cal.loc[cal["method"] == method,
-                                                                                    "restarts"].max())})
+                              "ratio_to_raw": value / raw, **_pooled_columns(about, method),
+                              "restarts": int(cal.loc[cal["method"] == method, "restarts"].max())})
         best = about["best"]
         floor = about["noise_floor"]
         report = diagnoses / folder.name / "report.json"
@@ -241,7 +251,10 @@ def main() -> None:
         "thermometer, and cannot fly (`memoriser / best`: a method that does not beat it has learned nothing from "
         "the temperature that the split's clock does not give). Every fit sees the screened training parts "
         "(`screened`: samples dropped). Intervals: 95 % block bootstrap over the held-out parts (every method on "
-        "the same draws); `runner-up / best` is a tie when its interval reaches 1.\n\n"
+        "the same draws); `runner-up / best` is a tie when its interval reaches 1. `best`, `runner-up / best`, "
+        "`best / raw`, `memoriser / best` and `model / best` are tcbench calibrate's ranking on every held-out "
+        "sample pooled (`board.csv`: `pooled_*`); the drift columns are RMS over the parts, which can order two "
+        "close methods the other way.\n\n"
         "The noise floor is a limit, with its interval: the drift score white noise alone would give on the "
         "held-out parts (the raw residual's sample variance, half that of its first differences, over the samples "
         "in one window), 95 % block bootstrap drawn within each held-out part, jointly with every method's drift; "
