@@ -231,6 +231,7 @@ def main() -> None:
                                                            strict=True)]}).drop(
         columns=["drift / raw", "lo", "hi"]) if not pairs.empty else pairs
     pair_kinds = sorted(set(pairs["split_kind"])) if not pairs.empty else []
+    board_kinds = sorted(set(wide["split kind"]))
     cross_runs = "" if RUNS in pair_kinds else " None of these pairs is cross-run: no part is a separate recording."
     (args.out / "board.md").write_text(
         "# Real IMU records: calibration board\n\n"
@@ -239,8 +240,8 @@ def main() -> None:
         "`held_out_drift`). tofupilot: fitted on the first cooling branch (0), scored on the heating (1) and the "
         "second cooling (2), and fitted on both directions (0, 1), scored on the second cooling (2); PAN (a single "
         "cooling): cut into 5 time blocks, fitted on 0, 2, 4, scored on 1, 3.\n\n"
-        f"What the splits are (`split kind`): {kinds_in_words(sorted(set(wide['split kind'])))} No split on this "
-        "board is across runs.\n\n"
+        f"What the splits are (`split kind`): {kinds_in_words(board_kinds)}"
+        f"{'' if any(RUNS in k for k in board_kinds) else ' No split on this board is across runs.'}\n\n"
         "Methods: networks (bp: Levenberg-Marquardt when the rows allow it, else gradient descent; bp_gd: gradient "
         "descent, 1000 epochs; elman: Adam, 500 epochs): the median of `networks` restarts, their inputs held to "
         "the box they were trained on. model = the diagnosed physics (tcbench diagnose on the fitted parts) as a "
