@@ -8,7 +8,8 @@ import numpy as np
 
 import pytest
 
-from tcbench.compensation.holdout import BLOCKS_MIN, block_sums, floor_intervals, noise_sums, ratio_interval
+from tcbench.compensation.holdout import (BLOCKS_MIN, FloorIntervals, block_sums, floor_intervals, noise_sums,
+                                         ratio_interval)
 
 
 def test_the_pooled_drift_is_the_rms_of_every_part_s_running_mean() -> None:
@@ -36,7 +37,7 @@ def test_the_ratio_interval_covers_the_truth_and_is_degenerate_for_a_tie() -> No
 
 
 def _floor(parts: dict[str, list[np.ndarray]], raw: list[np.ndarray], t: list[np.ndarray], window_s: float,
-           seed: int = 0) -> dict[str, object]:
+           seed: int = 0) -> FloorIntervals:
     dt = [float(np.median(np.diff(x))) for x in t]
     sums = block_sums(parts, dt, window_s)
     noise = noise_sums(raw, t, dt, window_s, sums.block_s)
@@ -54,18 +55,18 @@ def test_the_floor_is_white_noise_s_drift_score_with_an_interval_that_covers_it(
         raw = [n + 0.002 * x for n, x in zip(noise, t)]  # a slope the differences do not see
         drift = [n + 3.0 * sigma / np.sqrt(window_s) * np.sin(x / 400.0) for n, x in zip(noise, t)]
         got = _floor({"white": noise, "drift": drift, "raw": raw}, raw, t, window_s, seed)
-        point, lo, hi = got["floor"]
+        point, lo, hi = got.floor
         assert lo < point < hi
         covered += lo <= sigma / np.sqrt(window_s) <= hi
         # noise alone is at the floor (its interval reaches 1) but for the bootstrap's misses; a
         # drift of three floors never is
-        at_floor += got["x_floor"]["white"][1] <= 1.0 <= got["x_floor"]["white"][2]
-        assert got["x_floor"]["drift"][1] > 1.5
+        at_floor += got.x_floor["white"][1] <= 1.0 <= got.x_floor["white"][2]
+        assert got.x_floor["drift"][1] > 1.5
         # the drift is the RMS over the parts of each part's drift, the point of the ratio
         tracks = [np.convolve(d, np.ones(60) / 60, mode="valid") for d in drift]
         over_parts = np.sqrt(np.mean([np.mean(x ** 2) for x in tracks]))
-        assert got["drift"]["drift"] == pytest.approx(over_parts)
-        assert got["x_floor"]["drift"][0] == pytest.approx(over_parts / point)
+        assert got.drift["drift"] == pytest.approx(over_parts)
+        assert got.x_floor["drift"][0] == pytest.approx(over_parts / point)
     # the floor's interval covers the truth 28 times in 30; noise alone's ratio interval reaches 1
     # 25 times (ten blocks of overlapping running means: a bootstrap interval narrower than nominal)
     assert covered >= 25 and at_floor >= 23
@@ -78,7 +79,7 @@ def test_the_floor_leaves_out_gaps_and_spikes() -> None:
     clean = rng.normal(0.0, 0.01, t[0].size)
     stepped = clean + np.repeat(np.arange(8) * 0.5, 250)  # the level jumps between bursts
     stepped[100] += 5.0  # and one spike
-    one, other = (_floor({"m": [x]}, [x], t, 5.0)["floor"] for x in (clean, stepped))
+    one, other = (_floor({"m": [x]}, [x], t, 5.0).floor for x in (clean, stepped))
     assert other[0] == pytest.approx(one[0], rel=0.02)
     assert one[0] == pytest.approx(0.01 / np.sqrt(250), rel=0.1)
 

@@ -84,11 +84,10 @@ class Split:
 
     def describe(self, ks: list[int]) -> str:
         """``temperature branch 0 (cooling 51.6 -> -17.5 degC)`` or ``time blocks 1, 3``."""
-        plural = self.plural
         if len(ks) == 1:
             b = self.parts[ks[0]]
             return f"{self.noun} {ks[0]} ({b.direction} {b.from_c:.1f} -> {b.to_c:.1f} degC)"
-        return f"{plural} {', '.join(map(str, ks))}"
+        return f"{self.plural} {', '.join(map(str, ks))}"
 
 
 def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, Any, list[Any]]]]:
@@ -429,8 +428,8 @@ def _floor(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], 
     noise = noise_sums(held_raw, held_t, steps, cfg.drift_window_s, sums.block_s)
     got = floor_intervals(sums, noise, {m: [f"{m}#{i}" for i in range(len(per))] for m, per in held.items()},
                           seed=cfg.seed)
-    x_floor = {m: list(v) for m, v in got["x_floor"].items()}  # type: ignore[attr-defined]
-    return {"noise_floor": list(got["floor"]), "drift_over_parts": got["drift"], "x_floor": x_floor,  # type: ignore[call-overload]
+    x_floor = {m: list(v) for m, v in got.x_floor.items()}
+    return {"noise_floor": list(got.floor), "drift_over_parts": got.drift, "x_floor": x_floor,
             "at_floor": [m for m, (x, lo, _) in x_floor.items() if (lo <= 1.0 if lo == lo else x <= 1.0)],
             "floor_how": (f"white noise's drift score: the raw residual's sample variance (half that of its first "
                           f"differences, each block's slope, gaps and outliers left out) over the samples in one "

@@ -135,14 +135,23 @@ def noise_sums(raw: Sequence[np.ndarray], t_s: Sequence[np.ndarray], dt_s: Seque
     return NoiseSums(np.concatenate(squares or [np.array([])]), np.concatenate(counts or [np.array([])]))
 
 
+@dataclass(frozen=True)
+class FloorIntervals:
+    """The white-noise floor ``(point, lo, hi)``, each method's held-out drift (RMS over the parts)
+    and its drift over the floor ``(point, lo, hi)``."""
+
+    floor: tuple[float, float, float]
+    drift: dict[str, float]
+    x_floor: dict[str, tuple[float, float, float]]
+
+
 def floor_intervals(sums: BlockSums, noise: NoiseSums, restarts: Mapping[str, Sequence[str]], seed: int = 0,
-                    draws: int = DRAWS, level: float = LEVEL) -> dict[str, object]:
+                    draws: int = DRAWS, level: float = LEVEL) -> FloorIntervals:
     """The white-noise floor and each method's held-out drift over it, with ``level`` intervals of
     a block bootstrap drawn within each held-out part (a part keeps its number of blocks; every
     method and the floor on the same draws). A method's drift is the RMS over the held-out parts
     of each part's drift, the median over its restarts (``restarts``: method -> its keys in
-    ``sums.squares``), as a calibration's table scores a part. Returns ``floor`` and per method
-    ``drift`` (points) and ``x_floor`` ``(point, lo, hi)``; NaN bounds with one block."""
+    ``sums.squares``), as a calibration's table scores a part. NaN bounds with one block."""
     part = sums.part if sums.part is not None else np.zeros(sums.counts.size, dtype=np.int64)
     nb = sums.counts.size
     if noise.counts.size != nb:
@@ -168,8 +177,8 @@ def floor_intervals(sums: BlockSums, noise: NoiseSums, restarts: Mapping[str, Se
         lo, hi = np.nanquantile(x[1:], q)
         return float(x[0]), float(lo), float(hi)
 
-    return {"floor": interval(floor), "drift": {m: float(d[0]) for m, d in drift.items()},
-            "x_floor": {m: interval(d / floor) for m, d in drift.items()}}
+    return FloorIntervals(interval(floor), {m: float(d[0]) for m, d in drift.items()},
+                          {m: interval(d / floor) for m, d in drift.items()})
 
 
 def ratio_interval(sums: BlockSums, a: str, b: str, seed: int = 0, draws: int = DRAWS,
