@@ -120,7 +120,7 @@ def test_the_default_split_fits_the_branches_that_span_the_held_out_temperatures
 @pytest.mark.parametrize(("args", "words"), [
     (("train_branches=[5]",), "the recording has 3 temperature branches"),
     (("methods=[elman_magic]",), "methods: unknown method 'elman_magic'; known: raw, poly3, poly3_rate, bp, bp_gd, "
-                                 "elman, model; did you mean 'elman'?"),
+                                 "elman, model, memoriser; did you mean 'elman'?"),
     (("min_swing_c=0",), "must be > 0"),
     (("seed=-1",), "seed must be a non-negative integer"),
     (("restarts=0",), "restarts must be 1..1000"),

@@ -116,3 +116,59 @@ def test_binned_elman_steps_once_per_bin() -> None:
     assert scores(res, test.t_s)["drift_rms"] < 0.2 * scores(test.output - test.truth, test.t_s)["drift_rms"]
     with pytest.raises(ValueError, match="bin_s must be > 0 or None"):
         fit("bp", [train], bin_s=0.0)
+
+
+def _two_parts(drift: str) -> tuple[Record, np.ndarray]:
+    """Two 30-min parts at 1 Hz: the first cools 50 -> 0 degC, the second heats 0 -> 50 degC (its
+    temperature runs the other way at the same elapsed time); the offset a function of the time
+    since each part's start (``elapsed``) or of the temperature alone (``temperature``), plus
+    white noise. Returns the record and the parts' first times."""
+    part_s = 1800
+    elapsed = np.tile(np.arange(part_s, dtype=float), 2)
+    t = np.arange(2 * part_s, dtype=float)
+    tau = elapsed / part_s
+    temp = np.where(t < part_s, 50.0 - 50.0 * tau, 50.0 * tau)
+    if drift == "elapsed":
+        offset = 0.5 * np.exp(-elapsed / 300.0) + 0.1 * np.sin(2 * np.pi * elapsed / 900.0)
+    else:
+        offset = 0.01 * temp + 2e-4 * (temp - 10.0) ** 2
+    noise = np.random.default_rng(4).normal(0.0, 0.01, t.size)
+    return record(t, temp, offset + noise, np.zeros_like(t)), np.array([0.0, float(part_s)])
+
+
+def test_the_memoriser_removes_a_drift_keyed_to_the_part_s_clock_and_nothing_of_a_temperature_one() -> None:
+    held = slice(1800, 3600)
+    for drift in ("elapsed", "temperature"):
+        rec, starts_s = _two_parts(drift)
+        train = [rec.part(0, 1800)]
+        memoriser = fit("memoriser", train, part_starts_s=starts_s[:1])
+        res = {"raw": rec.output - rec.truth, "memoriser": residual(memoriser, rec, starts_s),
+               "poly3": residual(fit("poly3", train), rec)}
+        ratio = {m: scores(r[held], rec.t_s[held])["drift_rms"] / scores(res["raw"][held], rec.t_s[held])["drift_rms"]
+                 for m, r in res.items()}
+        if drift == "elapsed":
+            # the same time since each part's start: the memoriser takes it all, the cubic in the
+            # temperature (which runs the other way here) cannot
+            assert ratio["memoriser"] < 0.05 and ratio["poly3"] > 0.5, ratio
+        else:
+            # a function of the temperature alone, which the held-out part runs the other way:
+            # the memoriser removes nothing of it, the cubic nearly all
+            assert ratio["memoriser"] > 0.9 and ratio["poly3"] < 0.05, ratio
+    # without the parts' starts the memoriser reads the time since the record's: the second part
+    # then lies beyond the fitted one and gets the last bin's offset
+    rec, starts_s = _two_parts("elapsed")
+    memoriser = fit("memoriser", [rec.part(0, 1800)], part_starts_s=starts_s[:1])
+    np.testing.assert_allclose(memoriser.offset(rec)[held], memoriser.memory[1][-1])
+
+
+def test_the_memoriser_counts_from_each_part_s_start_not_each_screened_piece_s() -> None:
+    rec, starts_s = _two_parts("elapsed")
+    pieces = [rec.part(0, 700), rec.part(760, 1800)]  # the first part cut by screening
+    from_part = fit("memoriser", pieces, part_starts_s=starts_s[:1])
+    from_piece = fit("memoriser", pieces)
+    held = slice(1800, 3600)
+    raw = scores((rec.output - rec.truth)[held], rec.t_s[held])["drift_rms"]
+    assert scores(residual(from_part, rec, starts_s)[held], rec.t_s[held])["drift_rms"] < 0.05 * raw
+    assert scores(residual(from_piece, rec, starts_s)[held], rec.t_s[held])["drift_rms"] > 0.1 * raw
+    with pytest.raises(ValueError, match="part_starts_s is empty"):
+        fit("memoriser", pieces, part_starts_s=np.array([]))

@@ -70,7 +70,7 @@ def test_an_unknown_column_or_unit_of_import_says_the_one_it_probably_meant(
 
 @pytest.mark.parametrize(("args", "line"), [
     (["methods=[poly33]"], "methods: unknown method 'poly33'; known: raw, poly3, poly3_rate, bp, bp_gd, elman, "
-                           "model; did you mean 'poly3'?"),
+                           "model, memoriser; did you mean 'poly3'?"),
     (["settings.selection.wald_threshhold=3"], "did you mean 'settings.selection.wald_threshold'?"),
 ])
 def test_names_of_a_recording_command(args: list[str], line: str, workdir: Path,

@@ -77,13 +77,17 @@ class Split:
     def held_out(self) -> list[int]:
         return [k for k in range(len(self.parts)) if k not in self.train]
 
+    @property
+    def plural(self) -> str:
+        """``temperature branches``, ``time blocks``."""
+        return self.noun.replace("branch", "branches") if self.noun.endswith("branch") else self.noun + "s"
+
     def describe(self, ks: list[int]) -> str:
         """``temperature branch 0 (cooling 51.6 -> -17.5 degC)`` or ``time blocks 1, 3``."""
-        plural = self.noun.replace("branch", "branches") if self.noun.endswith("branch") else self.noun + "s"
         if len(ks) == 1:
             b = self.parts[ks[0]]
             return f"{self.noun} {ks[0]} ({b.direction} {b.from_c:.1f} -> {b.to_c:.1f} degC)"
-        return f"{plural} {', '.join(map(str, ks))}"
+        return f"{self.plural} {', '.join(map(str, ks))}"
 
 
 def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, Any, list[Any]]]]:
@@ -276,6 +280,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         fittable(np.concatenate([p.temp_c for p in screening.pieces] or [np.array([])]),
                  "the fitted parts left by screening (screen=false fits every sample)")
     jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
+    train_starts_s = rec.time_s[[split.parts[k].start for k in split.train]]  # the memoriser's clocks
     fitted: dict[str, list[Any]] = {m: [] for m in methods}
     diagnosis = None
     with tqdm(jobs, desc="fitting", unit="fit", leave=False, disable=None) as bar:
@@ -285,12 +290,13 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
                 diagnosis = _diagnosed(rec, split, cfg, screening.keep)
                 fitted[m].append(from_model(diagnosis[1]))
             else:
-                fitted[m].append(fit(m, screening.pieces, cfg.seed + r))
+                fitted[m].append(fit(m, screening.pieces, cfg.seed + r, part_starts_s=train_starts_s))
     rows: list[dict[str, Any]] = []
     residuals: dict[str, np.ndarray] = {}
     held: dict[str, list[list[np.ndarray]]] = {m: [[] for _ in runs] for m, runs in fitted.items()}
     held_raw: list[np.ndarray] = []
     held_temp: list[np.ndarray] = []
+    held_t: list[np.ndarray] = []
     held_labels: list[str] = []
     steps: list[float] = []
     drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
@@ -298,13 +304,15 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
                                          *[(p, o, ps, []) for p, o, ps in others]]:
         own = r is rec
         target = whole if own else record(r.time_s, r.temperature_c, r.output, r.input)
-        every = {m: [residual(model, target) for model in runs] for m, runs in fitted.items()}
+        starts_s = r.time_s[[b.start for b in parts]]
+        every = {m: [residual(model, target, starts_s) for model in runs] for m, runs in fitted.items()}
         dt_s = float(np.median(np.diff(r.time_s))) if r.time_s.size > 1 else 1.0
         for k, b in enumerate(parts):
             role = "train" if k in fitted_parts else "test"
             if role == "test":
                 steps.append(dt_s)
                 held_raw.append((r.output - r.input)[b.start:b.stop])
+                held_t.append(r.time_s[b.start:b.stop])
                 held_temp.append(r.temperature_c[b.start:b.stop])
                 held_labels.append(f"{Path(path).stem}:{k}")
             for m, runs in every.items():
@@ -321,6 +329,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     table = pd.DataFrame(rows)
     summary, about = _ranked(table, held, held_raw, steps, cfg, unit, drift_key)
     about["per_part"] = _per_part(held, held_raw, steps, held_labels, cfg)
+    about |= _floor(held, held_raw, held_t, steps, cfg)
     about |= _about(cfg, rec, split, unit, own_hash)
     about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
     about["range"] = _range(screening.pieces, held_temp)
@@ -400,6 +409,40 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[
         ranking["ratio_to_raw"] = list(to_raw[best])
     ranking["worse_than_raw"], ranking["no_better_than_raw"] = raw_verdicts(to_raw)
     return summary, ranking
+
+
+def _floor(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], held_t: list[np.ndarray],
+           steps: list[float], cfg: CalibrateConfig) -> dict[str, Any]:
+    """The white-noise floor of the held-out drift score and every method's drift over it, each
+    with its block-bootstrap interval drawn within each held-out part (:func:`~tcbench.compensation.
+    holdout.floor_intervals`): ``noise_floor`` ``[point, lo, hi]``, ``drift_over_parts`` (the RMS
+    over the held-out parts of each part's drift, the median of the restarts: the long table's
+    numbers) and ``x_floor`` ``{method: [point, lo, hi]}``; ``at_floor``: the methods whose
+    interval reaches 1. Nothing when nothing is held out."""
+    from tcbench.compensation.holdout import LEVEL, block_sums, floor_intervals, noise_sums
+
+    if not steps:
+        return {}
+    runs = {f"{m}#{i}": parts for m, per in held.items() for i, parts in enumerate(per)}
+    sums = block_sums(runs, steps, cfg.drift_window_s)
+    noise = noise_sums(held_raw, held_t, steps, cfg.drift_window_s, sums.block_s)
+    got = floor_intervals(sums, noise, {m: [f"{m}#{i}" for i in range(len(per))] for m, per in held.items()},
+                          seed=cfg.seed)
+    x_floor = {m: list(v) for m, v in got.x_floor.items()}
+    return {"noise_floor": list(got.floor), "drift_over_parts": got.drift, "x_floor": x_floor,
+            "at_floor": [m for m, (x, lo, _) in x_floor.items() if (lo <= 1.0 if lo == lo else x <= 1.0)],
+            "floor_how": (f"white noise's drift score: the raw residual's sample variance (half that of its first "
+                          f"differences, each block's slope, gaps and outliers left out) over the samples in one "
+                          f"{cfg.drift_window_s:g}-s window; {LEVEL:.0%} block bootstrap within each held-out part, "
+                          "every method on the same draws")}
+
+
+def _floor_line(about: dict[str, Any], unit: str) -> str:
+    """``White-noise floor 0.0011 [0.0009, 0.0013] deg/s; at the floor: ...`` in words."""
+    point, lo, hi = about["noise_floor"]
+    at = ", ".join(about["at_floor"]) or "none (every method's drift over the floor has its interval above 1)"
+    return (f"White-noise floor of the drift score {point:.3g} [{lo:.3g}, {hi:.3g}] {unit} ({about['floor_how']}); "
+            f"at the floor (the interval of the drift over it reaches 1): {at}.")
 
 
 def raw_verdicts(to_raw: dict[str, tuple[float, float, float]]) -> tuple[list[str], list[str]]:
@@ -504,7 +547,7 @@ def _about(cfg: CalibrateConfig, rec: Any, split: Split, unit: str, content_hash
     return {"recording": Path(cfg.recording).name, "content_hash": content_hash,
             "sensor": rec.meta.sensor, "unit": unit, "axis": axis,
             "device_id": rec.meta.device_id, "px4_device_id": source.get("px4_device_id"),
-            "parts": f"{len(split.parts)} {split.noun}s ({split.how})", "fitted": split.train, "fitted_why": split.why,
+            "parts": f"{len(split.parts)} {split.plural} ({split.how})", "fitted": split.train, "fitted_why": split.why,
             "held_out_parts": split.held_out, "test_recordings": [Path(p).name for p in cfg.test_recordings],
             "drift_window_s": cfg.drift_window_s}
 
@@ -666,6 +709,7 @@ def _write(tmp: Path, cfg: CalibrateConfig, rec: Any, split: Split, residuals: d
                    f"{about['blocks']} blocks of {about['block_s']:g} s, every method on the same draws). "
                    + _best_line(about, unit).replace("best held out: ", "Best: ") + ".\n\n"
                    + "".join(f"- {v}\n" for v in verdicts) + ("\n" if verdicts else "")
+                   + (_floor_line(about, unit) + "\n\n" if "noise_floor" in about else "")
                    + f"{markdown_table(summary.round(6))}\n")
     written["md"].write_text(f"# Calibration of {Path(cfg.recording).name}\n\n{' '.join(lines)}\n{note}{ranking}\n"
                              f"## Every part\n\n{markdown_table(table.drop(columns=['recording']) if not cfg.test_recordings else table)}"

@@ -384,7 +384,8 @@ SPECS: dict[str, CommandSpec] = {
             "methods": "offset models: raw, poly3 (PX4's cubic), poly3_rate (cubic + temperature rate), bp (trained by "
                        "Levenberg-Marquardt when the rows allow), bp_gd (gradient descent, 1000 epochs), elman (Adam) "
                        "(the seed papers' networks on [T, dT/dt]), model (the diagnosed physics without its "
-                       "clock-keyed terms)",
+                       "clock-keyed terms); not by default: memoriser (a control, no physics: the fitted parts' mean "
+                       "offset against the time since their start, at the same time in each held-out part)",
             "seed": "the networks' initial weights",
             "restarts": "networks per learner method, seeds seed, seed+1, ...: the board gives the median of their "
                         "scores (the plot shows the first)",

@@ -27,6 +27,10 @@ Methods, each a function of what a flight controller can read (the thermometer a
   not all that a compensator may use (:mod:`tcbench.compensation.fitted_model`); the command
   (:mod:`tcbench.commands.calibration`) runs the diagnosis and hands the model in with
   :func:`from_model`.
+- ``memoriser``: no physics, a control. The training parts' mean offset as a function of the time
+  elapsed since the start of the part each sample lies in (:func:`fit_memoriser`), subtracted from
+  a held-out part at the same elapsed time since its own start. Not among the command's default
+  methods: it needs the parts' starts, which a flight controller does not have.
 
 The training parts are screened first (:mod:`tcbench.compensation.screening`: handling bursts,
 spikes and thermometer glitches dropped, the parts cut at their gaps; the command does it and
@@ -51,10 +55,11 @@ from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 from tcbench.compensation.record import Record
 from tcbench.compensation.training import fit_network
 
-METHODS = ("raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")
+METHODS = ("raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model", "memoriser")
 LEARNERS = ("bp", "bp_gd", "elman")
 RATE_WINDOW_S = 120.0
 TRAIN_BIN_S = 5.0  # the networks' training bins: see fit()
+MEMORY_BIN_S = 5.0  # the memoriser's bins of elapsed time since a part's start
 
 
 def record(t_s: np.ndarray, temp_c: np.ndarray, output: np.ndarray, truth: np.ndarray) -> Record:
@@ -76,12 +81,18 @@ class OffsetModel:
     temp_range_c: tuple[float, float] | None = None  # a learner's training temperatures: its input is held to them
     rate_range: tuple[float, float] | None = None  # and its training rates (degC/s)
     training: dict[str, Any] | None = None  # how a network was trained (tcbench.compensation.training)
+    memory: tuple[np.ndarray, np.ndarray] | None = None  # the memoriser's elapsed times (s) and mean offsets
 
-    def offset(self, rec: Record) -> np.ndarray:
+    def offset(self, rec: Record, part_starts_s: np.ndarray | None = None) -> np.ndarray:
         """The offset at each sample of ``rec``. A sequential learner (``elman``) trained on bins
         steps once per bin: it runs on the record's bin means and its output is interpolated
         linearly between the bins' mean times (held beyond the first and last), so a sample reads
-        the bin after its own, up to ``1.5 bin_s`` ahead."""
+        the bin after its own, up to ``1.5 bin_s`` ahead. The memoriser reads the time elapsed
+        since the start of each sample's part (``part_starts_s``, the parts' first times, s;
+        ``None``: ``rec`` is one part); every other method ignores ``part_starts_s``."""
+        if self.memory is not None:
+            elapsed_s = elapsed_in_part_s(rec.t_s, part_starts_s)
+            return np.interp(elapsed_s, *self.memory)
         if self.sensor_model is not None:
             from tcbench.compensation.fitted_model import deterministic_output
 
@@ -110,8 +121,58 @@ def _predicted(learner: Any, rec: Record, temp_range_c: tuple[float, float] | No
     return np.asarray(learner.predict(inputs), dtype=np.float64).reshape(-1)
 
 
+def elapsed_in_part_s(t_s: np.ndarray, part_starts_s: np.ndarray | None = None) -> np.ndarray:
+    """The time (s) elapsed at each of ``t_s`` since the start of the part it lies in: the latest
+    of ``part_starts_s`` at or before it (``None``: since ``t_s[0]``, one part). A time before the
+    first start counts from the first start (negative elapsed times, held to the memoriser's
+    first bin)."""
+    t = np.asarray(t_s, dtype=np.float64)
+    if part_starts_s is None:
+        return t - t[0] if t.size else t.copy()
+    starts = np.sort(np.asarray(part_starts_s, dtype=np.float64).reshape(-1))
+    if starts.size == 0:
+        raise ValueError("part_starts_s is empty: give the parts' first times, or None for one part")
+    k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, None)
+    return t - starts[k]
+
+
+def fit_memoriser(train: Sequence[Record], part_starts_s: np.ndarray | None = None,
+                  bin_s: float = MEMORY_BIN_S) -> OffsetModel:
+    """The ``memoriser``: the mean offset (output minus true input) of the training samples in
+    each ``bin_s`` bin of the time elapsed since the start of their part (``part_starts_s``: the
+    first times of the parts the records ``train`` were cut from, e.g. the fitted temperature
+    branches or time blocks before screening cut them at gaps; ``None``: each record is a part),
+    at the bin's mean elapsed time; at a held-out part it is interpolated linearly in the time
+    elapsed since that part's start, and held beyond the first and last bins.
+
+    What it can know: whatever the training parts share at the same time since their start — a
+    constant bias, a warm-up or a drift keyed to the part's clock, and for the time blocks of one
+    slow cooling the level and the trend within a block that its neighbours share. What it cannot
+    know: the temperature. A held-out part whose temperature runs differently at the same elapsed
+    time (the other direction of a cycle, another range, another rate) gets the training parts'
+    offset at that time whatever its thermometer reads; beyond the longest training part it holds
+    the last bin's offset. A compensator cannot run it (a flight has no parts; the split is known
+    after the recording ends): it is a control. A method that does not beat it has not shown that
+    it learned anything from the thermometer that the split's own clock does not already give."""
+    if not bin_s > 0:
+        raise ValueError(f"bin_s must be > 0, got {bin_s}")
+    if not train:
+        raise ValueError("the memoriser needs at least one training record")
+    if part_starts_s is None:
+        elapsed = np.concatenate([elapsed_in_part_s(r.t_s) for r in train])
+    else:
+        elapsed = elapsed_in_part_s(np.concatenate([r.t_s for r in train]), part_starts_s)
+    target = np.concatenate([r.output - r.truth for r in train])
+    index = np.floor(np.clip(elapsed, 0.0, None) / bin_s).astype(np.int64)
+    counts = np.bincount(index)
+    kept = counts > 0
+    centres_s = np.bincount(index, weights=elapsed)[kept] / counts[kept]
+    means = np.bincount(index, weights=target)[kept] / counts[kept]
+    return OffsetModel("memoriser", memory=(centres_s, means))
+
+
 def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None = TRAIN_BIN_S,
-        bp_training: str = "lm") -> OffsetModel:
+        bp_training: str = "lm", part_starts_s: np.ndarray | None = None) -> OffsetModel:
     """The offset model ``method`` (one of :data:`METHODS`) fitted on the records ``train``; a
     network's initial weights drawn from ``seed``; ``bp`` trained by Levenberg-Marquardt when
     the rows allow it (``bp_training=gd``: gradient descent; :mod:`tcbench.compensation.training`).
@@ -128,13 +189,17 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     bins) and predicts on bins too (:meth:`OffsetModel.offset`). Fitted on the first branch of
     the tofupilot cycle (2 Hz, up to 3 degC/min) with ten seeds, the held-out drift on samples and
     on 5-s bins differ by less than the seeds' spread on every gyro axis, either way (coarser
-    bins began to cost both networks on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``)."""
+    bins began to cost both networks on y: ``benchmarks/calibrate_speed.py``, ``RESULTS.md``).
+
+    ``memoriser`` reads ``part_starts_s`` (:func:`fit_memoriser`); the other methods ignore it."""
     if method not in METHODS:
         raise ValueError(unknown_name("calibration method", method, METHODS))
     if method == "raw":
         return OffsetModel("raw")
     if method == "model":
         raise ValueError("the diagnosed model is fitted by tcbench diagnose: pass it to from_model()")
+    if method == "memoriser":
+        return fit_memoriser(train, part_starts_s)
     temp = np.concatenate([r.temp_c for r in train])
     target = np.concatenate([r.output - r.truth for r in train])
     rate = np.concatenate([r.rate_c_per_s for r in train])
@@ -163,9 +228,9 @@ def from_model(sensor_model: Any) -> OffsetModel:
     return OffsetModel("model", sensor_model=sensor_model)
 
 
-def residual(model: OffsetModel, rec: Record) -> np.ndarray:
-    """Output minus true input minus the model's offset."""
-    return rec.output - rec.truth - model.offset(rec)
+def residual(model: OffsetModel, rec: Record, part_starts_s: np.ndarray | None = None) -> np.ndarray:
+    """Output minus true input minus the model's offset (``part_starts_s``: see :meth:`OffsetModel.offset`)."""
+    return rec.output - rec.truth - model.offset(rec, part_starts_s)
 
 
 def scores(res: np.ndarray, t_s: np.ndarray, drift_window_s: float = 60.0) -> dict[str, float]:
