@@ -281,3 +281,10 @@ def test_gd_validation_stop_keeps_the_best_held_out_weights() -> None:
     history = net.fit(x, y)
     assert history.stopped == "validation" and history.best_epoch == history.iterations - 20
     assert min(history.val_loss) == history.val_loss[history.best_epoch]
+
+
+def test_the_matlab_preset_has_its_own_method_name() -> None:
+    from tcbench.runner.kinds.compensation import compensation_label
+
+    assert compensation_label({"name": "bp", "training": "gd", "preset": "matlab"}, {"name": "ifa"}) == "IFA-BP-gd-matlab"
+    assert compensation_label({"name": "bp", "training": "lm", "preset": None}, {"name": "none"}) == "random-BP-lm"
