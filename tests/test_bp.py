@@ -239,6 +239,9 @@ def test_matlab_preset_sets_its_keys_and_refuses_them_given() -> None:
     assert (gd.validation_fraction, gd.max_fail, gd.min_grad, gd.max_epochs) == (0.15, 6, 1e-5, 1000)
     assert (lm.min_grad, lm.max_epochs) == (1e-7, 1000)
     assert (BPParams().learning_rate, BPParams().momentum, BPParams().validation_fraction) == (0.1, 0.9, 0.0)
+    import dataclasses
+
+    assert dataclasses.replace(gd, epochs=5).learning_rate == 0.02  # resolved params copy as they are
     with pytest.raises(ValueError, match="leave learning_rate=0.05 out"):
         BPParams(preset="matlab", learning_rate=0.05)
     with pytest.raises(ValueError, match="preset must be null or one of matlab"):

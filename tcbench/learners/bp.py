@@ -109,14 +109,14 @@ class BPParams(LearnerParams):
             return
         if self.preset not in PRESETS:
             raise ValueError(f"bp: preset must be null or one of {', '.join(PRESETS)}, got {self.preset!r}")
-        defaults = {f.name: f.default for f in dataclasses.fields(self)}
-        owned = ("learning_rate", "momentum", "validation_fraction", "max_fail", "min_grad")
-        given = [k for k in owned if getattr(self, k) != defaults[k]]
-        if given:
-            raise ValueError(f"bp: preset {self.preset} sets {', '.join(owned)}; leave "
-                             f"{', '.join(f'{k}={getattr(self, k)!r}' for k in given)} out or drop the preset")
         values = {"learning_rate": 2.0 * MATLAB_LR, "momentum": 0.0, "validation_fraction": MATLAB_VALIDATION,
                   "max_fail": MATLAB_MAX_FAIL, "min_grad": MATLAB_MIN_GRAD.get(self.training, 0.0)}
+        defaults = {f.name: f.default for f in dataclasses.fields(self)}
+        # a key at its default or already at the preset's value (a copy of resolved params) is fine
+        given = [k for k in values if getattr(self, k) not in (defaults[k], values[k])]
+        if given:
+            raise ValueError(f"bp: preset {self.preset} sets {', '.join(values)}; leave "
+                             f"{', '.join(f'{k}={getattr(self, k)!r}' for k in given)} out or drop the preset")
         for key, value in values.items():
             object.__setattr__(self, key, value)  # frozen: the resolved values are what describe() reports
 
