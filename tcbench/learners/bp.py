@@ -343,7 +343,7 @@ class BPNetwork(Learner):
                 loss, grad = self.loss_and_grad(p, x, t)
                 if not (np.isfinite(loss) and np.isfinite(grad).all()):
                     history.stopped = "diverged"
-                    return (best if val is None else val.finish(history, best)), history
+                    return (best if val is None else val.finish(best)), history
                 history.loss.append(loss)
                 if history.iterations in marks:
                     history.snapshots[history.iterations] = p.copy()
@@ -356,7 +356,7 @@ class BPNetwork(Learner):
                     stop = "goal" if loss <= cfg.goal else "max_epochs"
                 if stop:
                     history.stopped = stop
-                    return (p if val is None else val.finish(history, p)), history
+                    return (p if val is None else val.finish(p)), history
                 v = cfg.momentum * v - cfg.learning_rate * grad
                 p = p + v
                 history.iterations += 1
@@ -377,7 +377,7 @@ class BPNetwork(Learner):
 
         def done(why: str, q: np.ndarray) -> tuple[np.ndarray, FitHistory]:
             history.stopped = why
-            return (q if val is None else val.finish(history, q)), history
+            return (q if val is None else val.finish(q)), history
 
         with np.errstate(all="ignore"):
             h, y = self.forward(p, x)
@@ -455,6 +455,6 @@ class _Validation:
             self.fails += 1
         return "validation" if self.fails >= self.max_fail else ""
 
-    def finish(self, history: FitHistory, p: np.ndarray) -> np.ndarray:
+    def finish(self, p: np.ndarray) -> np.ndarray:
         """The weights to keep: those of the best held-out error (``p`` if none was finite)."""
         return p if self.best is None else self.best
