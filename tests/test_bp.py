@@ -214,3 +214,80 @@ def test_checkpoints_are_the_shorter_trainings_of_the_same_trajectory() -> None:
         env(training="lm", checkpoints=[10])
     with pytest.raises(ValueError, match="checkpoints must be null or, with training gd"):
         env(epochs=20, checkpoints=[30])
+
+
+def test_matlab_preset_gd_steps_at_lr_001_on_mse_without_momentum() -> None:
+    """``preset=matlab`` with ``gd`` is ``traingd``: ``dX = -lr d mse/dp`` with lr 0.01 and
+    ``mse = 2 C``, so each step is ``-0.02 dC/dp`` of the rows it trains on, with no momentum."""
+    x, y = smooth_data(200, 0)
+    net = BPNetwork(2, {"training": "gd", "preset": "matlab", "epochs": 2}, rng=np.random.default_rng(3))
+    p0 = np.random.default_rng(7).uniform(-1.0, 1.0, net.n_params)
+    history = net.fit(x, y, init=p0)
+    assert history.best_epoch == 2 and len(history.val_loss) == 3  # the kept weights are the last epoch's
+    held = np.sort(np.random.default_rng(3).permutation(200)[:30])  # 15 % of 200, drawn as the learner draws
+    train = np.setdiff1d(np.arange(200), held)
+    xs, ts = net._scaled(x[train], y[train])
+    g0 = net.loss_and_grad(p0, xs, ts)[1]
+    p1 = p0 - 0.01 * (2.0 * g0)
+    p2 = p1 - 0.01 * (2.0 * net.loss_and_grad(p1, xs, ts)[1])
+    np.testing.assert_allclose(net.get_params(), p2, rtol=0, atol=1e-12)
+    assert net.params.learning_rate == 0.02 and net.params.momentum == 0.0 and net.params.max_epochs == 2
+
+
+def test_matlab_preset_sets_its_keys_and_refuses_them_given() -> None:
+    gd, lm = BPParams(preset="matlab"), BPParams(training="lm", preset="matlab")
+    assert (gd.validation_fraction, gd.max_fail, gd.min_grad, gd.max_epochs) == (0.15, 6, 1e-5, 1000)
+    assert (lm.min_grad, lm.max_epochs) == (1e-7, 1000)
+    assert (BPParams().learning_rate, BPParams().momentum, BPParams().validation_fraction) == (0.1, 0.9, 0.0)
+    import dataclasses
+
+    assert dataclasses.replace(gd, epochs=5).learning_rate == 0.02  # resolved params copy as they are
+    with pytest.raises(ValueError, match="leave learning_rate=0.05 out"):
+        BPParams(preset="matlab", learning_rate=0.05)
+    with pytest.raises(ValueError, match="preset must be null or one of matlab"):
+        BPParams(preset="keras")
+
+
+def noisy_data(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A smooth function under noise of 0.5: a 30-hidden network fitted by LM overfits 40 rows."""
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-2.0, 2.0, (n, 2))
+    return x, np.sin(x[:, 0]) + 0.3 * x[:, 1] ** 2 + 0.5 * rng.normal(size=n)
+
+
+def test_lm_validation_stop_keeps_the_best_held_out_weights() -> None:
+    x, y = noisy_data(40, 0)
+    params = {"training": "lm", "hidden": 30, "epochs": 200, "validation_fraction": 0.25, "max_fail": 6}
+    net = BPNetwork(2, params, rng=np.random.default_rng(4))
+    history = net.fit(x, y)
+    assert history.stopped == "validation" and history.iterations < 200
+    assert history.best_epoch == history.iterations - 6  # six steps in a row without a new best
+    assert len(history.val_loss) == history.iterations + 1
+    assert history.loss[-1] < history.loss[history.best_epoch]  # training error still fell: overfitting
+    rng = np.random.default_rng(4)
+    rng.uniform(-1.0, 1.0, net.n_params)  # the start the learner drew before its split
+    held = np.sort(rng.permutation(40)[:10])
+    # the kept weights' eq. 3 error on the held-out rows, in the [-1, 1] units of the targets
+    kept = 0.5 * np.mean((net.predict(x[held]) - y[held]) ** 2) / (0.5 * np.ptp(y)) ** 2
+    assert kept == pytest.approx(min(history.val_loss), rel=1e-9)
+    again = BPNetwork(2, params, rng=np.random.default_rng(4))
+    assert again.fit(x, y).val_loss == history.val_loss
+    np.testing.assert_array_equal(again.get_params(), net.get_params())
+    full = BPNetwork(2, {**params, "validation_fraction": 0.0}, rng=np.random.default_rng(4))
+    assert full.fit(x, y).iterations > history.iterations  # without the split it trains on
+
+
+def test_gd_validation_stop_keeps_the_best_held_out_weights() -> None:
+    x, y = noisy_data(40, 0)
+    net = BPNetwork(2, {"hidden": 30, "epochs": 3000, "validation_fraction": 0.25, "max_fail": 20},
+                    rng=np.random.default_rng(4))
+    history = net.fit(x, y)
+    assert history.stopped == "validation" and history.best_epoch == history.iterations - 20
+    assert min(history.val_loss) == history.val_loss[history.best_epoch]
+
+
+def test_the_matlab_preset_has_its_own_method_name() -> None:
+    from tcbench.runner.kinds.compensation import compensation_label
+
+    assert compensation_label({"name": "bp", "training": "gd", "preset": "matlab"}, {"name": "ifa"}) == "IFA-BP-gd-matlab"
+    assert compensation_label({"name": "bp", "training": "lm", "preset": None}, {"name": "none"}) == "random-BP-lm"

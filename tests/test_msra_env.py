@@ -147,6 +147,7 @@ def test_file_recordings_are_checked(tmp_path: Path) -> None:
         ({"bias_form": "minus"}, "bias_form must be one of plus, printed"),
         ({"device_seed": -1}, "device_seed must be a non-negative integer"),
         ({"train_files": ["a.csv"]}, "give both train_files and test_files"),
+        ({"clamp_inputs": "yes"}, "clamp_inputs must be true or false"),
     ],
 )
 def test_bad_task_parameters(kwargs: dict, message: str) -> None:
@@ -154,3 +155,65 @@ def test_bad_task_parameters(kwargs: dict, message: str) -> None:
 
     with pytest.raises(ValueError, match=message):
         MSRACompensationEnv(**kwargs)
+
+
+def _heated(tr, by_c: float):
+    """``tr`` with its thermometer reading ``by_c`` higher (its rate unchanged)."""
+    import dataclasses
+
+    from tcbench.compensation.data import TaskRecording
+
+    rec = tr.recording
+    data = rec.data.assign(temperature_c=rec.temperature_c + by_c)
+    return TaskRecording(tr.name, dataclasses.replace(rec, data=data), tr.truth)
+
+
+def test_clamped_inputs_predict_at_the_training_range_end() -> None:
+    """With ``clamp_inputs`` a test temperature beyond the training range gives the prediction at
+    the range's end (as ``tcbench calibrate`` holds a network's inputs); without, the network
+    extrapolates."""
+    from tcbench.compensation import methods
+    from tcbench.learners.bp import BPNetwork
+
+    data = simulated_data("roomtemp", 0, 0, 4, 2)
+    x, y = data.training_set()
+    net = BPNetwork(2, {"epochs": 30}, rng=np.random.default_rng(0))
+    net.fit(x, y)
+    low, high = data.input_range(x)
+    np.testing.assert_array_equal(low, x.min(axis=0))
+    np.testing.assert_array_equal(high, x.max(axis=0))
+    hot = _heated(data.test[0], 40.0)
+    out = hot.recording.output
+    rate = np.clip(data.features(hot.recording)[0][:, 1], low[1], high[1])
+    at_end = out - net.predict(np.column_stack([np.full(out.size, high[0]), rate]))
+    clamped = methods.learner_compensator(data, net, (low, high))
+    np.testing.assert_allclose(clamped(hot, out), at_end, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(clamped(_heated(data.test[0], 80.0), out), at_end, rtol=0, atol=1e-12)
+    free = methods.learner_compensator(data, net)
+    assert np.max(np.abs(free(hot, out) - at_end)) > 1e-3 * np.ptp(out)
+
+
+def test_fulltemp_clamps_the_temperature_not_the_output() -> None:
+    data = simulated_data("fulltemp", 0, 0, 3, 2)
+    x, _ = data.training_set()
+    low, high = data.input_range(x)
+    assert (low[0], high[0]) == (-np.inf, np.inf)
+    assert (low[1], high[1]) == (x[:, 1].min(), x[:, 1].max())
+
+
+def test_env_clamp_inputs_scores_the_clamped_learner() -> None:
+    scores = {}
+    for clamp in (False, True):
+        env = gym.make("tcbench/MSRA-ZeroBias-v0", learner="bp", learner_params=FAST_BP, budget=10,
+                       clamp_inputs=clamp).unwrapped
+        env.reset(seed=0)
+        env.data.test = [_heated(tr, 40.0) for tr in env.data.test]  # every test sample beyond the range
+        scores[clamp] = env.score(None)[0].summary()["zb_zero_start_ug"]
+        if clamp:
+            from tcbench.compensation import methods
+            from tcbench.compensation.scoring import score_outputs
+
+            fn = methods.learner_compensator(env.data, env.learner, env.data.input_range(env._x))
+            rmse = methods.training_rmse_ug(env.data, env.learner, env._x, env._y)
+            assert scores[True] == score_outputs(env.data, fn, env.bias_form, rmse).summary()["zb_zero_start_ug"]
+    assert scores[True] != pytest.approx(scores[False], rel=1e-3)

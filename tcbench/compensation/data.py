@@ -104,6 +104,16 @@ class MSRAData:
         rate = temperature_rate_c_per_s(rec.time_s, rec.temperature_c, self.rate_window_s)
         return np.column_stack([rec.temperature_c, rate]), u
 
+    def input_range(self, x_train: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds (each ``(2,)``) a learner's inputs are held to with
+        ``clamp_inputs``: the thermal columns' (temperature, and for ``bias`` its rate) minimum
+        and maximum over the training inputs ``x_train``; the output ``U`` of ``inverse`` is the
+        measurand and stays free (``-inf``, ``inf``)."""
+        low, high = np.min(x_train, axis=0), np.max(x_train, axis=0)
+        if self.form == "inverse":
+            low[0], high[0] = -np.inf, np.inf
+        return low, high
+
     def training_rows(self, rec: Recording, sequential: bool) -> np.ndarray:
         """Rows a learner trains on: labelled four-position samples (``train_on=positions``,
         fulltemp, feed-forward learners) or every row (recurrent learners need the sequence)."""

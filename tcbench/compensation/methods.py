@@ -32,10 +32,16 @@ def training_rmse_ug(data: MSRAData, learner: Learner, x: np.ndarray, y: np.ndar
     return rmse / per_g * 1e6
 
 
-def learner_compensator(data: MSRAData, learner: Learner) -> Compensator:
-    """A trained learner's compensation of a test recording."""
+def learner_compensator(data: MSRAData, learner: Learner,
+                        input_range: tuple[np.ndarray, np.ndarray] | None = None) -> Compensator:
+    """A trained learner's compensation of a test recording; ``input_range`` (lower, upper bounds
+    per input column) holds its inputs to that box first, as ``tcbench calibrate`` holds a
+    network's temperature and rate to their training range (beyond it a network's output is
+    whatever its activations extrapolate to)."""
     def compensate(tr: TaskRecording, output: np.ndarray) -> np.ndarray:
         x, _ = data.features(tr.recording, output)
+        if input_range is not None:
+            x = np.clip(x, *input_range)
         return data.compensate(output, learner.predict(x))
 
     return compensate

@@ -37,6 +37,8 @@ class FitHistory:
     stopped: str = ""  # why training ended: "max_epochs", "goal", "converged", "closed_form", ...
     seconds: float = 0.0
     snapshots: dict[int, np.ndarray] = field(default_factory=dict)  # parameters after N epochs (checkpoints)
+    val_loss: list[float] = field(default_factory=list)  # held-out eq. 3 error per epoch (validation stop)
+    best_epoch: int | None = None  # the epoch whose weights the validation stop kept
 
 
 @dataclass(frozen=True)

@@ -77,6 +77,9 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     train_on: ``positions`` (fulltemp: the labelled four-position samples) or ``all`` rows.
     rate_window_s: trailing window of the temperature-rate input (roomtemp, chamber), in s.
     bias_form: eq. 12 ``plus`` (default) or ``printed``.
+    clamp_inputs: hold the learner's test inputs to the range of its training inputs (the
+        temperature and its rate; fulltemp: the temperature, not the output U) as ``tcbench
+        calibrate`` does; default False, the boards' setting so far.
     """
 
     metadata = {"render_modes": []}
@@ -98,6 +101,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         rate_window_s: float = 120.0,
         bias_form: str = "plus",
         split: str = DEFAULT_TIER,
+        clamp_inputs: bool = False,
     ) -> None:
         if task not in TASKS:
             raise ValueError(unknown_name("static-input task", task, TASKS))
@@ -109,6 +113,9 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise ValueError(f"device_seed must be a non-negative integer, got {device_seed}")
         if recordings_seed is not None and (not is_integer(recordings_seed) or recordings_seed < 0):
             raise ValueError(f"recordings_seed must be a non-negative integer or null, got {recordings_seed}")
+        if not isinstance(clamp_inputs, (bool, np.bool_)):
+            raise ValueError(f"clamp_inputs must be true or false, got {clamp_inputs!r}")
+        self.clamp_inputs = bool(clamp_inputs)
         if bias_form not in BIAS_FORMS:
             raise ValueError(f"bias_form must be one of {', '.join(BIAS_FORMS)}, got {bias_form!r}")
         if (train_files is None) != (test_files is None):
@@ -198,8 +205,11 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     def _score_learner(self) -> Score:
         """The test recordings compensated by the learner with its current parameters."""
         assert self.data is not None and self.learner is not None
+        assert self._x is not None
         rmse = methods.training_rmse_ug(self.data, self.learner, self._x, self._y)
-        return score_outputs(self.data, methods.learner_compensator(self.data, self.learner), self.bias_form, rmse)
+        box = self.data.input_range(self._x) if self.clamp_inputs else None
+        return score_outputs(self.data, methods.learner_compensator(self.data, self.learner, box), self.bias_form,
+                             rmse)
 
     def score_baseline(self, which: str) -> Score:
         """``raw`` (no compensation), ``memoriser`` (the training runs' mean output at the same time

@@ -25,7 +25,7 @@ TAG_FILES_CHARS = 1000  # the file lists in a run's tags, cut beyond this
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm`` ...; for
+    """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm``, ``random-BP-lm-matlab`` (``learner.preset=matlab``) ...; for
     the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``
     (not the rows that run without it: the oracles and ``diagnosed``)."""
     if learner.get("label"):
@@ -40,6 +40,7 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
         prefix = "random" if opt == "none" else opt.upper()
         label = f"{prefix}-{name.upper() if name == 'bp' else name}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
+        label = f"{label}-{learner['preset']}" if learner.get("preset") else label  # IFA-BP-gd-matlab
     pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
     if pipeline is None or name.startswith("oracle") or name == "model":
         return label
