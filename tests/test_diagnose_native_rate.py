@@ -21,6 +21,7 @@ from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.native_rate import bin_means, full_rate_noise, plan_bins, plan_for
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.sensors.recording import Recording, make_recording, write_recording
+from averaging import by_hand
 
 OFF = "tracking.enabled=false"
 RATE_HZ, MINUTES, SIGMA = 200.0, 21.0, 0.3  # 252 000 rows, a little over the 20 min a full diagnosis needs
@@ -39,17 +40,6 @@ def _record(seed: int = 0, spikes: int = 0) -> Recording:
     out[rng.choice(t.size, spikes, replace=False)] += 60.0 * SIGMA
     return make_recording(t, temp + 0.02 * rng.standard_normal(t.size), np.zeros(t.size), out, sensor="gyro",
                           sample_rate_hz=RATE_HZ, device_id="d")
-
-
-def _by_hand(rec: Recording, k: int) -> Recording:
-    """``rec`` averaged by hand: means of ``k`` consecutive samples (a partial last bin dropped)."""
-    n = rec.time_s.size // k * k
-
-    def mean(x: np.ndarray) -> np.ndarray:
-        return x[:n].reshape(-1, k).mean(axis=1)
-
-    return make_recording(mean(rec.time_s), mean(rec.temperature_c), mean(rec.input), mean(rec.output),
-                          sensor="gyro", sample_rate_hz=RATE_HZ / k, device_id="d")
 
 
 def _intervals_meet(a: dict[str, Any], b: dict[str, Any], z: float = 3.0) -> tuple[bool, Any]:
@@ -99,7 +89,7 @@ def test_noise_terms_come_from_every_sample_and_outliers_enter_no_bin() -> None:
     binned, dropped = bin_means(rec, plan_bins(rec.time_s.size, RATE_HZ, RateSettings(max_rows=BUDGET)),
                                 full.zero_weight)
     clean = _record(seed=1)
-    hand = _by_hand(clean, 200)
+    hand = by_hand(clean, 200)
     n = hand.time_s.size
     # a bin holding a spike is the mean of its other 199 samples: within a few bin sigmas of the clean mean
     assert dropped == 0 and np.max(np.abs(binned.output[:n] - hand.output)) < 5.0 * SIGMA / np.sqrt(199.0)
@@ -130,7 +120,7 @@ def averaged() -> tuple[dict[str, Any], str, dict[str, Any]]:
 def test_the_averaged_diagnosis_names_what_the_hand_averaged_record_shows(
         averaged: tuple[dict[str, Any], str, dict[str, Any]]) -> None:
     report = averaged[0]
-    hand = diagnose(_by_hand(_record(), 200)).to_json()
+    hand = diagnose(by_hand(_record(), 200)).to_json()
     assert [e["id"] for e in report["effects"]] == [e["id"] for e in hand["effects"]]
     assert "temperature_rate" in [e["id"] for e in hand["effects"]]
     for mine, theirs in zip(report["effects"], hand["effects"], strict=True):

@@ -19,6 +19,7 @@ from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.diagnose.short_record import short_record
 from tcbench.diagnose.short_report import render_short_markdown
 from tcbench.sensors.recording import Recording, make_recording, write_recording
+from averaging import by_hand
 
 RATE_HZ, DURATION_S = 100.0, 600.0  # 60 000 rows: 10 min, short of the 20 min a full diagnosis needs
 BUDGET = 10_000  # settings.rate.max_rows: the record is averaged into 1 s bins of 100 samples, 600 rows
@@ -39,17 +40,6 @@ def _inclinometer(seed: int, spikes: int = 0) -> Recording:
                           sample_rate_hz=RATE_HZ, device_id="incl-2")
 
 
-def _by_hand(rec: Recording, k: int) -> Recording:
-    """``rec`` as means of ``k`` consecutive samples, by hand."""
-    n = rec.time_s.size // k * k
-
-    def mean(x: np.ndarray) -> np.ndarray:
-        return x[:n].reshape(-1, k).mean(axis=1)
-
-    return make_recording(mean(rec.time_s), mean(rec.temperature_c), mean(rec.input), mean(rec.output),
-                          sensor="accel", sample_rate_hz=RATE_HZ / k, device_id="incl-2")
-
-
 def _tests(report: dict) -> dict[str, dict]:
     return {t["id"]: t for t in report["tests"]}
 
@@ -62,7 +52,7 @@ def averaged() -> tuple[dict, str]:
 
 
 def test_the_slope_and_step_are_tested_on_the_bin_means_a_diagnosis_uses(averaged: tuple[dict, str]) -> None:
-    hand = _tests(short_record(_by_hand(_inclinometer(seed=4), 100), name="incl.csv").to_json())
+    hand = _tests(short_record(by_hand(_inclinometer(seed=4), 100), name="incl.csv").to_json())
     mine = _tests(averaged[0])
     for key in ("temperature_slope", "level_step"):
         assert mine[key]["status"] == hand[key]["status"] == "significant"

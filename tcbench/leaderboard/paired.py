@@ -74,11 +74,10 @@ def paired_gain(ok: pd.DataFrame, metric: str, failed: int) -> float:
     """Median over runs of raw ÷ the method on the run's own test runs (a failed run: gain 0): one
     definition for every row, the limits' and the methods'."""
     raw = f"raw_{metric}"
-    if metric not in ok or raw not in ok or ok.empty and not failed:
+    if metric not in ok or raw not in ok:
         return float("nan")
     gain = ok[raw].to_numpy(float) / ok[metric].to_numpy(float)
-    gain = gain[~np.isnan(gain)]
-    gain = np.concatenate([gain, np.zeros(failed)])
+    gain = np.concatenate([gain[~np.isnan(gain)], np.zeros(failed)])
     return float(np.median(gain)) if gain.size else float("nan")
 
 
