@@ -79,7 +79,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
     bias_form: eq. 12 ``plus`` (default) or ``printed``.
     clamp_inputs: hold the learner's test inputs to the range of its training inputs (the
         temperature and its rate; fulltemp: the temperature, not the output U) as ``tcbench
-        calibrate`` does; default False, the boards' setting so far.
+        calibrate`` does; default True, the boards' setting.
     """
 
     metadata = {"render_modes": []}
@@ -101,7 +101,7 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         rate_window_s: float = 120.0,
         bias_form: str = "plus",
         split: str = DEFAULT_TIER,
-        clamp_inputs: bool = False,
+        clamp_inputs: bool = True,
     ) -> None:
         if task not in TASKS:
             raise ValueError(unknown_name("static-input task", task, TASKS))

@@ -47,7 +47,7 @@ class MSRATaskConfig:
     rate_window_s: float = 120.0
     bias_form: str = "plus"
     split: str = "next_run"
-    clamp_inputs: bool = False
+    clamp_inputs: bool = True
 
 
 @dataclass
