@@ -42,6 +42,10 @@ TIER_NOTE = {
                 "scale factor, hysteresis state, chamber timing, ageing; docs/concepts/split-tiers.md).",
     "replay": "Tier `replay` (a diagnostic): the test runs replay the first training run's power-on with new "
               "noise, as every board measured before tiers. A claim reproduced here only is not held out.",
+    "new_profile": "Tier `new_profile`: the test runs are new power-ons under a programme the training never saw "
+                   "(the holds in reverse order, ramps twice as fast; at room temperature a room 5 °C warmer).",
+    "new_device": "Tier `new_device`: the training runs are of some units of the population, the test runs of "
+                  "others: whether a calibration of one unit carries to the lot.",
 }
 TITLE = {"msra_zerobias": "Table 1: zero-bias stability at room temperature (µg)",
          "msra_fulltemp": "Table 2: variation of scale factor (ppm) and bias (µg) over -40…60 °C"}
