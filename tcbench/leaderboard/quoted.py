@@ -231,7 +231,7 @@ def rewrite(page: Path) -> int:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m tcbench.leaderboard.quoted", description=__doc__.split("\n\n")[0])
     parser.add_argument("pages", nargs="+", type=Path, help="markdown pages to check or rewrite")
-    parser.add_argument("--check", action="store_true", help="change nothing; exit 1 listing every stale quote")
+    parser.add_argument("--check", action="store_true", help="change nothing; exit 1 listing every stale quote and table")
     args = parser.parse_args(argv)
     stale = 0
     try:
@@ -245,8 +245,8 @@ def main(argv: list[str] | None = None) -> int:
                     stale += 1
             else:
                 changed = rewrite(page)
-                print(f"{page}: {changed} quoted number{'s' if changed != 1 else ''} or table{'s' if changed != 1 else ''}"
-                      " rewritten")
+                print(f"{page}: {changed} quoted number{'s' if changed != 1 else ''} or "
+                      f"table{'s' if changed != 1 else ''} rewritten")
     except (QuoteError, OSError) as exc:
         print(f"quoted: {exc}", file=sys.stderr)
         return 2
