@@ -10,7 +10,8 @@ the cell as a board shows it (three significant digits; an interval column as wr
 the documentation site, whose links must stay inside the site, writes the number followed by the
 same locator in a comment: ``30.1<!-- ../../leaderboards/x.csv "oracle_thermometer | median_bias_ug" -->``.
 
-A page holds a table of a CSV between two markers, each alone on its line::
+A page holds a table of a CSV between two markers, each alone on its line,
+``<!-- table: CSV "ROWS | COLUMNS" -->`` and ``<!-- /table -->``::
 
     <!-- table: ../../leaderboards/real-imu/splits.csv "fit on → scored on=0 → 1,2 | record, raw, best" -->
     | record | raw | best |
