@@ -14,7 +14,9 @@ _GITHUB = TableFormat(lineabove=None, linebelowheader=lambda widths, _aligns: "|
                       datarow=DataRow("|", "|", "|"), padding=1, with_header_hide=None)
 
 
-def _fmt(value: object) -> str:
+def cell_text(value: object) -> str:
+    """A cell as a table shows it: floats to three significant digits, ``inf`` as ∞, NaN as –,
+    everything else as ``str`` gives it."""
     if isinstance(value, (float, np.floating)):
         if np.isinf(value):
             return "∞"
@@ -27,5 +29,5 @@ def _fmt(value: object) -> str:
 def markdown_table(table: pd.DataFrame) -> str:
     """A pandas table as a GitHub markdown table (floats to three significant digits, ``inf`` as
     ∞, NaN as –; every other cell as ``str`` gives it)."""
-    cells = table.astype(object).map(_fmt)
+    cells = table.astype(object).map(cell_text)
     return cells.to_markdown(index=False, tablefmt=_GITHUB, disable_numparse=True, stralign=None, numalign=None)

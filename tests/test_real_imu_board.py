@@ -37,6 +37,10 @@ def test_the_board_of_two_splits(workdir: Path, capsys: pytest.CaptureFixture[st
     one = pd.read_csv(workdir / "one" / "tofu-y" / "calibration.csv")
     test = one[(one["method"] == "poly3") & (one["role"] == "test")]["drift_rms_deg_per_s"]
     assert wide.loc[0, "poly3"] == pytest.approx(float(np.sqrt(np.mean(test ** 2))))
+    # the best's own drift and its ratio to raw's, the RMS over parts (the README's tables quote them)
+    best_drift = np.array([wide.loc[i, b] for i, b in enumerate(wide["best"])])
+    np.testing.assert_array_equal(wide["best's drift"], best_drift)
+    np.testing.assert_allclose(wide["best's drift / raw"], best_drift / wide["raw"], rtol=1e-12)
     best_over_raw = wide["best / raw"].str.split().str[0].astype(float)  # "0.408 [0.158, 0.476]": with its interval
     assert (wide["best"] != "raw").all() and (best_over_raw < 1).all()
     assert wide["best / raw"].str.match(r"^[0-9.]+ \[[0-9.]+, [0-9.]+\]$").all()

@@ -70,3 +70,7 @@ done
 echo "== board"
 python "$here/summarise.py" --calibrations "$out/calibration" "$out/calibration-both" --cross "$out/calibration-cross" \
     --diagnoses "$out/diagnosis" --out "$out"
+if [[ $out == leaderboards/real-imu ]]; then
+    echo "== the README's tables and numbers, read from the board's CSVs"
+    python -m tcbench.leaderboard.quoted "$here/README.md"
+fi

@@ -14,7 +14,11 @@ recordings scored with ``test_recordings=`` "runs". Only the last is a cross-run
 
 Usage: python experiments/real-imu/summarise.py --calibrations DIR [DIR ...] [--cross DIR ...]
 --diagnoses DIR --out DIR (``run.sh`` calls it; it reads ``DIR/<axis>/calibration.csv`` and
-``.json`` and ``DIAGNOSES/<axis>/report.json``).
+``.json`` and ``DIAGNOSES/<axis>/report.json``). It writes ``board.csv`` (one row per record, split
+and method), ``splits.csv`` (one per record and split: ``board.md``'s table), ``cross_part.csv``
+(every pair), ``cross_part_tally.csv`` (per record and method over the pairs), ``board.md`` and
+``board.png``; the README's tables and numbers are read from these CSVs
+(:mod:`tcbench.leaderboard.quoted`).
 """
 
 from __future__ import annotations
@@ -117,6 +121,7 @@ def board(calibrations: list[Path], diagnoses: Path) -> tuple[pd.DataFrame, pd.D
         wide_rows.append({"record": folder.name, "unit": unit.replace("_per_", "/"),
                           "fit on → scored on": split, "split kind": kind, "noise floor": _ci(floor),
                           **{m: scores.get(m, np.nan) for m in ORDER}, "best": best,
+                          "best's drift": scores[best], "best's drift / raw": scores[best] / raw,
                           "runner-up / best": runner,
                           "verdict": f"tie ({', '.join(about['tied'])})" if about.get("tied") else "win",
                           "best / raw": _ci(about["x_raw"].get(best)), "best / floor": _ci(about["x_floor"][best]),
@@ -220,8 +225,10 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     long.to_csv(args.out / "board.csv", index=False)
     pairs.to_csv(args.out / "cross_part.csv", index=False)
+    tally.to_csv(args.out / "cross_part_tally.csv", index=False)
     plot(long, args.out / "board.png")
     numbers = wide.drop(columns=["diagnosis of the whole record", "training"])
+    numbers.to_csv(args.out / "splits.csv", index=False)
     verdicts = wide[["record", "diagnosis of the whole record"]].drop_duplicates("record")
     training = [(r["record"], r["fit on → scored on"], t["line"]) for _, r in wide.iterrows()
                 for t in r["training"].values()]
@@ -254,8 +261,8 @@ def main() -> None:
         "(`screened`: samples dropped). Intervals: 95 % block bootstrap over the held-out parts (every method on "
         "the same draws); `runner-up / best` is a tie when its interval reaches 1. `best`, `runner-up / best`, "
         "`best / raw`, `memoriser / best` and `model / best` are tcbench calibrate's ranking on every held-out "
-        "sample pooled (`board.csv`: `pooled_*`); the drift columns are RMS over the parts, which can order two "
-        "close methods the other way.\n\n"
+        "sample pooled (`board.csv`: `pooled_*`); the drift columns, `best's drift` and `best's drift / raw` are "
+        "RMS over the parts, which can order two close methods the other way. This table is `splits.csv`.\n\n"
         "The noise floor is a limit, with its interval: the drift score white noise alone would give on the "
         "held-out parts (the raw residual's sample variance, half that of its first differences, over the samples "
         "in one window), 95 % block bootstrap drawn within each held-out part, jointly with every method's drift; "
@@ -270,7 +277,7 @@ def main() -> None:
         "(fit part, test part), every method's held-out drift over raw's with its 95 % block-bootstrap interval "
         "(`cross_part.csv`). Per record and method: the pairs it wins (lowest drift), those it ties with the "
         "pair's best (interval against the best reaches 1), the median of its drift over raw's, and the pairs "
-        "where it is worse than raw."
+        "where it is worse than raw (`cross_part_tally.csv`)."
         f"\n\n{markdown_table(tally)}\n\n### Every pair\n\n{markdown_table(pair_table)}\n\n"
         f"## Diagnosis of each whole record\n\n{markdown_table(verdicts)}\n")
     print(markdown_table(numbers))
