@@ -43,7 +43,7 @@ noise mostly averaged out), in the recording's unit.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -55,7 +55,6 @@ from tcbench.compensation.px4 import OffsetPolynomial, fit_offset
 from tcbench.compensation.record import Record
 from tcbench.compensation.training import fit_network
 
-METHODS = ("raw", "poly3", "poly3_rate", "bp", "bp_gd", "elman", "model", "memoriser")
 LEARNERS = ("bp", "bp_gd", "elman")
 RATE_WINDOW_S = 120.0
 TRAIN_BIN_S = 5.0  # the networks' training bins: see fit()
@@ -194,30 +193,84 @@ def fit(method: str, train: Sequence[Record], seed: int = 0, bin_s: float | None
     ``memoriser`` reads ``part_starts_s`` (:func:`fit_memoriser`); the other methods ignore it."""
     if method not in METHODS:
         raise ValueError(unknown_name("calibration method", method, METHODS))
-    if method == "raw":
-        return OffsetModel("raw")
-    if method == "model":
-        raise ValueError("the diagnosed model is fitted by tcbench diagnose: pass it to from_model()")
-    if method == "memoriser":
-        return fit_memoriser(train, part_starts_s)
-    temp = np.concatenate([r.temp_c for r in train])
-    target = np.concatenate([r.output - r.truth for r in train])
-    rate = np.concatenate([r.rate_c_per_s for r in train])
-    if method in LEARNERS:
-        if bin_s is not None and not bin_s > 0:
-            raise ValueError(f"bin_s must be > 0 or None, got {bin_s}")
-        network, algorithm = ("bp", "gd") if method == "bp_gd" else (method, bp_training)
-        learner, training = fit_network(network, train, seed, bin_s, algorithm)
-        return OffsetModel(method, learner=learner, bin_s=bin_s, temp_range_c=(float(temp.min()), float(temp.max())),
-                           rate_range=(float(rate.min()), float(rate.max())), training=training)
+    return FITTERS[method](_FitInputs(method, train, seed, bin_s, bp_training, part_starts_s))
+
+
+@dataclass(frozen=True)
+class _FitInputs:
+    """What :func:`fit` was given, for the fitter of its method (:data:`FITTERS`)."""
+
+    method: str
+    train: Sequence[Record]
+    seed: int
+    bin_s: float | None
+    bp_training: str
+    part_starts_s: np.ndarray | None
+
+    def temp_c(self) -> np.ndarray:
+        return np.concatenate([r.temp_c for r in self.train])
+
+    def target(self) -> np.ndarray:
+        return np.concatenate([r.output - r.truth for r in self.train])
+
+    def rate_c_per_s(self) -> np.ndarray:
+        return np.concatenate([r.rate_c_per_s for r in self.train])
+
+
+def _fit_raw(a: _FitInputs) -> OffsetModel:
+    return OffsetModel("raw")
+
+
+def _fit_model(a: _FitInputs) -> OffsetModel:
+    raise ValueError("the diagnosed model is fitted by tcbench diagnose: pass it to from_model()")
+
+
+def _fit_memoriser(a: _FitInputs) -> OffsetModel:
+    return fit_memoriser(a.train, a.part_starts_s)
+
+
+def _fit_poly3(a: _FitInputs) -> OffsetModel:
+    return OffsetModel("poly3", fit_offset(a.temp_c(), a.target()))
+
+
+def _fit_poly3_rate(a: _FitInputs) -> OffsetModel:
+    temp, target = a.temp_c(), a.target()
     cubic = fit_offset(temp, target)
-    if method == "poly3":
-        return OffsetModel("poly3", cubic)
     dt = np.clip(temp, cubic.tmin_c, cubic.tmax_c) - cubic.tref_c
-    design = np.column_stack([dt ** n for n in range(4)] + [rate])
+    design = np.column_stack([dt ** n for n in range(4)] + [a.rate_c_per_s()])
     coef, *_ = np.linalg.lstsq(design, target, rcond=None)
     both = OffsetPolynomial(tuple(float(c) for c in coef[:4]), cubic.tref_c, cubic.tmin_c, cubic.tmax_c)  # type: ignore[arg-type]
     return OffsetModel("poly3_rate", both, float(coef[4]))
+
+
+def _fit_learner(network: str, algorithm: str | None = None) -> Callable[[_FitInputs], OffsetModel]:
+    """The fitter of a network method: the learner ``network`` trained with ``algorithm``
+    (``None``: the ``bp_training`` asked for)."""
+
+    def fit_one(a: _FitInputs) -> OffsetModel:
+        if a.bin_s is not None and not a.bin_s > 0:
+            raise ValueError(f"bin_s must be > 0 or None, got {a.bin_s}")
+        learner, training = fit_network(network, a.train, a.seed, a.bin_s, algorithm or a.bp_training)
+        temp, rate = a.temp_c(), a.rate_c_per_s()
+        return OffsetModel(a.method, learner=learner, bin_s=a.bin_s,
+                           temp_range_c=(float(temp.min()), float(temp.max())),
+                           rate_range=(float(rate.min()), float(rate.max())), training=training)
+
+    return fit_one
+
+
+# The fitter of each calibration method; their names are :data:`METHODS`.
+FITTERS: dict[str, Callable[[_FitInputs], OffsetModel]] = {
+    "raw": _fit_raw,
+    "poly3": _fit_poly3,
+    "poly3_rate": _fit_poly3_rate,
+    "bp": _fit_learner("bp"),
+    "bp_gd": _fit_learner("bp", "gd"),
+    "elman": _fit_learner("elman"),
+    "model": _fit_model,
+    "memoriser": _fit_memoriser,
+}
+METHODS = tuple(FITTERS)
 
 
 def from_model(sensor_model: Any) -> OffsetModel:

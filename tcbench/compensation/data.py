@@ -33,6 +33,7 @@ test runs on one of four tiers (:data:`SPLITS`, docs/concepts/split-tiers.md), f
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -172,6 +173,39 @@ class RunSpec:
         return f"dev{self.device_seed}-seed{self.seed}{replay}{profile}"
 
 
+def _replay(protocol: str, d: int, train_seeds: list[int],
+            test_seeds: list[int]) -> tuple[list[RunSpec], list[RunSpec]]:
+    return [RunSpec(d, s, train_seeds[0]) for s in train_seeds], [RunSpec(d, s, train_seeds[0]) for s in test_seeds]
+
+
+def _next_run(protocol: str, d: int, train_seeds: list[int],
+              test_seeds: list[int]) -> tuple[list[RunSpec], list[RunSpec]]:
+    return [RunSpec(d, s) for s in train_seeds], [RunSpec(d, s) for s in test_seeds]
+
+
+def _new_profile(protocol: str, d: int, train_seeds: list[int],
+                 test_seeds: list[int]) -> tuple[list[RunSpec], list[RunSpec]]:
+    changes = tuple(sorted(NEW_PROFILE[protocol].items()))
+    return [RunSpec(d, s) for s in train_seeds], [RunSpec(d, s, None, changes) for s in test_seeds]
+
+
+def _new_device(protocol: str, d: int, train_seeds: list[int],
+                test_seeds: list[int]) -> tuple[list[RunSpec], list[RunSpec]]:
+    n_train = len(train_seeds)
+    return ([RunSpec(d + i, s) for i, s in enumerate(train_seeds)],
+            [RunSpec(d + n_train + j, s) for j, s in enumerate(test_seeds)])
+
+
+# The training and test runs of each tier: ``(protocol, device_seed, train seeds, test seeds) ->
+# (train, test)``; its keys are :data:`SPLITS`.
+TIER_RUNS: dict[str, Callable[[str, int, list[int], list[int]], tuple[list[RunSpec], list[RunSpec]]]] = {
+    "replay": _replay,
+    "next_run": _next_run,
+    "new_profile": _new_profile,
+    "new_device": _new_device,
+}
+
+
 def split_runs(protocol: str, split: str, device_seed: int, recordings_seed: int, n_train: int,
                n_test: int) -> tuple[list[RunSpec], list[RunSpec]]:
     """The training and test runs of a simulated task on tier ``split`` (:data:`SPLITS`); a
@@ -179,17 +213,7 @@ def split_runs(protocol: str, split: str, device_seed: int, recordings_seed: int
     check_tier(split)
     seeds = [recording_seed(recordings_seed, i) for i in range(n_train + n_test)]
     d = int(device_seed)
-    train = [RunSpec(d + i if split == "new_device" else d, s) for i, s in enumerate(seeds[:n_train])]
-    test_seeds = seeds[n_train:]
-    if split == "replay":
-        train = [RunSpec(d, s, seeds[0]) for s in seeds[:n_train]]
-        test = [RunSpec(d, s, seeds[0]) for s in test_seeds]
-    elif split == "new_profile":
-        test = [RunSpec(d, s, None, tuple(sorted(NEW_PROFILE[protocol].items()))) for s in test_seeds]
-    elif split == "new_device":
-        test = [RunSpec(d + n_train + j, s) for j, s in enumerate(test_seeds)]
-    else:
-        test = [RunSpec(d, s) for s in test_seeds]
+    train, test = TIER_RUNS[split](protocol, int(device_seed), seeds[:n_train], seeds[n_train:])
     if reused := set(train) & set(test):
         raise TaskDataError(f"split {split!r} would test on its own training run {sorted(reused, key=str)[0].name}")
     return train, test
@@ -230,6 +254,34 @@ def check_split(protocol: str, n_train: int, n_test: int, train_on: str, rate_wi
         raise TaskDataError(f"rate_window_s must be a positive number of seconds, got {rate_window_s}")
 
 
+def _check_chamber_file(rec: Recording, path: str, role: str) -> None:
+    if np.ptp(rec.input) > 1e-9:
+        raise TaskDataError(f"{path}: {role} recording's applied input varies "
+                            f"({rec.input.min():g}..{rec.input.max():g} g); the chamber task needs a static unit")
+
+
+def _check_fulltemp_file(rec: Recording, path: str, role: str) -> None:
+    labels = rec.position
+    if labels is None or not np.isin(labels.astype(str), ["+1g", "-1g"]).any():
+        raise TaskDataError(f"{path}: {role} recording has no four-position test "
+                            "(+0g, +1g, -0g, -1g); the full-temperature task needs one per node")
+    pos = np.where(labels == None, "", labels).astype(str)  # noqa: E711
+    try:
+        nodes = four_position(rec.temperature_c, rec.output, pos)
+    except ValueError as exc:
+        raise TaskDataError(f"{path}: {role} recording: {exc}") from None
+    if len(nodes) < 2:
+        raise TaskDataError(f"{path}: {role} recording has {len(nodes)} temperature node; need at least 2")
+
+
+# What a recording file must show for a protocol beyond its sensor kind: ``(recording, path, role)``
+# raising :class:`TaskDataError`; a protocol without an entry takes any recording of its kind.
+FILE_CHECKS: dict[str, Callable[[Recording, str, str], None]] = {
+    "chamber": _check_chamber_file,
+    "fulltemp": _check_fulltemp_file,
+}
+
+
 def _load(path: str, protocol: str, role: str) -> TaskRecording:
     try:
         rec = read_recording(path)
@@ -239,21 +291,9 @@ def _load(path: str, protocol: str, role: str) -> TaskRecording:
     if rec.meta.sensor != sensor:
         kind = rec.meta.sensor or "unknown (no sidecar)"
         raise TaskDataError(f"{path}: {role} recording is from a {kind} sensor; this task needs {sensor} recordings")
-    if protocol == "chamber" and np.ptp(rec.input) > 1e-9:
-        raise TaskDataError(f"{path}: {role} recording's applied input varies "
-                            f"({rec.input.min():g}..{rec.input.max():g} g); the chamber task needs a static unit")
-    if protocol == "fulltemp":
-        labels = rec.position
-        if labels is None or not np.isin(labels.astype(str), ["+1g", "-1g"]).any():
-            raise TaskDataError(f"{path}: {role} recording has no four-position test "
-                                "(+0g, +1g, -0g, -1g); the full-temperature task needs one per node")
-        pos = np.where(labels == None, "", labels).astype(str)  # noqa: E711
-        try:
-            nodes = four_position(rec.temperature_c, rec.output, pos)
-        except ValueError as exc:
-            raise TaskDataError(f"{path}: {role} recording: {exc}") from None
-        if len(nodes) < 2:
-            raise TaskDataError(f"{path}: {role} recording has {len(nodes)} temperature node; need at least 2")
+    check = FILE_CHECKS.get(protocol)
+    if check is not None:
+        check(rec, path, role)
     return TaskRecording(Path(path).stem, rec, None)
 
 

@@ -25,6 +25,7 @@ Conventions (stated in every report):
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -207,16 +208,19 @@ def _chamber(rec: TaskRecording, fn: Compensator) -> RecordingScore:
                           after_ug=(compensated_g - float(np.mean(compensated_g))) * 1e6)
 
 
+# How a test recording of each protocol is scored: ``(recording, compensator, data, bias_form,
+# probe) -> RecordingScore``.
+SCORERS: dict[str, Callable[[TaskRecording, Compensator, MSRAData, str, bool], RecordingScore]] = {
+    "fulltemp": lambda rec, fn, data, bias_form, probe: _fulltemp(rec, fn, bias_form, probe),
+    "roomtemp": lambda rec, fn, data, bias_form, probe: _roomtemp(rec, fn, data.scale_factor_hz_per_g),
+    "chamber": lambda rec, fn, data, bias_form, probe: _chamber(rec, fn),
+}
+
+
 def score_outputs(data: MSRAData, fn: Compensator, bias_form: str = "plus",
                   train_rmse_ug: float = float("nan"), probe: bool = True) -> Score:
     """Metrics before and after for each test recording compensated by ``fn``; ``probe``
     adds the +-0.5 g probe (fulltemp; not for the raw output, which is not in g)."""
-    recs = []
-    for rec in data.test:
-        if data.protocol == "fulltemp":
-            recs.append(_fulltemp(rec, fn, bias_form, probe))
-        elif data.protocol == "chamber":
-            recs.append(_chamber(rec, fn))
-        else:
-            recs.append(_roomtemp(rec, fn, data.scale_factor_hz_per_g))
+    score_one = SCORERS[data.protocol]
+    recs = [score_one(rec, fn, data, bias_form, probe) for rec in data.test]
     return Score(data.protocol, recs, train_rmse_ug)

@@ -16,7 +16,7 @@ windows of 32 steps).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -42,6 +42,20 @@ def bp_algorithm(requested: str, rows: int, n_params: int) -> tuple[str, str]:
     return "lm", f"{rows} rows >= {LM_ROWS_PER_PARAM} per weight ({n_params})"
 
 
+def _bp_params(requested: str, rows: int, seed: int) -> tuple[dict[str, Any], str]:
+    """``bp``'s parameters on ``rows`` rows: the training :func:`bp_algorithm` picks, and why."""
+    from tcbench.learners import registry
+
+    probe = registry.create("bp", 2, None, np.random.default_rng(seed))
+    algorithm, why = bp_algorithm(requested, rows, probe.n_params)
+    return {"training": algorithm}, why
+
+
+# The learners whose parameters the rows decide: ``(bp_training, rows, seed) -> (params, why)``;
+# any other learner is trained with its default parameters.
+TRAINING_CHOICES: dict[str, Callable[[str, int, int], tuple[dict[str, Any], str]]] = {"bp": _bp_params}
+
+
 def fit_network(method: str, train: Sequence[Record], seed: int, bin_s: float | None,
                 bp_training: str = "lm") -> tuple[Any, dict[str, Any]]:
     """A network ``method`` fitted on ``train`` (its normalisation on the samples, its training on
@@ -52,12 +66,8 @@ def fit_network(method: str, train: Sequence[Record], seed: int, bin_s: float | 
     rows = [r.binned(bin_s) for r in train] if bin_s else list(train)
     x = np.column_stack([np.concatenate([r.temp_c for r in rows]), np.concatenate([r.rate_c_per_s for r in rows])])
     y = np.concatenate([r.output - r.truth for r in rows])
-    params: dict[str, Any] | None = None
-    why = "its default"
-    if method == "bp":
-        probe = registry.create("bp", 2, None, np.random.default_rng(seed))
-        algorithm, why = bp_algorithm(bp_training, y.size, probe.n_params)
-        params = {"training": algorithm}
+    choose = TRAINING_CHOICES.get(method)
+    params, why = choose(bp_training, y.size, seed) if choose is not None else (None, "its default")
     learner = registry.create(method, 2, params, np.random.default_rng(seed))
     learner.scale_to(np.column_stack([np.concatenate([r.temp_c for r in train]),
                                       np.concatenate([r.rate_c_per_s for r in train])]),

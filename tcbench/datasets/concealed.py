@@ -32,6 +32,7 @@ Every random draw comes from generators spawned from ``np.random.SeedSequence(se
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -250,20 +251,22 @@ def _rms(x: np.ndarray) -> float:
     return float(np.sqrt(np.mean(x * x)))
 
 
+# The shapes whose parameters are more than a signed unit amplitude: ``(sign, rng) -> params``,
+# drawn in this order; every other effect is ``{_AMPLITUDE[effect]: sign}``.
+_SHAPES: dict[str, Callable[[float, np.random.Generator], dict[str, float]]] = {
+    "thermal_lag": lambda sign, rng: {"tau_s": float(rng.uniform(60.0, 900.0))},
+    "warmup": lambda sign, rng: {"amplitude": sign, "tau_s": float(rng.uniform(600.0, 1800.0))},
+    "hysteresis": lambda sign, rng: {"amplitude": sign, "width_c": float(rng.uniform(0.5, 3.0))},
+    "aging_drift": lambda sign, rng: {"rate_per_h": sign, "relax_amplitude": 0.0},
+    "bias_instability": lambda sign, rng: {"b": 1.0},
+}
+
+
 def _shape_params(effect: str, rng: np.random.Generator) -> dict[str, float]:
     """The effect's parameters with a unit amplitude of random sign (``b`` positive)."""
     sign = float(rng.choice([-1.0, 1.0]))
-    if effect == "thermal_lag":
-        return {"tau_s": float(rng.uniform(60.0, 900.0))}
-    if effect == "warmup":
-        return {"amplitude": sign, "tau_s": float(rng.uniform(600.0, 1800.0))}
-    if effect == "hysteresis":
-        return {"amplitude": sign, "width_c": float(rng.uniform(0.5, 3.0))}
-    if effect == "aging_drift":
-        return {"rate_per_h": sign, "relax_amplitude": 0.0}
-    if effect == "bias_instability":
-        return {"b": 1.0}
-    return {_AMPLITUDE[effect]: sign}
+    shape = _SHAPES.get(effect)
+    return shape(sign, rng) if shape is not None else {_AMPLITUDE[effect]: sign}
 
 
 def _build(sensor: str, effect: str | None, seed: int) -> _Parts:

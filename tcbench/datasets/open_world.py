@@ -57,6 +57,7 @@ so one seed gives one profile and one device whatever the kind, and the same rec
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -104,9 +105,6 @@ SHAPE: dict[str, str] = {
 }
 KINDS: tuple[str, ...] = tuple(SHAPE)
 SENSORS = ("msra", "gyro")
-ADDITIVE = ("step", "restart_after_gap", "periodic", "slow_oscillation", "compressor_cycling", "transient",
-            "temperature_bump", "second_node")
-DETERMINISTIC = (*ADDITIVE, "saturation")  # a model term can take them out: the refit target applies
 
 RATIO = (0.5, 1.0)
 STEP_AT = (0.15, 0.85)  # fraction of the span
@@ -194,59 +192,94 @@ def _term(effect: Effect, draw: _Draw, rng: np.random.Generator) -> np.ndarray:
     return effect.term(s, rng)
 
 
+def _step(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    t0 = float(draw.t_s[_at(draw.t_s, STEP_AT, rng)])
+    draw.params["time_s"], draw.where["time_s"] = t0, t0
+    return _term(BiasStep(time_s=t0, size=sign), draw, rng), "jump"
+
+
+def _restart_after_gap(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    t = draw.t_s
+    start = float(t[_at(t, GAP_AT, rng)])
+    gap_s = float(np.round(rng.uniform(*GAP_S)))
+    draw.keep = ~((t >= start) & (t < start + gap_s))
+    after = float(t[np.searchsorted(t, start + gap_s)])
+    draw.params |= {"gap_start_s": start, "gap_s": gap_s, "time_s": after}
+    draw.where["time_s"] = after
+    return _term(BiasStep(time_s=after, size=sign), draw, rng), "jump"
+
+
+def _sinusoid(period_range_s: tuple[float, float]) -> Callable[[_Draw, np.random.Generator, float],
+                                                                tuple[np.ndarray, str]]:
+    """The pattern of a sinusoid whose period is drawn in ``period_range_s``."""
+
+    def pattern(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+        period = float(rng.uniform(*period_range_s))
+        phase = float(rng.uniform(0.0, 2.0 * np.pi))
+        draw.params |= {"period_s": period, "phase_rad": phase}
+        draw.where["period_s"] = period
+        return _term(Periodic(period_s=period, amplitude=sign, phase_rad=phase), draw, rng), "amplitude"
+
+    return pattern
+
+
+def _compressor_cycling(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    period = float(rng.uniform(*PERIOD_S))
+    duty = float(rng.uniform(*DUTY))
+    phase = float(rng.uniform(0.0, 1.0))
+    below_c = draw.room_c - COMPRESSOR_BELOW_C
+    draw.params |= {"period_s": period, "duty": duty, "phase_cycles": phase, "below_c": below_c}
+    draw.where["period_s"] = period
+    running = (np.mod(draw.t_s / period + phase, 1.0) < duty) & (draw.temp_c < below_c)
+    return sign * running.astype(float), "jump"
+
+
+def _transient(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    t0 = float(draw.t_s[_at(draw.t_s, TRANSIENT_AT, rng)])
+    tau = float(rng.uniform(*TRANSIENT_TAU_S))
+    draw.params |= {"time_s": t0, "tau_s": tau}
+    draw.where["time_s"] = t0
+    return _term(Transient(time_s=t0, tau_s=tau, amplitude=sign), draw, rng), "jump"
+
+
+def _temperature_bump(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    width = float(rng.uniform(*BUMP_WIDTH_C))
+    lo, hi = float(draw.temp_c.min()), float(draw.temp_c.max())
+    centre = float(rng.uniform(lo + width, hi - width))
+    draw.params |= {"centre_c": centre, "width_c": width}
+    draw.where["temperature_c"] = [centre - 2.0 * width, centre + 2.0 * width]
+    return _term(TemperatureBump(centre_c=centre, width_c=width, amplitude=sign), draw, rng), "amplitude"
+
+
+def _second_node(draw: _Draw, rng: np.random.Generator, sign: float) -> tuple[np.ndarray, str]:
+    tau = float(rng.uniform(*SECOND_NODE_TAU_S))
+    draw.params["tau_s"] = tau
+    return _term(SecondNode(tau_s=tau, coef_per_c=sign), draw, rng), "coef_per_c"
+
+
+# The additive kinds: ``(draw, rng, sign) -> (unit-amplitude contribution, amplitude parameter)``;
+# each fills ``draw.params``, ``draw.where`` and (for a gap) ``draw.keep``.
+PATTERNS: dict[str, Callable[[_Draw, np.random.Generator, float], tuple[np.ndarray, str]]] = {
+    "step": _step,
+    "restart_after_gap": _restart_after_gap,
+    "periodic": _sinusoid(PERIOD_S),
+    "slow_oscillation": _sinusoid(SLOW_PERIOD_S),
+    "compressor_cycling": _compressor_cycling,
+    "transient": _transient,
+    "temperature_bump": _temperature_bump,
+    "second_node": _second_node,
+}
+ADDITIVE: tuple[str, ...] = tuple(PATTERNS)
+DETERMINISTIC = (*ADDITIVE, "saturation")  # a model term can take them out: the refit target applies
+
+
 def _pattern(kind: str, draw: _Draw, rng: np.random.Generator) -> tuple[np.ndarray, str, float]:
     """Unit-amplitude contribution of an additive ``kind`` (sign included), the name of its
-    amplitude parameter and the sign; fills ``draw.params``, ``draw.where`` and (for a gap)
-    ``draw.keep``. Every kind but ``compressor_cycling`` (gated by the temperature) is the term
-    of the library effect of the same form."""
-    t, temp = draw.t_s, draw.temp_c
+    amplitude parameter and the sign (:data:`PATTERNS`). Every kind but ``compressor_cycling``
+    (gated by the temperature) is the term of the library effect of the same form."""
     sign = float(rng.choice([-1.0, 1.0]))
-    p, w = draw.params, draw.where
-    if kind == "step":
-        t0 = float(t[_at(t, STEP_AT, rng)])
-        p["time_s"], w["time_s"] = t0, t0
-        return _term(BiasStep(time_s=t0, size=sign), draw, rng), "jump", sign
-    if kind == "restart_after_gap":
-        start = float(t[_at(t, GAP_AT, rng)])
-        gap_s = float(np.round(rng.uniform(*GAP_S)))
-        draw.keep = ~((t >= start) & (t < start + gap_s))
-        after = float(t[np.searchsorted(t, start + gap_s)])
-        p |= {"gap_start_s": start, "gap_s": gap_s, "time_s": after}
-        w["time_s"] = after
-        return _term(BiasStep(time_s=after, size=sign), draw, rng), "jump", sign
-    if kind in ("periodic", "slow_oscillation"):
-        period = float(rng.uniform(*(PERIOD_S if kind == "periodic" else SLOW_PERIOD_S)))
-        phase = float(rng.uniform(0.0, 2.0 * np.pi))
-        p |= {"period_s": period, "phase_rad": phase}
-        w["period_s"] = period
-        return _term(Periodic(period_s=period, amplitude=sign, phase_rad=phase), draw, rng), "amplitude", sign
-    if kind == "compressor_cycling":
-        period = float(rng.uniform(*PERIOD_S))
-        duty = float(rng.uniform(*DUTY))
-        phase = float(rng.uniform(0.0, 1.0))
-        below_c = draw.room_c - COMPRESSOR_BELOW_C
-        p |= {"period_s": period, "duty": duty, "phase_cycles": phase, "below_c": below_c}
-        w["period_s"] = period
-        running = (np.mod(t / period + phase, 1.0) < duty) & (temp < below_c)
-        return sign * running.astype(float), "jump", sign
-    if kind == "transient":
-        t0 = float(t[_at(t, TRANSIENT_AT, rng)])
-        tau = float(rng.uniform(*TRANSIENT_TAU_S))
-        p |= {"time_s": t0, "tau_s": tau}
-        w["time_s"] = t0
-        return _term(Transient(time_s=t0, tau_s=tau, amplitude=sign), draw, rng), "jump", sign
-    if kind == "temperature_bump":
-        width = float(rng.uniform(*BUMP_WIDTH_C))
-        lo, hi = float(temp.min()), float(temp.max())
-        centre = float(rng.uniform(lo + width, hi - width))
-        p |= {"centre_c": centre, "width_c": width}
-        w["temperature_c"] = [centre - 2.0 * width, centre + 2.0 * width]
-        return _term(TemperatureBump(centre_c=centre, width_c=width, amplitude=sign), draw, rng), "amplitude", sign
-    if kind == "second_node":
-        tau = float(rng.uniform(*SECOND_NODE_TAU_S))
-        p["tau_s"] = tau
-        return _term(SecondNode(tau_s=tau, coef_per_c=sign), draw, rng), "coef_per_c", sign
-    raise ValueError(f"not an additive kind: {kind!r}")  # pragma: no cover
+    d, amp_name = PATTERNS[kind](draw, rng, sign)
+    return d, amp_name, sign
 
 
 def _split(draw: _Draw) -> tuple[np.ndarray, np.ndarray]:
@@ -305,6 +338,110 @@ def _one_band(draw: _Draw, clipped: np.ndarray, group: np.ndarray) -> bool:
     return not bool((group & ~clipped & (temp > lo) & (temp < hi)).any())
 
 
+@dataclass
+class _Mix:
+    """One recording while its kind is hidden: the draw, the noise-free output ``base``, the
+    white sigma and the drawn ``rho``, the unit white noise, the thermometer ``reading`` before
+    its quantisation, and what a kind sets: the ``output``, the ``thermometer`` reading, the
+    ``ratio`` and the ``white_sigma`` of the truth; ``rng`` the kind's own stream."""
+
+    draw: _Draw
+    base: np.ndarray
+    sigma: float
+    rho: float
+    white: np.ndarray
+    reading: np.ndarray
+    output: np.ndarray
+    thermometer: np.ndarray
+    ratio: float
+    white_sigma: float
+    rng: np.random.Generator
+
+
+def _additive(kind: str) -> Callable[[_Mix], None]:
+    """Hide the additive ``kind`` sized so that what the minimal model cannot absorb is ``rho * sigma``."""
+
+    def hide(m: _Mix) -> None:
+        d, amp_name, sign = _pattern(kind, m.draw, m.rng)
+        scale = m.rho * m.sigma / _left(d, m.draw)
+        m.draw.params[amp_name] = sign * scale
+        m.output = m.base + d * scale + m.sigma * m.white
+        m.ratio = m.rho
+
+    return hide
+
+
+def _hide_saturation(m: _Mix) -> None:
+    draw, sigma = m.draw, m.sigma
+    fixed, varying = _split(draw)
+    share, ceiling, threshold, group, amount = _saturation(draw, varying, m.rng)
+    k = m.rho * sigma / _left(amount, draw)  # temperature sensitivity that makes the clip rho sigma
+    draw.base = fixed + k * varying
+    level = float(np.median(fixed[group]) + k * threshold)
+    outside = draw.base[~group]
+    if outside.size and (outside.max() >= level if ceiling else outside.min() <= level):
+        raise RuntimeError("the clip level reaches samples at another input")  # pragma: no cover
+    noisy = draw.base + sigma * m.white
+    m.output = np.minimum(noisy, level) if ceiling else np.maximum(noisy, level)
+    band = draw.temp_c[amount != 0]
+    draw.params |= {"level": level, "ceiling": float(ceiling), "band_share": share, "tempco_scale": k,
+                    "band_low_c": float(band.min()), "band_high_c": float(band.max())}
+    draw.where["level"] = level
+    m.ratio = m.rho
+
+
+def _hide_output_quantisation(m: _Mix) -> None:
+    q = float(np.sqrt(12.0) * m.rho * m.sigma)
+    m.output = noise.quantise(m.output, q)
+    m.draw.params["step"] = q
+    m.draw.where["level"] = q
+    m.ratio = m.rho
+
+
+def _hide_thermometer_steps(m: _Mix) -> None:
+    draw = m.draw
+    m.thermometer = noise.quantise(m.reading, THERMOMETER_STEPS_C)
+    fixed, varying = _split(draw)
+    k = m.rho * m.sigma / _left(varying, draw, temp_c=m.thermometer)
+    draw.base = fixed + k * varying
+    m.output = draw.base + m.sigma * m.white
+    draw.params |= {"step_c": THERMOMETER_STEPS_C, "tempco_scale": k}
+    draw.where["level"] = THERMOMETER_STEPS_C
+    m.ratio = m.rho
+
+
+def _hide_variance_temperature(m: _Mix) -> None:
+    draw = m.draw
+    growth = float(m.rng.uniform(*VARIANCE_GROWTH))
+    lo, hi = float(draw.temp_c.min()), float(draw.temp_c.max())
+    sigma_t = m.sigma * growth ** ((draw.temp_c - lo) / (hi - lo))
+    m.output = m.base + sigma_t * m.white
+    m.white_sigma = _rms(sigma_t)
+    draw.params |= {"sigma_cold": m.sigma, "growth": growth}
+    draw.where["temperature_c"] = [(lo + hi) / 2.0, hi]
+
+
+def _hide_spikes(m: _Mix) -> None:
+    draw = m.draw
+    times, sizes = _spikes(draw.t_s, m.sigma, m.rng)
+    idx = np.searchsorted(draw.t_s, times)
+    m.output = m.output.copy()
+    m.output[idx] += sizes
+    draw.params |= {"count": float(times.size), **{f"size_{i}": float(s) for i, s in enumerate(sizes)}}
+    draw.where["time_s"] = [float(x) for x in times]
+
+
+# How each kind is hidden in a recording (its keys are :data:`KINDS`).
+HIDE: dict[str, Callable[[_Mix], None]] = {
+    **{kind: _additive(kind) for kind in ADDITIVE},
+    "saturation": _hide_saturation,
+    "output_quantisation": _hide_output_quantisation,
+    "thermometer_steps": _hide_thermometer_steps,
+    "variance_temperature": _hide_variance_temperature,
+    "spikes": _hide_spikes,
+}
+
+
 def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Recording, OpenWorld]:
     """A schema-v1 recording (1 Hz; MSRA output in Hz, gyro in deg/s) with ``kind`` hidden
     (``None``: a control) and its truth. Raises ``ValueError`` for an unknown sensor or kind or
@@ -332,59 +469,10 @@ def open_world_recording(sensor: str, kind: str | None, seed: int) -> tuple[Reco
     reading = profile.temp_c + r_thermo.standard_normal(n) * THERMOMETER_NOISE_C
     thermometer = noise.quantise(reading, THERMOMETER_STEP_C)
     output = base + sigma * white
-    ratio, white_sigma = float("nan"), sigma
-    if kind in ADDITIVE:
-        d, amp_name, sign = _pattern(kind, draw, r_kind)
-        scale = rho * sigma / _left(d, draw)
-        draw.params[amp_name] = sign * scale
-        output = base + d * scale + sigma * white
-        ratio = rho
-    elif kind == "saturation":
-        fixed, varying = _split(draw)
-        share, ceiling, threshold, group, amount = _saturation(draw, varying, r_kind)
-        k = rho * sigma / _left(amount, draw)  # temperature sensitivity that makes the clip rho sigma
-        draw.base = fixed + k * varying
-        level = float(np.median(fixed[group]) + k * threshold)
-        outside = draw.base[~group]
-        if outside.size and (outside.max() >= level if ceiling else outside.min() <= level):
-            raise RuntimeError("the clip level reaches samples at another input")  # pragma: no cover
-        noisy = draw.base + sigma * white
-        output = np.minimum(noisy, level) if ceiling else np.maximum(noisy, level)
-        band = draw.temp_c[amount != 0]
-        draw.params |= {"level": level, "ceiling": float(ceiling), "band_share": share, "tempco_scale": k,
-                        "band_low_c": float(band.min()), "band_high_c": float(band.max())}
-        draw.where["level"] = level
-        ratio = rho
-    elif kind == "output_quantisation":
-        q = float(np.sqrt(12.0) * rho * sigma)
-        output = noise.quantise(output, q)
-        draw.params["step"] = q
-        draw.where["level"] = q
-        ratio = rho
-    elif kind == "thermometer_steps":
-        thermometer = noise.quantise(reading, THERMOMETER_STEPS_C)
-        fixed, varying = _split(draw)
-        k = rho * sigma / _left(varying, draw, temp_c=thermometer)
-        draw.base = fixed + k * varying
-        output = draw.base + sigma * white
-        draw.params |= {"step_c": THERMOMETER_STEPS_C, "tempco_scale": k}
-        draw.where["level"] = THERMOMETER_STEPS_C
-        ratio = rho
-    elif kind == "variance_temperature":
-        growth = float(r_kind.uniform(*VARIANCE_GROWTH))
-        lo, hi = float(draw.temp_c.min()), float(draw.temp_c.max())
-        sigma_t = sigma * growth ** ((draw.temp_c - lo) / (hi - lo))
-        output = base + sigma_t * white
-        white_sigma = _rms(sigma_t)
-        draw.params |= {"sigma_cold": sigma, "growth": growth}
-        draw.where["temperature_c"] = [(lo + hi) / 2.0, hi]
-    elif kind == "spikes":
-        times, sizes = _spikes(draw.t_s, sigma, r_kind)
-        idx = np.searchsorted(draw.t_s, times)
-        output = output.copy()
-        output[idx] += sizes
-        draw.params |= {"count": float(times.size), **{f"size_{i}": float(s) for i, s in enumerate(sizes)}}
-        draw.where["time_s"] = [float(x) for x in times]
+    mix = _Mix(draw, base, sigma, rho, white, reading, output, thermometer, float("nan"), sigma, r_kind)
+    if kind is not None:
+        HIDE[kind](mix)
+    draw, output, thermometer, ratio, white_sigma = mix.draw, mix.output, mix.thermometer, mix.ratio, mix.white_sigma
     kept = draw.keep
     t_kept = draw.t_s[kept]
     truth = OpenWorld(sensor, kind, SHAPE.get(kind) if kind else None, dict(draw.where),

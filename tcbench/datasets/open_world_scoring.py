@@ -9,7 +9,7 @@ read by shape and where, never by id; a missing or malformed key is no match, no
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -65,6 +65,35 @@ def _band_matches(true: Sequence[float], found: Any) -> bool:
     return bool(f[0] <= hi - quarter and f[1] >= lo + quarter)
 
 
+def _time_matches(true: Any, found: Mapping[str, Any], span_s: float) -> bool:
+    return found.get("time_s") is not None and _times_match(true, found["time_s"], time_tolerance_s(span_s))
+
+
+def _period_matches(true: Any, found: Mapping[str, Any], span_s: float) -> bool:
+    p = _period(found)
+    return p is not None and abs(p - float(true)) <= PERIOD_TOLERANCE * float(true)
+
+
+def _temperature_matches(true: Any, found: Mapping[str, Any], span_s: float) -> bool:
+    return found.get("temperature_c") is not None and _band_matches(true, found["temperature_c"])
+
+
+def _level_matches(true: Any, found: Mapping[str, Any], span_s: float) -> bool:
+    if found.get("level") is None:
+        return False
+    level = float(_numbers(found["level"])[0])
+    return abs(level - float(true)) <= LEVEL_TOLERANCE * abs(float(true))
+
+
+# How each key of a truth's ``where`` is matched: ``(true value, found where, span_s) -> bool``.
+WHERE_MATCHERS: dict[str, Callable[[Any, Mapping[str, Any], float], bool]] = {
+    "time_s": _time_matches,
+    "period_s": _period_matches,
+    "temperature_c": _temperature_matches,
+    "level": _level_matches,
+}
+
+
 def where_matches(true: Mapping[str, Any], found: Mapping[str, Any] | None, span_s: float) -> bool:
     """Whether ``found`` states every key of the truth's ``where`` within the fixed tolerances:
     instants within :func:`time_tolerance_s`, period within 15 % (``frequency_hz`` accepted),
@@ -73,23 +102,8 @@ def where_matches(true: Mapping[str, Any], found: Mapping[str, Any] | None, span
     found = found if isinstance(found, Mapping) else {}
     try:
         for key, value in true.items():
-            if key == "time_s":
-                if found.get("time_s") is None or not _times_match(value, found["time_s"], time_tolerance_s(span_s)):
-                    return False
-            elif key == "period_s":
-                p = _period(found)
-                if p is None or abs(p - float(value)) > PERIOD_TOLERANCE * float(value):
-                    return False
-            elif key == "temperature_c":
-                if found.get("temperature_c") is None or not _band_matches(value, found["temperature_c"]):
-                    return False
-            elif key == "level":
-                if found.get("level") is None:
-                    return False
-                level = float(_numbers(found["level"])[0])
-                if abs(level - float(value)) > LEVEL_TOLERANCE * abs(float(value)):
-                    return False
-            else:  # pragma: no cover - the truth only uses the keys above
+            matches = WHERE_MATCHERS.get(key)
+            if matches is None or not matches(value, found, span_s):  # the truth only uses the keys above
                 return False
     except (TypeError, ValueError):
         return False

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -231,6 +232,15 @@ def _kind(rec: Recording, out: Path | None, files: dict[str, Path]) -> Report:
     return Report(km.metrics | floor, conventions, None, files, details)
 
 
+# The report of a run without complete four-position groups, by its kind's ``report``
+# (:data:`tcbench.sensors.kinds.REPORTS`): ``(recording, scale_factor, out, files) -> Report``.
+REPORTERS: dict[str, Callable[[Recording, float | None, Path | None, dict[str, Path]], Report]] = {
+    "inertial": lambda rec, scale_factor, out, files: _kind(rec, out, files),
+    "zero_bias": _msra,
+    "rate": lambda rec, scale_factor, out, files: _gyro(rec, out, files),
+}
+
+
 def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None = None) -> Report:
     """Metrics (and, with ``out``, plots, ``metrics.json`` and ``nodes.csv``) of a recording."""
     sensor = rec.meta.sensor
@@ -249,12 +259,8 @@ def analyse(rec: Recording, out: Path | None = None, scale_factor: float | None 
     pos = _positions(rec) if kind.positions else None
     if pos is not None and np.isin(pos, ["+1g", "-1g"]).any():  # a four-position test
         report = _four_position(rec, pos, out, files)
-    elif kind.report == "zero_bias":
-        report = _msra(rec, scale_factor, out, files)
-    elif kind.report == "rate":
-        report = _gyro(rec, out, files)
     else:
-        report = _kind(rec, out, files)
+        report = REPORTERS[kind.report](rec, scale_factor, out, files)
     if out is not None:
         payload: dict[str, Any] = {"device_id": rec.meta.device_id, "sensor": sensor,
                                    "metrics": report.metrics, "conventions": report.conventions, **report.details}

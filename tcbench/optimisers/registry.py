@@ -19,6 +19,7 @@ from tcbench.optimisers.protocol import Optimiser, OptimiserParams
 from tcbench.plugins import Entry, PluginRegistry, UnknownPluginError
 
 GROUP = "tcbench.optimisers"
+NO_SEARCH = "none"  # a compensation job's optimiser that searches nothing: the learner's random start
 
 
 class UnknownOptimiserError(UnknownPluginError):
@@ -31,7 +32,7 @@ available = REGISTRY.available
 broken = REGISTRY.broken
 get = REGISTRY.get
 
-__all__ = ["GROUP", "Entry", "UnknownOptimiserError", "available", "broken", "create", "get", "register"]
+__all__ = ["GROUP", "NO_SEARCH", "Entry", "UnknownOptimiserError", "available", "broken", "create", "get", "register"]
 
 
 def create(

@@ -52,6 +52,11 @@ class OptimiserConfig:
     params: dict[str, Any]
     label: Any = None
 
+    @property
+    def searches(self) -> bool:
+        """Whether it searches (``none``, :data:`~tcbench.optimisers.registry.NO_SEARCH`: a random start)."""
+        return self.name != optimisers.NO_SEARCH
+
 
 def learner_of(c: dict[str, Any]) -> LearnerConfig:
     """The job's learner: its config's ``learner``, which the task's defaults list fills when
@@ -121,7 +126,7 @@ def validate_compensation(c: dict[str, Any], task: dict[str, Any], env: Any = No
 def _check_optimiser(opt: OptimiserConfig, env: Any, budget: int) -> None:
     """The optimiser of the learner's initial weights: none, or a registered single-objective one
     with valid parameters and a budget of at least one generation (a learner that can be searched)."""
-    if opt.name == "none" or env.learner is None or not env.learner.searchable:
+    if not opt.searches or env.learner is None or not env.learner.searchable:
         return
     try:
         ocls = optimisers.get(opt.name)

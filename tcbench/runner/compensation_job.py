@@ -4,47 +4,35 @@ env's arguments, the learner and the optimiser, the job's names and the env it r
 The env is built once per job in a process: the plan check of a command line
 (:meth:`~tcbench.runner.kinds.JobKind.plan_check`, before any job starts) keeps the env it built
 and checked for the job that runs next in the same process with the same env arguments
-(:func:`keep`, :mod:`~tcbench.runner.kept_env`), which takes it instead of building another (an
-env is fresh until its first ``reset``: a check reads it, never steps it). A job on a worker
-process is prepared there.
+(:func:`~tcbench.runner.prepared_job.keep`, :mod:`~tcbench.runner.kept_env`), which takes it
+instead of building another (an env is fresh until its first ``reset``: a check reads it, never
+steps it). A job on a worker process is prepared there. What it shares with an optimisation job
+is :class:`~tcbench.runner.prepared_job.PreparedJob`.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from tcbench.runner import kept_env
-from tcbench.runner.compensation_config import LearnerConfig, OptimiserConfig, learner_of, optimiser_of, \
-    validate_compensation
+from tcbench.runner.compensation_config import LearnerConfig, learner_of, optimiser_of, validate_compensation
 from tcbench.runner.config import checked_config
 from tcbench.runner.kinds import JobNames
+from tcbench.runner.prepared_job import PreparedJob, run_settings
 from tcbench.sensors.data_hash import shared_recordings
 from tcbench.tasks import TaskSpec, task_kwargs
 
 
-@dataclass(frozen=True)
-class CompensationJob:
-    """One compensation job, checked: what its names, its run, its record and its summary need.
+@dataclass(frozen=True, kw_only=True)
+class CompensationJob(PreparedJob):
+    """One compensation job, checked (:class:`~tcbench.runner.prepared_job.PreparedJob`): its
+    learner too, and ``in_sample``, the test files that are also training files."""
 
-    task: the task's config as checked against its schema; task_kwargs: its env's keyword
-    arguments. plots: ``tracking.plots`` (null: draw). in_sample: the test files that are also
-    training files. env: the task's env (unwrapped), built once and not yet reset."""
-
-    spec: TaskSpec
-    task: dict[str, Any]
-    task_kwargs: dict[str, Any]
     learner: LearnerConfig
-    optimiser: OptimiserConfig
-    budget: int
-    seed: int
-    progress: bool
-    plots: bool | None
-    names: JobNames
     in_sample: tuple[str, ...]
-    env: Any = field(repr=False, compare=False)
 
     @property
     def env_key(self) -> str:
@@ -66,12 +54,6 @@ def in_sample(task: dict[str, Any]) -> list[str]:
     return shared_recordings(task["train_files"], task["test_files"])
 
 
-def keep(job: CompensationJob) -> None:
-    """Keep ``job``'s env for the next job prepared in this process from the same env arguments
-    (the plan check's job hands it to the job that runs; :mod:`~tcbench.runner.kept_env`)."""
-    kept_env.keep(job.env_key, job.env)
-
-
 def draw_of(c: dict[str, Any]) -> int | None:
     """The draw of power-ons a simulated compensation job trains and tests on: ``task.recordings_seed``,
     or the run seed where it is null (restart *i* on draw *i*: a method and its limits meet the same
@@ -85,8 +67,8 @@ def draw_of(c: dict[str, Any]) -> int | None:
 def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) -> CompensationJob:
     """The compensation job of config ``c``, checked as :func:`validate
     <tcbench.runner.config.validate>` checks it (one-line ConfigErrors naming the key), then named
-    (``names(c)``), with its env: the one a plan check kept for these arguments (:func:`keep`),
-    else built now."""
+    (``names(c)``), with its env: the one a plan check kept for these arguments
+    (:func:`~tcbench.runner.prepared_job.keep`), else built now."""
     spec, task = checked_config(c)
     learner, optimiser = learner_of(c), optimiser_of(c)
     if (draw := draw_of(c)) is not None:
@@ -94,6 +76,5 @@ def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames]) 
     kwargs = task_kwargs(task)
     kept = kept_env.take(env_key(spec, learner, c["budget"], kwargs))
     env = validate_compensation(c, task, kept)
-    plots = (c.get("tracking") or {}).get("plots")
-    return CompensationJob(spec, task, kwargs, learner, optimiser, int(c["budget"]), int(c["seed"]),
-                           bool(c["progress"]), plots, names(c), tuple(in_sample(c["task"])), env)
+    return CompensationJob(spec=spec, task=task, task_kwargs=kwargs, learner=learner, optimiser=optimiser,
+                           **run_settings(c), names=names(c), in_sample=tuple(in_sample(c["task"])), env=env)

@@ -311,7 +311,7 @@ def compensate(env: Any, learner: str, optimiser: str, optimiser_params: dict[st
     t0 = time.perf_counter()
     init = None
     init_loss = float("nan")
-    if env.learner.searchable and optimiser != "none":
+    if env.learner.searchable and optimiser != registry.NO_SEARCH:
         opt = registry.create(optimiser, env.lower, env.upper, budget, rng, optimiser_params)
         trace = ask_tell(opt, env, budget, progress)[0].trace
         init, init_loss = opt.best.x, float(opt.best.f)

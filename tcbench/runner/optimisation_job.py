@@ -3,46 +3,34 @@ env's arguments, the optimiser, the job's names, its IOHprofiler folder and the 
 
 The env is built once per job in a process, as a compensation job's
 (:mod:`~tcbench.runner.compensation_job`): the plan check keeps the env it built and checked
-(:func:`keep`, :mod:`~tcbench.runner.kept_env`) for the job that runs next in the same process
-with the same env arguments, which takes it instead of building another; a job on a worker
-process is prepared there, on an env of its own.
+(:func:`~tcbench.runner.prepared_job.keep`, :mod:`~tcbench.runner.kept_env`) for the job that
+runs next in the same process with the same env arguments, which takes it instead of building
+another; a job on a worker process is prepared there, on an env of its own.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from tcbench.runner import kept_env
-from tcbench.runner.compensation_config import OptimiserConfig, optimiser_of
+from tcbench.runner.compensation_config import optimiser_of
 from tcbench.runner.config import checked_config, validate_optimisation
 from tcbench.runner.kinds import JobNames
+from tcbench.runner.prepared_job import PreparedJob, run_settings
 from tcbench.tasks import TaskSpec, task_kwargs
 
 
-@dataclass(frozen=True)
-class OptimisationJob:
-    """One optimisation job, checked: what its names, its run, its record and its summary need.
+@dataclass(frozen=True, kw_only=True)
+class OptimisationJob(PreparedJob):
+    """One optimisation job, checked (:class:`~tcbench.runner.prepared_job.PreparedJob`).
 
-    task: the task's config as checked against its schema; task_kwargs: its env's keyword
-    arguments. plots: ``tracking.plots`` (null: draw). ioh_folder: where its IOHprofiler log
-    goes (``tracking.ioh_dir``), or None. env: the task's env (unwrapped), built once and not yet
-    reset."""
+    ioh_folder: where its IOHprofiler log goes (``tracking.ioh_dir``), or None."""
 
-    spec: TaskSpec
-    task: dict[str, Any]
-    task_kwargs: dict[str, Any]
-    optimiser: OptimiserConfig
-    budget: int
-    seed: int
-    progress: bool
-    plots: bool | None
-    names: JobNames
     ioh_folder: Path | None
-    env: Any = field(repr=False, compare=False)
 
     @property
     def env_key(self) -> str:
@@ -62,22 +50,15 @@ def env_key(spec: TaskSpec, budget: int, kwargs: dict[str, Any]) -> str:
     return json.dumps([spec.gym_id, budget, kwargs], sort_keys=True, default=str)
 
 
-def keep(job: OptimisationJob) -> None:
-    """Keep ``job``'s env for the next job prepared in this process from the same env arguments
-    (the plan check's job hands it to the job that runs; :mod:`~tcbench.runner.kept_env`)."""
-    kept_env.keep(job.env_key, job.env)
-
-
 def prepare_job(c: dict[str, Any], names: Callable[[dict[str, Any]], JobNames],
                 ioh_folder: Callable[[dict[str, Any]], Path | None]) -> OptimisationJob:
     """The optimisation job of config ``c``, checked as :func:`validate
     <tcbench.runner.config.validate>` checks it (one-line ConfigErrors naming the key), then named
     (``names(c)``) and given its IOHprofiler folder (``ioh_folder(c)``), with its env: the one a
-    plan check kept for these arguments (:func:`keep`), else built now."""
+    plan check kept for these arguments (:func:`~tcbench.runner.prepared_job.keep`), else built now."""
     spec, task = checked_config(c)
     kwargs = task_kwargs(task)
     kept = kept_env.take(env_key(spec, c["budget"], kwargs))
     env = validate_optimisation(c, spec, task, kept)
-    plots = (c.get("tracking") or {}).get("plots")
-    return OptimisationJob(spec, task, kwargs, optimiser_of(c), int(c["budget"]), int(c["seed"]),
-                           bool(c["progress"]), plots, names(c), ioh_folder(c), env)
+    return OptimisationJob(spec=spec, task=task, task_kwargs=kwargs, optimiser=optimiser_of(c), **run_settings(c),
+                           names=names(c), ioh_folder=ioh_folder(c), env=env)

@@ -17,6 +17,7 @@ residual), so each is a small frozen dataclass whose fields are its parameters.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -478,7 +479,7 @@ class _EffectPlugins(PluginRegistry[Effect]):
             raise ValueError(f"effect {name!r}: stage {cls.stage!r} is none of {', '.join(STAGES)}")
 
 
-STAGES = ("die", "output", "final", "thermometer")
+DIE, OUTPUT, FINAL, THERMOMETER = STAGES = ("die", "output", "final", "thermometer")
 PLUGINS: PluginRegistry[Effect] = _EffectPlugins(EFFECTS_GROUP, Effect, "effect")
 
 
@@ -548,6 +549,11 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
     return cls(**values)
 
 
+def at_stage(effects: Iterable[Effect], stage: str) -> list[Effect]:
+    """The effects acting at ``stage`` (one of :data:`STAGES`), in list order."""
+    return [effect for effect in effects if effect.stage == stage]
+
+
 def apply_effects(
     base: np.ndarray, effects: list[Effect], s: Signals, rng: np.random.Generator
 ) -> np.ndarray:
@@ -556,26 +562,23 @@ def apply_effects(
     streams = rng.spawn(len(effects)) if effects else []
     y = base
     for effect, stream in zip(effects, streams, strict=True):
-        if effect.stage == "output":
+        if effect.stage == OUTPUT:
             y += effect.term(s, stream)
-    for effect in effects:
-        if effect.stage == "final":
-            y = effect.transform(y)
+    for effect in at_stage(effects, FINAL):
+        y = effect.transform(y)
     return y
 
 
 def thermometer_reading(effects: list[Effect], temp_c: np.ndarray) -> np.ndarray:
     """The thermometer reading after the ``thermometer`` stage effects (``temp_c`` if none)."""
-    for effect in effects:
-        if effect.stage == "thermometer":
-            temp_c = effect.reading(temp_c)
+    for effect in at_stage(effects, THERMOMETER):
+        temp_c = effect.reading(temp_c)
     return temp_c
 
 
 def die_temperature(effects: list[Effect], s: Signals) -> np.ndarray:
     """Die temperature after the ``die`` stage effects (the thermometer's if none)."""
     temp = s.temp_meas_c
-    for effect in effects:
-        if effect.stage == "die":
-            temp = effect.die_temperature(dataclasses.replace(s, temp_meas_c=temp))
+    for effect in at_stage(effects, DIE):
+        temp = effect.die_temperature(dataclasses.replace(s, temp_meas_c=temp))
     return temp

@@ -72,7 +72,7 @@ class SensorModel:
             mine = self.effect(effect_id)
             if mine is None:
                 new = fx.make_effect(effect_id, **params)
-                at = next((i for i, e in enumerate(current) if e.stage == "final"), len(current))
+                at = next((i for i, e in enumerate(current) if e.stage == fx.FINAL), len(current))
                 current.insert(at, new)
             else:
                 merged = mine.params() | dict(params)

@@ -20,6 +20,7 @@ tunes them on ``tcbench/Gyro-VMDTuning-v0`` (MOPSO by default, §3.2).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from importlib.metadata import entry_points
 from typing import Any
 
@@ -29,7 +30,7 @@ import numpy as np
 from tcbench.compensation.data import DEFAULT_TIER, TaskDataError, check_tier
 from tcbench.compensation.gyro.cache import cached_front
 from tcbench.compensation.gyro.data import GyroData, check_effects, check_settings
-from tcbench.compensation.gyro.pipeline import FrontEnd, ParallelPipeline, PipelineConfig
+from tcbench.compensation.gyro.pipeline import TUNED, FrontEnd, ParallelPipeline, PipelineConfig
 from tcbench.compensation.gyro.scoring import DPS_TO_DPH, Method, score_record
 from tcbench.compensation.gyro.tuning import PAPER_BEST, tuning_window
 from tcbench.compensation.methods import memorised
@@ -44,7 +45,6 @@ from tcbench.tasks.msra_env import make_learner
 from tcbench.tasks.weight_search import WeightSearch
 
 ENV_ID = GYRO_DRIFTNOISE_ID
-BASELINES = ("raw", "memoriser", "oracle", "oracle_thermometer", "model")
 PIPELINE_KEYS = tuple(f.name for f in dataclasses.fields(PipelineConfig))
 
 
@@ -55,6 +55,56 @@ def _check_tuner(name: object) -> None:
     known = sorted(entry_points(group="tcbench.optimisers").names)
     if not isinstance(name, str) or name not in known:
         raise ValueError(f"tuner must be the name of a multi-objective optimiser ({', '.join(known)}), got {name!r}")
+
+
+def _raw(env: GyroDriftNoiseEnv, bandwidth: bool) -> Score:
+    assert env.pipeline is not None
+    env.pipeline.learner = None
+    return env._score_pipeline(float("nan"), bandwidth)
+
+
+def _memoriser(env: GyroDriftNoiseEnv, bandwidth: bool) -> Score:
+    assert env.data is not None
+    memo = memorised(env.data.train, "output")
+    recs = [score_record(tr, lambda y, tr=tr: y - memo(tr.recording.time_s), env.amplitude_dps, None,
+                         bandwidth) for tr in env.data.test]
+    return Score("gyro", recs)
+
+
+def _model(env: GyroDriftNoiseEnv, bandwidth: bool) -> Score:
+    from tcbench.tasks.diagnosed import diagnose_runs, gyro_method
+
+    assert env.data is not None
+    fitted = diagnose_runs(env.data.train)
+    recs = [score_record(tr, gyro_method(fitted, tr.recording.time_s, tr.recording.temperature_c),
+                         env.amplitude_dps, None, bandwidth) for tr in env.data.test]
+    return Score("gyro", recs, extra={"diagnosed": fitted})
+
+
+def _oracle(thermometer: bool) -> Callable[[GyroDriftNoiseEnv, bool], Score]:
+    """The simulator's drift removed: of the package temperature, or (``thermometer``) of the
+    thermometer reading."""
+
+    def score(env: GyroDriftNoiseEnv, bandwidth: bool) -> Score:
+        assert env.data is not None
+        if not env.data.has_truth:
+            raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
+        recs = [score_record(tr, lambda y, tr=tr: oracle_inverse(y, tr.truth, thermometer), env.amplitude_dps,
+                             None, bandwidth) for tr in env.data.test]
+        return Score("gyro", recs)
+
+    return score
+
+
+# How each baseline scores the env's test records: ``(env, bandwidth) -> Score``.
+BASELINE_SCORES: dict[str, Callable[[GyroDriftNoiseEnv, bool], Score]] = {
+    "raw": _raw,
+    "memoriser": _memoriser,
+    "oracle": _oracle(False),
+    "oracle_thermometer": _oracle(True),
+    "model": _model,
+}
+BASELINES = tuple(BASELINE_SCORES)
 
 
 class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
@@ -124,7 +174,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
                     "rate_window_s": rate_window_s, "learner_block_s": learner_block_s}
         self.config = PipelineConfig(**pipeline, **({"k": k} if k is not None else {}),
                                      **({"alpha": alpha} if alpha is not None else {}))
-        self.needs_tuning = decomposition == "vmd" and (k is None or alpha is None)
+        self.needs_tuning = decomposition in TUNED and (k is None or alpha is None)
         if recordings_seed is None and self.needs_tuning:
             raise ValueError("recordings_seed null draws the runs from the run seed; give task.k and task.alpha (or "
                              "decomposition none or emd), since VMD is tuned on fixed recordings")
@@ -239,26 +289,7 @@ class GyroDriftNoiseEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
         :mod:`tcbench.tasks.diagnosed`)."""
         if self.data is None or self.pipeline is None:
             raise RuntimeError("call reset() before score_baseline()")
-        if which == "raw":
-            self.pipeline.learner = None
-            return self._score_pipeline(float("nan"), bandwidth)
-        if which == "memoriser":
-            memo = memorised(self.data.train, "output")
-            recs = [score_record(tr, lambda y, tr=tr: y - memo(tr.recording.time_s), self.amplitude_dps, None,
-                                 bandwidth) for tr in self.data.test]
-            return Score("gyro", recs)
-        if which == "model":
-            from tcbench.tasks.diagnosed import diagnose_runs, gyro_method
-
-            fitted = diagnose_runs(self.data.train)
-            recs = [score_record(tr, gyro_method(fitted, tr.recording.time_s, tr.recording.temperature_c),
-                                 self.amplitude_dps, None, bandwidth) for tr in self.data.test]
-            return Score("gyro", recs, extra={"diagnosed": fitted})
-        if which not in ("oracle", "oracle_thermometer"):
+        score = BASELINE_SCORES.get(which)
+        if score is None:
             raise ValueError(unknown_name("baseline", which, BASELINES))
-        if not self.data.has_truth:
-            raise TaskDataError("the oracle needs the simulator's truth; recordings read from files have none")
-        thermometer = which == "oracle_thermometer"
-        recs = [score_record(tr, lambda y, tr=tr: oracle_inverse(y, tr.truth, thermometer), self.amplitude_dps,
-                             None, bandwidth) for tr in self.data.test]
-        return Score("gyro", recs)
+        return score(self, bandwidth)

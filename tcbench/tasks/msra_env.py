@@ -18,6 +18,7 @@ files (for example real ones).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
@@ -57,6 +58,48 @@ def make_learner(name: str, params: dict[str, Any] | None, form: str, rng: np.ra
     if "form" in fields and values.get("form", "auto") == "auto":
         values["form"] = form
     return cls(n_inputs, values, rng)
+
+
+def _raw(data: MSRAData, bias_form: str) -> Score:
+    return score_outputs(data, methods.raw_compensator(data), bias_form, probe=False)
+
+
+def _memoriser(data: MSRAData, bias_form: str) -> Score:
+    return score_outputs(data, methods.memoriser_compensator(data), bias_form)
+
+
+def _lagpoly(data: MSRAData, bias_form: str) -> Score:
+    return score_outputs(data, methods.lagpoly_compensator(data), bias_form)
+
+
+def _model(data: MSRAData, bias_form: str) -> Score:
+    from tcbench.tasks.diagnosed import diagnosed_compensator
+
+    fn, fitted = diagnosed_compensator(data)
+    score = score_outputs(data, fn, bias_form)
+    score.extra["diagnosed"] = fitted
+    return score
+
+
+def _oracle(thermometer: bool) -> Callable[[MSRAData, str], Score]:
+    """The oracle fed the package temperature, or (``thermometer``) the thermometer reading."""
+
+    def score(data: MSRAData, bias_form: str) -> Score:
+        return score_outputs(data, methods.oracle_compensator(data, thermometer=thermometer), bias_form)
+
+    return score
+
+
+# How each baseline (:data:`tcbench.compensation.methods.BASELINES`) scores a task's test
+# recordings: ``(data, bias_form) -> Score``.
+BASELINE_SCORES: dict[str, Callable[[MSRAData, str], Score]] = {
+    "raw": _raw,
+    "memoriser": _memoriser,
+    "oracle": _oracle(False),
+    "oracle_thermometer": _oracle(True),
+    "lagpoly": _lagpoly,
+    "model": _model,
+}
 
 
 class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
@@ -221,18 +264,4 @@ class MSRACompensationEnv(WeightSearch, gym.Env[np.ndarray, np.ndarray]):
             raise RuntimeError("call reset() before score_baseline()")
         if which not in self.baselines:
             raise ValueError(unknown_name("baseline", which, self.baselines, f" of task {self.task}"))
-        if which == "raw":
-            return score_outputs(self.data, methods.raw_compensator(self.data), self.bias_form, probe=False)
-        if which == "memoriser":
-            return score_outputs(self.data, methods.memoriser_compensator(self.data), self.bias_form)
-        if which == "lagpoly":
-            return score_outputs(self.data, methods.lagpoly_compensator(self.data), self.bias_form)
-        if which == "model":
-            from tcbench.tasks.diagnosed import diagnosed_compensator
-
-            fn, fitted = diagnosed_compensator(self.data)
-            score = score_outputs(self.data, fn, self.bias_form)
-            score.extra["diagnosed"] = fitted
-            return score
-        fn = methods.oracle_compensator(self.data, thermometer=which == "oracle_thermometer")
-        return score_outputs(self.data, fn, self.bias_form)
+        return BASELINE_SCORES[which](self.data, self.bias_form)

@@ -17,6 +17,7 @@ block, the same on every record whatever its sample rate.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,8 +30,33 @@ from tcbench.signal.tfpf import tfpf
 from tcbench.signal.vmd import vmd
 
 LABELS = ("noise", "mixed", "drift")
-DECOMPOSITIONS = ("vmd", "emd", "none")
-DENOISERS = ("tfpf", "wavelet", "none")
+
+
+def _vmd_modes(y: np.ndarray, config: PipelineConfig) -> np.ndarray:
+    return vmd(y, config.k, config.alpha).modes
+
+
+def _emd_modes(y: np.ndarray, config: PipelineConfig) -> np.ndarray:
+    return emd_imfs(y)[::-1]  # the residue first, then the IMFs from the slowest
+
+
+# The decompositions of a parallel pipeline: ``(output, config) -> modes (k, n)`` sorted by centre
+# frequency ascending; ``none`` (not here) is the serial pipeline, which decomposes nothing.
+DECOMPOSERS: dict[str, Callable[[np.ndarray, PipelineConfig], np.ndarray]] = {"vmd": _vmd_modes, "emd": _emd_modes}
+DECOMPOSITIONS = (*DECOMPOSERS, "none")
+TUNED = ("vmd",)  # the decompositions whose k and alpha a job tunes when the task leaves them unset
+
+
+def _no_denoise(x: np.ndarray, window: int, fs_hz: float, level: int | None) -> np.ndarray:
+    return x.copy()
+
+
+# The denoisers: ``(x, tfpf window, fs_hz, wavelet level) -> denoised x``.
+DENOISERS: dict[str, Callable[[np.ndarray, int, float, int | None], np.ndarray]] = {
+    "tfpf": lambda x, window, fs_hz, level: tfpf(x, window, fs_hz=fs_hz),
+    "wavelet": lambda x, window, fs_hz, level: wavelet_denoise(x, level=level),
+    "none": _no_denoise,
+}
 INPUTS = ("t_rate", "t")
 ENTROPY_WINDOWS = 4  # contiguous windows a mode's sample entropy is averaged over
 ENTROPY_SAMPLES = 1250  # samples per window
@@ -167,6 +193,11 @@ class PipelineConfig:
                 raise ValueError(f"{name} must be a positive number of seconds, got {value!r}")
 
     @property
+    def serial(self) -> bool:
+        """Whether the pipeline is serial (``decomposition="none"``: no decomposition)."""
+        return self.decomposition not in DECOMPOSERS
+
+    @property
     def n_inputs(self) -> int:
         """Inputs of the drift learner: 2 ([T, dT/dt]) or 1 ([T])."""
         return 2 if self.inputs == "t_rate" else 1
@@ -244,24 +275,18 @@ def block_means(block: np.ndarray, values: np.ndarray) -> np.ndarray:
 
 def denoise(x: np.ndarray, how: str, window: int, fs_hz: float, level: int | None = None) -> np.ndarray:
     """``x`` through the denoiser ``how`` ("tfpf", "wavelet" at ``level``, or "none")."""
-    if how == "tfpf":
-        return tfpf(x, window, fs_hz=fs_hz)
-    if how == "wavelet":
-        return wavelet_denoise(x, level=level)
-    return x.copy()
+    return DENOISERS.get(how, _no_denoise)(x, window, fs_hz, level)
 
 
 def decompose(y: np.ndarray, config: PipelineConfig) -> np.ndarray:
     """Modes (k, n) of ``y`` sorted by centre frequency ascending (VMD or EMD; EMD's residue
     first, then its IMFs from the slowest)."""
-    if config.decomposition == "vmd":
-        return vmd(y, config.k, config.alpha).modes
-    return emd_imfs(y)[::-1]
+    return DECOMPOSERS[config.decomposition](y, config)
 
 
 def front_end(y: np.ndarray, fs_hz: float, config: PipelineConfig) -> FrontEnd:
     """Decomposition, classes and the denoised mixed part of ``y`` (learner-independent)."""
-    if config.decomposition == "none":
+    if config.serial:
         zeros = np.zeros_like(y)
         return FrontEnd(None, None, zeros, zeros, y.copy(), zeros)
     modes = decompose(y, config)
@@ -339,7 +364,7 @@ class ParallelPipeline:
         f = front if front is not None else front_end(y, fs_hz, self.config)
         predicted = self.predict_drift(t, temp)
         compensated = f.drift_part - predicted
-        if self.config.decomposition == "none":
+        if self.config.serial:
             out = denoise(compensated, self.config.denoise, self.config.tfpf_window, fs_hz, self.config.wavelet_level)
         else:
             out = f.denoised_mixed + compensated

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -13,8 +14,10 @@ import numpy as np
 from tcbench.compensation.methods import BASELINE_LABELS, BASELINES
 from tcbench.compensation.scoring import CONVENTIONS, PRIMARY, Score
 from tcbench.errors import ConfigError
+from tcbench.optimisers.registry import NO_SEARCH
 from tcbench.runner.compensation_config import learner_of
-from tcbench.runner.compensation_job import CompensationJob, draw_of, in_sample, keep, prepare_job
+from tcbench.runner.compensation_job import CompensationJob, draw_of, in_sample, prepare_job
+from tcbench.runner.prepared_job import keep
 from tcbench.runner.kinds import JobKind, JobNames
 from tcbench.runner.loop import CompensationResult, VMDTuning, compensate
 from tcbench.sensors.data_hash import DataHashError, content_hash
@@ -24,6 +27,27 @@ log = logging.getLogger(__name__)
 TAG_FILES_CHARS = 1000  # the file lists in a run's tags, cut beyond this
 
 
+def _poly_label(learner: dict[str, Any]) -> str:
+    """``poly3``; ``_rate`` with the temperature rate, ``_runs`` fitted within runs."""
+    label = f"poly{learner.get('degree', 3)}"
+    label += "_rate" if learner.get("form") == "bias_rate" else ""
+    return label + ("_runs" if learner.get("offsets") == "per_run" else "")
+
+
+# A gyro task's rows named without its pipeline (the oracles and ``diagnosed``), and those that
+# are the pipeline alone (``raw``: no drift learner).
+WITHOUT_PIPELINE = frozenset(name for name in BASELINES if name.startswith("oracle")) | {"model"}
+PIPELINE_ALONE = frozenset({"raw"})
+
+LEARNER_LABELS = {"bp": "BP"}  # a searched learner's name in its row's label where it differs (IFA-BP-gd)
+
+# The rows named without an optimiser, by learner: the baselines and the fitted polynomial.
+FIXED_LABELS: dict[str, Callable[[dict[str, Any]], str]] = {
+    **{name: lambda learner, name=name: BASELINE_LABELS.get(name, name) for name in BASELINES},
+    "poly": _poly_label,
+}
+
+
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
     """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm``, ``random-BP-lm-matlab`` (``learner.preset=matlab``) ...; for
     the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``
@@ -31,21 +55,19 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
     if learner.get("label"):
         return str(learner["label"])
     name = str(learner["name"])
-    if name in BASELINES or name == "poly":
-        label = f"poly{learner.get('degree', 3)}" if name == "poly" else BASELINE_LABELS.get(name, name)
-        label += "_rate" if name == "poly" and learner.get("form") == "bias_rate" else ""
-        label += "_runs" if name == "poly" and learner.get("offsets") == "per_run" else ""
+    if name in FIXED_LABELS:
+        label = FIXED_LABELS[name](learner)
     else:
         opt = str(optimiser.get("label") or optimiser["name"])
-        prefix = "random" if opt == "none" else opt.upper()
-        label = f"{prefix}-{name.upper() if name == 'bp' else name}"
+        prefix = "random" if opt == NO_SEARCH else opt.upper()
+        label = f"{prefix}-{LEARNER_LABELS.get(name, name)}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
         label = f"{label}-{learner['preset']}" if learner.get("preset") else label  # IFA-BP-gd-matlab
     pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
-    if pipeline is None or name.startswith("oracle") or name == "model":
+    if pipeline is None or name in WITHOUT_PIPELINE:
         return label
     front = pipeline(task)  # type: ignore[arg-type]
-    back = "" if name == "raw" else label + ("(T)" if task.get("inputs") == "t" else "")
+    back = "" if name in PIPELINE_ALONE else label + ("(T)" if task.get("inputs") == "t" else "")
     return "+".join(p for p in (front, back) if p) or "raw"
 
 
@@ -84,24 +106,26 @@ def score_document(score: Score) -> dict[str, Any]:
     }
 
 
+def _gyro_figures(score: Score, tuning: VMDTuning | None, where: Path, title: str) -> list[Path]:
+    """Seed 001's Figs. 11-14 and 17-19."""
+    from tcbench.compensation.gyro.plots import run_figures
+
+    return run_figures(score, tuning, where, title)
+
+
 def figures(score: Score, history_loss: list[float] | None, where: Path, title: str,
             tuning: VMDTuning | None = None) -> list[Path]:
     """The paper's figures for this run: Fig. 7 (zero bias) or Figs. 8-10 (full temperature) of
     seed 000; Figs. 11-14 and 17-19 of seed 001 (gyro)."""
     from tcbench.compensation import plots as cplots
 
-    if score.protocol == "gyro":
-        from tcbench.compensation.gyro.plots import run_figures
-
-        paths = run_figures(score, tuning, where, title)
-    else:
-        paths = _msra_figures(score, where, title)
+    paths = FIGURES.get(score.protocol, _msra_figures)(score, tuning, where, title)
     if history_loss and len(history_loss) > 1:
         paths.append(cplots.training_curve(where / "training_curve.png", history_loss, f"{title}: training"))
     return paths
 
 
-def _msra_figures(score: Score, where: Path, title: str) -> list[Path]:
+def _msra_figures(score: Score, tuning: VMDTuning | None, where: Path, title: str) -> list[Path]:
     """Seed 000's Fig. 7 (zero bias) or Figs. 8-9 (full temperature) per test recording."""
     from tcbench.compensation import plots as cplots
 
@@ -116,6 +140,10 @@ def _msra_figures(score: Score, where: Path, title: str) -> list[Path]:
             paths.append(cplots.zero_bias_before_after(
                 where / f"fig7_test{i}.png", r.t_s, r.before_ug, r.after_ug, f"{title}: test {i} ({r.name})"))
     return paths
+
+
+# A run's figures by protocol: ``(score, tuning, where, title) -> paths``; the MSRA tasks' otherwise.
+FIGURES: dict[str, Callable[[Score, VMDTuning | None, Path, str], list[Path]]] = {"gyro": _gyro_figures}
 
 
 def gyro_tables(result: CompensationResult, where: Path) -> list[Path]:

@@ -11,7 +11,8 @@ import numpy as np
 
 from tcbench.runner.kinds import JobKind, JobNames
 from tcbench.runner.loop import RunResult, run_optimisation
-from tcbench.runner.optimisation_job import OptimisationJob, keep, prepare_job
+from tcbench.runner.optimisation_job import OptimisationJob, prepare_job
+from tcbench.runner.prepared_job import keep
 from tcbench.tasks import task_spec
 
 

@@ -14,6 +14,7 @@ import yaml
 from tcbench.commands import recordings
 from tcbench.commands.schemas import ImportConfig, MetricsConfig, SimulateConfig, as_schema
 from tcbench.runner.kinds import JobKind, JobNames, announce
+from tcbench.sensors import kinds as sensor_kinds
 
 
 class RecordingKind(JobKind):
@@ -60,7 +61,8 @@ class SimulateKind(RecordingKind):
 
     def names(self, c: dict[str, Any]) -> JobNames:
         cfg: SimulateConfig = self.config(c)
-        return JobNames(recordings.simulation_stem(cfg), f"{cfg.sensor or 'msra'}-{cfg.protocol}", "simulate",
+        sensor = cfg.sensor or sensor_kinds.DEFAULT
+        return JobNames(recordings.simulation_stem(cfg), f"{sensor}-{cfg.protocol}", "simulate",
                         int(cfg.seed), {"tcbench.device_seed": str(cfg.device_seed)})
 
     def outputs(self, c: dict[str, Any]) -> list[Path]:

@@ -20,6 +20,7 @@ from importlib.metadata import entry_points
 from typing import Any
 
 BUILTIN = ("msra", "gyro", "accel")
+DEFAULT = BUILTIN[0]  # the kind a simulation makes when it names none
 ENTRY_POINT_GROUP = "tcbench.sensor_kinds"
 INPUT_FIELDS = ("accel_g", "rate_dps")  # the Profile/Signals field a kind's input is
 REPORTS = ("inertial", "zero_bias", "rate")  # the metrics ``tcbench metrics`` reads off a run (SensorKind.report)
