@@ -169,20 +169,22 @@ def _unscaled(spec: dict[str, Any], z: np.ndarray) -> np.ndarray:
     return (y + 1.0) * 0.5 * span + spec["y_low"]
 
 
-def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray) -> np.ndarray:
+def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray,
+                    rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """The offset the exported code computes at each sample, in numpy: ``clock_s`` the device's
-    clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on."""
+    clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
+    ``rate_c_per_s``: :func:`window_rate_c_per_s` of them when already computed."""
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     method = spec["method"]
+    if method != "poly3" and rate_c_per_s is None:
+        rate_c_per_s = window_rate_c_per_s(t, temp, spec["rate_window_s"])
+    rate = np.asarray(rate_c_per_s, dtype=np.float64)
     if method in ("poly3", "poly3_rate"):
         x = spec["x"]
         dt = np.clip(temp, spec["tmin_c"], spec["tmax_c"]) - spec["tref_c"]
         off = x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]))
-        if method == "poly3_rate":
-            off = off + spec["rate_coef"] * window_rate_c_per_s(t, temp, spec["rate_window_s"])
-        return off
-    rate = window_rate_c_per_s(t, temp, spec["rate_window_s"])
+        return off + spec["rate_coef"] * rate if method == "poly3_rate" else off
     if "wc" not in spec:
         x = _scaled_inputs(spec, temp, rate)
         h = _sigma(x @ np.asarray(spec["w1"]).T + np.asarray(spec["b1"]), spec["hidden_activation"])
