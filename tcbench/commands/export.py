@@ -195,6 +195,7 @@ def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) 
 def export(cfg: ExportConfig) -> dict[str, Path]:
     """Write the parameter files; print what each holds."""
     from tcbench.compensation.ardupilot import ardupilot_parameters, write_parm
+    from tcbench.compensation.c_export import EXPORTED
     from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, px4_polynomial, write_parameters
 
     by_sensor = check_export(cfg)
@@ -220,9 +221,12 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
         with staged_dir(out, [], cfg.overwrite, replaced) as tmp:
             written: dict[str, Path] = {}
             notes = [ln for axes in by_sensor.values() for c in axes.values() if (ln := c.cubic_line())]
-            comments = ([f"tcbench: these are the cubic's coefficients; {ln}" for ln in notes]
-                        + ["tcbench export formats=[c] writes the better method as C for a sensor's own processor"]
-                        * bool(notes))
+            bests = {(c.held_out or {}).get("best") for axes in by_sensor.values() for c in axes.values()
+                     if c.cubic_line()}
+            comments = [f"tcbench: these are the cubic's coefficients; {ln}" for ln in notes]
+            if exportable := sorted(bests & set(EXPORTED)):
+                comments.append(f"tcbench export formats=[c] writes {', '.join(exportable)} as C for a sensor's own "
+                                "processor")
             if "px4" in cfg.formats:
                 params: dict[str, float | int] = {}
                 for sensor, axes in polys.items():
@@ -250,7 +254,7 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
             print(f"tcbench: {line}")
     if "c" in cfg.formats:
         sources = [p for k, p in written.items() if k.startswith("c ") and p.suffix == ".c"]
-        print(f"tcbench: wrote {len(sources)} C99 compensators into {out} ({', '.join(p.stem for p in sources)}: "
+        print(f"tcbench: wrote {len(sources)} C99 compensator{'s' * (len(sources) != 1)} into {out} ({', '.join(p.stem for p in sources)}: "
               "a .h and a .c each; init once, update per sample; -DTC_..._FLOAT for the float build)")
         left = sorted({m for axes in by_sensor.values() for c in axes.values() for m in (c.held_out or {}).get("drift", {})
                        if m not in (c.device or {})} if by_sensor else set())
