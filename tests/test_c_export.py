@@ -16,7 +16,10 @@ from conftest import PAN_CSV
 
 from tcbench.compensation.c_export import (c_sources, device_clock_s, device_spec, streamed_offset,
                                            window_rate_c_per_s, window_samples, write_c)
-from tcbench.compensation.calibration import OffsetModel, fit, record
+from tcbench.compensation.calibration import OffsetModel, fit, from_model, record
+from tcbench.compensation.fitted_model import deterministic_output
+from tcbench.sensors.effects import EFFECTS
+from tcbench.sensors.fitted import PolynomialModel
 from tcbench.datasets.real import tofupilot_gyro
 from tcbench.sensors.simulate import simulate_recording
 
@@ -84,7 +87,21 @@ def models() -> dict[str, OffsetModel]:
     gyro = tofupilot_gyro("x")
     whole = record(gyro.time_s, gyro.temperature_c, gyro.output, gyro.input)
     part = whole.part(0, FIT_ROWS)
-    return {m: fit(m, [part], seed=0) for m in ("poly3", "poly3_rate", "bp", "elman")}
+    return {m: fit(m, [part], seed=0) for m in ("poly3", "poly3_rate", "bp", "elman")} | {"model": from_model(diagnosed())}
+
+
+def diagnosed() -> PolynomialModel:
+    """A diagnosed gyro model with every term the export runs (near the tofupilot gyro x's own
+    diagnosis: its core, hysteresis and bump), a warm-up and a line its compensator leaves out."""
+    e = EFFECTS
+    return PolynomialModel(sensor="gyro", centre_c=28.18, half_range_c=45.78, bias=(-4.128, 0.2612, 0.8546), ref_c=28.18,
+                           effects=(e["warmup"](amplitude=0.5, tau_s=300.0), e["thermal_lag"](tau_s=120.0),
+                                    e["temperature_rate"](coef_per_c_per_s=3.0),
+                                    e["hysteresis"](amplitude=-0.164, width_c=18.47, start_state=0.5),
+                                    e["temperature_cubic"](c3_per_c3=2e-6),
+                                    e["temperature_bump"](centre_c=10.34, width_c=1.5, amplitude=0.0352),
+                                    e["second_node"](tau_s=900.0, coef_per_c=0.01),
+                                    e["periodic"](period_s=661.0, amplitude=0.0225, phase_rad=0.55)))
 
 
 def _fullest(records: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]) -> int:
@@ -133,7 +150,7 @@ def rates() -> dict[tuple[str, str], np.ndarray]:
 
 
 @pytest.mark.parametrize("build", ["double", "float"])
-@pytest.mark.parametrize("method", ["poly3", "poly3_rate", "bp", "elman"])
+@pytest.mark.parametrize("method", ["poly3", "poly3_rate", "bp", "elman", "model"])
 def test_the_compiled_model_gives_pythons_output_on_every_record(programs: dict, records: dict, rates: dict,
                                                                  method: str, build: str) -> None:
     exe, spec = programs[(method, build)]
@@ -183,6 +200,32 @@ def test_the_reference_is_what_calibrate_scores(models: dict[str, OffsetModel], 
     last = np.flatnonzero(np.r_[index[1:] != index[:-1], True])
     np.testing.assert_allclose(streamed[last], on_bins, rtol=1e-9, atol=1e-9 * np.max(np.abs(on_bins)))
     assert not np.allclose(streamed, elman.offset(rec), atol=1e-3)  # the look-ahead differs elsewhere
+
+
+def test_the_streamed_model_is_the_diagnosed_one(models: dict[str, OffsetModel], records: dict) -> None:
+    """The device's diagnosed model (per sample: play operator at every sample, the lags on the
+    device's own intervals) is calibrate's compensator (uniform grid, 1-Hz play operator) on the
+    tofupilot record to 2e-4 of the offset's span, and leaves out the warm-up and the line as it
+    does. The rate term is left out of the comparison: the device's backward difference reads the
+    thermometer's noise (0.01 degC steps every 0.5 s) where calibrate's central difference on its
+    grid averages it, by 0.05 deg/s RMS with this model's 3 deg/s per degC/s."""
+    t_s, temp_c, raw = records["tofupilot gyro x"]
+    spec = device_spec(models["model"], window_samples(t_s))
+    assert [e["id"] for e in spec["effects"]] == ["thermal_lag", "temperature_rate", "hysteresis", "temperature_cubic",
+                                                  "temperature_bump", "second_node"]
+    no_rate = diagnosed().without("temperature_rate")
+    streamed = streamed_offset(device_spec(from_model(no_rate), 10), t_s - t_s[0], temp_c)
+    scored = deterministic_output(no_rate, t_s, temp_c, np.zeros_like(t_s), clock_terms=False)
+    assert np.max(np.abs(streamed - scored)) < 2e-4 * np.ptp(scored)
+    apart = streamed_offset(spec, t_s - t_s[0], temp_c) - deterministic_output(diagnosed(), t_s, temp_c,
+                                                                              np.zeros_like(t_s), clock_terms=False)
+    assert 0.02 < np.sqrt(np.mean(apart ** 2)) < 0.1
+
+
+def test_a_model_with_a_term_no_device_runs_is_refused() -> None:
+    model = PolynomialModel(sensor="gyro", bias=(0.1, 0.2), effects=(EFFECTS["saturation"](upper=10.0),))
+    with pytest.raises(ValueError, match="its saturation term is not exported as C"):
+        device_spec(from_model(model), 10)
 
 
 def test_a_ring_too_small_is_counted(models: dict[str, OffsetModel], records: dict, tmp_path: Path) -> None:

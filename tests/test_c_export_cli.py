@@ -11,6 +11,7 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from tcbench.cli import main
@@ -92,6 +93,41 @@ def test_export_writes_every_device_method_as_c_that_runs(workcopy: Path, capsys
         assert parm[0].startswith("# ") and line in parm[0] and f"{about['best']}, " in parm[0]
     else:
         assert not any(ln.startswith("#") for ln in parm)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler (cc) on this machine")
+def test_the_diagnosed_model_is_exported_and_runs(calibrated: Path, workdir: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """calibrate's diagnosed model (hysteresis and a bump on the tofupilot gyro x, its lines and
+    spectral terms left out) written as C gives the streamed offset, and its held-out drift is the
+    one calibrate scored to 1 %."""
+    from tcbench.compensation.calibration import scores
+    from tcbench.signal.branches import temperature_branches
+
+    shutil.copytree(calibrated / "rec", workdir / "rec")
+    assert main(["calibrate", "recording=rec/x.csv", "out=cal", "methods=[raw,poly3,model]",
+                 "tracking.enabled=false"]) == 0
+    code, out, err = run(capsys, "export", "calibrations=[cal]", "formats=[c]", "out=params")
+    assert code == 0 and "tc_gyro_x_model" in out, err
+    about = json.loads((workdir / "cal" / "calibration.json").read_text())
+    rec = read_recording(workdir / "rec" / "x.csv")
+    dt_s = np.r_[0.0, np.diff(rec.time_s)]
+    (workdir / "params" / "host.c").write_text(HOST.replace("NAME", "tc_gyro_x_model"))
+    subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", str(workdir / "params" / "host.c"),
+                    str(workdir / "params" / "tc_gyro_x_model.c"), "-lm", "-o", str(workdir / "model")], check=True)
+    lines = "".join(f"{a!r} {b!r} {c!r}\n" for a, b, c in zip(rec.temperature_c.tolist(), rec.output.tolist(),
+                                                               dt_s.tolist()))
+    got = np.array(subprocess.run([str(workdir / "model")], input=lines, capture_output=True, text=True,
+                                  check=True).stdout.split(), dtype=np.float64)
+    offset = streamed_offset(about["device"]["model"], device_clock_s(dt_s), rec.temperature_c)
+    np.testing.assert_allclose(got, rec.output - offset, rtol=0, atol=1e-9 * np.max(np.abs(rec.output)))
+    parts = temperature_branches(rec.time_s, rec.temperature_c, 5.0)
+    table = pd.read_csv(workdir / "cal" / "calibration.csv").set_index(["method", "branch"])
+    for k in about["held_out_parts"]:
+        rows = slice(parts[k].start, parts[k].stop)
+        device = scores(rec.output[rows] - offset[rows], rec.time_s[rows], 60.0)["drift_rms"]
+        assert device == pytest.approx(table.loc[("model", k), "drift_rms_deg_per_s"], rel=0.01)
 
 
 def test_calibrate_prints_the_c_export_and_it_runs(calibrated: Path, workdir: Path,

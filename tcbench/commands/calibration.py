@@ -588,7 +588,14 @@ def _device_specs(fitted: dict[str, list[Any]], t_s: np.ndarray) -> dict[str, An
     from tcbench.compensation.c_export import EXPORTED, device_spec, window_samples
 
     fullest = window_samples(t_s)
-    return {m: device_spec(runs[0], fullest) for m, runs in fitted.items() if m in EXPORTED and runs}
+    specs: dict[str, Any] = {}
+    for m, runs in fitted.items():
+        if m in EXPORTED and runs:
+            try:
+                specs[m] = device_spec(runs[0], fullest)
+            except ValueError as exc:  # a diagnosed term no device runs: export says which
+                specs.setdefault("_left_out", {})[m] = str(exc)
+    return specs
 
 
 def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict[str, Path]) -> None:
@@ -599,11 +606,12 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     print(f"\nlong table (every part): {written['md']}; residual plots: {written['png']}")
     if hint := _export_hint(about, Path(written["json"]).parent):
         print(hint)
-    if about.get("device"):
+    if [m for m in about.get("device", {}) if not m.startswith("_")]:
         import shlex
 
         folder = Path(written["json"]).parent
-        print(f"as C for the sensor's own processor ({', '.join(about['device'])}): tcbench export "
+        print(f"as C for the sensor's own processor ({', '.join(m for m in about['device'] if not m.startswith('_'))}): "
+              "tcbench export "
               f"{shlex.quote(f'calibrations=[{folder}]')} formats=[c]")
     if not about.get("held_out"):
         print("nothing held out: no method is ranked")

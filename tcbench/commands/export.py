@@ -24,7 +24,7 @@ has no constant, so its file is the same either way.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +52,7 @@ class AxisCalibration:
     static_level: float | None = None  # the median offset (calibration.json's export.static_level)
     device: dict[str, Any] | None = None  # the methods a device runs (calibration.json's device)
     held_out: dict[str, Any] | None = None  # best, drift per method (calibration.json's ranking)
+    left_out: dict[str, str] = field(default_factory=dict)  # fitted methods no device runs, and why
 
     def c_name(self, method: str) -> str:
         """The C name of ``method``'s export: ``tc_gyro_x_poly3``."""
@@ -86,7 +87,8 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
         sensor, unit, axis = about["sensor"], about["unit"], about.get("axis")
         level = fit.get("static_level")
         static_level = float(level) if level is not None else None
-        device = about.get("device")
+        device = dict(about.get("device") or {})
+        left_out = device.pop("_left_out", {})
         held_out = {k: about[k] for k in ("held_out", "best", "drift") if k in about}
     except (ValueError, KeyError, TypeError) as exc:
         raise CommandError(f"calibrations: {path}: not a calibration tcbench export reads ({exc})") from None
@@ -96,7 +98,7 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
     px4_id = about.get("px4_device_id")
     return AxisCalibration(Path(folder), str(sensor), str(unit), str(axis), poly,
                            int(px4_id) if px4_id is not None else None, static_level,
-                           device if isinstance(device, dict) else None, held_out)
+                           device or None, held_out, left_out)
 
 
 def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
@@ -256,13 +258,14 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
         sources = [p for k, p in written.items() if k.startswith("c ") and p.suffix == ".c"]
         print(f"tcbench: wrote {len(sources)} C99 compensator{'s' * (len(sources) != 1)} into {out} ({', '.join(p.stem for p in sources)}: "
               "a .h and a .c each; init once, update per sample; -DTC_..._FLOAT for the float build)")
-        left = sorted({m for axes in by_sensor.values() for c in axes.values() for m in (c.held_out or {}).get("drift", {})
-                       if m not in (c.device or {})} if by_sensor else set())
-        if left:
-            from tcbench.compensation.c_export import NOT_EXPORTED
+        from tcbench.compensation.c_export import EXPORTED, NOT_EXPORTED
 
-            print("tcbench: not written as C: " + "; ".join(f"{m} ({NOT_EXPORTED.get(m, 'not a device method')})"
-                                                          for m in left))
+        again = "its parameters are not in calibration.json: calibrate again"
+        left = {f"{c.sensor} {c.axis} {m}": c.left_out.get(m, again if m in EXPORTED else NOT_EXPORTED.get(m, m))
+                for axes in by_sensor.values() for c in axes.values()
+                for m in (c.held_out or {}).get("drift", {}) if m not in (c.device or {})}
+        if left:
+            print("tcbench: not written as C: " + "; ".join(f"{k} ({why})" for k, why in sorted(left.items())))
     every = ", ".join(f"{s} {''.join(sorted(a))}" for s, a in polys.items())
     if "px4" in written:
         print(f"tcbench: wrote {written['px4']} (PX4 TC_* of {every}, instance {cfg.px4_instance}; "

@@ -33,8 +33,18 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   bin left (at a bin's last sample the two agree): that causal form is what
   :func:`streamed_offset` computes and the compiled code is checked against.
 
-The diagnosed ``model`` (its thermal lag, hysteresis and steps run on a uniform grid) is not
-exported yet: one line says so.
+- ``model``: the diagnosed model as its compensator runs it
+  (:func:`~tcbench.compensation.fitted_model.compensator`: without the terms keyed to the
+  calibration run's clock or its rig), in streaming form: the die temperature through each
+  thermal lag as a first-order filter with its state, ``y += (1 - exp(-dt / tau)) (x - y)`` per
+  sample (Python's exact discretisation, on the device's own intervals); the bias polynomial in the
+  die temperature; and the terms :data:`MODEL_TERMS`. Python's calibration runs the model on a
+  uniform grid and reads it back at the samples, takes the thermometer's rate as a central
+  difference (it reads the next sample) and runs the hysteresis's play operator on a 1-Hz grid
+  interpolated back; the device takes the rate as the backward difference over the last interval
+  and runs the play operator at every sample. That causal form is what :func:`streamed_offset`
+  computes. The offset is the model's output at zero input (a static record's: its scale factor
+  is not applied). A model with another term is not exported, and the export says which.
 """
 
 from __future__ import annotations
@@ -48,9 +58,9 @@ import numpy as np
 
 from tcbench.compensation.calibration import RATE_WINDOW_S, OffsetModel
 
-EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman")  # what a device can run of calibrate's methods
-NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator",
-                "model": "the diagnosed model is not exported as C yet"}
+EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")  # what a device can run of calibrate's methods
+NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator"}
+MODEL_TERMS = ("thermal_lag", "temperature_rate", "hysteresis", "temperature_cubic", "temperature_bump", "second_node")
 CAPACITY_MARGIN = 1.5  # the rate ring holds this many times the calibration record's fullest window
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,62}$")
 
@@ -71,6 +81,8 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
     if model.method not in EXPORTED:
         raise ValueError(f"{model.method}: {NOT_EXPORTED.get(model.method, 'not a method a device runs')}")
     capacity = max(2, int(np.ceil(CAPACITY_MARGIN * max_window_samples)))
+    if model.method == "model":
+        return model_spec(model.sensor_model)
     if model.method in ("poly3", "poly3_rate"):
         c = model.cubic
         assert c is not None
@@ -141,6 +153,69 @@ def window_rate_c_per_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float = R
     return out
 
 
+def model_spec(sensor_model: Any) -> dict[str, Any]:
+    """The compensator of a diagnosed :class:`~tcbench.sensors.fitted.PolynomialModel` as plain
+    data: its core and its terms in order; ``ValueError`` naming a term a device does not run."""
+    from tcbench.compensation.fitted_model import compensator
+
+    quiet = compensator(sensor_model)
+    effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
+    if other := [e["id"] for e in effects if e["id"] not in MODEL_TERMS]:
+        raise ValueError(f"model: its {', '.join(other)} term{'s' * (len(other) > 1)} "
+                         f"{'are' if len(other) > 1 else 'is'} not exported as C (exported: {', '.join(MODEL_TERMS)})")
+    return {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
+            "bias": [float(b) for b in quiet.bias], "ref_c": float(quiet.ref_c), "effects": effects}
+
+
+def _model_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """The causal diagnosed model (see the module doc), per sample in a loop for the sequential
+    parts (the lags and the play operator), vectorised for the rest."""
+    dt = np.r_[0.0, np.diff(t)]
+    die = temp.copy()
+    offset = np.zeros(t.size)
+    terms: list[np.ndarray] = []
+    for e in spec["effects"]:  # the die stage first, as the simulator runs it
+        if e["id"] == "thermal_lag":
+            die = _lag(die, dt, e["tau_s"])
+    for e in spec["effects"]:
+        if e["id"] == "temperature_rate":
+            rate = np.r_[0.0, np.diff(temp) / np.where(dt[1:] > 0, dt[1:], 1.0)] if t.size else dt
+            terms.append(e["coef_per_c_per_s"] * rate)
+        elif e["id"] == "hysteresis":
+            w = e["width_c"]
+            state = np.empty(t.size)
+            p = float(die[0]) - float(np.clip(e["start_state"], -1.0, 1.0)) * w if t.size else 0.0
+            for i, x in enumerate(die.tolist()):
+                p = min(max(p, x - w), x + w)
+                state[i] = (x - p) / w
+            terms.append(e["amplitude"] * state)
+        elif e["id"] == "temperature_cubic":
+            terms.append(e["c3_per_c3"] * (die - spec["ref_c"]) ** 3)
+        elif e["id"] == "temperature_bump":
+            terms.append(e["amplitude"] * np.exp(-0.5 * ((die - e["centre_c"]) / e["width_c"]) ** 2))
+        elif e["id"] == "second_node":
+            terms.append(e["coef_per_c"] * (_lag(die, dt, e["tau_s"]) - die))
+    u = (die - spec["centre_c"]) / spec["half_range_c"]
+    for c in reversed(spec["bias"]):
+        offset = offset * u + c
+    for term in terms:
+        offset = offset + term
+    return offset
+
+
+def _lag(x: np.ndarray, dt: np.ndarray, tau_s: float) -> np.ndarray:
+    """``y += (1 - exp(-dt / tau)) (x - y)``, ``y = x`` at the first sample (``tau_s <= 0``: x)."""
+    if tau_s <= 0 or x.size == 0:
+        return x.copy()
+    gain = 1.0 - np.exp(-dt / tau_s)
+    out = np.empty_like(x)
+    y = float(x[0])
+    for i, (xi, g) in enumerate(zip(x.tolist(), gain.tolist())):
+        y = y + g * (xi - y)
+        out[i] = y
+    return out
+
+
 def device_clock_s(dt_s: np.ndarray) -> np.ndarray:
     """The clock a device keeps from the intervals it is given: 0 at the first sample, then the
     running sum of ``dt_s[1:]`` in double, added one by one as the C code adds them."""
@@ -177,6 +252,8 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     method = spec["method"]
+    if method == "model":
+        return _model_streamed(spec, t, temp)
     if method != "poly3" and rate_c_per_s is None:
         rate_c_per_s = window_rate_c_per_s(t, temp, spec["rate_window_s"])
     rate = np.asarray(rate_c_per_s, dtype=np.float64)
@@ -250,16 +327,19 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         raise ValueError(f"{name!r} is not a C identifier (letters, digits, _; not starting with a digit)")
     method = spec["method"]
     up = name.upper()
-    rated = method != "poly3"
+    rated = method not in ("poly3", "model")
     recurrent = "wc" in spec
+    slots = _model_slots(spec) if method == "model" else []
     h = int(spec.get("hidden", 0))
     cap = int(spec.get("rate_capacity", 0))
     # the state: doubles (clock, ring times), reals (ring temperatures, Elman's), int32 counters
     doubles = 1 + (cap if rated else 0)
-    reals = (cap if rated else 0) + (3 * h + 2 if recurrent else 0)
+    reals = (cap if rated else 0) + (3 * h + 2 if recurrent else 0) + len(slots)
     ints = 1 + (3 if rated else 0) + (2 if recurrent else 0)
     sizes = {"double": _state_bytes(doubles, reals, ints, 8), "float": _state_bytes(doubles, reals, ints, 4)}
-    if method == "poly3":
+    if method == "model":
+        flops, body = _model_body(spec)
+    elif method == "poly3":
         flops, body = "8", _cubic_body(spec)
     elif method == "poly3_rate":
         flops, body = f"10 + 9 n, n the samples in the rate window (at most {cap}: {10 + 9 * cap})", _cubic_body(spec)
@@ -304,7 +384,8 @@ typedef struct {{
     {name}_real drive[{h}];  /* W_c context + b1, once per bin */
     {name}_real pending[{h}];  /* the hidden state of the bin so far */
     {name}_real bin_temp_sum, bin_rate_sum;
-""" if recurrent else "") + """    int samples;  /* samples seen (saturates) */
+""" if recurrent else "") + (f"""    {name}_real memory[{len(slots)}];  /* {', '.join(slots)} */
+""" if slots else "") + """    int samples;  /* samples seen (saturates) */
 """ + ("""    int head, count;  /* the ring's oldest sample, samples in it */
     int dropped;  /* samples left out of a full window (0 when the capacity suffices) */
 """ if rated else "") + ("""    int bin, bin_count;  /* the current bin and its samples */
@@ -328,9 +409,66 @@ def _cubic_body(spec: dict[str, Any]) -> str:
 """
 
 
+def _model_slots(spec: dict[str, Any]) -> list[str]:
+    """The diagnosed model's state: each lag's and play operator's memory, the last temperature."""
+    names = {"thermal_lag": "die lag", "second_node": "second node", "hysteresis": "play operator"}
+    slots = [f"{names[e['id']]} {k}" for k, e in enumerate(spec["effects"]) if e["id"] in names]
+    return slots + ["last temperature"] * any(e["id"] == "temperature_rate" for e in spec["effects"])
+
+
+def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
+    """The update of the diagnosed model (see the module doc) and its operations per sample."""
+    slots = _model_slots(spec)
+    lines = ["    int first = s->samples == 1;", "    R die = temperature_c, offset = 0, u;"]
+    flops, calls = 0, 0
+    lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
+    for k, e in lags:  # the die stage first, in order, as the simulator runs it
+        at = slots.index(f"die lag {k}")
+        lines += [f"    if (first) s->memory[{at}] = die;",
+                  f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
+                  f"    die = s->memory[{at}];"]
+        flops, calls = flops + 5, calls + 1
+    lines.append(f"    u = (die - (R){_lit(spec['centre_c'])}) / (R){_lit(spec['half_range_c'])};")
+    for c in reversed(spec["bias"]):
+        lines.append(f"    offset = offset * u + (R){_lit(c)};")
+    flops += 2 + 2 * len(spec["bias"])
+    for k, e in enumerate(spec["effects"]):
+        if e["id"] == "temperature_rate":
+            at = slots.index("last temperature")
+            lines += [f"    if (!first && dt_s > 0) offset += (R){_lit(e['coef_per_c_per_s'])} * "
+                      f"((temperature_c - s->memory[{at}]) / dt_s);",
+                      f"    s->memory[{at}] = temperature_c;"]
+            flops += 4
+        elif e["id"] == "hysteresis":
+            at, w = slots.index(f"play operator {k}"), e["width_c"]
+            start = float(np.clip(e["start_state"], -1.0, 1.0))
+            lines += [f"    if (first) s->memory[{at}] = die - (R){_lit(start)} * (R){_lit(w)};",
+                      f"    if (s->memory[{at}] < die - (R){_lit(w)}) s->memory[{at}] = die - (R){_lit(w)};",
+                      f"    if (s->memory[{at}] > die + (R){_lit(w)}) s->memory[{at}] = die + (R){_lit(w)};",
+                      f"    offset += (R){_lit(e['amplitude'])} * ((die - s->memory[{at}]) / (R){_lit(w)});"]
+            flops += 6
+        elif e["id"] == "temperature_cubic":
+            lines += [f"    {{ R d = die - (R){_lit(spec['ref_c'])}; offset += (R){_lit(e['c3_per_c3'])} * (d * d * d); }}"]
+            flops += 5
+        elif e["id"] == "temperature_bump":
+            lines += [f"    {{ R z = (die - (R){_lit(e['centre_c'])}) / (R){_lit(e['width_c'])}; "
+                      f"offset += (R){_lit(e['amplitude'])} * TC_EXP((R)-0.5 * (z * z)); }}"]
+            flops, calls = flops + 6, calls + 1
+        elif e["id"] == "second_node":
+            at = slots.index(f"second node {k}")
+            lines += [f"    if (first) s->memory[{at}] = die;",
+                      f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
+                      f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
+            flops, calls = flops + 7, calls + 1
+    flops += 1
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+
+
 def _source(spec: dict[str, Any], name: str, up: str, body: str, rated: bool, recurrent: bool, h: int) -> str:
     method = spec["method"]
-    parts = [f"/* {name}.c: see {name}.h. */\n#include <math.h>\n#include \"{name}.h\"\n\ntypedef {name}_real R;\n"]
+    parts = [f"/* {name}.c: see {name}.h. */\n#include <math.h>\n#include \"{name}.h\"\n\ntypedef {name}_real R;\n"
+             f"#ifdef {up}_FLOAT\n#define TC_EXP expf\n#define TC_TANH tanhf\n#else\n#define TC_EXP exp\n"
+             "#define TC_TANH tanh\n#endif\n"]
     if rated:
         parts.append(f"""
 #define RATE_WINDOW_S {_lit(spec['rate_window_s'])}
@@ -372,15 +510,15 @@ static R rate_c_per_s({name}_state *s, R temperature_c)
     return sxx > 0 ? sxy / sxx : 0;
 }}
 """)
-    if method not in ("poly3", "poly3_rate"):
+    if method not in ("poly3", "poly3_rate", "model"):
         low, high = spec["x_low"], spec["x_high"]
         span = [hi - lo if hi - lo > 0 else 1.0 for lo, hi in zip(low, high)]
         y_span = spec["y_high"] - spec["y_low"]
         y_span = y_span if y_span > 0 else 1.0
         t_lo, t_hi = spec["temp_range_c"]
         r_lo, r_hi = spec["rate_range"]
-        act = "tanh(a)" if spec["hidden_activation"] == "tanh" else "(R)0.5 * ((R)1 + tanh((R)0.5 * a))"
-        out = "tanh(z)" if spec["output_activation"] == "tanh" else "z"
+        act = "TC_TANH(a)" if spec["hidden_activation"] == "tanh" else "(R)0.5 * ((R)1 + TC_TANH((R)0.5 * a))"
+        out = "TC_TANH(z)" if spec["output_activation"] == "tanh" else "z"
         w_in = spec["wx"] if recurrent else spec["w1"]
         parts.append(f"""
 static const R W_IN[{h}][2] = {{{', '.join(_array(row) for row in w_in)}}};
@@ -425,7 +563,9 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
         update.append("    {\n    R rate = rate_c_per_s(s, temperature_c);")
     else:
         update.append("    {")
-    if method in ("poly3", "poly3_rate"):
+    if method == "model":
+        update.append(body.rstrip("\n"))
+    elif method in ("poly3", "poly3_rate"):
         update.append(body.rstrip("\n"))
         if method == "poly3_rate":
             update.append(f"    offset = offset + (R){_lit(spec['rate_coef'])} * rate;")
