@@ -207,7 +207,7 @@ def test_the_streamed_model_is_the_diagnosed_one(models: dict[str, OffsetModel],
     device's own intervals) is calibrate's compensator (uniform grid, 1-Hz play operator) on the
     tofupilot record to 2e-4 of the offset's span, and leaves out the warm-up and the line as it
     does. The rate term is left out of the comparison: the device's backward difference reads the
-    thermometer's noise (0.01 degC steps every 0.5 s) where calibrate's central difference on its
+    thermometer's steps (about 0.01 degC every 0.5 s) where calibrate's central difference on its
     grid averages it, by 0.05 deg/s RMS with this model's 3 deg/s per degC/s."""
     t_s, temp_c, raw = records["tofupilot gyro x"]
     spec = device_spec(models["model"], window_samples(t_s))

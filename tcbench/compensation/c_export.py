@@ -10,8 +10,8 @@ Each method ``tcbench calibrate`` fits that a device can run is written as ``<na
 the first sample's is ignored) and returns ``raw`` minus the model's offset. ``<name>_real`` is
 ``double``, or ``float`` when ``<NAME>_FLOAT`` is defined; the clock (the sum of the ``dt_s``)
 is a ``double`` in both builds, so that the trailing rate window and the time bins keep their
-edges over hours. No allocation, no library call but ``tanh`` (the networks' sigmoid is
-``(1 + tanh(a / 2)) / 2``).
+edges over hours. No allocation, no library call but ``tanh`` and ``exp`` (``tanhf`` and ``expf``
+in the float build; the networks' sigmoid is ``(1 + tanh(a / 2)) / 2``).
 
 What each method runs (:func:`device_spec` gives its parameters, :func:`streamed_offset` runs the
 same arithmetic in numpy, the reference the compiled code is checked against):
