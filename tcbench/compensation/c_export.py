@@ -159,10 +159,10 @@ def model_spec(sensor_model: Any) -> dict[str, Any]:
     from tcbench.compensation.fitted_model import compensator
 
     quiet = compensator(sensor_model)
-    effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
-    if other := [e["id"] for e in effects if e["id"] not in MODEL_TERMS]:
+    if other := [type(e).id for e in quiet.effects if type(e).id not in MODEL_TERMS]:
         raise ValueError(f"model: its {', '.join(other)} term{'s' * (len(other) > 1)} "
                          f"{'are' if len(other) > 1 else 'is'} not exported as C (exported: {', '.join(MODEL_TERMS)})")
+    effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
     return {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
             "bias": [float(b) for b in quiet.bias], "ref_c": float(quiet.ref_c), "effects": effects}
 
