@@ -85,7 +85,7 @@ def test_an_unknown_format_of_export_says_the_one_it_probably_meant(workdir: Pat
                                                                      capsys: pytest.CaptureFixture[str]) -> None:
     (workdir / "cal").mkdir()
     line = _refused(capsys, ["export", "calibrations=[cal]", "formats=[px5]"])
-    assert line.endswith("formats: unknown format 'px5'; known: px4, ardupilot; did you mean 'px4'?"), line
+    assert line.endswith("formats: unknown format 'px5'; known: px4, ardupilot, c; did you mean 'px4'?"), line
 
 
 def test_an_unknown_experiment_lists_the_experiments_of_the_store(workdir: Path,

@@ -39,9 +39,15 @@ def test_the_own_imu_tutorial_runs(workdir: Path, capsys: pytest.CaptureFixture[
         assert main(command[1:]) == 0, " ".join(command)
     out = capsys.readouterr().out
     mine = workdir / "my-imu"
-    px4 = (mine / "params" / "px4_tc_params.txt").read_text().splitlines()
+    script = (mine / "params" / "px4_tc_params.txt").read_text().splitlines()
+    px4 = [ln for ln in script if not ln.startswith("# ")]
     assert px4[0] == "param set TC_G0_ID 2293768" and len(px4) == 1 + 12 + 3 + 1
-    assert (mine / "params" / "ardupilot_tcal.parm").read_text().startswith("INS_TCAL1_ENABLE 1")
+    parm = [ln for ln in (mine / "params" / "ardupilot_tcal.parm").read_text().splitlines() if not ln.startswith("# ")]
+    assert parm[0] == "INS_TCAL1_ENABLE 1"
+    bests = {a: json.loads((mine / "calibration" / f"imu-imu.gyro.{a}" / "calibration.json").read_text())["best"]
+             for a in "xyz"}
+    notes = [ln for ln in script if ln.startswith("# tcbench: these are the cubic's coefficients; gyro ")]
+    assert [ln.split("; ")[1].split(":")[0] for ln in notes] == [f"gyro {a}" for a in "xyz" if bests[a] != "poly3"]
     pan = json.loads((mine / "calibration" / "pan-x" / "calibration.json").read_text())
     assert pan["held_out_parts"] == [1, 3] and pan["axis"] == "x"
     boards = sorted(p.name for p in (mine / "boards").glob("calibration-*.md"))

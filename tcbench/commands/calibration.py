@@ -8,7 +8,9 @@ interval on every ratio (:mod:`tcbench.compensation.holdout`; a best whose inter
 next reaches 1 is a tie), say in one line when a method is worse than raw held out, and write the long table (``calibration.md`` and
 ``.csv``), the residual plots and ``calibration.json`` (the ranking, and the cubic refitted on the
 whole record with its static level and the recording's sensor, unit, axis and device id, which
-``tcbench export`` turns into PX4 and ArduPilot parameters; the last lines print that command).
+``tcbench export`` turns into PX4 and ArduPilot parameters, and under ``device`` the parameters of
+every fitted method a device can run, which ``tcbench export formats=[c]`` writes as C; the last
+lines print that command).
 
 Something is always held out: with no ``train_branches=``, a record of several temperature
 branches is fitted on the consecutive branches whose temperatures span what the others need
@@ -335,6 +337,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     about["range"] = _range(screening.pieces, held_temp)
     about["training"] = _training(fitted)
     about["export"] = _export_fit(whole, cfg.screen)
+    about["device"] = _device_specs(fitted, rec.time_s)
     out = Path(cfg.out)
     replaced: list[Path] = []
     try:
@@ -578,6 +581,23 @@ def _export_fit(whole: Any, screen: bool = True) -> dict[str, Any] | None:
             "static_level": float(np.median(offset))}
 
 
+def _device_specs(fitted: dict[str, list[Any]], t_s: np.ndarray) -> dict[str, Any]:
+    """What ``tcbench export formats=[c]`` writes as C of each method a device can run
+    (:func:`tcbench.compensation.c_export.device_spec`; a network's first restart, seed ``seed``,
+    as the plot shows it), its rate ring sized to the record's fullest 120-s window."""
+    from tcbench.compensation.c_export import EXPORTED, device_spec, window_samples
+
+    fullest = window_samples(t_s)
+    specs: dict[str, Any] = {}
+    for m, runs in fitted.items():
+        if m in EXPORTED and runs:
+            try:
+                specs[m] = device_spec(runs[0], fullest)
+            except ValueError as exc:  # a diagnosed term no device runs: export says which
+                specs.setdefault("_left_out", {})[m] = str(exc)
+    return specs
+
+
 def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict[str, Path]) -> None:
     """The short table and the verdict, as the last lines a user reads."""
     from tcbench.tables import markdown_table
@@ -586,6 +606,13 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
     print(f"\nlong table (every part): {written['md']}; residual plots: {written['png']}")
     if hint := _export_hint(about, Path(written["json"]).parent):
         print(hint)
+    if [m for m in about.get("device", {}) if not m.startswith("_")]:
+        import shlex
+
+        folder = Path(written["json"]).parent
+        print(f"as C for the sensor's own processor ({', '.join(m for m in about['device'] if not m.startswith('_'))}): "
+              "tcbench export "
+              f"{shlex.quote(f'calibrations=[{folder}]')} formats=[c]")
     if not about.get("held_out"):
         print("nothing held out: no method is ranked")
         return

@@ -1,7 +1,13 @@
 """What ``tcbench export`` does: gather the calibrations of one IMU (``tcbench calibrate``'s
 ``calibration.json``, one per axis and sensor kind) and write the autopilots' parameter files,
 every axis in its slot: PX4's ``TC_G<i>_*``/``TC_A<i>_*`` (:mod:`tcbench.compensation.px4`) and
-ArduPilot's ``INS_TCAL<n>_*`` (:mod:`tcbench.compensation.ardupilot`).
+ArduPilot's ``INS_TCAL<n>_*`` (:mod:`tcbench.compensation.ardupilot`); with ``formats=[c]``, C99
+of every method the calibration fitted that a device can run, ``tc_<kind>_<axis>_<method>.h`` and
+``.c`` each (:mod:`tcbench.compensation.c_export`).
+
+The autopilots run a cubic only. Where a calibration's best held-out method is not the cubic, both
+parameter files say so in a comment, and the command prints one line per axis with the cubic's
+held-out drift against the best method's.
 
 The axis of a calibration is the one its recording's sidecar names (``tcbench import axes=``, or
 a PX4 log's field) or ``calibrate axis=``; a calibration without one is refused, as are two of one
@@ -18,7 +24,7 @@ has no constant, so its file is the same either way.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -28,8 +34,9 @@ from tcbench.errors import unknown_name
 from tcbench.sensors import kinds
 from tcbench.staging import OutputRefusedError, moved, staged_dir
 
-FORMATS = ("px4", "ardupilot")
+FORMATS = ("px4", "ardupilot", "c")
 FILES = {"px4": "px4_tc_params.txt", "ardupilot": "ardupilot_tcal.parm"}  # the file of each format in OUT/
+AUTOPILOTS = ("px4", "ardupilot")
 
 
 @dataclass(frozen=True)
@@ -43,6 +50,26 @@ class AxisCalibration:
     poly: Any  # OffsetPolynomial
     px4_device_id: int | None
     static_level: float | None = None  # the median offset (calibration.json's export.static_level)
+    device: dict[str, Any] | None = None  # the methods a device runs (calibration.json's device)
+    held_out: dict[str, Any] | None = None  # best, drift per method (calibration.json's ranking)
+    left_out: dict[str, str] = field(default_factory=dict)  # fitted methods no device runs, and why
+
+    def c_name(self, method: str) -> str:
+        """The C name of ``method``'s export: ``tc_gyro_x_poly3``."""
+        return f"tc_{self.sensor}_{self.axis}_{method}"
+
+    def cubic_line(self) -> str | None:
+        """``gyro x: the cubic the autopilots run leaves 0.106 deg/s held out; model 0.054 (the best)``
+        when the best held-out method is not the cubic, else None."""
+        ranked = self.held_out or {}
+        best = ranked.get("best")
+        if not ranked.get("held_out") or best in (None, "poly3"):
+            return None
+        drift = ranked.get("drift", {})
+        cubic = (f"leaves {drift['poly3']:.3g} {self.unit} held out" if drift.get("poly3") is not None
+                 else "was not scored (calibrate with poly3 among methods=)")
+        return (f"{self.sensor} {self.axis}: the cubic the autopilots run {cubic}; the best held-out method, {best}, "
+                f"{drift.get(best, float('nan')):.3g}")
 
 
 def read_calibration(folder: str | Path) -> AxisCalibration:
@@ -60,14 +87,18 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
         sensor, unit, axis = about["sensor"], about["unit"], about.get("axis")
         level = fit.get("static_level")
         static_level = float(level) if level is not None else None
+        device = dict(about.get("device") or {})
+        left_out = device.pop("_left_out", {})
+        held_out = {k: about[k] for k in ("held_out", "best", "drift") if k in about}
     except (ValueError, KeyError, TypeError) as exc:
         raise CommandError(f"calibrations: {path}: not a calibration tcbench export reads ({exc})") from None
     if axis not in ("x", "y", "z"):
         raise CommandError(f"calibrations: {folder}: the recording's axis is unknown; import it with axes=x|y|z, "
                            "or calibrate it again with axis=x|y|z")
-    device = about.get("px4_device_id")
+    px4_id = about.get("px4_device_id")
     return AxisCalibration(Path(folder), str(sensor), str(unit), str(axis), poly,
-                           int(device) if device is not None else None, static_level)
+                           int(px4_id) if px4_id is not None else None, static_level,
+                           device or None, held_out, left_out)
 
 
 def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
@@ -85,21 +116,50 @@ def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
     if not 1 <= cfg.ardupilot_imu <= 3:
         raise CommandError(f"ardupilot_imu must be 1..3, got {cfg.ardupilot_imu}")
     writable_folder(cfg.out)
-    free_outputs(cfg.out, [FILES[f] for f in dict.fromkeys(cfg.formats)], cfg.overwrite)
+    autopilots = [f for f in dict.fromkeys(cfg.formats) if f in AUTOPILOTS]
     by_sensor: dict[str, dict[str, AxisCalibration]] = {}
     for folder in cfg.calibrations:
         cal = read_calibration(folder)
-        if not px4_covers(cal.sensor):
+        if "c" in cfg.formats and not cal.device:
+            raise CommandError(f"calibrations: {folder}: its calibration.json holds no method a device runs "
+                               "(calibrated before tcbench wrote them, or with none of "
+                               "poly3, poly3_rate, bp, bp_gd, elman); calibrate it again for formats=[c]")
+        if autopilots and not px4_covers(cal.sensor):
             raise CommandError(f"calibrations: {folder}: a {cal.sensor} recording; the autopilots calibrate gyro and accel")
         axes = by_sensor.setdefault(cal.sensor, {})
         if cal.axis in axes:
             raise CommandError(f"calibrations: {axes[cal.axis].folder} and {folder} are both {cal.sensor} axis {cal.axis}")
         axes[cal.axis] = cal
+    free_outputs(cfg.out, [FILES[f] for f in autopilots] + c_files(by_sensor) * ("c" in cfg.formats), cfg.overwrite)
     if "px4" in cfg.formats:
         for sensor in by_sensor:
             device_id(cfg, sensor, by_sensor[sensor])
             static_levels(sensor, by_sensor[sensor])
     return by_sensor
+
+
+def c_files(by_sensor: dict[str, dict[str, AxisCalibration]]) -> list[str]:
+    """The C files ``formats=[c]`` writes into OUT/: a header and a source per method and axis."""
+    return [f"{cal.c_name(m)}.{ext}" for axes in by_sensor.values() for cal in axes.values()
+            for m in cal.device or {} for ext in ("h", "c")]
+
+
+def write_c_files(by_sensor: dict[str, dict[str, AxisCalibration]], folder: Path) -> list[Path]:
+    """Every calibration's device methods as C in ``folder``."""
+    from tcbench.compensation.c_export import write_c
+
+    written: list[Path] = []
+    for axes in by_sensor.values():
+        for cal in axes.values():
+            for method, spec in (cal.device or {}).items():
+                about = (f"{cal.sensor} axis {cal.axis}, output in {cal.unit}: tcbench calibrate's {method} of "
+                         f"{cal.folder.name}")
+                try:
+                    written += write_c(spec, cal.c_name(method), folder, about)
+                except (KeyError, TypeError, ValueError) as exc:
+                    raise CommandError(f"calibrations: {cal.folder}: its device method {method} cannot be "
+                                       f"written as C ({exc}); calibrate it again") from None
+    return written
 
 
 def static_levels(sensor: str, axes: dict[str, AxisCalibration]) -> dict[str, float]:
@@ -137,12 +197,14 @@ def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) 
 def export(cfg: ExportConfig) -> dict[str, Path]:
     """Write the parameter files; print what each holds."""
     from tcbench.compensation.ardupilot import ardupilot_parameters, write_parm
+    from tcbench.compensation.c_export import EXPORTED
     from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, px4_polynomial, write_parameters
 
     by_sensor = check_export(cfg)
-    to_si = {s: px4_factor(s, next(iter(axes.values())).unit) for s, axes in by_sensor.items()}
+    autopilots = any(f in AUTOPILOTS for f in cfg.formats)
+    to_si = {s: px4_factor(s, next(iter(axes.values())).unit) for s, axes in by_sensor.items()} if autopilots else {}
     polys = {s: {a: c.poly for a, c in axes.items()} for s, axes in by_sensor.items()}
-    for sensor, axes in polys.items():
+    for sensor, axes in polys.items() if autopilots else ():
         missing = [a for a in ("x", "y", "z") if a not in axes]
         if missing:
             print(f"tcbench: {sensor} axis {', '.join(missing)}: no calibration given; its coefficients are 0 "
@@ -160,6 +222,13 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
     try:
         with staged_dir(out, [], cfg.overwrite, replaced) as tmp:
             written: dict[str, Path] = {}
+            notes = [ln for axes in by_sensor.values() for c in axes.values() if (ln := c.cubic_line())]
+            bests = {(c.held_out or {}).get("best") for axes in by_sensor.values() for c in axes.values()
+                     if c.cubic_line()}
+            comments = [f"tcbench: these are the cubic's coefficients; {ln}" for ln in notes]
+            if exportable := sorted(bests & set(EXPORTED)):
+                comments.append(f"tcbench export formats=[c] writes {', '.join(exportable)} as C for a sensor's own "
+                                "processor")
             if "px4" in cfg.formats:
                 params: dict[str, float | int] = {}
                 for sensor, axes in polys.items():
@@ -167,19 +236,36 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
                     px4_axes = {a: px4_polynomial(p, sensor, levels.get(a, 0.0)) for a, p in axes.items()}
                     params |= px4_parameters(px4_axes, sensor, cfg.px4_instance,
                                              device_id(cfg, sensor, by_sensor[sensor]), to_px4_unit=to_si[sensor])
-                written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys))
+                written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys), comments)
             if "ardupilot" in cfg.formats:
                 try:
                     ap = ardupilot_parameters(polys, cfg.ardupilot_imu, to_si)
                 except ValueError as exc:
                     raise CommandError(f"ardupilot: {exc}") from None
-                written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"])
+                written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"], comments)
+            if "c" in cfg.formats:
+                written |= {f"c {p.name}": p for p in write_c_files(by_sensor, tmp)}
     except OutputRefusedError as exc:
         raise refused_output(exc) from None
     except OSError as exc:
         raise cannot_write(out, exc, "the parameter files") from None
     written = moved(written, tmp, out)
     say_replaced(replaced)
+    if any(f in written for f in AUTOPILOTS):
+        for line in notes:
+            print(f"tcbench: {line}")
+    if "c" in cfg.formats:
+        sources = [p for k, p in written.items() if k.startswith("c ") and p.suffix == ".c"]
+        print(f"tcbench: wrote {len(sources)} C99 compensator{'s' * (len(sources) != 1)} into {out} ({', '.join(p.stem for p in sources)}: "
+              "a .h and a .c each; init once, update per sample; -DTC_..._FLOAT for the float build)")
+        from tcbench.compensation.c_export import EXPORTED, NOT_EXPORTED
+
+        again = "its parameters are not in calibration.json: calibrate again"
+        left = {f"{c.sensor} {c.axis} {m}": c.left_out.get(m, again if m in EXPORTED else NOT_EXPORTED.get(m, m))
+                for axes in by_sensor.values() for c in axes.values()
+                for m in (c.held_out or {}).get("drift", {}) if m not in (c.device or {})}
+        if left:
+            print("tcbench: not written as C: " + "; ".join(f"{k} ({why})" for k, why in sorted(left.items())))
     every = ", ".join(f"{s} {''.join(sorted(a))}" for s, a in polys.items())
     if "px4" in written:
         print(f"tcbench: wrote {written['px4']} (PX4 TC_* of {every}, instance {cfg.px4_instance}; "

@@ -14,7 +14,7 @@ constant of the fitted cubic does not travel, and what comes back is ``offset(T)
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -82,10 +82,10 @@ def ardupilot_correction(params: Mapping[str, float | int], temp_c: np.ndarray, 
     return p(np.asarray(temp_c)) - p(np.asarray([cal_temp_c]))[0]
 
 
-def write_parm(params: Mapping[str, float | int], path: str | Path) -> Path:
+def write_parm(params: Mapping[str, float | int], path: str | Path, comments: Sequence[str] = ()) -> Path:
     """``params`` as an ArduPilot parameter file (``NAME VALUE`` per line), which Mission Planner,
-    MAVProxy (``param load``) and QGroundControl load."""
-    lines = [f"{k} {v:d}" if isinstance(v, int) else f"{k} {v:.9g}" for k, v in params.items()]
+    MAVProxy (``param load``) and QGroundControl load; ``comments`` first, each a ``#`` line."""
+    lines = [f"# {c}" for c in comments] + [f"{k} {v:d}" if isinstance(v, int) else f"{k} {v:.9g}" for k, v in params.items()]
     path = Path(path)
     path.write_text("\n".join(lines) + "\n")
     return path

@@ -169,10 +169,12 @@ def px4_offset(params: Mapping[str, float | int], temp_c: np.ndarray, sensor: st
     return x[0] + x[1] * dt + x[2] * dt ** 2 + x[3] * dt ** 3
 
 
-def write_parameters(params: Mapping[str, float | int], path: str | Path, sensors: Sequence[str] | str) -> Path:
+def write_parameters(params: Mapping[str, float | int], path: str | Path, sensors: Sequence[str] | str,
+                     comments: Sequence[str] = ()) -> Path:
     """``params`` as a PX4 console script (``param set NAME VALUE`` per line, then the enable
-    switch of each of ``sensors``), to paste into the NuttX shell or run from the SD card."""
-    lines = [f"param set {k} {v:d}" if isinstance(v, int) else f"param set {k} {v:.9g}" for k, v in params.items()]
+    switch of each of ``sensors``), to paste into the NuttX shell or run from the SD card;
+    ``comments`` first, each a ``#`` line the shell skips."""
+    lines = [f"# {c}" for c in comments] + [f"param set {k} {v:d}" if isinstance(v, int) else f"param set {k} {v:.9g}" for k, v in params.items()]
     kinds_ = [sensors] if isinstance(sensors, str) else list(sensors)
     lines += [f"param set TC_{px4_type(s)[0]}_ENABLE 1" for s in dict.fromkeys(kinds_)]
     path = Path(path)

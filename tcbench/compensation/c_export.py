@@ -1,0 +1,607 @@
+"""A fitted offset model as C99 a firmware can call per sample (``tcbench export formats=[c]``).
+
+Each method ``tcbench calibrate`` fits that a device can run is written as ``<name>.h`` and
+``<name>.c`` with a streaming API::
+
+    void <name>_init(<name>_state *s);
+    <name>_real <name>_update(<name>_state *s, <name>_real temperature_c, <name>_real raw, <name>_real dt_s);
+
+``update`` takes one sample in time order (``dt_s``: the time since the previous sample, > 0;
+the first sample's is ignored) and returns ``raw`` minus the model's offset. ``<name>_real`` is
+``double``, or ``float`` when ``<NAME>_FLOAT`` is defined; the clock (the sum of the ``dt_s``)
+is a ``double`` in both builds, so that the trailing rate window and the time bins keep their
+edges over hours. No allocation, no library call but ``tanh`` and ``exp`` (``tanhf`` and ``expf``
+in the float build; the networks' sigmoid is ``(1 + tanh(a / 2)) / 2``).
+
+What each method runs (:func:`device_spec` gives its parameters, :func:`streamed_offset` runs the
+same arithmetic in numpy, the reference the compiled code is checked against):
+
+- ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range.
+- ``poly3_rate``: that cubic plus the rate coefficient times the temperature rate, the
+  least-squares slope over the trailing :data:`~tcbench.compensation.calibration.RATE_WINDOW_S`
+  window ``t_i - w < t_j <= t_i``, the estimator
+  :func:`~tcbench.compensation.features.temperature_rate_c_per_s` computes for calibrate (causal),
+  each window centred before its moments are summed (:func:`window_rate_c_per_s`), kept in a ring of at most ``<NAME>_RATE_CAPACITY`` samples (the most any window of
+  the calibration record held, with half again as margin; more are counted in ``s->dropped``
+  and the oldest left out).
+- ``bp`` and ``bp_gd``: the network on ``[T, dT/dt]`` held to its training box, scaled to
+  [-1, 1] as it was trained and its output scaled back.
+- ``elman``: the recurrent network steps once per time bin (``bin_s`` from the first sample),
+  as it was trained. Python's calibration scores it on the bins' means interpolated between the
+  bins' mean times, which reads up to 1.5 bins ahead; the device cannot. Here each sample gets
+  the network's output for the mean of its bin so far, from the context the previous complete
+  bin left (at a bin's last sample the two agree): that causal form is what
+  :func:`streamed_offset` computes and the compiled code is checked against.
+
+- ``model``: the diagnosed model as its compensator runs it
+  (:func:`~tcbench.compensation.fitted_model.compensator`: without the terms keyed to the
+  calibration run's clock or its rig), in streaming form: the die temperature through each
+  thermal lag as a first-order filter with its state, ``y += (1 - exp(-dt / tau)) (x - y)`` per
+  sample (Python's exact discretisation, on the device's own intervals); the bias polynomial in the
+  die temperature; and the terms :data:`MODEL_TERMS`. Python's calibration runs the model on a
+  uniform grid and reads it back at the samples, takes the thermometer's rate as a central
+  difference (it reads the next sample) and runs the hysteresis's play operator on a 1-Hz grid
+  interpolated back; the device takes the rate as the backward difference over the last interval
+  and runs the play operator at every sample. That causal form is what :func:`streamed_offset`
+  computes. The offset is the model's output at zero input (a static record's: its scale factor
+  is not applied). A model with another term is not exported, and the export says which.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tcbench.compensation.calibration import RATE_WINDOW_S, OffsetModel
+
+EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")  # what a device can run of calibrate's methods
+NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator"}
+MODEL_TERMS = ("thermal_lag", "temperature_rate", "hysteresis", "temperature_cubic", "temperature_bump", "second_node")
+CAPACITY_MARGIN = 1.5  # the rate ring holds this many times the calibration record's fullest window
+NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,62}$")
+
+
+def window_samples(t_s: np.ndarray, window_s: float = RATE_WINDOW_S) -> int:
+    """The most samples any trailing window ``t_i - window_s < t_j <= t_i`` of ``t_s`` holds."""
+    t = np.asarray(t_s, dtype=np.float64)
+    if t.size == 0:
+        return 0
+    start = np.searchsorted(t, t - window_s, side="right")
+    return int(np.max(np.arange(1, t.size + 1) - start))
+
+
+def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: float = RATE_WINDOW_S) -> dict[str, Any]:
+    """The parameters of ``model`` a device runs, as plain data (``calibration.json`` keeps them);
+    ``max_window_samples``: the fullest rate window of the calibration record. ``ValueError`` for a
+    method no device runs (:data:`NOT_EXPORTED`)."""
+    if model.method not in EXPORTED:
+        raise ValueError(f"{model.method}: {NOT_EXPORTED.get(model.method, 'not a method a device runs')}")
+    capacity = max(2, int(np.ceil(CAPACITY_MARGIN * max_window_samples)))
+    if model.method == "model":
+        return model_spec(model.sensor_model)
+    if model.method in ("poly3", "poly3_rate"):
+        c = model.cubic
+        assert c is not None
+        spec: dict[str, Any] = {"method": model.method, "x": [float(v) for v in c.x], "tref_c": c.tref_c,
+                                "tmin_c": c.tmin_c, "tmax_c": c.tmax_c}
+        if model.method == "poly3_rate":
+            spec |= {"rate_coef": float(model.rate_coef), "rate_window_s": rate_window_s, "rate_capacity": capacity}
+        return spec
+    learner = model.learner
+    if learner.x_scaler is None or learner.y_scaler is None:
+        raise ValueError(f"{model.method}: the network has no normalisation (not fitted)")
+    h, m = learner.params.hidden, learner.n_inputs
+    p = learner.get_params()
+    spec = {"method": model.method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
+            "output_activation": learner.params.output_activation,
+            "x_low": learner.x_scaler.low.tolist(), "x_high": learner.x_scaler.high.tolist(),
+            "y_low": float(learner.y_scaler.low[0]), "y_high": float(learner.y_scaler.high[0]),
+            "temp_range_c": list(model.temp_range_c or (-np.inf, np.inf)),
+            "rate_range": list(model.rate_range or (-np.inf, np.inf)),
+            "rate_window_s": rate_window_s, "rate_capacity": capacity}
+    if learner.sequential:
+        i, j = h * m, h * m + h * h
+        spec |= {"wx": p[:i].reshape(h, m).tolist(), "wc": p[i:j].reshape(h, h).tolist(), "b1": p[j:j + h].tolist(),
+                 "w2": p[j + h:j + 2 * h].tolist(), "b2": float(p[-1]), "bin_s": float(model.bin_s or 0.0)}
+        if not spec["bin_s"] > 0:
+            raise ValueError(f"{model.method}: a recurrent network exported per sample needs its training bins")
+    else:
+        spec |= {"w1": p[:h * m].reshape(h, m).tolist(), "b1": p[h * m:h * m + h].tolist(),
+                 "w2": p[h * m + h:h * m + 2 * h].tolist(), "b2": float(p[-1])}
+    return spec
+
+
+def window_rate_c_per_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float = RATE_WINDOW_S,
+                        floats: int = 2_000_000) -> np.ndarray:
+    """The temperature rate (degC/s) the exported code computes: the least-squares slope over the
+    trailing window ``t_i - window_s < t_j <= t_i`` (the estimator of
+    :func:`~tcbench.compensation.features.temperature_rate_c_per_s`), each window centred on its
+    own samples before its moments are summed, as the C does. The prefix-sum form calibrate runs
+    sums moments about the record's first sample, which loses digits when a window holds a few
+    closely spaced samples far from it (a burst's first samples: on the PAN record one rate off by
+    0.2 %); this one keeps them. Vectorised over windows, ``floats`` values at a time."""
+    t = np.asarray(t_s, dtype=np.float64).reshape(-1)
+    y = np.asarray(temp_c, dtype=np.float64).reshape(-1)
+    if t.shape != y.shape:
+        raise ValueError(f"t_s has {t.size} samples, temp_c {y.size}")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t_s must be strictly increasing")
+    out = np.zeros(t.size)
+    if t.size == 0:
+        return out
+    start = np.searchsorted(t, t - window_s, side="right")
+    width = int(np.max(np.arange(t.size) - start)) + 1
+    step = max(1, floats // width)
+    k = np.arange(width)
+    for a in range(0, t.size, step):
+        rows = np.arange(a, min(a + step, t.size))
+        idx = start[rows, None] + k
+        inside = idx <= rows[:, None]
+        idx = np.minimum(idx, rows[:, None])
+        n = inside.sum(axis=1)
+        u = np.where(inside, t[idx] - t[rows, None], 0.0)
+        v = np.where(inside, y[idx] - y[rows, None], 0.0)
+        u = np.where(inside, u - (u.sum(axis=1) / n)[:, None], 0.0)
+        v = np.where(inside, v - (v.sum(axis=1) / n)[:, None], 0.0)
+        sxx, sxy = (u * u).sum(axis=1), (u * v).sum(axis=1)
+        ok = (n >= 2) & (sxx > 0)
+        out[rows] = np.where(ok, sxy / np.where(ok, sxx, 1.0), 0.0)
+    return out
+
+
+def model_spec(sensor_model: Any) -> dict[str, Any]:
+    """The compensator of a diagnosed :class:`~tcbench.sensors.fitted.PolynomialModel` as plain
+    data: its core and its terms in order; ``ValueError`` naming a term a device does not run."""
+    from tcbench.compensation.fitted_model import compensator
+
+    quiet = compensator(sensor_model)
+    if other := [type(e).id for e in quiet.effects if type(e).id not in MODEL_TERMS]:
+        raise ValueError(f"model: its {', '.join(other)} term{'s' * (len(other) > 1)} "
+                         f"{'are' if len(other) > 1 else 'is'} not exported as C (exported: {', '.join(MODEL_TERMS)})")
+    effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
+    return {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
+            "bias": [float(b) for b in quiet.bias], "ref_c": float(quiet.ref_c), "effects": effects}
+
+
+def _model_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """The causal diagnosed model (see the module doc), per sample in a loop for the sequential
+    parts (the lags and the play operator), vectorised for the rest."""
+    dt = np.r_[0.0, np.diff(t)]
+    die = temp.copy()
+    offset = np.zeros(t.size)
+    terms: list[np.ndarray] = []
+    for e in spec["effects"]:  # the die stage first, as the simulator runs it
+        if e["id"] == "thermal_lag":
+            die = _lag(die, dt, e["tau_s"])
+    for e in spec["effects"]:
+        if e["id"] == "temperature_rate":
+            rate = np.r_[0.0, np.diff(temp) / np.where(dt[1:] > 0, dt[1:], 1.0)] if t.size else dt
+            terms.append(e["coef_per_c_per_s"] * rate)
+        elif e["id"] == "hysteresis":
+            w = e["width_c"]
+            state = np.empty(t.size)
+            p = float(die[0]) - float(np.clip(e["start_state"], -1.0, 1.0)) * w if t.size else 0.0
+            for i, x in enumerate(die.tolist()):
+                p = min(max(p, x - w), x + w)
+                state[i] = (x - p) / w
+            terms.append(e["amplitude"] * state)
+        elif e["id"] == "temperature_cubic":
+            terms.append(e["c3_per_c3"] * (die - spec["ref_c"]) ** 3)
+        elif e["id"] == "temperature_bump":
+            terms.append(e["amplitude"] * np.exp(-0.5 * ((die - e["centre_c"]) / e["width_c"]) ** 2))
+        elif e["id"] == "second_node":
+            terms.append(e["coef_per_c"] * (_lag(die, dt, e["tau_s"]) - die))
+    u = (die - spec["centre_c"]) / spec["half_range_c"]
+    for c in reversed(spec["bias"]):
+        offset = offset * u + c
+    for term in terms:
+        offset = offset + term
+    return offset
+
+
+def _lag(x: np.ndarray, dt: np.ndarray, tau_s: float) -> np.ndarray:
+    """``y += (1 - exp(-dt / tau)) (x - y)``, ``y = x`` at the first sample (``tau_s <= 0``: x)."""
+    if tau_s <= 0 or x.size == 0:
+        return x.copy()
+    gain = 1.0 - np.exp(-dt / tau_s)
+    out = np.empty_like(x)
+    y = float(x[0])
+    for i, (xi, g) in enumerate(zip(x.tolist(), gain.tolist())):
+        y = y + g * (xi - y)
+        out[i] = y
+    return out
+
+
+def device_clock_s(dt_s: np.ndarray) -> np.ndarray:
+    """The clock a device keeps from the intervals it is given: 0 at the first sample, then the
+    running sum of ``dt_s[1:]`` in double, added one by one as the C code adds them."""
+    dt = np.asarray(dt_s, dtype=np.float64).reshape(-1)
+    if dt.size == 0:
+        return dt.copy()
+    return np.concatenate([[0.0], np.cumsum(dt[1:])])
+
+
+def _sigma(a: np.ndarray, kind: str) -> np.ndarray:
+    return np.tanh(a) if kind == "tanh" else 0.5 * (1.0 + np.tanh(0.5 * a))
+
+
+def _scaled_inputs(spec: dict[str, Any], temp_c: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """``[T, dT/dt]`` held to the training box and mapped to [-1, 1] as the network was trained."""
+    x = np.column_stack([np.clip(temp_c, *spec["temp_range_c"]), np.clip(rate, *spec["rate_range"])])
+    low, high = np.asarray(spec["x_low"]), np.asarray(spec["x_high"])
+    span = np.where(high - low > 0, high - low, 1.0)
+    return 2.0 * (x - low) / span - 1.0
+
+
+def _unscaled(spec: dict[str, Any], z: np.ndarray) -> np.ndarray:
+    y = np.tanh(z) if spec["output_activation"] == "tanh" else z
+    span = spec["y_high"] - spec["y_low"]
+    span = span if span > 0 else 1.0
+    return (y + 1.0) * 0.5 * span + spec["y_low"]
+
+
+def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray,
+                    rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+    """The offset the exported code computes at each sample, in numpy: ``clock_s`` the device's
+    clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
+    ``rate_c_per_s``: :func:`window_rate_c_per_s` of them when already computed."""
+    t = np.asarray(clock_s, dtype=np.float64)
+    temp = np.asarray(temp_c, dtype=np.float64)
+    method = spec["method"]
+    if method == "model":
+        return _model_streamed(spec, t, temp)
+    if method != "poly3" and rate_c_per_s is None:
+        rate_c_per_s = window_rate_c_per_s(t, temp, spec["rate_window_s"])
+    rate = np.asarray(rate_c_per_s, dtype=np.float64)
+    if method in ("poly3", "poly3_rate"):
+        x = spec["x"]
+        dt = np.clip(temp, spec["tmin_c"], spec["tmax_c"]) - spec["tref_c"]
+        off = x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]))
+        return off + spec["rate_coef"] * rate if method == "poly3_rate" else off
+    if "wc" not in spec:
+        x = _scaled_inputs(spec, temp, rate)
+        h = _sigma(x @ np.asarray(spec["w1"]).T + np.asarray(spec["b1"]), spec["hidden_activation"])
+        return _unscaled(spec, h @ np.asarray(spec["w2"]) + spec["b2"])
+    return _elman_streamed(spec, t, temp, rate)
+
+
+def _elman_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray) -> np.ndarray:
+    """The causal Elman: each sample the output for its bin's mean so far, from the context of the
+    previous complete bin (see the module doc)."""
+    wx, wc = np.asarray(spec["wx"]), np.asarray(spec["wc"])
+    b1, w2 = np.asarray(spec["b1"]), np.asarray(spec["w2"])
+    index = np.floor(t / spec["bin_s"]).astype(np.int64)
+    starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
+    stops = np.r_[starts[1:], t.size]
+    out = np.empty(t.size)
+    context = np.zeros(wc.shape[0])
+    for a, b in zip(starts, stops):
+        count = np.arange(1, b - a + 1)
+        means = np.column_stack([np.cumsum(temp[a:b]) / count, np.cumsum(rate[a:b]) / count])
+        drive = wc @ context + b1
+        h = _sigma(_scaled_inputs(spec, means[:, 0], means[:, 1]) @ wx.T + drive, spec["hidden_activation"])
+        out[a:b] = _unscaled(spec, h @ w2 + spec["b2"])
+        context = h[-1]
+    return out
+
+
+# -- the C sources ----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CSource:
+    """The header and source of one exported method, and what its header states."""
+
+    header: str
+    source: str
+    state_bytes: dict[str, int]  # by build: double, float (x86-64 and ARM EABI alignment)
+    flops: str  # floating-point operations per sample, in words
+
+
+def _lit(v: float) -> str:
+    """A C double literal that reads back exactly (hexadecimal)."""
+    v = float(v)
+    if np.isinf(v):
+        return "HUGE_VAL" if v > 0 else "-HUGE_VAL"
+    return v.hex()
+
+
+def _array(values: Any) -> str:
+    flat = np.asarray(values, dtype=np.float64).reshape(-1)
+    return "{" + ", ".join(_lit(v) for v in flat) + "}"
+
+
+def _state_bytes(doubles: int, reals: int, ints: int, real_size: int) -> int:
+    size = 8 * doubles + real_size * reals + 4 * ints
+    return -(-size // 8) * 8
+
+
+def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
+    """``<name>.h`` and ``<name>.c`` of ``spec`` (:func:`device_spec`); ``about``: one line for
+    the header (the recording, sensor, axis and unit)."""
+    if not NAME.match(name):
+        raise ValueError(f"{name!r} is not a C identifier (letters, digits, _; not starting with a digit)")
+    method = spec["method"]
+    up = name.upper()
+    rated = method not in ("poly3", "model")
+    recurrent = "wc" in spec
+    slots = _model_slots(spec) if method == "model" else []
+    h = int(spec.get("hidden", 0))
+    cap = int(spec.get("rate_capacity", 0))
+    # the state: doubles (clock, ring times), reals (ring temperatures, Elman's), int32 counters
+    doubles = 1 + (cap if rated else 0)
+    reals = (cap if rated else 0) + (3 * h + 2 if recurrent else 0) + len(slots)
+    ints = 1 + (3 if rated else 0) + (2 if recurrent else 0)
+    sizes = {"double": _state_bytes(doubles, reals, ints, 8), "float": _state_bytes(doubles, reals, ints, 4)}
+    if method == "model":
+        flops, body = _model_body(spec)
+    elif method == "poly3":
+        flops, body = "8", _cubic_body(spec)
+    elif method == "poly3_rate":
+        flops, body = f"10 + 9 n, n the samples in the rate window (at most {cap}: {10 + 9 * cap})", _cubic_body(spec)
+    else:
+        per = 8 + 4 * h + 2 * h + 6
+        if recurrent:
+            per += 6
+            flops = (f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap}); "
+                     f"and {2 * h * h + h} more once per {spec['bin_s']:g}-s bin")
+        else:
+            flops = f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})"
+        body = ""
+    lines = [f"/* {name}.h: temperature compensation by the {method} method, exported by tcbench export formats=[c].",
+             *([f" * {about}"] if about else []),
+             " *",
+             f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
+             " * the offset. dt_s is the time since the previous sample (> 0; the first sample's is ignored).",
+             f" * Build: double by default; define {up}_FLOAT for float (the clock stays a double).",
+             f" * State: {sizes['double']} bytes (double build), {sizes['float']} bytes (float build); no allocation.",
+             f" * Floating-point operations per sample: {flops}.",
+             " * Compile as ISO C99 (-std=c99: no fused multiply-add contraction) to reproduce tcbench's numbers.",
+             " */"]
+    header = "\n".join(lines) + f"""
+#ifndef {up}_H
+#define {up}_H
+
+#ifdef {up}_FLOAT
+typedef float {name}_real;
+#else
+typedef double {name}_real;
+#endif
+""" + (f"""
+#ifndef {up}_RATE_CAPACITY
+#define {up}_RATE_CAPACITY {cap}  /* samples the trailing {spec['rate_window_s']:g}-s rate window can hold */
+#endif
+""" if rated else "") + f"""
+typedef struct {{
+    double clock_s;  /* time since the first sample (s) */
+""" + (f"""    double ring_t_s[{up}_RATE_CAPACITY];  /* the rate window's times and temperatures */
+    {name}_real ring_temp_c[{up}_RATE_CAPACITY];
+""" if rated else "") + (f"""    {name}_real context[{h}];  /* the hidden state the last complete bin left */
+    {name}_real drive[{h}];  /* W_c context + b1, once per bin */
+    {name}_real pending[{h}];  /* the hidden state of the bin so far */
+    {name}_real bin_temp_sum, bin_rate_sum;
+""" if recurrent else "") + (f"""    {name}_real memory[{len(slots)}];  /* {', '.join(slots)} */
+""" if slots else "") + """    int samples;  /* samples seen (saturates) */
+""" + ("""    int head, count;  /* the ring's oldest sample, samples in it */
+    int dropped;  /* samples left out of a full window (0 when the capacity suffices) */
+""" if rated else "") + ("""    int bin, bin_count;  /* the current bin and its samples */
+""" if recurrent else "") + f"""}} {name}_state;
+
+void {name}_init({name}_state *s);
+{name}_real {name}_update({name}_state *s, {name}_real temperature_c, {name}_real raw, {name}_real dt_s);
+
+#endif
+"""
+    source = _source(spec, name, up, body, rated, recurrent, h)
+    return CSource(header, source, sizes, flops)
+
+
+def _cubic_body(spec: dict[str, Any]) -> str:
+    x = spec["x"]
+    return f"""    R t = temperature_c < (R){_lit(spec['tmin_c'])} ? (R){_lit(spec['tmin_c'])}
+        : (temperature_c > (R){_lit(spec['tmax_c'])} ? (R){_lit(spec['tmax_c'])} : temperature_c);
+    R d = t - (R){_lit(spec['tref_c'])};
+    R offset = (R){_lit(x[0])} + d * ((R){_lit(x[1])} + d * ((R){_lit(x[2])} + d * (R){_lit(x[3])}));
+"""
+
+
+def _model_slots(spec: dict[str, Any]) -> list[str]:
+    """The diagnosed model's state: each lag's and play operator's memory, the last temperature."""
+    names = {"thermal_lag": "die lag", "second_node": "second node", "hysteresis": "play operator"}
+    slots = [f"{names[e['id']]} {k}" for k, e in enumerate(spec["effects"]) if e["id"] in names]
+    return slots + ["last temperature"] * any(e["id"] == "temperature_rate" for e in spec["effects"])
+
+
+def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
+    """The update of the diagnosed model (see the module doc) and its operations per sample."""
+    slots = _model_slots(spec)
+    lines = ["    int first = s->samples == 1;", "    R die = temperature_c, offset = 0, u;"]
+    flops, calls = 0, 0
+    lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
+    for k, e in lags:  # the die stage first, in order, as the simulator runs it
+        at = slots.index(f"die lag {k}")
+        lines += [f"    if (first) s->memory[{at}] = die;",
+                  f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
+                  f"    die = s->memory[{at}];"]
+        flops, calls = flops + 5, calls + 1
+    lines.append(f"    u = (die - (R){_lit(spec['centre_c'])}) / (R){_lit(spec['half_range_c'])};")
+    for c in reversed(spec["bias"]):
+        lines.append(f"    offset = offset * u + (R){_lit(c)};")
+    flops += 2 + 2 * len(spec["bias"])
+    for k, e in enumerate(spec["effects"]):
+        if e["id"] == "temperature_rate":
+            at = slots.index("last temperature")
+            lines += [f"    if (!first && dt_s > 0) offset += (R){_lit(e['coef_per_c_per_s'])} * "
+                      f"((temperature_c - s->memory[{at}]) / dt_s);",
+                      f"    s->memory[{at}] = temperature_c;"]
+            flops += 4
+        elif e["id"] == "hysteresis":
+            at, w = slots.index(f"play operator {k}"), e["width_c"]
+            start = float(np.clip(e["start_state"], -1.0, 1.0))
+            lines += [f"    if (first) s->memory[{at}] = die - (R){_lit(start)} * (R){_lit(w)};",
+                      f"    if (s->memory[{at}] < die - (R){_lit(w)}) s->memory[{at}] = die - (R){_lit(w)};",
+                      f"    if (s->memory[{at}] > die + (R){_lit(w)}) s->memory[{at}] = die + (R){_lit(w)};",
+                      f"    offset += (R){_lit(e['amplitude'])} * ((die - s->memory[{at}]) / (R){_lit(w)});"]
+            flops += 6
+        elif e["id"] == "temperature_cubic":
+            lines += [f"    {{ R d = die - (R){_lit(spec['ref_c'])}; offset += (R){_lit(e['c3_per_c3'])} * (d * d * d); }}"]
+            flops += 5
+        elif e["id"] == "temperature_bump":
+            lines += [f"    {{ R z = (die - (R){_lit(e['centre_c'])}) / (R){_lit(e['width_c'])}; "
+                      f"offset += (R){_lit(e['amplitude'])} * TC_EXP((R)-0.5 * (z * z)); }}"]
+            flops, calls = flops + 6, calls + 1
+        elif e["id"] == "second_node":
+            at = slots.index(f"second node {k}")
+            lines += [f"    if (first) s->memory[{at}] = die;",
+                      f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
+                      f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
+            flops, calls = flops + 7, calls + 1
+    flops += 1
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+
+
+def _source(spec: dict[str, Any], name: str, up: str, body: str, rated: bool, recurrent: bool, h: int) -> str:
+    method = spec["method"]
+    parts = [f"/* {name}.c: see {name}.h. */\n#include <math.h>\n#include \"{name}.h\"\n\ntypedef {name}_real R;\n"
+             f"#ifdef {up}_FLOAT\n#define TC_EXP expf\n#define TC_TANH tanhf\n#else\n#define TC_EXP exp\n"
+             "#define TC_TANH tanh\n#endif\n"]
+    if rated:
+        parts.append(f"""
+#define RATE_WINDOW_S {_lit(spec['rate_window_s'])}
+
+/* The least-squares slope (degC/s) of the temperatures in the trailing window t_i - w < t_j <= t_i. */
+static R rate_c_per_s({name}_state *s, R temperature_c)
+{{
+    int k, n, at;
+    double edge = s->clock_s - RATE_WINDOW_S, t_mean = 0.0;
+    R y_mean = 0, sxx = 0, sxy = 0;
+    while (s->count > 0 && s->ring_t_s[s->head] <= edge) {{
+        s->head = (s->head + 1) % {up}_RATE_CAPACITY;
+        s->count--;
+    }}
+    if (s->count == {up}_RATE_CAPACITY) {{
+        s->head = (s->head + 1) % {up}_RATE_CAPACITY;
+        s->count--;
+        s->dropped++;
+    }}
+    at = (s->head + s->count) % {up}_RATE_CAPACITY;
+    s->ring_t_s[at] = s->clock_s;
+    s->ring_temp_c[at] = temperature_c;
+    n = ++s->count;
+    if (n < 2) return 0;
+    for (k = 0; k < n; k++) {{
+        at = (s->head + k) % {up}_RATE_CAPACITY;
+        t_mean += s->ring_t_s[at] - s->clock_s;
+        y_mean += s->ring_temp_c[at] - temperature_c;
+    }}
+    t_mean /= n;
+    y_mean /= (R)n;
+    for (k = 0; k < n; k++) {{
+        at = (s->head + k) % {up}_RATE_CAPACITY;
+        R u = (R)(s->ring_t_s[at] - s->clock_s - t_mean);
+        R v = s->ring_temp_c[at] - temperature_c - y_mean;
+        sxx += u * u;
+        sxy += u * v;
+    }}
+    return sxx > 0 ? sxy / sxx : 0;
+}}
+""")
+    if method not in ("poly3", "poly3_rate", "model"):
+        low, high = spec["x_low"], spec["x_high"]
+        span = [hi - lo if hi - lo > 0 else 1.0 for lo, hi in zip(low, high)]
+        y_span = spec["y_high"] - spec["y_low"]
+        y_span = y_span if y_span > 0 else 1.0
+        t_lo, t_hi = spec["temp_range_c"]
+        r_lo, r_hi = spec["rate_range"]
+        act = "TC_TANH(a)" if spec["hidden_activation"] == "tanh" else "(R)0.5 * ((R)1 + TC_TANH((R)0.5 * a))"
+        out = "TC_TANH(z)" if spec["output_activation"] == "tanh" else "z"
+        w_in = spec["wx"] if recurrent else spec["w1"]
+        parts.append(f"""
+static const R W_IN[{h}][2] = {{{', '.join(_array(row) for row in w_in)}}};
+static const R B1[{h}] = {_array(spec['b1'])};
+static const R W2[{h}] = {_array(spec['w2'])};
+static const R B2 = {_lit(spec['b2'])};
+""" + (f"static const R W_C[{h}][{h}] = {{{', '.join(_array(row) for row in spec['wc'])}}};\n" if recurrent else "")
+                     + f"""
+/* The network's output (the offset) for [T, dT/dt], held to the training box, scaled to [-1, 1];
+   hidden: its hidden outputs, drive: W_c context + b1 (Elman) or b1. */
+static R network(R temperature_c, R rate, const R *drive, R *hidden)
+{{
+    int j;
+    R t = temperature_c < (R){_lit(t_lo)} ? (R){_lit(t_lo)} : (temperature_c > (R){_lit(t_hi)} ? (R){_lit(t_hi)} : temperature_c);
+    R r = rate < (R){_lit(r_lo)} ? (R){_lit(r_lo)} : (rate > (R){_lit(r_hi)} ? (R){_lit(r_hi)} : rate);
+    R x0 = (R)2 * (t - (R){_lit(low[0])}) / (R){_lit(span[0])} - (R)1;
+    R x1 = (R)2 * (r - (R){_lit(low[1])}) / (R){_lit(span[1])} - (R)1;
+    R z = 0;
+    for (j = 0; j < {h}; j++) {{
+        R a = x0 * W_IN[j][0] + x1 * W_IN[j][1] + drive[j];
+        hidden[j] = {act};
+        z += hidden[j] * W2[j];
+    }}
+    z += B2;
+    return ({out} + (R)1) * (R)0.5 * (R){_lit(y_span)} + (R){_lit(spec['y_low'])};
+}}
+""")
+    init = [f"void {name}_init({name}_state *s)\n{{", "    s->clock_s = 0.0;", "    s->samples = 0;"]
+    if rated:
+        init += ["    s->head = 0;", "    s->count = 0;", "    s->dropped = 0;"]
+    if recurrent:
+        init += ["    {", "        int j;", f"        for (j = 0; j < {h}; j++) {{",
+                 "            s->context[j] = 0;", "            s->pending[j] = 0;", "            s->drive[j] = B1[j];",
+                 "        }", "    }", "    s->bin = 0;", "    s->bin_count = 0;", "    s->bin_temp_sum = 0;",
+                 "    s->bin_rate_sum = 0;"]
+    parts.append("\n" + "\n".join(init) + "\n}\n")
+    update = [f"\n{name}_real {name}_update({name}_state *s, {name}_real temperature_c, {name}_real raw, {name}_real dt_s)",
+              "{",
+              "    if (s->samples > 0) s->clock_s += (double)dt_s;",
+              "    if (s->samples < 2147483647) s->samples++;"]
+    if rated:
+        update.append("    {\n    R rate = rate_c_per_s(s, temperature_c);")
+    else:
+        update.append("    {")
+    if method == "model":
+        update.append(body.rstrip("\n"))
+    elif method in ("poly3", "poly3_rate"):
+        update.append(body.rstrip("\n"))
+        if method == "poly3_rate":
+            update.append(f"    offset = offset + (R){_lit(spec['rate_coef'])} * rate;")
+    elif not recurrent:
+        update += [f"    R hidden[{h}];", "    R offset = network(temperature_c, rate, B1, hidden);"]
+    else:
+        update += [f"    R offset;",
+                   f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});",
+                   "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
+                   "        int i, j;",
+                   f"        for (j = 0; j < {h}; j++) s->context[j] = s->pending[j];",
+                   f"        for (i = 0; i < {h}; i++) {{",
+                   "            R a = 0;",
+                   f"            for (j = 0; j < {h}; j++) a += W_C[i][j] * s->context[j];",
+                   "            s->drive[i] = a + B1[i];",
+                   "        }",
+                   "        s->bin_count = 0;",
+                   "        s->bin_temp_sum = 0;",
+                   "        s->bin_rate_sum = 0;",
+                   "    }",
+                   "    s->bin = bin;",
+                   "    s->bin_count++;",
+                   "    s->bin_temp_sum += temperature_c;",
+                   "    s->bin_rate_sum += rate;",
+                   "    offset = network(s->bin_temp_sum / (R)s->bin_count, s->bin_rate_sum / (R)s->bin_count, "
+                   "s->drive, s->pending);"]
+    update += ["    return raw - offset;", "    }", "}\n"]
+    parts.append("\n".join(update))
+    return "".join(parts)
+
+
+def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = "") -> list[Path]:
+    """Write ``<name>.h`` and ``<name>.c`` of ``spec`` into ``folder``; their paths."""
+    src = c_sources(spec, name, about)
+    folder = Path(folder)
+    paths = [folder / f"{name}.h", folder / f"{name}.c"]
+    paths[0].write_text(src.header)
+    paths[1].write_text(src.source)
+    return paths
