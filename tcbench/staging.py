@@ -47,11 +47,14 @@ def refusal_line(exc: OutputRefusedError, hint: str = "out=") -> str:
     return str(exc)
 
 
+REPLACED = "tcbench: overwrite=true: replaced "  # how the line below starts
+
+
 def replaced_line(replaced: list[Path], shown: int = 5) -> str:
     """The one line an ``overwrite=true`` command prints for the files it replaced."""
     names = ", ".join(str(p) for p in replaced[:shown])
     more = len(replaced) - shown
-    return f"tcbench: overwrite=true: replaced {names}" + (f" and {more} more file{'s' * (more > 1)}" if more > 0 else "")
+    return f"{REPLACED}{names}" + (f" and {more} more file{'s' * (more > 1)}" if more > 0 else "")
 
 
 def _inside(path: Path, root: Path) -> bool:

@@ -291,3 +291,17 @@ def test_the_matlab_preset_has_its_own_method_name() -> None:
 
     assert compensation_label({"name": "bp", "training": "gd", "preset": "matlab"}, {"name": "ifa"}) == "IFA-BP-gd-matlab"
     assert compensation_label({"name": "bp", "training": "lm", "preset": None}, {"name": "none"}) == "random-BP-lm"
+
+
+def test_a_learner_let_to_extrapolate_has_its_own_method_name() -> None:
+    """task.clamp_inputs=false names the fitted learners' rows apart from the default's clamped ones;
+    the baselines, which take no learner inputs, keep their names."""
+    from tcbench.runner.kinds.compensation import compensation_label
+
+    free = {"name": "msra_zerobias", "clamp_inputs": False}
+    held = {"name": "msra_zerobias", "clamp_inputs": True}
+    assert compensation_label({"name": "bp", "training": "gd"}, {"name": "ifa"}, free) == "IFA-BP-gd-unclamped"
+    assert compensation_label({"name": "bp", "training": "gd"}, {"name": "ifa"}, held) == "IFA-BP-gd"
+    assert compensation_label({"name": "poly", "offsets": "per_run"}, {"name": "none"}, free) == "poly3_runs-unclamped"
+    assert compensation_label({"name": "memoriser"}, {"name": "none"}, free) == "memoriser"
+    assert compensation_label({"name": "lagpoly"}, {"name": "none"}, free) == "lagpoly"

@@ -16,6 +16,7 @@ link out of ``out`` is refused, as by every command.
 
 from __future__ import annotations
 
+import io
 import sys
 import textwrap
 import time
@@ -30,6 +31,7 @@ from tcbench.commands.schemas import QuickstartConfig
 from tcbench.diagnose.significance import ROBUST_WALD, SURROGATE
 from tcbench.errors import ConfigError
 from tcbench.papers import SEED_000
+from tcbench.staging import REPLACED
 
 HEADER = """\
 tcbench: a benchmark for temperature compensation of MEMS inertial sensors. It simulates sensors
@@ -303,8 +305,14 @@ def _diagnosis(cfg: QuickstartConfig, sweep: str, experiment: str, uri: str | No
     # the job tcbench diagnose runs (its report, and its run in MLflow), over an earlier quickstart's report
     c = as_dict(OmegaConf.structured(DiagnoseConfig(recording=str(path), out=str(out), overwrite=True)))
     c["tracking"] |= {"uri": uri, "experiment": experiment, "sweep_id": sweep}
-    with (out.parent / LOG).open("a") as log, redirect_stdout(log):  # its summary lines: the quickstart prints its own
+    said = io.StringIO()
+    with redirect_stdout(said):  # its summary lines go to the log (the quickstart prints its own) ...
         outcome = run_job(c)
+    with (out.parent / LOG).open("a") as log:
+        log.write(said.getvalue())
+    for line in said.getvalue().splitlines():  # ... but not what it replaced of an earlier quickstart
+        if line.startswith(REPLACED):
+            print(line)
     if isinstance(outcome, JobFailure):
         if outcome.user:
             raise ConfigError(outcome.error)

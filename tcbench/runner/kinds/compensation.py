@@ -39,6 +39,7 @@ def _poly_label(learner: dict[str, Any]) -> str:
 WITHOUT_PIPELINE = frozenset(name for name in BASELINES if name.startswith("oracle")) | {"model"}
 PIPELINE_ALONE = frozenset({"raw"})
 
+UNCLAMPED = "-unclamped"  # the label's suffix when task.clamp_inputs=false (the default holds inputs to the training range)
 LEARNER_LABELS = {"bp": "BP"}  # a searched learner's name in its row's label where it differs (IFA-BP-gd)
 
 # The rows named without an optimiser, by learner: the baselines and the fitted polynomial.
@@ -49,7 +50,8 @@ FIXED_LABELS: dict[str, Callable[[dict[str, Any]], str]] = {
 
 
 def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task: dict[str, Any] | None = None) -> str:
-    """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm``, ``random-BP-lm-matlab`` (``learner.preset=matlab``) ...; for
+    """Leaderboard name: ``raw``, ``oracle``, ``diagnosed`` (``learner=model``), ``poly3`` (``poly3_rate`` with the temperature rate, ``poly3_runs`` fitted within runs), ``IFA-BP-gd``, ``random-BP-lm``, ``random-BP-lm-matlab`` (``learner.preset=matlab``), ``poly3-unclamped`` (a fitted
+    learner with ``task.clamp_inputs=false``) ...; for
     the gyro task prefixed by its pipeline: ``MOVMD-TFPF+BAS-elman-adam``, ``WTD``, ``EMD-WTD+SA-BP-gd``
     (not the rows that run without it: the oracles and ``diagnosed``)."""
     if learner.get("label"):
@@ -63,6 +65,8 @@ def compensation_label(learner: dict[str, Any], optimiser: dict[str, Any], task:
         label = f"{prefix}-{LEARNER_LABELS.get(name, name)}"
         label = f"{label}-{learner['training']}" if learner.get("training") else label
         label = f"{label}-{learner['preset']}" if learner.get("preset") else label  # IFA-BP-gd-matlab
+    if task is not None and task.get("clamp_inputs") is False and name not in BASELINES:
+        label += UNCLAMPED  # a fitted learner let to extrapolate beside the default's clamped row
     pipeline = task_spec(str(task["name"])).pipeline if task is not None else None
     if pipeline is None or name in WITHOUT_PIPELINE:
         return label
