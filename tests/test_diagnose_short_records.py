@@ -132,8 +132,8 @@ def test_each_open_world_term_says_why_it_cannot_be_tested() -> None:
                          "second_node"]
     assert why["bias_step"] == why["transient"] == why_no_steps(tiny.t_s)
     assert why["periodic"] == why["gated_periodic"] == why["duty_cycle"] == why_no_lines(tiny.t_s)
-    assert why["second_node"] == ("a second thermal node needs what thermal lag needs: the temperature never changes "
-                                  "faster than 0.05 degC/min")
+    assert why["second_node"] == ("a second thermal node needs what thermal lag needs: the thermometer never moves "
+                                  "faster than 0 degC/min; a thermal lag needs ramps of at least 0.05 degC/min")
     t = np.arange(500.0)  # steps testable after the first 50 s block, but under 600 s of record after it
     short = _data(t, 20.0 + 10.0 * t / t[-1])
     fold = (t // 50.0).astype(np.int64) % 5

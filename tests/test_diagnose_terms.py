@@ -143,12 +143,28 @@ def test_skip_reasons_where_the_recording_cannot_show_the_effect() -> None:
     t_s = np.arange(n, dtype=float)
     rising = dataclasses.replace(d, t_s=t_s, temp_c=10.0 + t_s / 60.0, rate_c_per_s=np.full(n, 1 / 60.0),
                                  input=d.input[:n], temp_raw_c=10.0 + t_s / 60.0)
-    assert "only moves one way" in str(term("hysteresis").skip(rising))
+    assert "only rises faster than 0.05 degC/min" in str(term("hysteresis").skip(rising))
     assert term("thermal_lag").skip(rising) is None
     still = dataclasses.replace(rising, rate_c_per_s=np.zeros(n))
     for effect in ("thermal_lag", "temperature_rate"):
-        assert "never changes faster" in str(term(effect).skip(still))
+        assert "never moves faster than 0 degC/min" in str(term(effect).skip(still))
         assert Designer(still).why_not_identifiable(effect) == term(effect).skip(still)
+
+
+def test_a_slow_heat_and_cool_is_refused_for_its_rate_not_as_one_way() -> None:
+    """Issue 46: a 25 h record heating and cooling at 0.02 degC/min was refused hysteresis because
+    "the temperature only moves one way", though it moves both ways: too slowly to count."""
+    n = 3600
+    t_s = np.arange(n, dtype=float)
+    rate_c_per_s = np.where(t_s < n / 2, 0.02, -0.02) / 60.0
+    temp_c = 20.0 + np.cumsum(rate_c_per_s)
+    d = _data()
+    slow = dataclasses.replace(d, t_s=t_s, temp_c=temp_c, rate_c_per_s=rate_c_per_s, input=d.input[:n],
+                               temp_raw_c=temp_c)
+    for effect in ("hysteresis", "thermal_lag", "temperature_rate"):
+        why = str(term(effect).skip(slow))
+        assert "never moves faster than 0.02 degC/min" in why and "at least 0.05 degC/min" in why
+        assert "one way" not in why
 
 
 def test_unknown_ids_are_refused() -> None:

@@ -8,7 +8,8 @@ the model leaves, not flicker; and the recheck may not hand flicker structure th
 shows. The Allan test reads the in-sample residual: a held-out one carries each fold's
 coefficient error, constant over its blocks, which looks like slow noise. The test's
 false-alarm probability is :class:`~tcbench.diagnose.settings.FlickerSettings`; the recheck takes
-each kept effect's score variance under the flicker found exactly (no draws, so no seed).
+each kept effect's score variance under the flicker found exactly (no draws, so no seed), drops
+the weakest first and measures the flicker again after each drop.
 """
 
 from __future__ import annotations
@@ -113,9 +114,12 @@ def final_rmse(att: Attribution) -> float:
 @dataclass(frozen=True)
 class FlickerScreen(Screen):
     """The Allan test of the final residual; when it finds flicker behind kept effects, they are
-    tested again with that flicker in the noise model (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`)
-    and the test is run again on what remains (``settings.screens.flicker``, its shortest tau
-    ``settings.locate.min_allan_samples``)."""
+    tested again with that flicker in the noise model, the weakest dropped first and the flicker
+    measured again on what remains after each drop, never past where the reference shows
+    deterministic structure (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`); the test
+    is run again on what remains (``settings.screens.flicker``, its shortest tau
+    ``settings.locate.min_allan_samples``), and the flicker it names is the one the kept effects
+    were judged against."""
 
     settings: DiagnoseSettings = DEFAULTS
     id = ID
@@ -138,7 +142,13 @@ class FlickerScreen(Screen):
             return replace(found, b=None)
         if found.b is None or len(att.final.ids) <= len(att.base.ids):
             return found
-        rechecked = recheck_with_flicker(att, found.b)
+        settings = self.settings
+
+        def flicker_of(model: Model, fit: Fit) -> float | None:
+            return flicker_test(att, fit, model, settings.screens.flicker.false_alarm,
+                                settings.locate.min_allan_samples)[1]
+
+        rechecked = recheck_with_flicker(att, found.b, flicker_of, reference.structure_remains)
         if rechecked is att or reference.structure_remains(final_rmse(rechecked)):
             return found
         allan, b = self.test(rechecked)

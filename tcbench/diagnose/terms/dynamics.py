@@ -19,10 +19,22 @@ def _moves(data: DiagnosisData) -> tuple[np.ndarray, np.ndarray]:
     return data.rate_c_per_s > MIN_RATE_C_PER_S, data.rate_c_per_s < -MIN_RATE_C_PER_S
 
 
-def _still(data: DiagnosisData) -> str | None:
+def _fastest_c_per_min(data: DiagnosisData) -> float:
+    """The thermometer's fastest rate of change, either way (degC/min)."""
+    return float(np.max(np.abs(data.rate_c_per_s), initial=0.0)) * 60.0
+
+
+def _too_slow(data: DiagnosisData, effect: str) -> str:
+    """Why ``effect`` cannot be told on a record whose temperature never moves faster than
+    :data:`MIN_RATE_C_PER_S`: how fast it does move, and what the term needs."""
+    return (f"the thermometer never moves faster than {_fastest_c_per_min(data):.2g} degC/min; {effect} needs "
+            f"ramps of at least {MIN_RATE_C_PER_S * 60.0:g} degC/min")
+
+
+def _still(data: DiagnosisData, effect: str) -> str | None:
     rising, falling = _moves(data)
     if not (rising | falling).any():
-        return "the temperature never changes faster than 0.05 degC/min"
+        return _too_slow(data, effect)
     return None
 
 
@@ -46,7 +58,7 @@ class ThermalLagTerm(Term):
     }
 
     def skip(self, data: DiagnosisData) -> str | None:
-        return _still(data)
+        return _still(data, "a thermal lag")
 
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
         return (
@@ -78,7 +90,7 @@ class TemperatureRateTerm(Term):
         return self.effect_column(data, value, temp_c)
 
     def skip(self, data: DiagnosisData) -> str | None:
-        return _still(data)
+        return _still(data, "a temperature-rate term")
 
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
         c = params["coef_per_c_per_s"]
@@ -125,9 +137,12 @@ class HysteresisTerm(Term):
 
     def skip(self, data: DiagnosisData) -> str | None:
         rising, falling = _moves(data)
+        if not (rising | falling).any():  # heating and cooling too slowly to count, not one way
+            return _too_slow(data, "hysteresis") + ", heating and cooling through the same temperatures"
         if not (rising.any() and falling.any()):
-            return ("the temperature only moves one way; hysteresis needs the same temperatures reached heating "
-                    "and cooling")
+            return (f"the temperature only {'rises' if rising.any() else 'falls'} faster than "
+                    f"{MIN_RATE_C_PER_S * 60.0:g} degC/min; hysteresis needs the same temperatures reached "
+                    "heating and cooling")
         return None
 
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
