@@ -2,12 +2,41 @@
 
 from __future__ import annotations
 
+import errno
+import os
 import re
+import stat
 from collections.abc import Iterable, Mapping
 
 
 class ConfigError(ValueError):
     """A config value is out of range or names something unknown."""
+
+
+# what a path that is not a regular file is, by its ``st_mode`` type
+_FILE_KINDS = ((stat.S_ISFIFO, "a named pipe"), (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"),
+               (stat.S_ISBLK, "a block device"))
+
+
+def file_problem(path: str | os.PathLike[str]) -> str | None:
+    """What stops ``path`` being read as an input file, named by what it is ("no such file",
+    "a symlink loop", "no such file (a broken symlink ...)", "a named pipe, not a regular file", ...); None for a
+    regular file or a directory (a directory is left to the reader's own message). Never opens
+    the path, so a named pipe without a writer cannot block."""
+    if not os.path.lexists(path):
+        return "no such file"
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "a symlink loop (the link leads back to itself)"
+        if exc.errno == errno.ENOENT:
+            return f"no such file (a broken symlink to {os.readlink(path)})"
+        return f"cannot be read ({exc.strerror})"
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None
+    kind = next((name for test, name in _FILE_KINDS if test(mode)), "a special file")
+    return f"{kind}, not a regular file"
 
 
 def error_line(text: str) -> str:
