@@ -39,6 +39,14 @@ def file_problem(path: str | os.PathLike[str]) -> str | None:
     return f"{kind}, not a regular file"
 
 
+def listed(names: Iterable[str], first: int = 5) -> str:
+    """``names`` quoted and joined, at most ``first`` of them and then how many more (a header of
+    20 000 unknown columns is one short line, not 87 KB)."""
+    names = list(names)
+    shown = ", ".join(map(repr, names[:first]))
+    return shown if len(names) <= first else f"{shown} and {len(names) - first} more ({len(names)} in all)"
+
+
 def error_line(text: str) -> str:
     """One line of an error's text: the first, or where a database names its error (SQLAlchemy
     puts "(sqlite3.OperationalError) database or disk is full" below a line about autoflush)."""

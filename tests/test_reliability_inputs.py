@@ -311,3 +311,28 @@ def test_lines_ending_in_cr_alone_are_named(workdir: Path, capsys: pytest.Captur
     path.write_bytes(path.read_bytes().replace(b"\n", b"\r"))
     line = refused(capsys, workdir, [*command, OFF], "rec.csv: lines end in a carriage return (CR) alone")
     assert "64 KiB" not in line
+
+
+# -- 7. messages that fit on a line ---------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [["metrics", "rec.parquet", "out=m"], ["diagnose", "recording=rec.parquet", "out=d"]],
+                         ids=lambda c: c[0])
+def test_twenty_thousand_unknown_columns_are_one_short_line(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                            command: list[str]) -> None:
+    """A recording with 20 000 unknown columns was refused in one line 87 KB long."""
+    import pandas as pd
+
+    rec = pd.read_csv(gyro(workdir / "rec.csv", rows=50))
+    extra = pd.DataFrame(np.zeros((len(rec), 20_000)), columns=[f"c{i}" for i in range(20_000)])
+    pd.concat([rec, extra], axis=1).to_parquet(workdir / "rec.parquet")
+    line = refused(capsys, workdir, [*command, OFF], "rec.parquet: unknown column 'c0', 'c1'", "20000")
+    assert len(line) < 300 and "'c19999'" not in line, len(line)
+
+
+@pytest.mark.parametrize("rows", [1, 10])
+def test_diagnose_on_a_record_too_short_to_test_anything_is_one_line(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                                     rows: int) -> None:
+    """A 1-row and a 10-row record exited 0 with a short-record report in which nothing ran."""
+    gyro(workdir / "rec.csv", rows=rows)
+    refused(capsys, workdir, ["diagnose", "recording=rec.csv", "out=d", OFF], "rec.csv: too short to test anything",
+            f"{rows} sample", "at least 30 samples")
