@@ -97,6 +97,10 @@ BAD_VALUES = [  # (command line, words its one line holds)
     (["simulate", "sensor=gyro", "protocol=static", "out="], ["out=", "folder"]),
     (["run", "-m", "task=sphere", "budget=20", "hydra.launcher.n_jobs=0"], ["hydra.launcher.n_jobs=0", "positive"]),
     (["run", "--cfg", "bogus"], ["--cfg bogus", "job, hydra or all"]),
+    (["run", "task=sphere", "budget=20", "tracking.uri=sqlite:///"], ["sqlite:///", "no database file"]),
+    (["run", "task=sphere", "budget=20", "tracking.uri=sqlite://"], ["sqlite://", "no database file"]),
+    (["simulate", "sensor=gyro", "protocol=static", "effects.hysteresis.amplitude=nan"],
+     ["effects.hysteresis.amplitude: nan is not finite"]),
 ]
 
 
