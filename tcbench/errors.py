@@ -47,6 +47,15 @@ def listed(names: Iterable[str], first: int = 5) -> str:
     return shown if len(names) <= first else f"{shown} and {len(names) - first} more ({len(names)} in all)"
 
 
+def disk_full(exc: BaseException) -> str | None:
+    """The words for a write the disk (or the user's quota) had no room for, naming the file when
+    the error does; None for any other error."""
+    if not isinstance(exc, OSError) or exc.errno not in (errno.ENOSPC, errno.EDQUOT):
+        return None
+    where = f" {exc.filename}" if exc.filename else ""
+    return f"the disk is full: cannot write{where} ({exc.strerror or os.strerror(exc.errno)})"
+
+
 def error_line(text: str) -> str:
     """One line of an error's text: the first, or where a database names its error (SQLAlchemy
     puts "(sqlite3.OperationalError) database or disk is full" below a line about autoflush)."""

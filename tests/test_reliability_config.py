@@ -320,3 +320,24 @@ def test_compensation_board_counts_failed_runs_in_median_and_interval() -> None:
     assert table.loc["crashy", "failed"] == 7 and np.isinf(table.loc["crashy", "median_drift_ug"])
     assert "failed" in table.loc["crashy", "ci95_drift_ug"]
     assert list(table.index) == ["steady", "crashy"]
+
+
+def test_a_job_failing_on_a_full_disk_says_so_in_words(workdir: Path, monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """calibrate (any job) whose artifact could not be written said "OSError: [Errno 28] No space
+    left on device": its line says the disk is full and what could not be written."""
+    import errno
+
+    from tcbench.tracking.store import JobRun
+
+    def full(self, path):  # type: ignore[no-untyped-def]
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setattr(JobRun, "log_artifact", full)
+    assert main(["run", "task=sphere", "budget=20"]) == 1
+    captured = capsys.readouterr()
+    text = captured.out + captured.err
+    (line,) = [ln for ln in text.splitlines() if "FAILED ifa" in ln]
+    assert "the disk is full: cannot write" in line and "config.yaml (No space left on device)" in line, line
+    assert "[Errno" not in text and "Traceback" not in text
+    assert [s for s, _ in statuses(workdir)] == ["FAILED"]

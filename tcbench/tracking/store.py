@@ -31,6 +31,7 @@ from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 from tcbench._version import __version__  # noqa: E402
+from tcbench.errors import disk_full  # noqa: E402
 from tcbench.tracking.checks import (  # noqa: E402,F401 - the checks are part of this module's interface
     StoreError,
     check_store,
@@ -293,7 +294,8 @@ def ended_by(exc: BaseException) -> tuple[str, str]:
     FAILED for anything else (a store that cannot be written included)."""
     if isinstance(exc, KeyboardInterrupt):
         return "KILLED", INTERRUPTED
-    return "FAILED", f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+    return "FAILED", f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else \
+        disk_full(exc) or f"{type(exc).__name__}: {exc}"
 
 
 def unwritable(uri: str, why: str, runs: str, sweep_id: str | None = None) -> StoreError:
