@@ -2,12 +2,58 @@
 
 from __future__ import annotations
 
+import errno
+import os
 import re
+import stat
 from collections.abc import Iterable, Mapping
 
 
 class ConfigError(ValueError):
     """A config value is out of range or names something unknown."""
+
+
+# what a path that is not a regular file is, by its ``st_mode`` type
+_FILE_KINDS = ((stat.S_ISFIFO, "a named pipe"), (stat.S_ISSOCK, "a socket"), (stat.S_ISCHR, "a character device"),
+               (stat.S_ISBLK, "a block device"))
+
+
+def file_problem(path: str | os.PathLike[str]) -> str | None:
+    """What stops ``path`` being read as an input file, named by what it is ("no such file",
+    "a symlink loop", "no such file (a broken symlink ...)", "a named pipe, not a regular file", ...); None for a
+    regular file or a directory (a directory is left to the reader's own message). Never opens
+    the path, so a named pipe without a writer cannot block."""
+    if not os.path.lexists(path):
+        return "no such file"
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            return "a symlink loop (the link leads back to itself)"
+        if exc.errno == errno.ENOENT:
+            return f"no such file (a broken symlink to {os.readlink(path)})"
+        return f"cannot be read ({exc.strerror})"
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None
+    kind = next((name for test, name in _FILE_KINDS if test(mode)), "a special file")
+    return f"{kind}, not a regular file"
+
+
+def listed(names: Iterable[str], first: int = 5) -> str:
+    """``names`` quoted and joined, at most ``first`` of them and then how many more (a header of
+    20 000 unknown columns is one short line, not 87 KB)."""
+    names = list(names)
+    shown = ", ".join(map(repr, names[:first]))
+    return shown if len(names) <= first else f"{shown} and {len(names) - first} more ({len(names)} in all)"
+
+
+def disk_full(exc: BaseException) -> str | None:
+    """The words for a write the disk (or the user's quota) had no room for, naming the file when
+    the error does; None for any other error."""
+    if not isinstance(exc, OSError) or exc.errno not in (errno.ENOSPC, errno.EDQUOT):
+        return None
+    where = f" {exc.filename}" if exc.filename else ""
+    return f"the disk is full: cannot write{where} ({exc.strerror or os.strerror(exc.errno)})"
 
 
 def error_line(text: str) -> str:

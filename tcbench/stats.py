@@ -17,6 +17,24 @@ def with_failures(values: np.ndarray, failed: int = 0, higher_is_better: bool = 
     return np.concatenate([x[~np.isnan(x)], np.full(int(failed), worst)])
 
 
+def failure_tie_break(values: np.ndarray, failed: int = 0, higher_is_better: bool = False) -> dict[str, float]:
+    """Sort keys (lower ranks higher) that order methods whose median counting failures ties,
+    typically at ``±inf``: a method without any finished run last, then the smaller share of
+    failed runs, then the better median of the finished runs."""
+    x = np.asarray(values, dtype=float)
+    x = x[np.isfinite(x)]
+    runs = x.size + int(failed)
+    median = float(np.median(x)) if x.size else np.inf
+    return {
+        "_no_finished": float(x.size == 0),
+        "_failed_share": int(failed) / runs if runs else 1.0,
+        "_finished_median": -median if higher_is_better and x.size else median,
+    }
+
+
+TIE_BREAK_KEYS = ["_failed_share", "_finished_median"]
+
+
 def percentiles(values: np.ndarray, q: list[float]) -> np.ndarray:
     """``np.percentile`` (linear) of values that may hold ``±inf`` (failed runs): a percentile
     that falls on, or between a finite value and, an infinite one is that infinity."""

@@ -22,9 +22,16 @@ def fresh_logging(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def snapshot(root: Path) -> dict[str, str]:
-    """Every file and folder under ``root`` with a digest of its content."""
-    return {str(p.relative_to(root)): "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
-            for p in sorted(root.rglob("*"))}
+    """Every file and folder under ``root`` with a digest of its content (a named pipe, a link
+    loop ... by what it is, never opened)."""
+    def digest(p: Path) -> str:
+        if p.is_dir():
+            return "dir"
+        if p.is_file():
+            return hashlib.sha256(p.read_bytes()).hexdigest()
+        return f"special {p.lstat().st_mode:o}"
+
+    return {str(p.relative_to(root)): digest(p) for p in sorted(root.rglob("*"))}
 
 
 def refused(capsys: pytest.CaptureFixture[str], root: Path, args: list[str], *names: str) -> str:

@@ -97,6 +97,10 @@ BAD_VALUES = [  # (command line, words its one line holds)
     (["simulate", "sensor=gyro", "protocol=static", "out="], ["out=", "folder"]),
     (["run", "-m", "task=sphere", "budget=20", "hydra.launcher.n_jobs=0"], ["hydra.launcher.n_jobs=0", "positive"]),
     (["run", "--cfg", "bogus"], ["--cfg bogus", "job, hydra or all"]),
+    (["run", "task=sphere", "budget=20", "tracking.uri=sqlite:///"], ["sqlite:///", "no database file"]),
+    (["run", "task=sphere", "budget=20", "tracking.uri=sqlite://"], ["sqlite://", "no database file"]),
+    (["simulate", "sensor=gyro", "protocol=static", "effects.hysteresis.amplitude=nan"],
+     ["effects.hysteresis.amplitude: nan is not finite"]),
 ]
 
 
@@ -267,6 +271,41 @@ def test_optimisation_board_counts_failed_runs_in_median_and_interval() -> None:
     assert row.count("failed") >= 3  # median, ci95_high and the IQR
 
 
+def test_optimisation_board_breaks_a_failed_median_tie_by_fewer_failures() -> None:
+    """Ten seeds each: 0, 10, 7 and 5 failed. The three with median "failed" were ranked by name
+    (allfail above flaky and halffail); fewer failures rank higher, no finished run last."""
+    from tcbench.leaderboard.optimisation import summarise
+
+    runs = pd.concat([_optimisation_runs("fa", list(np.linspace(1, 2, 10)), 0),
+                      _optimisation_runs("allfail", [], 10),
+                      _optimisation_runs("flaky", [0.1, 0.2, 0.3], 7),
+                      _optimisation_runs("halffail", [3.0, 3.1, 3.2, 3.3, 3.4], 5)], ignore_index=True)
+    table = summarise(runs)
+    assert list(table["method"]) == ["fa", "halffail", "flaky", "allfail"]
+    # equal failures: the better finished runs rank higher
+    tied = pd.concat([_optimisation_runs("worse", [9.0, 9.5, 9.9], 7),
+                      _optimisation_runs("better", [0.5, 0.6, 0.7], 7)], ignore_index=True)
+    assert list(summarise(tied)["method"]) == ["better", "worse"]
+    # COCO's ERT rule stays: 30 % success above 0 %, whatever the failures
+    coco = runs.copy()
+    coco.loc[(coco["method"] == "flaky") & (coco["status"] == "FINISHED"), ["target_hit", "evals_to_target"]] = [True, 50]
+    assert list(summarise(coco)["method"]) == ["flaky", "fa", "halffail", "allfail"]
+
+
+def test_compensation_board_breaks_a_failed_median_tie_by_fewer_failures() -> None:
+    from tcbench.leaderboard.compensation import summarise
+
+    def runs(method: str, drifts: list[float], failed: int) -> list[dict[str, object]]:
+        done = [{"status": "FINISHED", "drift_ug": d, "raw_drift_ug": 100.0, "hysteresis_ug": d,
+                 "temp_slope_ug_per_c": d, "train_rmse_ug": d} for d in drifts]
+        return [{"method": method, "seed": i, **r} for i, r in
+                enumerate(done + [{"status": "FAILED"}] * failed)]
+
+    table = summarise(pd.DataFrame(runs("allfail", [], 10) + runs("flaky", [1.0, 1.1, 1.2], 7)
+                                   + runs("halffail", [2.0] * 5, 5) + runs("steady", [5.0] * 10, 0)), "chamber")
+    assert list(table["method"]) == ["steady", "halffail", "flaky", "allfail"]
+
+
 def test_compensation_board_counts_failed_runs_in_median_and_interval() -> None:
     from tcbench.leaderboard.compensation import summarise
 
@@ -281,3 +320,24 @@ def test_compensation_board_counts_failed_runs_in_median_and_interval() -> None:
     assert table.loc["crashy", "failed"] == 7 and np.isinf(table.loc["crashy", "median_drift_ug"])
     assert "failed" in table.loc["crashy", "ci95_drift_ug"]
     assert list(table.index) == ["steady", "crashy"]
+
+
+def test_a_job_failing_on_a_full_disk_says_so_in_words(workdir: Path, monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """calibrate (any job) whose artifact could not be written said "OSError: [Errno 28] No space
+    left on device": its line says the disk is full and what could not be written."""
+    import errno
+
+    from tcbench.tracking.store import JobRun
+
+    def full(self, path):  # type: ignore[no-untyped-def]
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setattr(JobRun, "log_artifact", full)
+    assert main(["run", "task=sphere", "budget=20"]) == 1
+    captured = capsys.readouterr()
+    text = captured.out + captured.err
+    (line,) = [ln for ln in text.splitlines() if "FAILED ifa" in ln]
+    assert "the disk is full: cannot write" in line and "config.yaml (No space left on device)" in line, line
+    assert "[Errno" not in text and "Traceback" not in text
+    assert [s for s, _ in statuses(workdir)] == ["FAILED"]

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import threading
 from dataclasses import replace
 
 from pathlib import Path
@@ -244,3 +246,93 @@ def test_a_positional_file_with_an_equals_sign_names_file_and_key(workdir: Path,
     gyro(workdir / "a=b.csv", rows=200)
     refused(capsys, workdir, ["metrics", "a=b.csv", OFF], "a=b.csv", "'a' is no key", "recording=a=b.csv")
     ran(capsys, ["metrics", "recording=a=b.csv", "out=m", OFF])
+
+
+# -- 6. files that are not regular files, and lines that end in CR alone ---------------------
+
+WHAT_READS = [["diagnose", "recording=rec.csv", "out=d"], ["metrics", "rec.csv", "out=m"],
+              ["import", "csv=rec.csv", "sensor=gyro", "time=time_s:s", "temperature=temperature_c:degC",
+               "output=output:deg/s", "out=i"],
+              ["calibrate", "recording=rec.csv", "out=c", FAST]]
+
+
+class PipeWatch:
+    """Opens the named pipe ``path`` for writing whenever a reader waits on it, and closes it at
+    once (the reader sees an empty file): a command that opens the pipe cannot hang the test, and
+    ``blocked`` says it did."""
+
+    def __init__(self, path: Path) -> None:
+        self.path, self.blocked, self.stop = path, False, threading.Event()
+        self.thread = threading.Thread(target=self._watch, daemon=True)
+
+    def _watch(self) -> None:
+        while not self.stop.wait(0.05):
+            try:
+                fd = os.open(self.path, os.O_WRONLY | os.O_NONBLOCK)  # ENXIO while no one reads
+            except OSError:
+                continue
+            self.blocked = True
+            os.close(fd)
+
+    def __enter__(self) -> PipeWatch:
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop.set()
+        self.thread.join()
+
+
+@pytest.mark.parametrize("command", WHAT_READS, ids=lambda c: c[0])
+def test_a_named_pipe_is_refused_by_what_it_is(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                               command: list[str]) -> None:
+    """diagnose on a named pipe without a writer blocked for ever; metrics, import and calibrate
+    called it "no such file"."""
+    os.mkfifo(workdir / "rec.csv")
+    with PipeWatch(workdir / "rec.csv") as watch:
+        refused(capsys, workdir, [*command, OFF], "rec.csv: a named pipe, not a regular file")
+    assert not watch.blocked
+
+
+@pytest.mark.parametrize("command", WHAT_READS, ids=lambda c: c[0])
+def test_a_symlink_loop_is_refused_by_what_it_is(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                 command: list[str]) -> None:
+    (workdir / "rec.csv").symlink_to("rec.csv")
+    refused(capsys, workdir, [*command, OFF], "rec.csv: a symlink loop")
+
+
+@pytest.mark.parametrize("rows", [5, 5000])
+@pytest.mark.parametrize("command", WHAT_READS, ids=lambda c: c[0])
+def test_lines_ending_in_cr_alone_are_named(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                            command: list[str], rows: int) -> None:
+    """A table whose lines end in CR alone was "the first line is longer than 64 KiB" (or, under
+    64 KiB, a header of every row)."""
+    path = gyro(workdir / "rec.csv", rows=rows)
+    path.write_bytes(path.read_bytes().replace(b"\n", b"\r"))
+    line = refused(capsys, workdir, [*command, OFF], "rec.csv: lines end in a carriage return (CR) alone")
+    assert "64 KiB" not in line
+
+
+# -- 7. messages that fit on a line ---------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [["metrics", "rec.parquet", "out=m"], ["diagnose", "recording=rec.parquet", "out=d"]],
+                         ids=lambda c: c[0])
+def test_twenty_thousand_unknown_columns_are_one_short_line(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                            command: list[str]) -> None:
+    """A recording with 20 000 unknown columns was refused in one line 87 KB long."""
+    import pandas as pd
+
+    rec = pd.read_csv(gyro(workdir / "rec.csv", rows=50))
+    extra = pd.DataFrame(np.zeros((len(rec), 20_000)), columns=[f"c{i}" for i in range(20_000)])
+    pd.concat([rec, extra], axis=1).to_parquet(workdir / "rec.parquet")
+    line = refused(capsys, workdir, [*command, OFF], "rec.parquet: unknown column 'c0', 'c1'", "20000")
+    assert len(line) < 300 and "'c19999'" not in line, len(line)
+
+
+@pytest.mark.parametrize("rows", [1, 10])
+def test_diagnose_on_a_record_too_short_to_test_anything_is_one_line(workdir: Path, capsys: pytest.CaptureFixture[str],
+                                                                     rows: int) -> None:
+    """A 1-row and a 10-row record exited 0 with a short-record report in which nothing ran."""
+    gyro(workdir / "rec.csv", rows=rows)
+    refused(capsys, workdir, ["diagnose", "recording=rec.csv", "out=d", OFF], "rec.csv: too short to test anything",
+            f"{rows} sample", "at least 30 samples")

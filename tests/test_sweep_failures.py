@@ -52,7 +52,7 @@ def site(tmp_path: Path) -> Path:
 
 
 def tcbench(*args: str, cwd: Path, site: Path, timeout: float = 300) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(site)}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(site), os.environ.get("PYTHONPATH")]))}
     env.pop("MLFLOW_TRACKING_URI", None)
     return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=timeout)
@@ -208,14 +208,17 @@ def small_disk(tmp_path: Path):  # type: ignore[no-untyped-def]
         subprocess.run(["umount", "-l", str(where)], capture_output=True)
 
 
-def test_a_full_store_disk_fails_jobs_in_one_line_each(site: Path, tmp_path: Path, small_disk) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize("plots", [[], ["tracking.plots=true"]], ids=["no-plots", "plots"])
+def test_a_full_store_disk_fails_jobs_in_one_line_each(site: Path, tmp_path: Path, small_disk,  # type: ignore[no-untyped-def]
+                                                       plots: list[str]) -> None:
     """A full disk under the store ended in 55-126-line tracebacks and left runs RUNNING, later
     reported as another process's. Now every job ends (FINISHED, FAILED, or no run), each error
-    is one line, and no run is left RUNNING."""
+    is one line, and no run is left RUNNING. With plots, the figure that filled the disk left its
+    run RUNNING: the failed copy (then the failed run's artifacts) are removed to record its end."""
     disk = small_disk("1200k")  # room for the empty store (about 0.95 MB) and some runs
     work = tmp_path / "work"
     work.mkdir()
-    run = tcbench("run", "-m", "task=sphere", "budget=60", "seed=range(40)",
+    run = tcbench("run", "-m", "task=sphere", "budget=60", "seed=range(40)", *plots,
                   f"tracking.uri=sqlite:///{disk / 'mlflow.db'}", cwd=work, site=site)
     assert run.returncode == 1, run.stdout + run.stderr
     assert "Traceback" not in run.stdout + run.stderr

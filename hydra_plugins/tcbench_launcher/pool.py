@@ -16,8 +16,10 @@ import multiprocessing
 import os
 import signal
 import threading
+import time
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
@@ -43,11 +45,30 @@ def _exit_with_parent() -> None:
     threading.Thread(target=watch, daemon=True, name="tcbench-parent-watch").start()
 
 
+@contextmanager
+def _sigint_ignored_by_children() -> Iterator[None]:
+    """Around starting a worker: SIGINT ignored (a disposition a spawned process keeps through
+    ``exec``, so a Ctrl-C at the terminal cannot interrupt a worker still starting, before its
+    own code runs) and blocked meanwhile in this process, so a Ctrl-C then is delivered, not lost,
+    once the handler is back."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
 def _worker(conn: Connection, job: Job, init: Callable[[], None] | None) -> None:
     """Worker loop: ``(index, cfg)`` in; ``("run", index, run_id)`` when the job opens its
     MLflow run and ``("done", index, ok, value)`` out; ``None`` in ends it."""
     _exit_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked while the parent started it
     if init is not None:
         init()
     from tcbench.tracking import store as tracking
@@ -77,6 +98,24 @@ def _died(proc: multiprocessing.process.BaseProcess) -> str:
     return f"exited with code {code}"
 
 
+def _end(procs: list[multiprocessing.process.BaseProcess], at_once: bool, grace_s: float = 5.0) -> None:
+    """End every worker: ``at_once`` (a Ctrl-C, an error) by SIGTERM, else (every job done) each
+    given ``grace_s`` to exit by itself; any left then is killed (SIGKILL). Each is reaped, so
+    none outlives the sweep and none holds its runs when they are marked, and no wait is
+    unbounded: a worker still starting, or slow to exit, cannot hold the sweep's end."""
+    for proc in procs:
+        if at_once and proc.pid is not None and proc.is_alive():
+            proc.terminate()
+    deadline = time.monotonic() + grace_s
+    for proc in procs:
+        if proc.pid is not None:
+            proc.join(max(0.0, deadline - time.monotonic()))
+    for proc in procs:
+        if proc.pid is not None and proc.is_alive():
+            proc.kill()
+            proc.join(1.0)
+
+
 def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
              init: Callable[[], None] | None = None,
              on_lost_run: Callable[[int, str, str], None] | None = None,
@@ -90,10 +129,14 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
     results: list[tuple[bool, Any] | None] = [None] * len(configs)
     busy: dict[Connection, tuple[multiprocessing.process.BaseProcess, int | None, str | None]] = {}
 
+    started: list[multiprocessing.process.BaseProcess] = []  # every worker, ended by the finally below
+
     def start() -> None:
         parent_end, child_end = context.Pipe()
         proc = context.Process(target=_worker, args=(child_end, job, init), daemon=True)
-        proc.start()
+        started.append(proc)  # before it runs: a Ctrl-C while it starts still ends it
+        with _sigint_ignored_by_children():
+            proc.start()
         child_end.close()
         busy[parent_end] = (proc, None, None)
         give(parent_end)
@@ -104,12 +147,15 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
             index, cfg = pending.popleft()
             conn.send((index, cfg))
             busy[conn] = (proc, index, None)
-        else:
-            conn.send(None)
-            proc.join()
+        else:  # no job left: the worker ends by itself, and is reaped when it has (or ended below)
+            try:
+                conn.send(None)
+            except OSError:
+                pass
             conn.close()
             del busy[conn]
 
+    done = False
     try:
         for _ in range(min(n_workers, len(configs))):
             start()
@@ -144,9 +190,7 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
                             on_lost_run(index, run_id, f"WorkerDied: the worker process running the job {why}")
                     if pending:
                         start()
+        done = True
     finally:  # on Ctrl-C too: the workers end, and are reaped, before the sweep marks their runs KILLED
-        for proc, _, _ in busy.values():
-            proc.terminate()
-        for proc, _, _ in busy.values():
-            proc.join(10)
+        _end(started, at_once=not done)
     return [r if r is not None else (False, WorkerDied("the job never ran")) for r in results]

@@ -557,11 +557,32 @@ COMMANDS: dict[str, Callable[[list[str]], int]] = {name: _handler(spec) for name
 
 def main(argv: list[str] | None = None) -> int:
     try:
-        return _main(list(sys.argv[1:] if argv is None else argv))
+        code = _main(list(sys.argv[1:] if argv is None else argv))
     except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: not an error of ours
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so that the interpreter's last flush does not fail again
         return 0
+    if code == INTERRUPTED and argv is None:  # the command itself, not a call from Python
+        _exit_now(code)
+    return code
+
+
+INTERRUPTED = 130  # the exit code of a command ended by Ctrl-C
+
+
+def _exit_now(code: int) -> None:
+    """End the process at once after a Ctrl-C, its runs marked and its workers reaped: the
+    interpreter's teardown (collecting every object of MLflow, Hydra, pandas) took seconds, and
+    on a loaded machine a minute, after the user asked it to stop."""
+    import logging
+
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
 
 
 def _main(argv: list[str]) -> int:
@@ -584,7 +605,7 @@ def _main(argv: list[str]) -> int:
             return exc.code or 0
         raise
     except KeyboardInterrupt:
-        return _fail("interrupted", 130)
+        return _fail("interrupted", INTERRUPTED)
 
 if __name__ == "__main__":
     sys.exit(main())

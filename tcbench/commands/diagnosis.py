@@ -234,6 +234,11 @@ def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str, settings: Any) -> 
         report = short_record(rec, sensor, name=Path(cfg.recording).name, settings=settings)
     except DiagnosisDataError as exc:
         raise CommandError(f"{cfg.recording}: {exc}") from None
+    fewest = min(settings.short.min_fit_samples, 2 * settings.short.min_side_samples + 1)
+    if not report.ran and report.samples < fewest:
+        raise CommandError(f"{cfg.recording}: too short to test anything: {report.samples} sample"
+                           f"{'s' * (report.samples != 1)} over {report.duration_s:.4g} s; the short-record tests "
+                           f"need at least {fewest} samples, a full diagnosis {report.full_duration_s:.0f} s")
     written = _written(write_short_report, report, cfg)
     print(f"tcbench: {report.verdict}")
     ran = [f"{t.id} ({t.status})" for t in report.tests if t.ran]

@@ -4,7 +4,8 @@ Per method: runs (one per seed), failed runs, for each metric the median over re
 bootstrap 95 % interval, the value of the run with the smallest training RMSE ("best of N by
 training RMSE", the paper's selection) and the improvement over the raw output (median over runs of raw ÷ the method, on each run's own test runs).
 Rows are ordered by the median of the task's primary metric (bias variation for full
-temperature, zero-start stability for zero bias). Every median and interval counts a failed run as
+temperature, zero-start stability for zero bias); where that ties (median "failed"), by the smaller
+share of failed runs, then the median of the finished runs, a method without a finished run last. Every median and interval counts a failed run as
 worse than any finished one (:func:`tcbench.stats.with_failures`; "failed" where it falls on
 them), so a method cannot rank, nor show a tight interval, on the few restarts it finished; raw
 and the oracle are deterministic, one run.
@@ -41,7 +42,7 @@ from tcbench.leaderboard.files import (
 from tcbench.tables import markdown_table
 from tcbench.compensation.data import DEFAULT_TIER
 from tcbench.compensation.scoring import FLAGS, METRIC_NAMES, PRIMARY, TRAIN_RMSE
-from tcbench.stats import bootstrap_median_ci, paired_p_value, with_failures
+from tcbench.stats import TIE_BREAK_KEYS, bootstrap_median_ci, failure_tie_break, paired_p_value, with_failures
 from tcbench.leaderboard.paired import (
     draw_column, limit_by_draw, n_draws, paired_gain, paired_ratios, pairing_index, ratio_summary,
 )
@@ -130,13 +131,16 @@ def summarise(runs: pd.DataFrame, protocol: str) -> pd.DataFrame:
             ratio, low, high = ratio_summary(paired_ratios(g, limit, primary))
             row[column], row[f"ci95_{column}"], row[f"_high_{column}"] = ratio, _interval(low, high), high
         row["_rank"] = row[f"median_{SHORT[primary]}"]
+        finished = ok[primary].to_numpy(float) if primary in ok else np.array([])
+        row.update(failure_tie_break(finished, failed, primary in HIGHER_IS_BETTER))
         rows.append(row)
         values[method] = pd.Series(ok[primary].to_numpy(float), index=pairing_index(ok)) if primary in ok else pd.Series(dtype=float)
     table = pd.DataFrame(rows)
     if table.empty:
         return table
-    table = table.sort_values(["_rank", f"median_{SHORT[primary]}"], na_position="last").reset_index(drop=True)
-    table = table.drop(columns="_rank")
+    keys = ["_no_finished", "_rank", *TIE_BREAK_KEYS, f"median_{SHORT[primary]}"]
+    table = table.sort_values(keys, na_position="last", kind="stable").reset_index(drop=True)
+    table = table.drop(columns=["_rank", "_no_finished", *TIE_BREAK_KEYS])
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     names = table["method"].tolist()
     table["p_vs_next"] = [paired_p_value(values[a], values[b]) for a, b in zip(names, names[1:], strict=False)] + [np.nan]

@@ -5,7 +5,9 @@ the final error (best - optimum),
 success rate at the task's target precision, expected running time (ERT) to that target, and a
 rank. ERT = (evaluations spent by all runs, counting a successful run only up to its first hit
 and a failed run at its full budget) / (number of successful runs); infinite when none succeed.
-Rank orders methods by success rate (higher first), then ERT, then median final error. A failed
+Rank orders methods by success rate (higher first), then ERT, then median final error; where
+those tie (a median "failed"), the smaller share of failed runs, then the median of the finished
+runs, ranks higher, and a method without any finished run ranks last. A failed
 run is a failure to reach the target: it counts in the success rate, in ERT at its full budget,
 and in every median, quartile and interval as worse than any finished run (:func:`tcbench.stats.with_failures`:
 ``+inf``, shown "failed"; ``-inf`` for the hypervolume), so a method that failed on half its runs
@@ -34,7 +36,14 @@ from tcbench.leaderboard.files import (
     write_board_files,
 )
 from tcbench.tables import markdown_table
-from tcbench.stats import bootstrap_median_ci, paired_p_value, percentiles, with_failures
+from tcbench.stats import (
+    TIE_BREAK_KEYS,
+    bootstrap_median_ci,
+    failure_tie_break,
+    paired_p_value,
+    percentiles,
+    with_failures,
+)
 
 COLUMNS = [
     "rank", "method", "seeds", "failed", "median_best", "median_error", "ci95_low", "ci95_high",
@@ -138,14 +147,15 @@ def summarise(runs: pd.DataFrame) -> pd.DataFrame:
             else np.nan,
             "median_igd": _median(g.loc[ok, "igd"], n_failed) if "igd" in g else np.nan,
             "_rank_error": q50,
+            **failure_tie_break(err, n_failed),
         })
     table = pd.DataFrame(rows)
     columns = MO_COLUMNS if is_multiobjective(runs) else COLUMNS
     if table.empty:
         return pd.DataFrame(columns=columns)
+    keys = ["_no_finished", "success_rate", "ert_evals", "_rank_error", *TIE_BREAK_KEYS, "median_error"]
     table = table.sort_values(
-        ["success_rate", "ert_evals", "_rank_error", "median_error"], ascending=[False, True, True, True],
-        na_position="last",
+        keys, ascending=[k != "success_rate" for k in keys], na_position="last", kind="stable",
     ).reset_index(drop=True)
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     methods = table["method"].tolist()
@@ -254,7 +264,8 @@ def write(board: Board, out_dir: Path, client, source: str) -> dict[str, Path]: 
         f"Source: {source}. Optimum value f* = {board.f_opt:g}; error = final best − f*; "
         f"target precision {board.target_precision:g}; budget {budget} evaluations.",
         "Rank: success rate, then ERT (expected evaluations to reach the target), then median "
-        "error. ci95 = bootstrap 95 % interval of the median error; IQR = inter-quartile range of "
+        "error, then the smaller share of failed runs and the median of the finished ones (a method "
+        "without a finished run last). ci95 = bootstrap 95 % interval of the median error; IQR = inter-quartile range of "
         "the final error over seeds; p_vs_next = Wilcoxon signed-rank p-value against the next "
         "row, paired by seed (p ≥ 0.05: the two are not told apart by these seeds). Failed runs "
         f"count as unsuccessful runs that used their whole budget. {FAILED_RULE}",

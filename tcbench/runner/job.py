@@ -21,7 +21,7 @@ from typing import Any
 import yaml
 
 from tcbench.runner.schema import as_dict
-from tcbench.errors import ConfigError, error_line
+from tcbench.errors import ConfigError, disk_full, error_line
 from tcbench.runner.kinds import JobKind, kind_of
 
 log = logging.getLogger(__name__)
@@ -46,7 +46,7 @@ def failed(name: str, exc: BaseException) -> JobFailure:
     """Log and remember a job's failure; the sweep goes on."""
     user = isinstance(exc, ConfigError)
     error = f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else str(exc) if user else \
-        f"{type(exc).__name__}: {exc}"
+        disk_full(exc) or f"{type(exc).__name__}: {exc}"
     if isinstance(exc, MemoryError):
         from tcbench.runner.memory import ENV
 

@@ -540,12 +540,15 @@ def make_effect(effect_id: str, **params: Any) -> Effect:
     unknown = sorted(set(params) - known)
     if unknown:
         raise ValueError(f"effect {effect_id!r} has no parameter {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    unbounded = {f.name for f in dataclasses.fields(cls) if isinstance(f.default, float) and np.isinf(f.default)}
     values = {}
     for key, value in params.items():
         try:
             values[key] = float(value)
         except (TypeError, ValueError):
             raise ValueError(f"effect {effect_id!r}: {key} must be a number, got {value!r}") from None
+        if np.isnan(values[key]) or (np.isinf(values[key]) and key not in unbounded):  # a limit may be ±inf
+            raise ValueError(f"effects.{effect_id}.{key}: {values[key]:g} is not finite")
     return cls(**values)
 
 

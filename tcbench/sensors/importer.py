@@ -32,7 +32,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pcsv
 
-from tcbench.errors import meant
+from tcbench.errors import file_problem, meant
 from tcbench.sensors.recording import (
     NUMERIC_COLUMNS,
     AXES,
@@ -282,8 +282,8 @@ def import_csv_axes(path: str | Path, sensor: str, columns: Mapping[str, str], o
     try:
         if path.is_dir():
             raise RecordingError("is a directory, not a CSV file")
-        if not path.is_file():
-            raise RecordingError("no such file")
+        if problem := file_problem(path):
+            raise RecordingError(problem)
         delimiter = sniff_delimiter(path)
         header = _header_names(path, delimiter)
         _scan_text(path, header, delimiter)

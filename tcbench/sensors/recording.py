@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from tcbench.errors import file_problem
+
 from tcbench.sensors.recording_files import (
     _atomic_write,
     _format,
@@ -228,8 +230,8 @@ def read_recording(path: str | Path) -> Recording:
         if path.is_dir():
             raise RecordingError("is a directory, not a recording (give the .csv or .parquet file inside it)")
         fmt = _format(path)
-        if not path.is_file():
-            raise RecordingError("no such file")
+        if problem := file_problem(path):
+            raise RecordingError(problem)
         data = _read_csv(path) if fmt == ".csv" else _read_parquet(path)
         _check_table(data)
     side = sidecar_path(path)

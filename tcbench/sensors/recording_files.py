@@ -52,6 +52,8 @@ def table_rows(path: str | Path) -> int | None:
     try:
         if _format(path) == ".parquet":
             return int(pq.ParquetFile(path).metadata.num_rows) if path.is_file() else None
+        if not path.is_file():  # never opened: a named pipe would block
+            return None
         lines, last = 0, b"\n"
         with path.open("rb") as f:
             while piece := f.read(CHUNK_BYTES):
@@ -85,6 +87,9 @@ def _header_line(path: Path) -> str:
         line = f.readline(MAX_HEADER_BYTES + 1)
     if b"\0" in line:
         raise RecordingError("the header holds a NUL byte: a binary file, not CSV text")
+    if b"\r" in line.rstrip(b"\r\n"):
+        raise RecordingError("lines end in a carriage return (CR) alone, old Mac style: a CSV table's lines end "
+                             "in LF or CR LF (convert the line ends, e.g. tr '\\r' '\\n')")
     if len(line) > MAX_HEADER_BYTES:
         raise RecordingError(f"the first line is longer than {MAX_HEADER_BYTES >> 10} KiB: not a CSV header")
     try:

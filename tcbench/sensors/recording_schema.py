@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from tcbench.errors import unknown_name
+from tcbench.errors import listed, unknown_name
 from tcbench.sensors import kinds
 
 SCHEMA_VERSION = 1
@@ -76,17 +77,17 @@ def _in_file(name: str | None) -> Iterator[None]:
 
 def _check_columns(names: list[str]) -> None:
     """Required columns present, no unknown or duplicate ones."""
-    dup = sorted({c for c in names if names.count(c) > 1})
+    dup = sorted(c for c, n in Counter(names).items() if n > 1)
     if dup:
         raise RecordingError(f"duplicate column {dup[0]!r}")
     unknown = [c for c in names if c not in COLUMNS]
     missing = [c for c in NUMERIC_COLUMNS if c not in names]
     if missing:
-        also = f" (found unknown {', '.join(map(repr, unknown))})" if unknown else ""
+        also = f" (found unknown {listed(unknown)})" if unknown else ""
         raise RecordingError(f"missing column {missing[0]!r}{also}")
     if unknown:
         allowed = ", ".join(COLUMNS)
-        raise RecordingError(f"unknown column {', '.join(map(repr, unknown))} (schema v1 allows only {allowed})")
+        raise RecordingError(f"unknown column {listed(unknown)} (schema v1 allows only {allowed})")
 
 
 def _normalise(data: pd.DataFrame) -> pd.DataFrame:

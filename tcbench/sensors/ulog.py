@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tcbench.errors import file_problem
 from tcbench.sensors import kinds
 from tcbench.sensors.recording import AXES, RecordingError
 
@@ -64,8 +65,10 @@ def read_topic(path: str | Path, sensor: str) -> list[TopicInstance]:
         raise RecordingError(f"a PX4 log has no topic tcbench reads for sensor {sensor!r} "
                              f"(it reads: {', '.join(f'{k} from {v[0]}' for k, v in known.items())})", file=str(path))
     topic = known[sensor][0]
-    if not path.is_file():
-        raise RecordingError("no such file" if not path.exists() else "is a directory, not a ULog file", file=str(path))
+    if path.is_dir():
+        raise RecordingError("is a directory, not a ULog file", file=str(path))
+    if problem := file_problem(path):
+        raise RecordingError(problem, file=str(path))
     from pyulog import ULog
 
     try:

@@ -73,6 +73,9 @@ def check_store(uri: str | None, *, create: bool, timeout_s: float = 5.0) -> str
     local store that does not exist instead of making an empty one; ``create=True`` refuses one
     whose folder does not exist (no folder is made for a store)."""
     resolved = tracking_uri(uri)
+    if resolved.startswith("sqlite:") and not resolved.removeprefix("sqlite:").lstrip("/").strip():
+        raise StoreError(f"tracking store {resolved} names no database file (an in-memory store keeps nothing); "
+                         "give one, e.g. sqlite:///mlflow.db")
     db = sqlite_path(resolved)
     if db is not None:
         if db.is_dir():

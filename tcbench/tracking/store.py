@@ -14,12 +14,15 @@ import hashlib
 import json
 import logging
 import os
+import shutil
 import socket
 import subprocess
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlparse
+from urllib.request import url2pathname
 
 os.environ.setdefault("MLFLOW_DISABLE_TELEMETRY", "true")
 
@@ -28,6 +31,7 @@ from mlflow.entities import Metric, Param, RunTag  # noqa: E402
 from mlflow.tracking import MlflowClient  # noqa: E402
 
 from tcbench._version import __version__  # noqa: E402
+from tcbench.errors import disk_full  # noqa: E402
 from tcbench.tracking.checks import (  # noqa: E402,F401 - the checks are part of this module's interface
     StoreError,
     check_store,
@@ -174,9 +178,10 @@ class JobRun:
     tags are kept until :meth:`flush` (called when the job ends, finished or failed) and sent in
     as few ``log_batch`` calls as MLflow's limits allow, each one a database transaction."""
 
-    def __init__(self, c: MlflowClient, run_id: str) -> None:
+    def __init__(self, c: MlflowClient, run_id: str, artifact_uri: str | None = None) -> None:
         self.client = c
         self.run_id = run_id
+        self.artifact_dir = local_artifact_dir(artifact_uri)
         self._params: list[Param] = []
         self._metrics: list[Metric] = []
         self._tags: list[RunTag] = []
@@ -199,7 +204,19 @@ class JobRun:
         self._metrics += [Metric(k, float(v), ts, 0) for k, v in values.items()]
 
     def log_artifact(self, path: Path) -> None:
-        self.client.log_artifact(self.run_id, str(path))
+        """Copy ``path`` into the run's artifacts; a copy that fails (a full disk) is removed, so
+        the bytes it took do not stop the run's end from being recorded."""
+        try:
+            self.client.log_artifact(self.run_id, str(path))
+        except BaseException:
+            if self.artifact_dir is not None:
+                (self.artifact_dir / Path(path).name).unlink(missing_ok=True)
+            raise
+
+    def drop_artifacts(self) -> None:
+        """Remove the run's local artifacts (what a run that cannot be recorded leaves on a full disk)."""
+        if self.artifact_dir is not None and self.artifact_dir.is_dir():
+            shutil.rmtree(self.artifact_dir, ignore_errors=True)
 
     def set_tag(self, key: str, value: str) -> None:
         self._tags.append(RunTag(key, value))
@@ -212,6 +229,16 @@ class JobRun:
         while params or metrics or tags:
             self.client.log_batch(self.run_id, metrics=metrics[:_BATCH], params=params[:100], tags=tags[:100])
             params, metrics, tags = params[100:], metrics[_BATCH:], tags[100:]
+
+
+def local_artifact_dir(artifact_uri: str | None) -> Path | None:
+    """The folder of a run's artifacts when they are on this machine's file system, else None."""
+    if not artifact_uri:
+        return None
+    parsed = urlparse(artifact_uri)
+    if parsed.scheme not in ("", "file"):
+        return None
+    return Path(url2pathname(parsed.path))
 
 
 @functools.cache
@@ -267,7 +294,8 @@ def ended_by(exc: BaseException) -> tuple[str, str]:
     FAILED for anything else (a store that cannot be written included)."""
     if isinstance(exc, KeyboardInterrupt):
         return "KILLED", INTERRUPTED
-    return "FAILED", f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else f"{type(exc).__name__}: {exc}"
+    return "FAILED", f"sys.exit({exc.code})" if isinstance(exc, SystemExit) else \
+        disk_full(exc) or f"{type(exc).__name__}: {exc}"
 
 
 def unwritable(uri: str, why: str, runs: str, sweep_id: str | None = None) -> StoreError:
@@ -304,7 +332,7 @@ def job_run(
     run_id = run.info.run_id
     if on_run_created is not None:
         on_run_created(run_id)
-    handle = JobRun(c, run_id)
+    handle = JobRun(c, run_id, run.info.artifact_uri)
     handle.log_params(flatten(cfg))
     try:
         yield handle
@@ -317,6 +345,9 @@ def job_run(
         except Exception:  # noqa: BLE001 - what the job logged is lost; its end is still recorded below
             log.debug("params and metrics of run %s could not be sent", run_id)
         problem = end_run(c, run_id, error, status)
+        if problem is not None and handle.artifact_dir is not None:
+            handle.drop_artifacts()  # a full disk: the failed run's files give the room to record its end
+            problem = end_run(c, run_id, error, status)
         if problem is not None and not isinstance(exc, KeyboardInterrupt):
             raise unwritable(uri, problem, f"run {run_id}") from exc
         raise
