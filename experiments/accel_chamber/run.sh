@@ -23,6 +23,12 @@ tcbench run -m task=accel_chamber 'task.device_seed=range(10)' \
   tracking.experiment=accel-chamber "${common[@]}"
 tcbench run -m task=accel_chamber 'task.device_seed=range(10)' learner=poly learner.form=bias,bias_rate \
   optimiser=none 'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
+# The fitted learners let to extrapolate (task.clamp_inputs=false: rows named -unclamped) beside the
+# default's, which hold their test inputs to the training range.
+tcbench run -m task=accel_chamber task.clamp_inputs=false learner=poly learner.form=bias,bias_rate optimiser=none \
+  'seed=range(30)' tracking.experiment=accel-chamber "${common[@]}"
+tcbench run -m task=accel_chamber task.clamp_inputs=false learner=bp learner.training=gd,lm optimiser=ifa \
+  'seed=range(30)' budget=510 tracking.experiment=accel-chamber "${common[@]}"
 # The other tiers on device 0: new_device (other units of the lot), new_profile (a programme the
 # training never saw) and replay (the diagnostic the boards stood on before power-ons: the test
 # cycles replay the training cycles' power-on with new noise); IFA-BP over 30 restarts on each.

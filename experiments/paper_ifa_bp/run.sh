@@ -35,6 +35,14 @@ tcbench run -m task=msra_zerobias,msra_fulltemp task.split=replay learner=bp lea
 # validation stop) beside ours (next_run)
 tcbench run -m task=msra_zerobias,msra_fulltemp learner=bp learner.training=gd,lm learner.preset=matlab \
   optimiser=fa,ifa 'seed=range(30)' budget=510 tracking.experiment=paper-ifa-bp "${common[@]}"
+# the fitted learners let to extrapolate (task.clamp_inputs=false: rows named -unclamped) beside the
+# default's, which hold their test inputs to the training range (next_run)
+for task in msra_zerobias msra_fulltemp; do
+  tcbench run -m task=$task task.clamp_inputs=false learner=poly learner.offsets=shared,per_run optimiser=none \
+    'seed=range(30)' tracking.experiment=paper-ifa-bp "${common[@]}"
+  tcbench run -m task=$task task.clamp_inputs=false learner=bp learner.training=gd,lm optimiser=fa,ifa 'seed=range(30)' \
+    budget=510 tracking.experiment=paper-ifa-bp "${common[@]}"
+done
 # the cubic with the networks' inputs on zero bias: [T, dT/dt] (poly3_rate)
 tcbench run -m task=msra_zerobias task.split=next_run,new_device,new_profile,replay learner=poly learner.form=bias_rate \
   optimiser=none 'seed=range(30)' \
