@@ -292,30 +292,26 @@ def test_optimisation_board_breaks_a_failed_median_tie_by_fewer_failures() -> No
     assert list(summarise(coco)["method"]) == ["flaky", "fa", "halffail", "allfail"]
 
 
+def _chamber_runs(method: str, drifts: list[float], failed: int) -> list[dict[str, object]]:
+    """A compensation method's runs on a chamber board: the finished ones' drifts, then ``failed`` failures."""
+    done = [{"status": "FINISHED", "drift_ug": d, "raw_drift_ug": 100.0, "hysteresis_ug": d,
+             "temp_slope_ug_per_c": d, "train_rmse_ug": d} for d in drifts]
+    return [{"method": method, "seed": i, **r} for i, r in enumerate(done + [{"status": "FAILED"}] * failed)]
+
+
 def test_compensation_board_breaks_a_failed_median_tie_by_fewer_failures() -> None:
     from tcbench.leaderboard.compensation import summarise
 
-    def runs(method: str, drifts: list[float], failed: int) -> list[dict[str, object]]:
-        done = [{"status": "FINISHED", "drift_ug": d, "raw_drift_ug": 100.0, "hysteresis_ug": d,
-                 "temp_slope_ug_per_c": d, "train_rmse_ug": d} for d in drifts]
-        return [{"method": method, "seed": i, **r} for i, r in
-                enumerate(done + [{"status": "FAILED"}] * failed)]
-
-    table = summarise(pd.DataFrame(runs("allfail", [], 10) + runs("flaky", [1.0, 1.1, 1.2], 7)
-                                   + runs("halffail", [2.0] * 5, 5) + runs("steady", [5.0] * 10, 0)), "chamber")
+    table = summarise(pd.DataFrame(_chamber_runs("allfail", [], 10) + _chamber_runs("flaky", [1.0, 1.1, 1.2], 7)
+                                   + _chamber_runs("halffail", [2.0] * 5, 5) + _chamber_runs("steady", [5.0] * 10, 0)),
+                      "chamber")
     assert list(table["method"]) == ["steady", "halffail", "flaky", "allfail"]
 
 
 def test_compensation_board_counts_failed_runs_in_median_and_interval() -> None:
     from tcbench.leaderboard.compensation import summarise
 
-    def runs(method: str, drifts: list[float], failed: int) -> list[dict[str, object]]:
-        done = [{"status": "FINISHED", "drift_ug": d, "raw_drift_ug": 100.0, "hysteresis_ug": d,
-                 "temp_slope_ug_per_c": d, "train_rmse_ug": d} for d in drifts]
-        return [{"method": method, "seed": i, **r} for i, r in
-                enumerate(done + [{"status": "FAILED"}] * failed)]
-
-    table = summarise(pd.DataFrame(runs("crashy", [1.0, 1.01, 1.02], 7) + runs("steady", [5.0] * 10, 0)),
+    table = summarise(pd.DataFrame(_chamber_runs("crashy", [1.0, 1.01, 1.02], 7) + _chamber_runs("steady", [5.0] * 10, 0)),
                       "chamber").set_index("method")
     assert table.loc["crashy", "failed"] == 7 and np.isinf(table.loc["crashy", "median_drift_ug"])
     assert "failed" in table.loc["crashy", "ci95_drift_ug"]
