@@ -311,7 +311,8 @@ def test_compensation_board_breaks_a_failed_median_tie_by_fewer_failures() -> No
 def test_compensation_board_counts_failed_runs_in_median_and_interval() -> None:
     from tcbench.leaderboard.compensation import summarise
 
-    table = summarise(pd.DataFrame(_chamber_runs("crashy", [1.0, 1.01, 1.02], 7) + _chamber_runs("steady", [5.0] * 10, 0)),
+    crashy, steady = _chamber_runs("crashy", [1.0, 1.01, 1.02], 7), _chamber_runs("steady", [5.0] * 10, 0)
+    table = summarise(pd.DataFrame(crashy + steady),
                       "chamber").set_index("method")
     assert table.loc["crashy", "failed"] == 7 and np.isinf(table.loc["crashy", "median_drift_ug"])
     assert "failed" in table.loc["crashy", "ci95_drift_ug"]
