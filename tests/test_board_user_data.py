@@ -130,3 +130,29 @@ def test_the_limits_count_once_per_seed_whatever_the_settings_beside_them() -> N
     assert sorted(table.index) == ["oracle", "poly3 [task.rate_window_s=120]", "poly3 [task.rate_window_s=60]"]
     assert table["runs"].tolist() == [1, 1, 1]
     assert table.loc["poly3 [task.rate_window_s=120]", "x_oracle"] == 10.0  # the limit row still divides
+
+
+def test_a_run_killed_before_it_sent_its_params_yields_to_its_finished_rerun() -> None:
+    """A resumed sweep reruns a killed job; the killed attempt, which never sent its params (so no
+    ``task.split``), neither opens a board of its own nor counts beside the rerun."""
+    params = {"task.split": "next_run"}
+
+    def run(method: str, seed: int, status: str, start: int, sent: bool, drift_ug: float) -> dict:
+        return {"run_id": f"{method}{seed}{start}", "status": status, "task": "accel_chamber-dev0",
+                "method": method, "seed": seed, "config_hash": f"h{method}", "start_time": start,
+                "error_message": "", "task_name": "accel_chamber", "draw_tag": str(seed),
+                "split": board._split_of(params if sent else {}, {}), "params": params if sent else {},
+                "drift_ug": drift_ug}
+
+    runs = pd.DataFrame([run("oracle", s, "FINISHED", s, True, 5.0) for s in range(2)]
+                        + [run("poly3", 0, "KILLED", 10, False, float("nan")),
+                           run("poly3", 0, "FINISHED", 11, True, 40.0), run("poly3", 1, "FINISHED", 12, True, 50.0)])
+    (b,) = board.boards(runs, protocols())
+    assert b.split == "next_run"
+    assert b.table.set_index("method").loc["poly3", ["runs", "failed"]].tolist() == [2, 0]
+
+
+def test_a_killed_run_takes_its_tier_from_the_tag_set_when_it_opened() -> None:
+    assert board._split_of({}, {"tcbench.split": "replay"}) == "replay"
+    assert board._split_of({"task.split": "new_device"}, {"tcbench.split": "replay"}) == "new_device"
+    assert board._split_of({"seed": "0"}, {}) == "before tiers"

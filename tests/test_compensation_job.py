@@ -114,6 +114,8 @@ def test_a_null_recordings_seed_makes_restart_i_meet_draw_i(builds: list[str]) -
     other = kind.job(_job(*QUICK, "task.recordings_seed=null", "seed=5"))
     assert drawn.names.tags["tcbench.draw"] == "4" and fixed.names.tags["tcbench.draw"] == "4"
     assert other.names.tags["tcbench.draw"] == "5"
+    # the tier is a tag from the start: a run killed before it sends its params still has it
+    assert {job.names.tags["tcbench.split"] for job in (drawn, fixed, other)} == {"next_run"}
     for job in (drawn, fixed, other):
         job.env.reset(seed=0)
     same = [np.array_equal(a.recording.output, b.recording.output)

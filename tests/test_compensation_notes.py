@@ -106,7 +106,7 @@ def test_boards_are_named_by_their_tier() -> None:
     frames = []
     for split in ("next_run", "replay"):
         r = _runs("raw", np.full(3, 4e4), np.full(3, 4e4))
-        r["split"], r["task"], r["task_name"], r["config_hash"] = split, "msra_fulltemp-dev0", "msra_fulltemp", "h"
+        r["split"], r["task"], r["task_name"], r["config_hash"] = split, "msra_fulltemp-dev0", "msra_fulltemp", f"h{split}"
         r["run_id"], r["start_time"], r["data_hash"], r["in_sample"] = [f"{split}{i}" for i in range(3)], 0, "", ""
         frames.append(r)
     made = {b.split: b for b in boards(pd.concat(frames, ignore_index=True), {"msra_fulltemp": "fulltemp"})}

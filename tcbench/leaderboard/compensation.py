@@ -24,6 +24,7 @@ one per (task, method, seed).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -84,16 +85,20 @@ def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.Da
             "start_time": r.info.start_time, "error_message": t.get("tcbench.error", ""),
             "task_name": t.get("tcbench.task_name"), "data_hash": t.get("tcbench.data_hash", ""),
             "train_files": t.get("tcbench.train_files", ""), "test_files": t.get("tcbench.test_files", ""),
-            "in_sample": t.get("tcbench.in_sample", ""), "split": _split_of(dict(r.data.params)),
+            "in_sample": t.get("tcbench.in_sample", ""), "split": _split_of(dict(r.data.params), t),
             "draw_tag": t.get("tcbench.draw", ""),
             "params": dict(r.data.params), **r.data.metrics,
         })
     return pd.DataFrame(rows)
 
 
-def _split_of(params: dict[str, str]) -> str:
+def _split_of(params: dict[str, str], tags: Mapping[str, str]) -> str:
     """The tier of a run's simulated test runs: ``task.split``; ``files`` for the user's recordings;
-    ``before tiers`` for a run made before tiers existed (its runs differed in noise alone)."""
+    ``before tiers`` for a run made before tiers existed (its runs differed in noise alone). A run
+    killed before it sent its params has its tier from the ``tcbench.split`` tag set when it opened
+    (empty for runs opened before that tag existed)."""
+    if not params:
+        return tags.get("tcbench.split", "")
     if params.get("task.train_files", "None") not in ("None", "", "null"):
         return "files"
     return params.get("task.split", "before tiers")
@@ -327,10 +332,11 @@ def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[Compensation
 
 
 def _one_run_per_job(runs: pd.DataFrame) -> pd.DataFrame:
-    """The newest finished run per task, tier, method, config and seed; per task, tier, method and
+    """The newest finished run per task, method, config and seed (the config holds the tier, so a
+    run killed before it sent its params yields to its finished rerun); per task, tier, method and
     seed for the limits, whose names leave out the settings they do not depend on (the gyro pipeline)."""
     limit = runs["method"].isin(list(LIMITS.values()))
-    kept = [one_run_per_job(runs[~limit], ("task", "split", "method", "config_hash", "seed")),
+    kept = [one_run_per_job(runs[~limit], ("task", "method", "config_hash", "seed")),
             one_run_per_job(runs[limit], ("task", "split", "method", "seed"))]
     return pd.concat([k for k in kept if not k.empty] or [runs.iloc[:0]]).sort_index()
 

@@ -186,10 +186,11 @@ class CompensationKind(JobKind):
         except DataHashError as exc:
             raise ConfigError(str(exc)) from None
         method = compensation_label(c["learner"], c["optimiser"], c["task"])
-        draw = draw_of(c)
+        draw, split = draw_of(c), "files" if c["task"].get("train_files") else c["task"].get("split")
         return JobNames(f"{method}-{tkey}-s{c['seed']}", tkey, method, int(c["seed"]),
                         {"tcbench.task_name": str(c["task"]["name"]), **data,
-                         **({"tcbench.draw": str(draw)} if draw is not None else {})})
+                         **({"tcbench.draw": str(draw)} if draw is not None else {}),
+                         **({"tcbench.split": str(split)} if split is not None else {})})
 
     def job(self, c: dict[str, Any]) -> CompensationJob:
         return prepare_job(c, self.names)
