@@ -14,9 +14,9 @@ import pandas as pd
 import pytest
 from conftest import PAN_CSV
 
-from tcbench.compensation.c_export import (c_sources, device_clock_s, device_spec, streamed_offset,
-                                           window_rate_c_per_s, window_samples, write_c)
+from tcbench.compensation.c_export import c_sources, device_clock_s, device_spec, streamed_offset, window_samples, write_c
 from tcbench.compensation.calibration import OffsetModel, fit, from_model, record
+from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.fitted_model import deterministic_output
 from tcbench.sensors.effects import EFFECTS
 from tcbench.sensors.fitted import PolynomialModel
@@ -149,6 +149,24 @@ def rates() -> dict[tuple[str, str], np.ndarray]:
     return {}
 
 
+EPSILON = {"double": 2.0 ** -52, "float": 2.0 ** -23}
+
+
+def _stable(spec: dict, clock: np.ndarray, temp_c: np.ndarray, rate: np.ndarray, bound: np.ndarray,
+            build: str) -> np.ndarray:
+    """The samples before the reference first moves by a tenth of ``bound`` when its temperatures
+    or its rates move by the build's rounding (one part in 2^52 or 2^23). The Elman fitted on 100
+    bins expands its context far outside its training (W_c's largest singular value is about 3.5):
+    a rounding difference there grows tenfold every ~100 s, so after that point no two correct
+    implementations (numpy's order of operations, the C's) agree to the tolerance."""
+    ref = streamed_offset(spec, clock, temp_c, rate)
+    eps = EPSILON[build]
+    moved = np.maximum(np.abs(streamed_offset(spec, clock, temp_c * (1 + eps), rate) - ref),
+                       np.abs(streamed_offset(spec, clock, temp_c, rate * (1 + eps)) - ref))
+    beyond = np.flatnonzero(10.0 * moved > bound)
+    return np.arange(clock.size) < (beyond[0] if beyond.size else clock.size)
+
+
 @pytest.mark.parametrize("build", ["double", "float"])
 @pytest.mark.parametrize("method", ["poly3", "poly3_rate", "bp", "elman", "model"])
 def test_the_compiled_model_gives_pythons_output_on_every_record(programs: dict, records: dict, rates: dict,
@@ -162,11 +180,16 @@ def test_the_compiled_model_gives_pythons_output_on_every_record(programs: dict,
         assert said.get("dropped", 0) == 0, f"{label}: the rate ring overflowed"
         clock = device_clock_s(fed_dt)
         if method != "poly3" and (label, build) not in rates:
-            rates[(label, build)] = window_rate_c_per_s(clock, fed_temp)
-        want = fed_raw - streamed_offset(spec, clock, fed_temp, rates.get((label, build)))
+            rates[(label, build)] = temperature_rate_c_per_s(clock, fed_temp)
+        rate = rates.get((label, build))
+        want = fed_raw - streamed_offset(spec, clock, fed_temp, rate)
         bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
-        worst = int(np.argmax(np.abs(got - want) / bound))
-        assert np.all(np.abs(got - want) <= bound), (label, worst, got[worst], want[worst])
+        keep = np.ones(t_s.size, dtype=bool)
+        if "wc" in spec:  # up to where the reference's own rounding has grown to the tolerance (_stable)
+            keep = _stable(spec, clock, fed_temp, rate, bound, build)
+            assert np.mean(keep) > 0.8, label
+        worst = int(np.argmax(np.where(keep, np.abs(got - want) / bound, 0.0)))
+        assert np.all(np.abs(got - want)[keep] <= bound[keep]), (label, worst, got[worst], want[worst])
         assert np.ptp(want - fed_raw) > 0, label  # the model corrects something there
 
 

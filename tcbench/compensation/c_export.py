@@ -19,11 +19,10 @@ same arithmetic in numpy, the reference the compiled code is checked against):
 - ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range.
 - ``poly3_rate``: that cubic plus the rate coefficient times the temperature rate, the
   least-squares slope over the trailing :data:`~tcbench.compensation.calibration.RATE_WINDOW_S`
-  window ``t_i - w < t_j <= t_i``, the estimator
-  :func:`~tcbench.compensation.features.temperature_rate_c_per_s` computes for calibrate (causal),
-  each window centred before its moments are summed (:func:`window_rate_c_per_s`), kept in a ring of at most ``<NAME>_RATE_CAPACITY`` samples (the most any window of
-  the calibration record held, with half again as margin; more are counted in ``s->dropped``
-  and the oldest left out).
+  window ``t_i - w < t_j <= t_i``, each window's moments centred on its own means: the estimator
+  calibrate computes (:func:`~tcbench.compensation.features.temperature_rate_c_per_s`), over a ring
+  of at most ``<NAME>_RATE_CAPACITY`` samples (the most any window of the calibration record held,
+  with half again as margin; more are counted in ``s->dropped`` and the oldest left out).
 - ``bp`` and ``bp_gd``: the network on ``[T, dT/dt]`` held to its training box, scaled to
   [-1, 1] as it was trained and its output scaled back.
 - ``elman``: the recurrent network steps once per time bin (``bin_s`` from the first sample),
@@ -57,6 +56,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.compensation.calibration import RATE_WINDOW_S, OffsetModel
+from tcbench.compensation.features import temperature_rate_c_per_s
 
 EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")  # what a device can run of calibrate's methods
 NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator"}
@@ -113,44 +113,6 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
         spec |= {"w1": p[:h * m].reshape(h, m).tolist(), "b1": p[h * m:h * m + h].tolist(),
                  "w2": p[h * m + h:h * m + 2 * h].tolist(), "b2": float(p[-1])}
     return spec
-
-
-def window_rate_c_per_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float = RATE_WINDOW_S,
-                        floats: int = 2_000_000) -> np.ndarray:
-    """The temperature rate (degC/s) the exported code computes: the least-squares slope over the
-    trailing window ``t_i - window_s < t_j <= t_i`` (the estimator of
-    :func:`~tcbench.compensation.features.temperature_rate_c_per_s`), each window centred on its
-    own samples before its moments are summed, as the C does. The prefix-sum form calibrate runs
-    sums moments about the record's first sample, which loses digits when a window holds a few
-    closely spaced samples far from it (a burst's first samples: on the PAN record one rate off by
-    0.2 %); this one keeps them. Vectorised over windows, ``floats`` values at a time."""
-    t = np.asarray(t_s, dtype=np.float64).reshape(-1)
-    y = np.asarray(temp_c, dtype=np.float64).reshape(-1)
-    if t.shape != y.shape:
-        raise ValueError(f"t_s has {t.size} samples, temp_c {y.size}")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t_s must be strictly increasing")
-    out = np.zeros(t.size)
-    if t.size == 0:
-        return out
-    start = np.searchsorted(t, t - window_s, side="right")
-    width = int(np.max(np.arange(t.size) - start)) + 1
-    step = max(1, floats // width)
-    k = np.arange(width)
-    for a in range(0, t.size, step):
-        rows = np.arange(a, min(a + step, t.size))
-        idx = start[rows, None] + k
-        inside = idx <= rows[:, None]
-        idx = np.minimum(idx, rows[:, None])
-        n = inside.sum(axis=1)
-        u = np.where(inside, t[idx] - t[rows, None], 0.0)
-        v = np.where(inside, y[idx] - y[rows, None], 0.0)
-        u = np.where(inside, u - (u.sum(axis=1) / n)[:, None], 0.0)
-        v = np.where(inside, v - (v.sum(axis=1) / n)[:, None], 0.0)
-        sxx, sxy = (u * u).sum(axis=1), (u * v).sum(axis=1)
-        ok = (n >= 2) & (sxx > 0)
-        out[rows] = np.where(ok, sxy / np.where(ok, sxx, 1.0), 0.0)
-    return out
 
 
 def model_spec(sensor_model: Any) -> dict[str, Any]:
@@ -248,14 +210,15 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
                     rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """The offset the exported code computes at each sample, in numpy: ``clock_s`` the device's
     clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
-    ``rate_c_per_s``: :func:`window_rate_c_per_s` of them when already computed."""
+    ``rate_c_per_s``: :func:`~tcbench.compensation.features.temperature_rate_c_per_s` of them when
+    already computed."""
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     method = spec["method"]
     if method == "model":
         return _model_streamed(spec, t, temp)
     if method != "poly3" and rate_c_per_s is None:
-        rate_c_per_s = window_rate_c_per_s(t, temp, spec["rate_window_s"])
+        rate_c_per_s = temperature_rate_c_per_s(t, temp, spec["rate_window_s"])
     rate = np.asarray(rate_c_per_s, dtype=np.float64)
     if method in ("poly3", "poly3_rate"):
         x = spec["x"]
