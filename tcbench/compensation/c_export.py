@@ -26,8 +26,10 @@ same arithmetic in numpy, the reference the compiled code is checked against):
 - ``bp`` and ``bp_gd``: the network on ``[T, dT/dt]`` held to its training box, scaled to
   [-1, 1] as it was trained and its output scaled back.
 - ``elman``: the recurrent network steps once per time bin (``bin_s`` from the first sample),
-  as it was trained. Python's calibration scores it on the bins' means interpolated between the
-  bins' mean times, which reads up to 1.5 bins ahead; the device cannot. Here each sample gets
+  as it was trained (once per sample when it was trained on every sample: ``bin_s`` 0, a
+  ``tcbench run`` network, :mod:`tcbench.compensation.run_device`). Python's calibration scores
+  it on the bins' means interpolated between the bins' mean times, which reads up to 1.5 bins
+  ahead; the device cannot. Here each sample gets
   the network's output for the mean of its bin so far, from the context the previous complete
   bin left (at a bin's last sample the two agree): that causal form is what
   :func:`streamed_offset` computes and the compiled code is checked against.
@@ -91,24 +93,34 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
         if model.method == "poly3_rate":
             spec |= {"rate_coef": float(model.rate_coef), "rate_window_s": rate_window_s, "rate_capacity": capacity}
         return spec
-    learner = model.learner
+    return network_spec(model.method, model.learner, model.temp_range_c, model.rate_range, rate_window_s, capacity,
+                        model.bin_s)
+
+
+def network_spec(method: str, learner: Any, temp_range_c: Any, rate_range: Any, rate_window_s: float, capacity: int,
+                 bin_s: float | None) -> dict[str, Any]:
+    """A fitted BP or Elman network on ``[T, dT/dt]`` as plain data: its weights, scaling and input
+    box (``None``: unbounded); ``capacity``: the rate ring's samples; ``bin_s``: the time bins an
+    Elman steps once per (0: once per sample, as a network trained on every sample runs)."""
     if learner.x_scaler is None or learner.y_scaler is None:
-        raise ValueError(f"{model.method}: the network has no normalisation (not fitted)")
+        raise ValueError(f"{method}: the network has no normalisation (not fitted)")
     h, m = learner.params.hidden, learner.n_inputs
+    if m != 2:
+        raise ValueError(f"{method}: a network on {m} inputs; the device runs one on [T, dT/dt]")
     p = learner.get_params()
-    spec = {"method": model.method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
+    spec = {"method": method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
             "output_activation": learner.params.output_activation,
             "x_low": learner.x_scaler.low.tolist(), "x_high": learner.x_scaler.high.tolist(),
             "y_low": float(learner.y_scaler.low[0]), "y_high": float(learner.y_scaler.high[0]),
-            "temp_range_c": list(model.temp_range_c or (-np.inf, np.inf)),
-            "rate_range": list(model.rate_range or (-np.inf, np.inf)),
+            "temp_range_c": [float(v) for v in (temp_range_c if temp_range_c is not None else (-np.inf, np.inf))],
+            "rate_range": [float(v) for v in (rate_range if rate_range is not None else (-np.inf, np.inf))],
             "rate_window_s": rate_window_s, "rate_capacity": capacity}
     if learner.sequential:
         i, j = h * m, h * m + h * h
         spec |= {"wx": p[:i].reshape(h, m).tolist(), "wc": p[i:j].reshape(h, h).tolist(), "b1": p[j:j + h].tolist(),
-                 "w2": p[j + h:j + 2 * h].tolist(), "b2": float(p[-1]), "bin_s": float(model.bin_s or 0.0)}
-        if not spec["bin_s"] > 0:
-            raise ValueError(f"{model.method}: a recurrent network exported per sample needs its training bins")
+                 "w2": p[j + h:j + 2 * h].tolist(), "b2": float(p[-1]), "bin_s": float(bin_s or 0.0)}
+        if not spec["bin_s"] >= 0:
+            raise ValueError(f"{method}: bin_s must be >= 0, got {bin_s}")
     else:
         spec |= {"w1": p[:h * m].reshape(h, m).tolist(), "b1": p[h * m:h * m + h].tolist(),
                  "w2": p[h * m + h:h * m + 2 * h].tolist(), "b2": float(p[-1])}
@@ -237,7 +249,7 @@ def _elman_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate:
     previous complete bin (see the module doc)."""
     wx, wc = np.asarray(spec["wx"]), np.asarray(spec["wc"])
     b1, w2 = np.asarray(spec["b1"]), np.asarray(spec["w2"])
-    index = np.floor(t / spec["bin_s"]).astype(np.int64)
+    index = np.floor(t / spec["bin_s"]).astype(np.int64) if spec["bin_s"] > 0 else np.arange(t.size)
     starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
     stops = np.r_[starts[1:], t.size]
     out = np.empty(t.size)
@@ -311,7 +323,8 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         if recurrent:
             per += 6
             flops = (f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap}); "
-                     f"and {2 * h * h + h} more once per {spec['bin_s']:g}-s bin")
+                     f"and {2 * h * h + h} more once per "
+                     + (f"{spec['bin_s']:g}-s bin)" if spec["bin_s"] > 0 else "sample)"))
         else:
             flops = f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})"
         body = ""
@@ -536,7 +549,8 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
         update += [f"    R hidden[{h}];", "    R offset = network(temperature_c, rate, B1, hidden);"]
     else:
         update += [f"    R offset;",
-                   f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});",
+                   (f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});" if spec["bin_s"] > 0
+                    else "    int bin = s->samples;  /* a network trained on every sample steps every sample */"),
                    "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
                    "        int i, j;",
                    f"        for (j = 0; j < {h}; j++) s->context[j] = s->pending[j];",
