@@ -14,7 +14,8 @@ import pandas as pd
 import pytest
 from conftest import PAN_CSV
 
-from tcbench.compensation.c_export import c_sources, device_clock_s, device_spec, streamed_offset, window_samples, write_c
+from tcbench.compensation.c_export import (c_sources, device_clock_s, device_spec, streamed_corrected, streamed_offset,
+                                           window_samples, write_c)
 from tcbench.compensation.calibration import OffsetModel, fit, from_model, record
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.fitted_model import deterministic_output
@@ -268,3 +269,37 @@ def test_names_and_methods_no_device_runs_are_refused() -> None:
         c_sources({"method": "poly3", "x": [0, 0, 0, 0], "tref_c": 0, "tmin_c": 0, "tmax_c": 1}, "9lives")
     with pytest.raises(ValueError, match="memoriser: a control"):
         device_spec(OffsetModel("memoriser"), 10)
+
+
+def test_a_model_with_a_scale_factor_returns_the_input(records: dict, tmp_path: Path) -> None:
+    """A diagnosis of a record with several input levels has a scale factor in the die temperature
+    (``bias(u) + a s(u)``): its C returns ``(raw - offset) / s(u)``, the input that explains the
+    reading. Compiled, it gives :func:`streamed_corrected` to the tolerance in both builds, and on
+    the model's own output for a slow swing of rates over the tofupilot thermometer it returns
+    those rates to 1e-3 of their span (``raw - offset`` alone misses them by the scale factor's
+    2 %; the die lag runs per sample on the device, on calibrate's grid in the model)."""
+    t_s, temp_c, _ = records["tofupilot gyro x"]
+    model = PolynomialModel(sensor="gyro", centre_c=28.18, half_range_c=45.78, bias=(-4.128, 0.2612, 0.8546),
+                            scale_factor=(1.02, 0.015, -0.004), ref_c=28.18,
+                            effects=(EFFECTS["thermal_lag"](tau_s=120.0),
+                                     EFFECTS["temperature_cubic"](c3_per_c3=2e-6)))
+    rates = 50.0 * np.sin(2 * np.pi * t_s / 900.0)  # deg/s, a slow swing through the cycle
+    raw = deterministic_output(model, t_s, temp_c, rates, clock_terms=False)
+    spec = device_spec(from_model(model), 10)
+    assert spec["scale_factor"] == [1.02, 0.015, -0.004]
+    clock = t_s - t_s[0]
+    corrected = streamed_corrected(spec, clock, temp_c, raw)
+    assert np.max(np.abs(corrected - rates)) < 1e-3 * np.ptp(rates)
+    assert np.max(np.abs(raw - streamed_offset(spec, clock, temp_c) - rates)) > 1e-2 * np.ptp(rates)
+    write_c(spec, "scaled", tmp_path)
+    (tmp_path / "host.c").write_text(HOST.replace("UPNAME", "SCALED").replace("NAME", "scaled"))
+    dt_s = np.r_[0.0, np.diff(t_s)]
+    for build in ("double", "float"):
+        flags = ["-DSCALED_FLOAT"] if build == "float" else []
+        subprocess.run([CC, "-std=c99", "-O2", *flags, str(tmp_path / "host.c"), str(tmp_path / "scaled.c"), "-lm",
+                        "-o", str(tmp_path / build)], check=True)
+        got, _ = _run(tmp_path / build, temp_c, raw, dt_s)
+        fed_temp, fed_raw, fed_dt = (_as_fed(v, build) for v in (temp_c, raw, dt_s))
+        want = streamed_corrected(spec, device_clock_s(fed_dt), fed_temp, fed_raw)
+        bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
+        assert np.all(np.abs(got - want) <= bound), build

@@ -44,8 +44,13 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   difference (it reads the next sample) and runs the hysteresis's play operator on a 1-Hz grid
   interpolated back; the device takes the rate as the backward difference over the last interval
   and runs the play operator at every sample. That causal form is what :func:`streamed_offset`
-  computes. The offset is the model's output at zero input (a static record's: its scale factor
-  is not applied). A model with another term is not exported, and the export says which.
+  computes. The offset is the model's output at zero input. A model whose scale factor is not
+  one (a diagnosis of a record with several input levels: the core is ``bias(u) + a s(u)``, ``u``
+  the normalised die temperature) returns the input that explains the reading,
+  ``(raw - offset) / s(u)`` (:func:`streamed_corrected`); a diagnosis of a static record (one input
+  level, all ``tcbench calibrate`` sees on a static record) writes a unit scale factor and its
+  bias absorbs the level, so the model returns ``raw - offset``. A model with another term (an
+  accelerometer's ``k a^2``, ``accel_nonlinearity``) is not exported, and the export says which.
 """
 
 from __future__ import annotations
@@ -137,8 +142,39 @@ def model_spec(sensor_model: Any) -> dict[str, Any]:
         raise ValueError(f"model: its {', '.join(other)} term{'s' * (len(other) > 1)} "
                          f"{'are' if len(other) > 1 else 'is'} not exported as C (exported: {', '.join(MODEL_TERMS)})")
     effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
-    return {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
+    spec = {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
             "bias": [float(b) for b in quiet.bias], "ref_c": float(quiet.ref_c), "effects": effects}
+    if tuple(float(k) for k in quiet.scale_factor) != (1.0,):
+        if not any(float(k) != 0.0 for k in quiet.scale_factor):
+            raise ValueError("model: its scale factor is zero (the output does not follow the input)")
+        spec["scale_factor"] = [float(k) for k in quiet.scale_factor]
+    return spec
+
+
+def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray, raw: np.ndarray,
+                       rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+    """What the exported code returns at each sample, in numpy: ``raw`` minus
+    :func:`streamed_offset`, over the diagnosed model's scale factor where it has one (the input
+    that explains the reading)."""
+    corrected = np.asarray(raw, dtype=np.float64) - streamed_offset(spec, clock_s, temp_c, rate_c_per_s)
+    if spec["method"] != "model" or "scale_factor" not in spec:
+        return corrected
+    u = (_model_die(spec, np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
+         - spec["centre_c"]) / spec["half_range_c"]
+    scale = np.zeros_like(u)
+    for k in reversed(spec["scale_factor"]):
+        scale = scale * u + k
+    return corrected / scale
+
+
+def _model_die(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """The die temperature the diagnosed model runs on: the thermometer through its thermal lags."""
+    dt = np.r_[0.0, np.diff(t)]
+    die = temp.copy()
+    for e in spec["effects"]:
+        if e["id"] == "thermal_lag":
+            die = _lag(die, dt, e["tau_s"])
+    return die
 
 
 def _model_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
@@ -332,7 +368,9 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
              *([f" * {about}"] if about else []),
              " *",
              f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
-             " * the offset. dt_s is the time since the previous sample (> 0; the first sample's is ignored).",
+             (" * the offset, over the scale factor s(T_die) (the input that explains the reading). dt_s is the"
+              if method == "model" and "scale_factor" in spec else " * the offset. dt_s is the"),
+             " * time since the previous sample (> 0; the first sample's is ignored).",
              f" * Build: double by default; define {up}_FLOAT for float (the clock stays a double).",
              f" * State: {sizes['double']} bytes (double build), {sizes['float']} bytes (float build); no allocation.",
              f" * Floating-point operations per sample: {flops}.",
@@ -395,7 +433,8 @@ def _model_slots(spec: dict[str, Any]) -> list[str]:
 def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     """The update of the diagnosed model (see the module doc) and its operations per sample."""
     slots = _model_slots(spec)
-    lines = ["    int first = s->samples == 1;", "    R die = temperature_c, offset = 0, u;"]
+    lines = ["    int first = s->samples == 1;",
+             "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
     flops, calls = 0, 0
     lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
     for k, e in lags:  # the die stage first, in order, as the simulator runs it
@@ -436,6 +475,11 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
                       f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                       f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
             flops, calls = flops + 7, calls + 1
+    if "scale_factor" in spec:  # the input that explains the reading: (raw - offset) / s(u)
+        lines.append("    scale = 0;")
+        for k in reversed(spec["scale_factor"]):
+            lines.append(f"    scale = scale * u + (R){_lit(k)};")
+        flops += 2 * len(spec["scale_factor"]) + 1
     flops += 1
     return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
 
@@ -569,7 +613,8 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
                    "    s->bin_rate_sum += rate;",
                    "    offset = network(s->bin_temp_sum / (R)s->bin_count, s->bin_rate_sum / (R)s->bin_count, "
                    "s->drive, s->pending);"]
-    update += ["    return raw - offset;", "    }", "}\n"]
+    scaled = method == "model" and "scale_factor" in spec
+    update += ["    return (raw - offset) / scale;" if scaled else "    return raw - offset;", "    }", "}\n"]
     parts.append("\n".join(update))
     return "".join(parts)
 
@@ -582,3 +627,4 @@ def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = ""
     paths[0].write_text(src.header)
     paths[1].write_text(src.source)
     return paths
+
