@@ -628,3 +628,20 @@ def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = ""
     paths[1].write_text(src.source)
     return paths
 
+
+# -- calibrate's numbers as the device runs them ----------------------------------------------------
+
+STREAMED = ("elman", "model")  # the methods whose streamed (causal) output is not calibrate's own
+
+
+def streamed_residual(model: OffsetModel, rec: Any) -> np.ndarray | None:
+    """Output minus true input minus the offset the exported code computes over the whole record
+    ``rec`` (a :class:`~tcbench.compensation.record.Record`) from its first sample: the causal
+    form of the Elman and of the diagnosed model (see the module doc), where calibrate's own
+    offset reads ahead; None for a method no device runs (:func:`device_spec` refuses it)."""
+    try:
+        spec = device_spec(model, window_samples(rec.t_s))
+    except ValueError:
+        return None
+    clock = rec.t_s - rec.t_s[0] if rec.t_s.size else rec.t_s
+    return rec.output - rec.truth - streamed_offset(spec, clock, rec.temp_c)
