@@ -14,9 +14,10 @@ import pandas as pd
 import pytest
 from conftest import PAN_CSV
 
-from tcbench.compensation.c_export import (c_sources, device_clock_s, device_spec, streamed_offset,
-                                           window_rate_c_per_s, window_samples, write_c)
+from tcbench.compensation.c_export import (c_sources, device_clock_s, device_spec, streamed_corrected, streamed_offset,
+                                           window_samples, write_c)
 from tcbench.compensation.calibration import OffsetModel, fit, from_model, record
+from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.fitted_model import deterministic_output
 from tcbench.sensors.effects import EFFECTS
 from tcbench.sensors.fitted import PolynomialModel
@@ -149,6 +150,24 @@ def rates() -> dict[tuple[str, str], np.ndarray]:
     return {}
 
 
+EPSILON = {"double": 2.0 ** -52, "float": 2.0 ** -23}
+
+
+def _stable(spec: dict, clock: np.ndarray, temp_c: np.ndarray, rate: np.ndarray, bound: np.ndarray,
+            build: str) -> np.ndarray:
+    """The samples before the reference first moves by a tenth of ``bound`` when its temperatures
+    or its rates move by the build's rounding (one part in 2^52 or 2^23). The Elman fitted on 100
+    bins expands its context far outside its training (W_c's largest singular value is about 3.5):
+    a rounding difference there grows tenfold every ~100 s, so after that point no two correct
+    implementations (numpy's order of operations, the C's) agree to the tolerance."""
+    ref = streamed_offset(spec, clock, temp_c, rate)
+    eps = EPSILON[build]
+    moved = np.maximum(np.abs(streamed_offset(spec, clock, temp_c * (1 + eps), rate) - ref),
+                       np.abs(streamed_offset(spec, clock, temp_c, rate * (1 + eps)) - ref))
+    beyond = np.flatnonzero(10.0 * moved > bound)
+    return np.arange(clock.size) < (beyond[0] if beyond.size else clock.size)
+
+
 @pytest.mark.parametrize("build", ["double", "float"])
 @pytest.mark.parametrize("method", ["poly3", "poly3_rate", "bp", "elman", "model"])
 def test_the_compiled_model_gives_pythons_output_on_every_record(programs: dict, records: dict, rates: dict,
@@ -162,11 +181,16 @@ def test_the_compiled_model_gives_pythons_output_on_every_record(programs: dict,
         assert said.get("dropped", 0) == 0, f"{label}: the rate ring overflowed"
         clock = device_clock_s(fed_dt)
         if method != "poly3" and (label, build) not in rates:
-            rates[(label, build)] = window_rate_c_per_s(clock, fed_temp)
-        want = fed_raw - streamed_offset(spec, clock, fed_temp, rates.get((label, build)))
+            rates[(label, build)] = temperature_rate_c_per_s(clock, fed_temp)
+        rate = rates.get((label, build))
+        want = fed_raw - streamed_offset(spec, clock, fed_temp, rate)
         bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
-        worst = int(np.argmax(np.abs(got - want) / bound))
-        assert np.all(np.abs(got - want) <= bound), (label, worst, got[worst], want[worst])
+        keep = np.ones(t_s.size, dtype=bool)
+        if "wc" in spec:  # up to where the reference's own rounding has grown to the tolerance (_stable)
+            keep = _stable(spec, clock, fed_temp, rate, bound, build)
+            assert np.mean(keep) > 0.8, label
+        worst = int(np.argmax(np.where(keep, np.abs(got - want) / bound, 0.0)))
+        assert np.all(np.abs(got - want)[keep] <= bound[keep]), (label, worst, got[worst], want[worst])
         assert np.ptp(want - fed_raw) > 0, label  # the model corrects something there
 
 
@@ -245,3 +269,37 @@ def test_names_and_methods_no_device_runs_are_refused() -> None:
         c_sources({"method": "poly3", "x": [0, 0, 0, 0], "tref_c": 0, "tmin_c": 0, "tmax_c": 1}, "9lives")
     with pytest.raises(ValueError, match="memoriser: a control"):
         device_spec(OffsetModel("memoriser"), 10)
+
+
+def test_a_model_with_a_scale_factor_returns_the_input(records: dict, tmp_path: Path) -> None:
+    """A diagnosis of a record with several input levels has a scale factor in the die temperature
+    (``bias(u) + a s(u)``): its C returns ``(raw - offset) / s(u)``, the input that explains the
+    reading. Compiled, it gives :func:`streamed_corrected` to the tolerance in both builds, and on
+    the model's own output for a slow swing of rates over the tofupilot thermometer it returns
+    those rates to 1e-3 of their span (``raw - offset`` alone misses them by the scale factor's
+    2 %; the die lag runs per sample on the device, on calibrate's grid in the model)."""
+    t_s, temp_c, _ = records["tofupilot gyro x"]
+    model = PolynomialModel(sensor="gyro", centre_c=28.18, half_range_c=45.78, bias=(-4.128, 0.2612, 0.8546),
+                            scale_factor=(1.02, 0.015, -0.004), ref_c=28.18,
+                            effects=(EFFECTS["thermal_lag"](tau_s=120.0),
+                                     EFFECTS["temperature_cubic"](c3_per_c3=2e-6)))
+    rates = 50.0 * np.sin(2 * np.pi * t_s / 900.0)  # deg/s, a slow swing through the cycle
+    raw = deterministic_output(model, t_s, temp_c, rates, clock_terms=False)
+    spec = device_spec(from_model(model), 10)
+    assert spec["scale_factor"] == [1.02, 0.015, -0.004]
+    clock = t_s - t_s[0]
+    corrected = streamed_corrected(spec, clock, temp_c, raw)
+    assert np.max(np.abs(corrected - rates)) < 1e-3 * np.ptp(rates)
+    assert np.max(np.abs(raw - streamed_offset(spec, clock, temp_c) - rates)) > 1e-2 * np.ptp(rates)
+    write_c(spec, "scaled", tmp_path)
+    (tmp_path / "host.c").write_text(HOST.replace("UPNAME", "SCALED").replace("NAME", "scaled"))
+    dt_s = np.r_[0.0, np.diff(t_s)]
+    for build in ("double", "float"):
+        flags = ["-DSCALED_FLOAT"] if build == "float" else []
+        subprocess.run([CC, "-std=c99", "-O2", *flags, str(tmp_path / "host.c"), str(tmp_path / "scaled.c"), "-lm",
+                        "-o", str(tmp_path / build)], check=True)
+        got, _ = _run(tmp_path / build, temp_c, raw, dt_s)
+        fed_temp, fed_raw, fed_dt = (_as_fed(v, build) for v in (temp_c, raw, dt_s))
+        want = streamed_corrected(spec, device_clock_s(fed_dt), fed_temp, fed_raw)
+        bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
+        assert np.all(np.abs(got - want) <= bound), build

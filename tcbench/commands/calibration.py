@@ -251,6 +251,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     from tqdm import tqdm
 
     from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
+    from tcbench.compensation.c_export import STREAMED, streamed_residual
     from tcbench.compensation.screening import screened_all
 
     rec, split, others = check_calibrate(cfg)
@@ -300,6 +301,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     held_temp: list[np.ndarray] = []
     held_t: list[np.ndarray] = []
     held_labels: list[str] = []
+    held_causal: dict[str, list[list[np.ndarray]]] = {}  # the Elman's and the model's streamed residuals
     steps: list[float] = []
     drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
     for path, r, parts, fitted_parts in [(cfg.recording, rec, split.parts, split.train),
@@ -308,6 +310,7 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
         target = whole if own else record(r.time_s, r.temperature_c, r.output, r.input)
         starts_s = r.time_s[[b.start for b in parts]]
         every = {m: [residual(model, target, starts_s) for model in runs] for m, runs in fitted.items()}
+        causal = {m: [streamed_residual(model, target) for model in fitted[m]] for m in STREAMED if m in fitted}
         dt_s = float(np.median(np.diff(r.time_s))) if r.time_s.size > 1 else 1.0
         for k, b in enumerate(parts):
             role = "train" if k in fitted_parts else "test"
@@ -322,6 +325,9 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
                 if role == "test":
                     for i, res in enumerate(runs):
                         held[m][i].append(res[b.start:b.stop])
+                    for i, res in enumerate(causal.get(m, [])):
+                        if res is not None:
+                            held_causal.setdefault(m, [[] for _ in runs])[i].append(res[b.start:b.stop])
                 rows.append({"recording": Path(path).stem, "method": m, "branch": k, "direction": b.direction,
                              "from_c": b.from_c, "to_c": b.to_c, "role": role,
                              drift_key: float(np.median([x["drift_rms"] for x in s])),
@@ -331,6 +337,8 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     table = pd.DataFrame(rows)
     summary, about = _ranked(table, held, held_raw, steps, cfg, unit, drift_key)
     about["per_part"] = _per_part(held, held_raw, steps, held_labels, cfg)
+    if steps and held_causal:
+        about["streamed"] = _streamed_drift(held_causal, steps, cfg)
     about |= _floor(held, held_raw, held_t, steps, cfg)
     about |= _about(cfg, rec, split, unit, own_hash)
     about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
@@ -412,6 +420,19 @@ def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[
         ranking["ratio_to_raw"] = list(to_raw[best])
     ranking["worse_than_raw"], ranking["no_better_than_raw"] = raw_verdicts(to_raw)
     return summary, ranking
+
+
+def _streamed_drift(causal: dict[str, list[list[np.ndarray]]], steps: list[float], cfg: CalibrateConfig
+                    ) -> dict[str, Any]:
+    """The held-out drift of the Elman and the diagnosed model as the exported C runs them (causal,
+    from each record's first sample: :func:`~tcbench.compensation.c_export.streamed_residual`),
+    pooled as the ranking pools calibrate's own, beside it in ``drift``."""
+    from tcbench.compensation.holdout import block_sums
+
+    runs = {f"{m}#{i}": parts for m, per in causal.items() for i, parts in enumerate(per)}
+    sums = block_sums(runs, steps, cfg.drift_window_s)
+    return {m: float(np.sqrt(np.mean([sums.squares[f"{m}#{i}"].sum() for i in range(len(per))]) / sums.counts.sum()))
+            for m, per in causal.items()}
 
 
 def _floor(held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], held_t: list[np.ndarray],
@@ -620,6 +641,11 @@ def _print_summary(summary: Any, about: dict[str, Any], unit: str, written: dict
         if line:
             print(line)
     print(_best_line(about, unit))
+    apart = {m: v for m, v in about.get("streamed", {}).items() if f"{v:.3g}" != f"{about['drift'][m]:.3g}"}
+    if apart:  # calibration.json keeps both always; the line only where they differ as printed
+        print("as the device runs them (causal, the exported C): " + "; ".join(
+            f"{m} {v:.3g} {unit} held out (calibrate's, reading ahead: {about['drift'][m]:.3g})"
+            for m, v in apart.items()))
 
 
 def _export_hint(about: dict[str, Any], folder: Path) -> str | None:

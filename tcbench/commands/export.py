@@ -101,12 +101,71 @@ def read_calibration(folder: str | Path) -> AxisCalibration:
                            device or None, held_out, left_out)
 
 
+@dataclass(frozen=True)
+class RunNetwork:
+    """The network a ``tcbench run`` compensation job kept (its ``device.json``)."""
+
+    source: str  # the run id, or the device.json given
+    name: str  # the C name's stem: tc_<sensor>_<learner>_<run id's first 8>
+    about: str  # the header's line
+    spec: dict[str, Any]
+
+
+def read_run(given: str) -> list[RunNetwork]:
+    """The networks of one ``runs=`` entry: a run id in the store ``$MLFLOW_TRACKING_URI`` (else
+    ./mlflow.db), or the path of a run's ``device.json``; one line when it has none a device runs."""
+    from tcbench.compensation.run_device import FILE
+
+    path = Path(given)
+    if path.is_file():
+        run_id = path.parent.parent.name if path.parent.name == "artifacts" else path.parent.name
+    else:
+        from tcbench.tracking.store import StoreError, check_store, client, local_artifact_dir
+
+        try:
+            uri = check_store(None, create=False)
+            run = client(uri).get_run(given)
+        except StoreError as exc:
+            raise CommandError(f"runs: {exc}") from None
+        except Exception:  # MLflow's lookup of an unknown id raises its own exception types
+            raise CommandError(f"runs: {given}: no such run in {uri} (a tcbench run's id, or the path of its "
+                               f"{FILE})") from None
+        folder = local_artifact_dir(run.info.artifact_uri)
+        path = (folder / FILE) if folder is not None else Path(given) / FILE
+        if not path.is_file():
+            raise CommandError(f"runs: {given}: the run kept no {FILE} (not a compensation run of a network, "
+                               "or run before tcbench kept one)")
+        run_id = given
+    try:
+        about = json.loads(path.read_text())
+        device, left = dict(about["device"]), dict(about.get("left_out") or {})
+        sensor, unit = str(about.get("sensor") or "sensor"), str(about.get("unit") or "")
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise CommandError(f"runs: {path}: not a {FILE} tcbench export reads ({exc})") from None
+    if not device:
+        why = "; ".join(f"{k}: {v}" for k, v in left.items()) or "no network"
+        raise CommandError(f"runs: {given}: no network a device runs ({why})")
+    return [RunNetwork(given, f"tc_{sensor}_{method}_{run_id[:8]}",
+                       f"{sensor}, output in {unit}: the {about.get('method', method)} network of tcbench run {run_id} "
+                       f"on {about.get('task', '?')}", spec) for method, spec in device.items()]
+
+
+def check_runs(cfg: ExportConfig) -> list[RunNetwork]:
+    """The networks of ``runs=``; one line when a format other than C is asked of them."""
+    if not cfg.runs:
+        return []
+    if other := [f for f in cfg.formats if f != "c"]:
+        raise CommandError(f"runs: a run's network is written as C only (formats=[c]), not {', '.join(other)}")
+    return [n for given in cfg.runs for n in read_run(str(given))]
+
+
 def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
     """Every argument before any work; the calibrations by sensor kind and axis."""
     from tcbench.compensation.px4 import px4_covers
 
-    if not cfg.calibrations:
-        raise CommandError("calibrations=[DIR,...] is required: the out= folders of tcbench calibrate")
+    if not cfg.calibrations and not cfg.runs:
+        raise CommandError("calibrations=[DIR,...] is required: the out= folders of tcbench calibrate "
+                           "(or runs=[ID,...]: tcbench run compensation runs, formats=[c])")
     if bad := [f for f in cfg.formats if f not in FORMATS]:
         raise CommandError(f"formats: {unknown_name('format', bad[0], FORMATS)}")
     if not cfg.formats:
@@ -130,7 +189,11 @@ def check_export(cfg: ExportConfig) -> dict[str, dict[str, AxisCalibration]]:
         if cal.axis in axes:
             raise CommandError(f"calibrations: {axes[cal.axis].folder} and {folder} are both {cal.sensor} axis {cal.axis}")
         axes[cal.axis] = cal
-    free_outputs(cfg.out, [FILES[f] for f in autopilots] + c_files(by_sensor) * ("c" in cfg.formats), cfg.overwrite)
+    names = [n.name for n in check_runs(cfg)]
+    if twice := sorted({n for n in names if names.count(n) > 1}):
+        raise CommandError(f"runs: {twice[0]} is given twice")
+    free_outputs(cfg.out, [FILES[f] for f in autopilots] + c_files(by_sensor) * ("c" in cfg.formats)
+                 + [f"{n}.{ext}" for n in names for ext in ("h", "c")], cfg.overwrite)
     if "px4" in cfg.formats:
         for sensor in by_sensor:
             device_id(cfg, sensor, by_sensor[sensor])
@@ -159,6 +222,19 @@ def write_c_files(by_sensor: dict[str, dict[str, AxisCalibration]], folder: Path
                 except (KeyError, TypeError, ValueError) as exc:
                     raise CommandError(f"calibrations: {cal.folder}: its device method {method} cannot be "
                                        f"written as C ({exc}); calibrate it again") from None
+    return written
+
+
+def write_run_c_files(networks: list[RunNetwork], folder: Path) -> list[Path]:
+    """Every run network as C in ``folder``."""
+    from tcbench.compensation.c_export import write_c
+
+    written: list[Path] = []
+    for n in networks:
+        try:
+            written += write_c(n.spec, n.name, folder, n.about)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise CommandError(f"runs: {n.source}: its network cannot be written as C ({exc})") from None
     return written
 
 
@@ -201,6 +277,7 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
     from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, px4_polynomial, write_parameters
 
     by_sensor = check_export(cfg)
+    networks = check_runs(cfg)
     autopilots = any(f in AUTOPILOTS for f in cfg.formats)
     to_si = {s: px4_factor(s, next(iter(axes.values())).unit) for s, axes in by_sensor.items()} if autopilots else {}
     polys = {s: {a: c.poly for a, c in axes.items()} for s, axes in by_sensor.items()}
@@ -245,6 +322,7 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
                 written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"], comments)
             if "c" in cfg.formats:
                 written |= {f"c {p.name}": p for p in write_c_files(by_sensor, tmp)}
+                written |= {f"c {p.name}": p for p in write_run_c_files(networks, tmp)}
     except OutputRefusedError as exc:
         raise refused_output(exc) from None
     except OSError as exc:

@@ -423,9 +423,11 @@ SPECS: dict[str, CommandSpec] = {
         runs_here="tcbench.commands.export",
         params={
             "calibrations": "the out= folders of tcbench calibrate (their calibration.json): one per axis and kind",
+            "runs": "tcbench run compensation runs (their ids in $MLFLOW_TRACKING_URI, or their device.json) whose "
+                    "trained network formats=[c] writes as C",
             "out": "output folder",
             "overwrite": OVERWRITE,
-            "formats": "px4, ardupilot, or both",
+            "formats": "px4, ardupilot, c (C99 of every method a device runs), or several",
             "device_id": "PX4's TC_*_ID: the sensor's device id (CAL_GYROn_ID / CAL_ACCn_ID), one number or "
                          "{gyro: N, accel: M}; null: the id the PX4 log gave (required for px4 otherwise)",
             "px4_instance": "the TC_G<i> / TC_A<i> instance (0..3)",

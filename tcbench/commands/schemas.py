@@ -170,6 +170,7 @@ class ExportConfig:
     (one per axis and sensor kind of one IMU)."""
 
     calibrations: list[str] = field(default_factory=list)
+    runs: list[str] = field(default_factory=list)  # tcbench run ids (or their device.json) whose network formats=[c] writes
     out: str = "export"
     overwrite: bool = False
     formats: list[str] = field(default_factory=lambda: ["px4", "ardupilot"])

@@ -19,16 +19,17 @@ same arithmetic in numpy, the reference the compiled code is checked against):
 - ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range.
 - ``poly3_rate``: that cubic plus the rate coefficient times the temperature rate, the
   least-squares slope over the trailing :data:`~tcbench.compensation.calibration.RATE_WINDOW_S`
-  window ``t_i - w < t_j <= t_i``, the estimator
-  :func:`~tcbench.compensation.features.temperature_rate_c_per_s` computes for calibrate (causal),
-  each window centred before its moments are summed (:func:`window_rate_c_per_s`), kept in a ring of at most ``<NAME>_RATE_CAPACITY`` samples (the most any window of
-  the calibration record held, with half again as margin; more are counted in ``s->dropped``
-  and the oldest left out).
+  window ``t_i - w < t_j <= t_i``, each window's moments centred on its own means: the estimator
+  calibrate computes (:func:`~tcbench.compensation.features.temperature_rate_c_per_s`), over a ring
+  of at most ``<NAME>_RATE_CAPACITY`` samples (the most any window of the calibration record held,
+  with half again as margin; more are counted in ``s->dropped`` and the oldest left out).
 - ``bp`` and ``bp_gd``: the network on ``[T, dT/dt]`` held to its training box, scaled to
   [-1, 1] as it was trained and its output scaled back.
 - ``elman``: the recurrent network steps once per time bin (``bin_s`` from the first sample),
-  as it was trained. Python's calibration scores it on the bins' means interpolated between the
-  bins' mean times, which reads up to 1.5 bins ahead; the device cannot. Here each sample gets
+  as it was trained (once per sample when it was trained on every sample: ``bin_s`` 0, a
+  ``tcbench run`` network, :mod:`tcbench.compensation.run_device`). Python's calibration scores
+  it on the bins' means interpolated between the bins' mean times, which reads up to 1.5 bins
+  ahead; the device cannot. Here each sample gets
   the network's output for the mean of its bin so far, from the context the previous complete
   bin left (at a bin's last sample the two agree): that causal form is what
   :func:`streamed_offset` computes and the compiled code is checked against.
@@ -43,8 +44,13 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   difference (it reads the next sample) and runs the hysteresis's play operator on a 1-Hz grid
   interpolated back; the device takes the rate as the backward difference over the last interval
   and runs the play operator at every sample. That causal form is what :func:`streamed_offset`
-  computes. The offset is the model's output at zero input (a static record's: its scale factor
-  is not applied). A model with another term is not exported, and the export says which.
+  computes. The offset is the model's output at zero input. A model whose scale factor is not
+  one (a diagnosis of a record with several input levels: the core is ``bias(u) + a s(u)``, ``u``
+  the normalised die temperature) returns the input that explains the reading,
+  ``(raw - offset) / s(u)`` (:func:`streamed_corrected`); a diagnosis of a static record (one input
+  level, all ``tcbench calibrate`` sees on a static record) writes a unit scale factor and its
+  bias absorbs the level, so the model returns ``raw - offset``. A model with another term (an
+  accelerometer's ``k a^2``, ``accel_nonlinearity``) is not exported, and the export says which.
 """
 
 from __future__ import annotations
@@ -57,6 +63,7 @@ from typing import Any
 import numpy as np
 
 from tcbench.compensation.calibration import RATE_WINDOW_S, OffsetModel
+from tcbench.compensation.features import temperature_rate_c_per_s
 
 EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")  # what a device can run of calibrate's methods
 NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator"}
@@ -91,66 +98,38 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
         if model.method == "poly3_rate":
             spec |= {"rate_coef": float(model.rate_coef), "rate_window_s": rate_window_s, "rate_capacity": capacity}
         return spec
-    learner = model.learner
+    return network_spec(model.method, model.learner, model.temp_range_c, model.rate_range, rate_window_s, capacity,
+                        model.bin_s)
+
+
+def network_spec(method: str, learner: Any, temp_range_c: Any, rate_range: Any, rate_window_s: float, capacity: int,
+                 bin_s: float | None) -> dict[str, Any]:
+    """A fitted BP or Elman network on ``[T, dT/dt]`` as plain data: its weights, scaling and input
+    box (``None``: unbounded); ``capacity``: the rate ring's samples; ``bin_s``: the time bins an
+    Elman steps once per (0: once per sample, as a network trained on every sample runs)."""
     if learner.x_scaler is None or learner.y_scaler is None:
-        raise ValueError(f"{model.method}: the network has no normalisation (not fitted)")
+        raise ValueError(f"{method}: the network has no normalisation (not fitted)")
     h, m = learner.params.hidden, learner.n_inputs
+    if m != 2:
+        raise ValueError(f"{method}: a network on {m} inputs; the device runs one on [T, dT/dt]")
     p = learner.get_params()
-    spec = {"method": model.method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
+    spec = {"method": method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
             "output_activation": learner.params.output_activation,
             "x_low": learner.x_scaler.low.tolist(), "x_high": learner.x_scaler.high.tolist(),
             "y_low": float(learner.y_scaler.low[0]), "y_high": float(learner.y_scaler.high[0]),
-            "temp_range_c": list(model.temp_range_c or (-np.inf, np.inf)),
-            "rate_range": list(model.rate_range or (-np.inf, np.inf)),
+            "temp_range_c": [float(v) for v in (temp_range_c if temp_range_c is not None else (-np.inf, np.inf))],
+            "rate_range": [float(v) for v in (rate_range if rate_range is not None else (-np.inf, np.inf))],
             "rate_window_s": rate_window_s, "rate_capacity": capacity}
     if learner.sequential:
         i, j = h * m, h * m + h * h
         spec |= {"wx": p[:i].reshape(h, m).tolist(), "wc": p[i:j].reshape(h, h).tolist(), "b1": p[j:j + h].tolist(),
-                 "w2": p[j + h:j + 2 * h].tolist(), "b2": float(p[-1]), "bin_s": float(model.bin_s or 0.0)}
-        if not spec["bin_s"] > 0:
-            raise ValueError(f"{model.method}: a recurrent network exported per sample needs its training bins")
+                 "w2": p[j + h:j + 2 * h].tolist(), "b2": float(p[-1]), "bin_s": float(bin_s or 0.0)}
+        if not spec["bin_s"] >= 0:
+            raise ValueError(f"{method}: bin_s must be >= 0, got {bin_s}")
     else:
         spec |= {"w1": p[:h * m].reshape(h, m).tolist(), "b1": p[h * m:h * m + h].tolist(),
                  "w2": p[h * m + h:h * m + 2 * h].tolist(), "b2": float(p[-1])}
     return spec
-
-
-def window_rate_c_per_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float = RATE_WINDOW_S,
-                        floats: int = 2_000_000) -> np.ndarray:
-    """The temperature rate (degC/s) the exported code computes: the least-squares slope over the
-    trailing window ``t_i - window_s < t_j <= t_i`` (the estimator of
-    :func:`~tcbench.compensation.features.temperature_rate_c_per_s`), each window centred on its
-    own samples before its moments are summed, as the C does. The prefix-sum form calibrate runs
-    sums moments about the record's first sample, which loses digits when a window holds a few
-    closely spaced samples far from it (a burst's first samples: on the PAN record one rate off by
-    0.2 %); this one keeps them. Vectorised over windows, ``floats`` values at a time."""
-    t = np.asarray(t_s, dtype=np.float64).reshape(-1)
-    y = np.asarray(temp_c, dtype=np.float64).reshape(-1)
-    if t.shape != y.shape:
-        raise ValueError(f"t_s has {t.size} samples, temp_c {y.size}")
-    if np.any(np.diff(t) <= 0):
-        raise ValueError("t_s must be strictly increasing")
-    out = np.zeros(t.size)
-    if t.size == 0:
-        return out
-    start = np.searchsorted(t, t - window_s, side="right")
-    width = int(np.max(np.arange(t.size) - start)) + 1
-    step = max(1, floats // width)
-    k = np.arange(width)
-    for a in range(0, t.size, step):
-        rows = np.arange(a, min(a + step, t.size))
-        idx = start[rows, None] + k
-        inside = idx <= rows[:, None]
-        idx = np.minimum(idx, rows[:, None])
-        n = inside.sum(axis=1)
-        u = np.where(inside, t[idx] - t[rows, None], 0.0)
-        v = np.where(inside, y[idx] - y[rows, None], 0.0)
-        u = np.where(inside, u - (u.sum(axis=1) / n)[:, None], 0.0)
-        v = np.where(inside, v - (v.sum(axis=1) / n)[:, None], 0.0)
-        sxx, sxy = (u * u).sum(axis=1), (u * v).sum(axis=1)
-        ok = (n >= 2) & (sxx > 0)
-        out[rows] = np.where(ok, sxy / np.where(ok, sxx, 1.0), 0.0)
-    return out
 
 
 def model_spec(sensor_model: Any) -> dict[str, Any]:
@@ -163,8 +142,39 @@ def model_spec(sensor_model: Any) -> dict[str, Any]:
         raise ValueError(f"model: its {', '.join(other)} term{'s' * (len(other) > 1)} "
                          f"{'are' if len(other) > 1 else 'is'} not exported as C (exported: {', '.join(MODEL_TERMS)})")
     effects = [{"id": type(e).id, **{k: float(v) for k, v in e.params().items()}} for e in quiet.effects]
-    return {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
+    spec = {"method": "model", "centre_c": quiet.centre_c, "half_range_c": quiet.half_range_c,
             "bias": [float(b) for b in quiet.bias], "ref_c": float(quiet.ref_c), "effects": effects}
+    if tuple(float(k) for k in quiet.scale_factor) != (1.0,):
+        if not any(float(k) != 0.0 for k in quiet.scale_factor):
+            raise ValueError("model: its scale factor is zero (the output does not follow the input)")
+        spec["scale_factor"] = [float(k) for k in quiet.scale_factor]
+    return spec
+
+
+def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray, raw: np.ndarray,
+                       rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
+    """What the exported code returns at each sample, in numpy: ``raw`` minus
+    :func:`streamed_offset`, over the diagnosed model's scale factor where it has one (the input
+    that explains the reading)."""
+    corrected = np.asarray(raw, dtype=np.float64) - streamed_offset(spec, clock_s, temp_c, rate_c_per_s)
+    if spec["method"] != "model" or "scale_factor" not in spec:
+        return corrected
+    u = (_model_die(spec, np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
+         - spec["centre_c"]) / spec["half_range_c"]
+    scale = np.zeros_like(u)
+    for k in reversed(spec["scale_factor"]):
+        scale = scale * u + k
+    return corrected / scale
+
+
+def _model_die(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """The die temperature the diagnosed model runs on: the thermometer through its thermal lags."""
+    dt = np.r_[0.0, np.diff(t)]
+    die = temp.copy()
+    for e in spec["effects"]:
+        if e["id"] == "thermal_lag":
+            die = _lag(die, dt, e["tau_s"])
+    return die
 
 
 def _model_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
@@ -248,14 +258,15 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
                     rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """The offset the exported code computes at each sample, in numpy: ``clock_s`` the device's
     clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
-    ``rate_c_per_s``: :func:`window_rate_c_per_s` of them when already computed."""
+    ``rate_c_per_s``: :func:`~tcbench.compensation.features.temperature_rate_c_per_s` of them when
+    already computed."""
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     method = spec["method"]
     if method == "model":
         return _model_streamed(spec, t, temp)
     if method != "poly3" and rate_c_per_s is None:
-        rate_c_per_s = window_rate_c_per_s(t, temp, spec["rate_window_s"])
+        rate_c_per_s = temperature_rate_c_per_s(t, temp, spec["rate_window_s"])
     rate = np.asarray(rate_c_per_s, dtype=np.float64)
     if method in ("poly3", "poly3_rate"):
         x = spec["x"]
@@ -274,7 +285,7 @@ def _elman_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate:
     previous complete bin (see the module doc)."""
     wx, wc = np.asarray(spec["wx"]), np.asarray(spec["wc"])
     b1, w2 = np.asarray(spec["b1"]), np.asarray(spec["w2"])
-    index = np.floor(t / spec["bin_s"]).astype(np.int64)
+    index = np.floor(t / spec["bin_s"]).astype(np.int64) if spec["bin_s"] > 0 else np.arange(t.size)
     starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
     stops = np.r_[starts[1:], t.size]
     out = np.empty(t.size)
@@ -348,7 +359,8 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         if recurrent:
             per += 6
             flops = (f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap}); "
-                     f"and {2 * h * h + h} more once per {spec['bin_s']:g}-s bin")
+                     f"and {2 * h * h + h} more once per "
+                     + (f"{spec['bin_s']:g}-s bin)" if spec["bin_s"] > 0 else "sample)"))
         else:
             flops = f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})"
         body = ""
@@ -356,7 +368,9 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
              *([f" * {about}"] if about else []),
              " *",
              f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
-             " * the offset. dt_s is the time since the previous sample (> 0; the first sample's is ignored).",
+             (" * the offset, over the scale factor s(T_die) (the input that explains the reading). dt_s is the"
+              if method == "model" and "scale_factor" in spec else " * the offset. dt_s is the"),
+             " * time since the previous sample (> 0; the first sample's is ignored).",
              f" * Build: double by default; define {up}_FLOAT for float (the clock stays a double).",
              f" * State: {sizes['double']} bytes (double build), {sizes['float']} bytes (float build); no allocation.",
              f" * Floating-point operations per sample: {flops}.",
@@ -419,7 +433,8 @@ def _model_slots(spec: dict[str, Any]) -> list[str]:
 def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     """The update of the diagnosed model (see the module doc) and its operations per sample."""
     slots = _model_slots(spec)
-    lines = ["    int first = s->samples == 1;", "    R die = temperature_c, offset = 0, u;"]
+    lines = ["    int first = s->samples == 1;",
+             "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
     flops, calls = 0, 0
     lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
     for k, e in lags:  # the die stage first, in order, as the simulator runs it
@@ -460,6 +475,11 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
                       f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                       f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
             flops, calls = flops + 7, calls + 1
+    if "scale_factor" in spec:  # the input that explains the reading: (raw - offset) / s(u)
+        lines.append("    scale = 0;")
+        for k in reversed(spec["scale_factor"]):
+            lines.append(f"    scale = scale * u + (R){_lit(k)};")
+        flops += 2 * len(spec["scale_factor"]) + 1
     flops += 1
     return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
 
@@ -573,7 +593,8 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
         update += [f"    R hidden[{h}];", "    R offset = network(temperature_c, rate, B1, hidden);"]
     else:
         update += [f"    R offset;",
-                   f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});",
+                   (f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});" if spec["bin_s"] > 0
+                    else "    int bin = s->samples;  /* a network trained on every sample steps every sample */"),
                    "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
                    "        int i, j;",
                    f"        for (j = 0; j < {h}; j++) s->context[j] = s->pending[j];",
@@ -592,7 +613,8 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
                    "    s->bin_rate_sum += rate;",
                    "    offset = network(s->bin_temp_sum / (R)s->bin_count, s->bin_rate_sum / (R)s->bin_count, "
                    "s->drive, s->pending);"]
-    update += ["    return raw - offset;", "    }", "}\n"]
+    scaled = method == "model" and "scale_factor" in spec
+    update += ["    return (raw - offset) / scale;" if scaled else "    return raw - offset;", "    }", "}\n"]
     parts.append("\n".join(update))
     return "".join(parts)
 
@@ -605,3 +627,21 @@ def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = ""
     paths[0].write_text(src.header)
     paths[1].write_text(src.source)
     return paths
+
+
+# -- calibrate's numbers as the device runs them ----------------------------------------------------
+
+STREAMED = ("elman", "model")  # the methods whose streamed (causal) output is not calibrate's own
+
+
+def streamed_residual(model: OffsetModel, rec: Any) -> np.ndarray | None:
+    """Output minus true input minus the offset the exported code computes over the whole record
+    ``rec`` (a :class:`~tcbench.compensation.record.Record`) from its first sample: the causal
+    form of the Elman and of the diagnosed model (see the module doc), where calibrate's own
+    offset reads ahead; None for a method no device runs (:func:`device_spec` refuses it)."""
+    try:
+        spec = device_spec(model, window_samples(rec.t_s))
+    except ValueError:
+        return None
+    clock = rec.t_s - rec.t_s[0] if rec.t_s.size else rec.t_s
+    return rec.output - rec.truth - streamed_offset(spec, clock, rec.temp_c)

@@ -227,6 +227,11 @@ class CompensationKind(JobKind):
                 nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
                 files.append(where / f"nodes_test{i}.csv")
         files += gyro_tables(result, where)
+        if job.learner.name not in BASELINES and getattr(job.env, "learner", None) is not None:
+            from tcbench.compensation.run_device import FILE, device_document
+
+            (where / FILE).write_text(json.dumps(device_document(job.env, job.learner.name, job.names.method), indent=1))
+            files.append(where / FILE)
         if job.plots is not False:  # null: plot (a sweep's launcher decides)
             n = job.names
             files += figures(result.score, loss, where, f"{n.method} on {n.task}, seed {job.seed}", result.tuning)

@@ -1,0 +1,129 @@
+"""A network trained by a ``tcbench run`` compensation job, kept as ``device.json``
+(:mod:`tcbench.compensation.run_device`) and exported by ``tcbench export runs=[...] formats=[c]``:
+compiled with the system C compiler and run sample by sample over the run's test record, it gives
+the run's own compensation (the task's learner compensator) to 1e-9 (double build) and 1e-4 (float
+build), relative to the larger of the output and the record's largest raw reading."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import tcbench  # noqa: F401 - registers the envs
+from test_c_export import _stable
+from tcbench.compensation import methods
+from tcbench.compensation.c_export import device_clock_s, write_c
+from tcbench.compensation.features import temperature_rate_c_per_s
+from tcbench.compensation.run_device import device_document
+from tcbench.runner.loop import compensate
+
+CC = shutil.which("cc")
+TOLERANCE = {"double": 1e-9, "float": 1e-4}
+ENV = "tcbench/Accel-Chamber-v0"
+HOST = Path(__file__).with_name("test_c_export.py").read_text().split('HOST = r"""')[1].split('"""')[0]
+
+
+def _trained(learner: str, params: dict) -> tuple[object, dict]:
+    """The chamber task (one cycle to train, one to test) with ``learner`` trained as a run trains
+    it, and the ``device.json`` the run keeps."""
+    env = gym.make(ENV, learner=learner, learner_params=params, n_train=1, n_test=1, recordings_seed=0).unwrapped
+    compensate(env, learner, "none", {}, 1, 0)
+    return env, device_document(env, learner, f"random-{learner}")
+
+
+@pytest.fixture(scope="module")
+def trained() -> dict[str, tuple[object, dict]]:
+    """Each network trained once (lazily: the Elman's 30 epochs take about 20 s)."""
+    class Lazy(dict):
+        def __missing__(self, learner: str) -> tuple[object, dict]:
+            params = {"training": "gd", "epochs": 50} if learner == "bp" else {"epochs": 30}
+            self[learner] = _trained(learner, params)
+            return self[learner]
+
+    return Lazy()
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize("learner", ["bp", pytest.param("elman", marks=pytest.mark.slow)])
+def test_the_compiled_run_network_gives_the_runs_compensation(trained: dict, learner: str, build: str,
+                                                               tmp_path: Path) -> None:
+    env, doc = trained[learner]
+    assert doc["sensor"] == "accel" and doc["unit"] == "g" and list(doc["device"]) == [learner]
+    spec = json.loads(json.dumps(doc["device"][learner]))  # as the artifact holds it
+    name = f"tc_accel_{learner}"
+    write_c(spec, name, tmp_path)
+    (tmp_path / "host.c").write_text(HOST.replace("UPNAME", name.upper()).replace("NAME", name))
+    exe = tmp_path / name
+    flags = [f"-D{name.upper()}_FLOAT"] if build == "float" else []
+    subprocess.run([CC, "-std=c99", "-O2", *flags, str(tmp_path / "host.c"), str(tmp_path / f"{name}.c"), "-lm",
+                    "-o", str(exe)], check=True)
+    tr = env.data.test[0]
+    rec = tr.recording
+    t_s, temp_c, raw = rec.time_s, rec.temperature_c, rec.output
+    dt_s = np.r_[0.0, np.diff(t_s)]
+    lines = "".join(f"{a.hex()} {b.hex()} {c.hex()}\n" for a, b, c in zip(temp_c.tolist(), raw.tolist(), dt_s.tolist()))
+    done = subprocess.run([str(exe)], input=lines, capture_output=True, text=True, check=True)
+    got = np.array([float.fromhex(v) for v in done.stdout.split()])
+    assert "dropped 0" in done.stderr
+    box = env.data.input_range(env._x)
+    want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)  # the run's own compensation
+    bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
+    keep = np.ones(raw.size, dtype=bool)
+    if learner == "elman":  # up to where the reference's own rounding has grown to the tolerance
+        clock = device_clock_s(dt_s)
+        keep = _stable(spec, clock, temp_c, temperature_rate_c_per_s(clock, temp_c, spec["rate_window_s"]), bound,
+                       build)
+        assert np.mean(keep) > 0.9
+    worst = int(np.argmax(np.where(keep, np.abs(got - want) / bound, 0.0)))
+    assert np.all(np.abs(got - want)[keep] <= bound[keep]), (worst, got[worst], want[worst])
+    assert np.ptp(want - raw) > 10 * TOLERANCE["float"] * np.max(np.abs(raw))  # the network corrects something
+
+
+def test_a_run_whose_network_no_device_runs_says_why() -> None:
+    env = gym.make("tcbench/MSRA-FullTemp-v0", learner="bp", learner_params={"training": "gd", "epochs": 2},
+                   n_train=1, n_test=1, recordings_seed=0).unwrapped
+    compensate(env, "bp", "none", {}, 1, 0)
+    doc = device_document(env, "bp", "random-BP-gd")
+    assert doc["device"] == {} and "maps the output and the temperature to the input" in doc["left_out"]["bp"]
+
+
+def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    env = os.environ | {"MLFLOW_TRACKING_URI": f"sqlite:///{cwd / 'mlflow.db'}",
+                        "PYTHONPATH": str(Path(tcbench.__file__).parents[1])}
+    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env, capture_output=True, text=True)
+
+
+@pytest.mark.slow
+def test_export_takes_a_runs_id_and_refuses_in_one_line(tmp_path: Path) -> None:
+    """``tcbench run`` keeps device.json; ``tcbench export runs=[ID] formats=[c]`` writes its C; an
+    unknown id, a run without a network, an autopilot format: one line each, exit 2."""
+    done = _tcbench("run", "task=accel_chamber", "task.n_train=1", "task.n_test=1", "task.recordings_seed=0",
+                    "learner=bp", "learner.epochs=20", "optimiser=none", "budget=1", "seed=0", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    found = list((tmp_path / "mlartifacts").rglob("device.json"))
+    assert len(found) == 1
+    run_id = found[0].parent.parent.name
+    done = _tcbench("export", f"runs=[{run_id}]", "formats=[c]", "out=c", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert {p.name for p in (tmp_path / "c").iterdir()} == {f"tc_accel_bp_{run_id[:8]}.{e}" for e in "ch"}
+    assert f"tcbench run {run_id} on accel_chamber" in (tmp_path / "c" / f"tc_accel_bp_{run_id[:8]}.h").read_text()
+    for args, says in ((["runs=[0123abcd]", "formats=[c]"], "runs: 0123abcd: no such run in"),
+                       ([f"runs=[{run_id}]"], "runs: a run's network is written as C only (formats=[c])")):
+        done = _tcbench("export", *args, "out=d", cwd=tmp_path)
+        assert done.returncode == 2 and done.stderr.strip().splitlines() == [f"tcbench: error: {done.stderr.split('error: ')[1].strip()}"]
+        assert says in done.stderr, done.stderr
+    done = _tcbench("run", "task=accel_chamber", "task.n_train=1", "task.n_test=1", "task.recordings_seed=0",
+                    "learner=raw", "seed=0", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    raw_id = [p.name for p in (tmp_path / "mlartifacts" / "tcbench").iterdir() if p.name != run_id][0]
+    done = _tcbench("export", f"runs=[{raw_id}]", "formats=[c]", "out=e", cwd=tmp_path)
+    assert done.returncode == 2 and "the run kept no device.json" in done.stderr, done.stderr
