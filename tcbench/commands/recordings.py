@@ -59,7 +59,8 @@ def _fitted_model(cfg: SimulateConfig) -> Any:
 
 def simulated_protocol(cfg: SimulateConfig) -> str:
     """The protocol a simulation runs: ``protocol``, else its sensor kind's default (the kind of
-    ``sensor``, of the model file when ``sensor`` is null, msra without either)."""
+    ``sensor``, of the model file when ``sensor`` is null, :data:`~tcbench.sensors.kinds.DEFAULT`
+    without either)."""
     if cfg.protocol is not None:
         return cfg.protocol
     from tcbench.sensors import kinds
@@ -73,7 +74,7 @@ def simulated_protocol(cfg: SimulateConfig) -> str:
         except ModelFileError as exc:
             raise CommandError(str(exc)) from None
     try:
-        return str(kinds.get(sensor or "msra").default_protocol)
+        return str(kinds.get(sensor or kinds.DEFAULT).default_protocol)
     except ValueError as exc:
         raise CommandError(str(exc)) from None
 
@@ -84,10 +85,12 @@ def simulation_stem(cfg: SimulateConfig) -> str:
     replays another's power-on."""
     if cfg.name is not None:
         return cfg.name
+    from tcbench.sensors import kinds
+
     replay = "" if cfg.power_on is None else f"-poweron{cfg.power_on}"
     if cfg.model:
         return f"{Path(str(cfg.model)).stem}-{simulated_protocol(cfg)}-seed{cfg.seed}{replay}"
-    return f"{cfg.sensor or 'msra'}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}{replay}"
+    return f"{cfg.sensor or kinds.DEFAULT}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}{replay}"
 
 
 def check_simulate(cfg: SimulateConfig) -> Any:
@@ -96,7 +99,7 @@ def check_simulate(cfg: SimulateConfig) -> Any:
     from tcbench.sensors import kinds
 
     fitted = _fitted_model(cfg) if cfg.model else None
-    cfg.sensor = cfg.sensor or "msra"
+    cfg.sensor = cfg.sensor or kinds.DEFAULT
     try:
         kind = kinds.get(cfg.sensor)
     except ValueError as exc:
