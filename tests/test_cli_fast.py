@@ -27,8 +27,9 @@ SLOW = ("mlflow", "matplotlib", "scipy", "pandas", "pyarrow", "torch", "sklearn"
         "tcbench.leaderboard")
 # and what --help does not need either: the help is built from the schemas
 NOT_FOR_HELP = ("hydra", "omegaconf", "hydra_plugins")
-# but the diagnosis's settings are plain dataclasses of the standard library: diagnose's schema holds them
-LIGHT = ("tcbench.diagnose", "tcbench.diagnose.settings")
+# but the diagnosis's settings are plain dataclasses of the standard library: diagnose's schema holds them;
+# and the registry of sensor kinds (the standard library too) names the default kind the schemas give
+LIGHT = ("tcbench.diagnose", "tcbench.diagnose.settings", "tcbench.sensors", "tcbench.sensors.kinds")
 
 ERRORS = [  # (command line, what its one line says)
     (["run", "bogus=1"], "bogus: no such config key"),

@@ -63,3 +63,28 @@ def test_at_stage_keeps_the_effects_of_one_stage_in_order(stage: str) -> None:
     assert {e.stage for e in library} == set(effects.STAGES)  # the library acts at every stage
     picked = effects.at_stage(library, stage)
     assert [e.id for e in picked] == [e.id for e in library if e.stage == stage]
+
+
+def test_every_board_folder_s_kind_has_its_pages() -> None:
+    from tcbench.leaderboard.pages import render
+    from tcbench.leaderboard.pages.catalogue import FAMILIES
+
+    assert {f.kind for f in FAMILIES.values()} <= set(render.KIND_PAGES)
+
+
+def test_a_board_s_notes_are_those_of_a_protocol_it_can_have() -> None:
+    from tcbench.leaderboard import compensation as board
+
+    assert set(board.NOTES) <= set(board.KEYS)
+
+
+def test_calibrate_fits_what_the_library_refuses_once_each() -> None:
+    """The methods ``tcbench calibrate`` fits itself are methods the library lists but will not fit,
+    and none is a network restarted ``restarts`` times."""
+    from tcbench.commands import calibration as command
+
+    assert set(command.OWN_FITS) <= set(calibration.METHODS)
+    assert not set(command.OWN_FITS) & set(calibration.LEARNERS)
+    for method in command.OWN_FITS:
+        with pytest.raises(ValueError, match="tcbench diagnose"):
+            calibration.fit(method, [])

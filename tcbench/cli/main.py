@@ -13,14 +13,16 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tcbench.cli.flags import (
-    CFG_CHOICES,
-    CONFIG_SOURCE_FLAGS,
-    HELP_FLAGS,
-    HYDRA_FLAGS,
-    HYDRA_INFO_FLAGS,
-    KEY_FLAGS,
-    VALUE_FLAGS,
+from tcbench.cli.argv import (
+    UserError,
+    app_words,
+    asks_info,
+    command_words,
+    configs_elsewhere,
+    given,
+    leaderboard_words,
+    run_flags,
+    shows_run_help,
 )
 from tcbench.commands.registry import SPECS, CommandSpec, load
 
@@ -45,112 +47,9 @@ USAGE = _usage()
 HYDRA_LOGGING = "tcbench_stderr"
 
 
-class UserError(Exception):
-    """A mistake in what the user asked for: reported in one line, exit code 2."""
-
-
 def _fail(message: str, code: int = 2) -> int:
     print(f"tcbench: error: {message}", file=sys.stderr)
     return code
-
-
-def _flag_name(arg: str) -> str | None:
-    """The option an argument is (``--cfg=job`` is ``--cfg``), or None for ``key=value``."""
-    return arg.split("=", 1)[0] if arg.startswith("-") else None
-
-
-def _unknown_option(command: str, flag: str) -> UserError:
-    return UserError(f"unknown option {flag!r} for tcbench {command}; see `tcbench {command} --help`")
-
-
-def _hydra_value(arg: str) -> str:
-    """``key=value`` as Hydra's override grammar reads it as that literal string: quoted when
-    the value would not parse (``out=run(1)``) or would be a sweep (``drop=a,b``). One job only:
-    with ``-m`` the user writes Hydra's grammar (``recording=a.csv,b.csv`` sweeps)."""
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-    from hydra.errors import HydraException
-
-    key, _, value = arg.partition("=")
-    try:
-        (override,) = OverridesParser.create().parse_overrides([arg])
-        if not override.is_sweep_override():
-            return arg
-    except HydraException:
-        pass
-    from tcbench.cli.app import hydra_string
-
-    return f"{key}={hydra_string(value)}"
-
-
-def _open_key(arg: str, command: str) -> str:
-    """``protocol_params.duration_s=3600`` as ``++protocol_params.duration_s=3600``: a key inside a
-    free-form dict of the schema (``protocol_params``, ``effects``) is added or replaced."""
-    import dataclasses
-
-    if arg.startswith(("+", "~")):
-        return arg
-    open_dicts = {f.name for f in dataclasses.fields(SPECS[command].schema_class()) if str(f.type).startswith("dict")}
-    return f"++{arg}" if arg.split("=", 1)[0].split(".", 1)[0] in open_dicts and "." in arg.split("=", 1)[0] else arg
-
-
-def _schema_keys(command: str) -> set[str]:
-    """The top-level keys of ``command``'s schema."""
-    import dataclasses
-
-    return {f.name for f in dataclasses.fields(SPECS[command].schema_class())}
-
-
-def _first_input_key(command: str) -> str:
-    """The first file argument of ``command`` (``recording``, ``csv``), or ``recording``."""
-    return next(iter(SPECS[command].inputs), "recording")
-
-
-def _file_not_key(arg: str, command: str) -> bool:
-    """True when ``arg`` is no ``key=value`` of ``command`` (its key is none of the schema's) but
-    the name of a file: ``tcbench metrics a=b.csv`` means the file ``a=b.csv``."""
-    import dataclasses
-
-    head = arg.partition("=")[0].lstrip("+~").split(".", 1)[0]
-    known = {f.name for f in dataclasses.fields(SPECS[command].schema_class())} | {"hydra"}
-    return head not in known and os.path.lexists(arg)
-
-
-def _literal_path(arg: str, command: str, multirun: bool) -> str:
-    """A file argument of ``command`` (``recording=``, ``csv=``, ``model=``, ``test_recordings=``)
-    quoted and escaped so that Hydra and OmegaConf pass its text on as it is: a name holding ``$``,
-    ``${...}``, commas or brackets is the file's name, never an interpolation or a sweep. One job
-    takes the whole text as the path (unquoted when it is quoted; a list key: its items, in Hydra's
-    list syntax); with ``-m`` Hydra's grammar still separates the values (``recording=a.csv,b.csv``),
-    each then literal. ``null`` stays null."""
-    import dataclasses
-
-    key, eq, value = arg.partition("=")
-    if not eq or key not in SPECS[command].inputs or value == "null":
-        return arg
-    from hydra.core.override_parser.overrides_parser import OverridesParser
-    from hydra.core.override_parser.types import ChoiceSweep
-    from hydra.errors import HydraException
-
-    from tcbench.cli.app import hydra_string
-    from tcbench.commands.schemas import literal
-
-    listed = any(f.name == key and str(f.type).startswith("list")
-                 for f in dataclasses.fields(SPECS[command].schema_class()))
-    quoted = len(value) > 1 and value[0] == value[-1] and value[0] in "'\""
-    if not multirun and not listed and not quoted:
-        return f"{key}={hydra_string(literal(value))}"
-    try:
-        (override,) = OverridesParser.create().parse_overrides([arg])
-    except HydraException:
-        return arg  # Hydra's own line names the problem
-    parsed = override.value()
-    items = parsed.list if isinstance(parsed, ChoiceSweep) else parsed if isinstance(parsed, list) else [parsed]
-    if not all(isinstance(v, str) for v in items):
-        return arg
-    quoted = [hydra_string(literal(v)) for v in items]
-    if isinstance(parsed, list) and not isinstance(parsed, ChoiceSweep):
-        return f"{key}=[{','.join(quoted)}]"
-    return f"{key}={','.join(quoted)}"
 
 
 @contextlib.contextmanager
@@ -165,64 +64,44 @@ def _quiet_job_log() -> Iterator[None]:
 
 
 def _app_command(command: str, argv: list[str]) -> int:
-    """A key=value command: a Hydra app on its primary config ``conf/<command>.yaml``. One job runs
-    here (no Hydra output folder); ``-m`` sweeps run through Hydra's launcher like ``tcbench run``'s,
-    but those of a command whose spec has ``runs_here`` one after another here. Every job is checked
-    before the first starts."""
-    from tcbench.cli import help as cli_help
+    """A key=value command: a Hydra app on its primary config ``conf/<command>.yaml``, its command
+    line read by :func:`tcbench.cli.argv.app_words`. One job runs here (no Hydra output folder);
+    ``-m`` sweeps run through Hydra's launcher like ``tcbench run``'s, but those of a command whose
+    spec has ``runs_here`` one after another here. Every job is checked before the first starts."""
+    words = app_words(command, argv)
+    if words.help:
+        from tcbench.cli import help as cli_help
 
-    if any(a in HELP_FLAGS for a in argv):  # the help of the schema: nothing else imported
         print(cli_help.usage(command))
         return 0
-    args: list[str] = []
-    flagged: list[str] = []  # key=value of KEY_FLAGS, after the positional argument is read
-    cfg: str | None = None
-    multirun = False
-    keys = _schema_keys(command)
-    it = iter(argv)
-    for a in it:
-        flag = _flag_name(a)
-        if flag is None:
-            args.append(a)
-        elif flag in KEY_FLAGS and KEY_FLAGS[flag][0] in keys:
-            value = a.split("=", 1)[1] if "=" in a else next(it, None)
-            if value is None:
-                raise UserError(f"{flag} needs a value ({flag} {KEY_FLAGS[flag][1]}); see `tcbench {command} --help`")
-            flagged.append(f"{KEY_FLAGS[flag][0]}={value}")
-        elif flag in {"--cfg", "-c"}:
-            cfg = a.split("=", 1)[1] if "=" in a else next(it, None)
-            if cfg != "job":
-                what = f"--cfg {cfg}" if cfg else "--cfg without a value"
-                raise UserError(f"{what}: tcbench {command} prints only its job config; use --cfg job")
-        elif flag in {"-m", "--multirun"}:
-            multirun = True
-        else:
-            raise _unknown_option(command, flag)
     spec = SPECS[command]
-    positional = spec.positional
-    if positional and args and "=" not in args[0]:
-        args = [f"{positional}={args[0]}", *args[1:]]
-    args += flagged
-    if bad := [a for a in args if "=" not in a or a.startswith("=")]:
-        raise UserError(f"expected key=value, got {bad[0]!r}")
-    if named := [a for a in args if _file_not_key(a, command)]:
-        key, _, _ = named[0].partition("=")
-        given = positional or _first_input_key(command)
-        raise UserError(f"{named[0]}: {key!r} is no key of tcbench {command}, and {named[0]} is a file; to read it, "
-                        f"give {given}={named[0]}")
-    if nul := [a for a in args if "\0" in a]:
-        raise UserError(f"{nul[0].split('=', 1)[0]}=: holds a NUL character")
-    args = [_literal_path(_open_key(a, command), command, multirun) for a in args]
-    if multirun and cfg is None and spec.runs_here:
-        return _in_turn(command, args)
-    if multirun and cfg is None:
-        checked = _run_sweep(["-m", *args], spec.config)
+    if words.sweeps and spec.runs_here:
+        return _in_turn(command, list(words.overrides))
+    if words.sweeps:
+        checked = _run_sweep(["-m", *words.overrides], spec.config)
         assert checked is not None
         if not checked.tracking_enabled:
             return _failures_report(checked.jobs)
         return _sweep_report(checked.sweep_id, checked.experiment, checked.tracking_uri,
                              None if checked.resume else checked.jobs)
-    args = [_hydra_value(a) for a in args]
+    c = _one_job(list(words.overrides), spec, words.cfg)
+    if c is None:
+        return 0
+    if spec.runs_here:
+        from tcbench.errors import ConfigError
+
+        check, work = _runs_here(spec)
+        try:
+            check(c)
+            return work(c)
+        except ConfigError as exc:
+            raise UserError(str(exc)) from None
+    return _run_one(command, c)
+
+
+def _one_job(args: list[str], spec: CommandSpec, cfg: str | None) -> dict[str, Any] | None:
+    """The config of one job composed from the overrides ``args``, its input files checked to
+    exist; with ``cfg`` (``--cfg job``) printed instead (None)."""
     from hydra import initialize_config_module
 
     from tcbench.cli.app import compose_job
@@ -238,18 +117,17 @@ def _app_command(command: str, argv: list[str]) -> int:
             from omegaconf import OmegaConf
 
             print(OmegaConf.to_yaml(composed), end="")
-            return 0
+            return None
         c = as_dict(composed)  # one job: its work makes the checks once (run_job), no check ahead
         check_inputs_exist(c)  # but a missing input file is named before its readers are imported
     except ConfigError as exc:
         raise UserError(str(exc)) from None
-    if spec.runs_here:
-        check, work = _runs_here(spec)
-        try:
-            check(c)
-            return work(c)
-        except ConfigError as exc:
-            raise UserError(str(exc)) from None
+    return c
+
+
+def _run_one(command: str, c: dict[str, Any]) -> int:
+    """One job of ``command`` run through the runner (:func:`tcbench.runner.job.run_job`): 0, or
+    its user error as a :class:`UserError`, or 1 with its failure said."""
     from tcbench.runner.job import FAILURES, JobFailure, run_job
 
     c["tracking"]["sweep_id"] = c["tracking"].get("sweep_id") or uuid.uuid4().hex[:12]
@@ -284,11 +162,11 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     from tcbench.cli.app import hydra_app, plan, sweep_dir, with_overrides
     from tcbench.errors import ConfigError
 
-    info = any(a in HYDRA_INFO_FLAGS or a.split("=", 1)[0] in HYDRA_INFO_FLAGS for a in args)
+    info = asks_info(args)
     if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
         args = with_overrides(args, [f"tracking.sweep_id={uuid.uuid4().hex[:12]}"])
-    elsewhere = any(a in CONFIG_SOURCE_FLAGS for a in args)
-    if not elsewhere and not _given(args, "hydra/hydra_logging"):  # Hydra's lines never between the results
+    elsewhere = configs_elsewhere(args)
+    if not elsewhere and not given(args, "hydra/hydra_logging"):  # Hydra's lines never between the results
         args = with_overrides(args, [f"hydra/hydra_logging={HYDRA_LOGGING}"])
     checked: Plan | None = None
     if elsewhere:
@@ -318,7 +196,7 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
                       "process that is gone marked KILLED; their jobs run again", file=sys.stderr)
         n = checked.jobs
         print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
-        if (where := sweep_dir(checked.outs)) is not None and not _given(args, "hydra.sweep.dir"):
+        if (where := sweep_dir(checked.outs)) is not None and not given(args, "hydra.sweep.dir"):
             args = with_overrides(args, [f"hydra.sweep.dir={where}"])  # Hydra's record of the sweep under out=
     saved, full_error = sys.argv, os.environ.get("HYDRA_FULL_ERROR")
     sys.argv = ["tcbench", *args]
@@ -341,11 +219,6 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         else:
             os.environ["HYDRA_FULL_ERROR"] = full_error
     return checked
-
-
-def _given(args: list[str], key: str) -> bool:
-    """Whether the command line sets ``key`` (``hydra.sweep.dir=...``, ``hydra/hydra_logging=...``)."""
-    return any(a.split("=", 1)[0].lstrip("+~").removeprefix("override ").strip() == key for a in args)
 
 
 def _mark_interrupted(checked: Plan) -> None:
@@ -426,28 +299,10 @@ def _failures_report(jobs: int) -> int:
     return 1
 
 
-def _check_cfg_value(args: list[str]) -> None:
-    """A UserError for ``--cfg`` (``-c``) without one of Hydra's values (job, hydra, all)."""
-    for i, a in enumerate(args):
-        flag, eq, value = a.partition("=")
-        if flag not in {"--cfg", "-c"}:
-            continue
-        given = value if eq else (args[i + 1] if i + 1 < len(args) else None)
-        if given not in CFG_CHOICES:
-            what = f"--cfg {given}" if given else "--cfg without a value"
-            raise UserError(f"{what}: expected {', '.join(CFG_CHOICES[:-1])} or {CFG_CHOICES[-1]}")
-
-
 def cmd_run(args: list[str]) -> int:
-    after_value_flag, flags = False, []
-    for a in args:
-        if not after_value_flag and (flag := _flag_name(a)) is not None:
-            if flag not in HYDRA_FLAGS:
-                raise _unknown_option("run", flag)
-            flags.append(flag)
-        after_value_flag = a in VALUE_FLAGS
-    _check_cfg_value(args)
-    if HELP_FLAGS & set(flags) and not CONFIG_SOURCE_FLAGS & set(flags):  # configs from elsewhere: Hydra's help
+    """``tcbench run``: Hydra's own command line (:func:`tcbench.cli.argv.run_flags`), every job
+    checked, then run through Hydra."""
+    if shows_run_help(run_flags(args)):  # configs from elsewhere: Hydra's help
         from tcbench.cli import help as cli_help
 
         print(cli_help.run_usage())
@@ -502,45 +357,12 @@ def _runs_here(spec: CommandSpec) -> tuple[Callable[[dict[str, Any]], None], Cal
     return (lambda c: module.check(as_schema(c, schema))), (lambda c: int(module.work(as_schema(c, schema))))
 
 
-# ``tcbench leaderboard``'s flags, kept as aliases of its keys
-LEADERBOARD_FLAGS = {"--experiment": "experiments", "--sweep": "sweep", "--tracking-uri": "tracking.uri"}
-
-
 def cmd_leaderboard(argv: list[str]) -> int:
     """``tcbench leaderboard``: its key=value (``conf/leaderboard.yaml``), or the flags
     ``--experiment`` (repeatable), ``--sweep``, ``--tracking-uri`` and ``--ecdf`` (``--out``: as
-    every command's, :data:`~tcbench.cli.flags.KEY_FLAGS`)."""
-    args: list[str] = []
-    experiments: list[str] = []
-    it = iter(argv)
-    for a in it:
-        flag, eq, value = a.partition("=")
-        if flag in LEADERBOARD_FLAGS:
-            if not eq:
-                given = next(it, None)
-                if given is None or given in HELP_FLAGS:
-                    if given in HELP_FLAGS:
-                        args.append(given)
-                        continue
-                    raise UserError(f"tcbench leaderboard: {flag} needs a value; see `tcbench leaderboard --help`")
-                value = given
-            if flag == "--experiment":
-                experiments.append(value)
-            else:
-                args.append(f"{LEADERBOARD_FLAGS[flag]}={value}")
-        elif flag == "--ecdf":
-            if eq:
-                raise UserError("tcbench leaderboard: --ecdf takes no value (or give ecdf=true)")
-            args.append("ecdf=true")
-        else:
-            args.append(a)
-    if len(experiments) == 1:
-        args.append(f"experiments={experiments[0]}")
-    elif experiments:
-        from tcbench.cli.app import hydra_string
-
-        args.append(f"experiments=[{','.join(hydra_string(e) for e in experiments)}]")
-    return _app_command("leaderboard", args)
+    every command's, :data:`~tcbench.cli.flags.KEY_FLAGS`), read by
+    :func:`tcbench.cli.argv.leaderboard_words`."""
+    return _app_command("leaderboard", leaderboard_words(argv))
 
 
 def _handler(spec: CommandSpec) -> Callable[[list[str]], int]:
@@ -586,8 +408,7 @@ def _exit_now(code: int) -> None:
 
 
 def _main(argv: list[str]) -> int:
-    if len(argv) == 2 and argv[0] == "help" and argv[1] in COMMANDS:  # tcbench help simulate
-        argv = [argv[1], "--help"]
+    argv = command_words(argv, COMMANDS)
     if not argv or argv[0] in {"-h", "--help", "help"}:
         print(USAGE)
         return 0 if argv else 2

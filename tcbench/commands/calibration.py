@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,17 +31,16 @@ import numpy as np
 
 from tcbench.commands.errors import (
     CommandError,
-    cannot_write,
     checked_store,
     free_outputs,
     read_recording_arg,
-    refused_output,
     say_replaced,
     writable_folder,
+    writing_errors,
 )
 from tcbench.commands.schemas import CalibrateConfig
 from tcbench.errors import unknown_name
-from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
+from tcbench.staging import moved, staged_dir
 
 
 FILES = ("calibration.csv", "calibration.json", "calibration.md", "residuals.png")  # OUT/, checked before any work
@@ -113,7 +113,8 @@ def check_calibrate(cfg: CalibrateConfig) -> tuple[Any, Split, list[tuple[str, A
     if cfg.axis is not None and cfg.axis not in ("x", "y", "z"):
         raise CommandError(f"axis={cfg.axis}: the axes are x, y and z")
     writable_folder(cfg.out)
-    free_outputs(cfg.out, list(FILES), cfg.overwrite, folders=["diagnosis"] if "model" in cfg.methods else [])
+    free_outputs(cfg.out, list(FILES), cfg.overwrite,
+                 folders=[f for m in dict.fromkeys(cfg.methods) if m in OWN_FITS for f in OWN_FITS[m].folders])
     checked_store(cfg.tracking)
     rec, split = _split(cfg.recording, cfg)
     others = []
@@ -246,25 +247,90 @@ def true_input(spec: object, input_unit: str) -> float:
 
 
 def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
-    """Fit, score, rank and write; print what is fitted and scored first, the held-out ranking last."""
-    import pandas as pd
-    from tqdm import tqdm
-
-    from tcbench.compensation.calibration import LEARNERS, fit, from_model, record, residual, scores
-    from tcbench.compensation.c_export import STREAMED, streamed_residual
-    from tcbench.compensation.screening import screened_all
+    """Fit, score, rank and write; print what is fitted and scored first, the held-out ranking last:
+    the stages :func:`_methods`, :func:`_announce`, :func:`_screened`, :func:`_fit_all`,
+    :func:`_scored`, :func:`_summarised`, :func:`_staged` and :func:`_print_summary`."""
+    from tcbench.compensation.calibration import record
 
     rec, split, others = check_calibrate(cfg)
     unit = rec.meta.units.get("output", "")
-    name = Path(cfg.recording).name
+    methods = _methods(cfg, rec, split)
+    own_hash = _announce(cfg, rec, split, others, methods, unit)
+    whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
+    screening = _screened(cfg, split, whole)
+    training = _Training(cfg, rec, split, screening)
+    fitted, diagnosis = _fit_all(training, methods)
+    scored = _scored(training, others, whole, fitted, unit)
+    summary, about = _summarised(training, scored, whole, fitted, unit, own_hash)
+    written = _staged(cfg, rec, split, scored, summary, about, unit, diagnosis)
+    _print_summary(summary, about, unit, written)
+    return CalibrationOutcome(scored.table, written, str(rec.meta.sensor), summary, about)
+
+
+@dataclass(frozen=True)
+class _Training:
+    """What every fit of a calibration is given: the config, the recording, its split and the
+    screening of its training parts."""
+
+    cfg: CalibrateConfig
+    rec: Any
+    split: Split
+    screening: Any  # tcbench.compensation.screening.Screening
+
+    @property
+    def starts_s(self) -> np.ndarray:
+        """The training parts' first times (s): the memoriser's clocks."""
+        return self.rec.time_s[[self.split.parts[k].start for k in self.split.train]]
+
+
+@dataclass(frozen=True)
+class OwnFit:
+    """A method calibrate fits itself rather than through :func:`tcbench.compensation.calibration.fit`:
+    ``fit`` gives its offset model and the diagnosis written beside the calibration (into the
+    ``folders`` of OUT/, by :func:`_staged`); ``left_out`` says why a recording is too short for
+    it (None: it is not)."""
+
+    fit: Callable[[_Training], tuple[Any, Any]]
+    left_out: Callable[[Any, Split], str | None]
+    folders: tuple[str, ...] = ()
+
+
+def _fit_diagnosed(training: _Training) -> tuple[Any, Any]:
+    """The ``model`` method: ``tcbench diagnose`` on the screened training parts, its model as
+    the offset; the diagnosis is written beside the calibration."""
+    from tcbench.compensation.calibration import from_model
+
+    diagnosis = _diagnosed(training.rec, training.split, training.cfg, training.screening.keep)
+    return from_model(diagnosis[1]), diagnosis
+
+
+def _fit_library(training: _Training, method: str, restart: int) -> Any:
+    """A method of :data:`tcbench.compensation.calibration.FITTERS` fitted on the screened parts,
+    a network's restart ``restart`` seeded ``seed + restart``."""
+    from tcbench.compensation.calibration import fit
+
+    return fit(method, training.screening.pieces, training.cfg.seed + restart, part_starts_s=training.starts_s)
+
+
+def _methods(cfg: CalibrateConfig, rec: Any, split: Split) -> list[str]:
+    """The methods to fit, once each in the order given, without those the recording is too short
+    for (said in one line each)."""
     methods = list(dict.fromkeys(cfg.methods))
-    if "model" in methods and (why := _too_short_to_diagnose(rec, split)):
-        methods.remove("model")
-        print(f"tcbench: model left out: {why}", file=sys.stderr)
+    for m in [m for m in methods if m in OWN_FITS]:
+        if why := OWN_FITS[m].left_out(rec, split):
+            methods.remove(m)
+            print(f"tcbench: {m} left out: {why}", file=sys.stderr)
+    return methods
+
+
+def _announce(cfg: CalibrateConfig, rec: Any, split: Split, others: list[tuple[str, Any, list[Any]]],
+              methods: list[str], unit: str) -> str:
+    """Print what is fitted and scored, why these parts are fitted, and a warning when the scores
+    are in-sample; the recording's content hash."""
     scored = split.describe(split.held_out) + " (held out)" if split.held_out else ""
     if cfg.test_recordings:
         scored += f"{' and ' if split.held_out else ''}every part of {', '.join(Path(p).name for p in cfg.test_recordings)}"
-    print(f"calibrate {name} ({rec.meta.sensor}, output in {unit}): fitting {', '.join(methods)} on "
+    print(f"calibrate {Path(cfg.recording).name} ({rec.meta.sensor}, output in {unit}): fitting {', '.join(methods)} on "
           f"{split.describe(split.train)}; scoring on {scored or 'the fitted parts only'}", flush=True)
     if split.why:
         print(f"  {split.why}", flush=True)
@@ -275,98 +341,150 @@ def calibrate_recording(cfg: CalibrateConfig) -> CalibrationOutcome:
     for path in (p for p in cfg.test_recordings if _content_hash(p) == own_hash):
         print(f"tcbench: warning: test_recordings: {path} holds the same data as {cfg.recording}: its scores are "
               "in-sample", file=sys.stderr)
-    whole = record(rec.time_s, rec.temperature_c, rec.output, rec.input)
+    return own_hash
+
+
+def _screened(cfg: CalibrateConfig, split: Split, whole: Any) -> Any:
+    """The training parts of ``whole`` screened (:func:`tcbench.compensation.screening.screened_all`),
+    said in one line; a :class:`CommandError` when screening leaves too little to fit."""
+    from tcbench.compensation.screening import screened_all
+
     train = [whole.part(split.parts[k].start, split.parts[k].stop) for k in split.train]
     screening = screened_all(train, cfg.screen)
     print(screening.describe() if cfg.screen else "not screened (screen=false): " + screening.describe(), flush=True)
     if cfg.screen:
         fittable(np.concatenate([p.temp_c for p in screening.pieces] or [np.array([])]),
                  "the fitted parts left by screening (screen=false fits every sample)")
-    jobs = [(m, r) for m in methods for r in range(cfg.restarts if m in LEARNERS else 1)]
-    train_starts_s = rec.time_s[[split.parts[k].start for k in split.train]]  # the memoriser's clocks
+    return screening
+
+
+def _fit_all(training: _Training, methods: list[str]) -> tuple[dict[str, list[Any]], Any]:
+    """Every restart of every method fitted (a network ``restarts`` times, the others once), with a
+    progress bar; and the diagnosis a method of :data:`OWN_FITS` made (None without one)."""
+    from tqdm import tqdm
+
+    from tcbench.compensation.calibration import LEARNERS
+
+    jobs = [(m, r) for m in methods for r in range(training.cfg.restarts if m in LEARNERS else 1)]
     fitted: dict[str, list[Any]] = {m: [] for m in methods}
     diagnosis = None
     with tqdm(jobs, desc="fitting", unit="fit", leave=False, disable=None) as bar:
         for m, r in bar:
             bar.set_postfix_str(m)
-            if m == "model":
-                diagnosis = _diagnosed(rec, split, cfg, screening.keep)
-                fitted[m].append(from_model(diagnosis[1]))
+            if m in OWN_FITS:
+                model, diagnosis = OWN_FITS[m].fit(training)
             else:
-                fitted[m].append(fit(m, screening.pieces, cfg.seed + r, part_starts_s=train_starts_s))
-    rows: list[dict[str, Any]] = []
-    residuals: dict[str, np.ndarray] = {}
-    held: dict[str, list[list[np.ndarray]]] = {m: [[] for _ in runs] for m, runs in fitted.items()}
-    held_raw: list[np.ndarray] = []
-    held_temp: list[np.ndarray] = []
-    held_t: list[np.ndarray] = []
-    held_labels: list[str] = []
-    held_causal: dict[str, list[list[np.ndarray]]] = {}  # the Elman's and the model's streamed residuals
-    steps: list[float] = []
-    drift_key, rms_key = f"drift_rms_{_slug(unit)}", f"rms_{_slug(unit)}"
+                model = _fit_library(training, m, r)
+            fitted[m].append(model)
+    return fitted, diagnosis
+
+
+@dataclass
+class _Scores:
+    """Every method scored on every part: the long table's rows, the calibrated recording's
+    residual of each method (its first restart), and the held-out parts: each method's residuals
+    (per restart), the raw residual, the temperatures, times, labels and sample steps (s)."""
+
+    drift_key: str
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    residuals: dict[str, np.ndarray] = field(default_factory=dict)
+    held: dict[str, list[list[np.ndarray]]] = field(default_factory=dict)
+    held_raw: list[np.ndarray] = field(default_factory=list)
+    held_temp: list[np.ndarray] = field(default_factory=list)
+    held_t: list[np.ndarray] = field(default_factory=list)
+    held_labels: list[str] = field(default_factory=list)
+    held_causal: dict[str, list[list[np.ndarray]]] = field(default_factory=dict)  # the Elman's and the model's streamed
+    steps: list[float] = field(default_factory=list)
+    table: Any = None  # the rows as a DataFrame
+
+
+def _scored(training: _Training, others: list[tuple[str, Any, list[Any]]], whole: Any,
+            fitted: dict[str, list[Any]], unit: str) -> _Scores:
+    """Every restart of every method scored on every part of the recording and of each test
+    recording (:func:`tcbench.compensation.calibration.scores`)."""
+    import pandas as pd
+
+    cfg, rec, split = training.cfg, training.rec, training.split
+    out = _Scores(f"drift_rms_{_slug(unit)}", held={m: [[] for _ in runs] for m, runs in fitted.items()})
     for path, r, parts, fitted_parts in [(cfg.recording, rec, split.parts, split.train),
                                          *[(p, o, ps, []) for p, o, ps in others]]:
-        own = r is rec
-        target = whole if own else record(r.time_s, r.temperature_c, r.output, r.input)
-        starts_s = r.time_s[[b.start for b in parts]]
-        every = {m: [residual(model, target, starts_s) for model in runs] for m, runs in fitted.items()}
-        causal = {m: [streamed_residual(model, target) for model in fitted[m]] for m in STREAMED if m in fitted}
-        dt_s = float(np.median(np.diff(r.time_s))) if r.time_s.size > 1 else 1.0
-        for k, b in enumerate(parts):
-            role = "train" if k in fitted_parts else "test"
-            if role == "test":
-                steps.append(dt_s)
-                held_raw.append((r.output - r.input)[b.start:b.stop])
-                held_t.append(r.time_s[b.start:b.stop])
-                held_temp.append(r.temperature_c[b.start:b.stop])
-                held_labels.append(f"{Path(path).stem}:{k}")
-            for m, runs in every.items():
-                s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
-                if role == "test":
-                    for i, res in enumerate(runs):
-                        held[m][i].append(res[b.start:b.stop])
-                    for i, res in enumerate(causal.get(m, [])):
-                        if res is not None:
-                            held_causal.setdefault(m, [[] for _ in runs])[i].append(res[b.start:b.stop])
-                rows.append({"recording": Path(path).stem, "method": m, "branch": k, "direction": b.direction,
-                             "from_c": b.from_c, "to_c": b.to_c, "role": role,
-                             drift_key: float(np.median([x["drift_rms"] for x in s])),
+        _score_recording(out, cfg, path, r, parts, fitted_parts, whole if r is rec else None, fitted, unit)
+    out.table = pd.DataFrame(out.rows)
+    return out
+
+
+def _score_recording(out: _Scores, cfg: CalibrateConfig, path: str, r: Any, parts: list[Any], fitted_parts: list[int],
+                     whole: Any, fitted: dict[str, list[Any]], unit: str) -> None:
+    """One recording's rows and held-out parts added to ``out`` (``whole``: the calibrated
+    recording's record, whose residuals are plotted; None for a test recording)."""
+    from tcbench.compensation.c_export import STREAMED, streamed_residual
+    from tcbench.compensation.calibration import record, residual, scores
+
+    rms_key = f"rms_{_slug(unit)}"
+    target = whole if whole is not None else record(r.time_s, r.temperature_c, r.output, r.input)
+    starts_s = r.time_s[[b.start for b in parts]]
+    every = {m: [residual(model, target, starts_s) for model in runs] for m, runs in fitted.items()}
+    causal = {m: [streamed_residual(model, target) for model in fitted[m]] for m in STREAMED if m in fitted}
+    dt_s = float(np.median(np.diff(r.time_s))) if r.time_s.size > 1 else 1.0
+    for k, b in enumerate(parts):
+        held_out = k not in fitted_parts
+        if held_out:
+            out.steps.append(dt_s)
+            out.held_raw.append((r.output - r.input)[b.start:b.stop])
+            out.held_t.append(r.time_s[b.start:b.stop])
+            out.held_temp.append(r.temperature_c[b.start:b.stop])
+            out.held_labels.append(f"{Path(path).stem}:{k}")
+        for m, runs in every.items():
+            s = [scores(res[b.start:b.stop], r.time_s[b.start:b.stop], cfg.drift_window_s) for res in runs]
+            if held_out:
+                for i, res in enumerate(runs):
+                    out.held[m][i].append(res[b.start:b.stop])
+                for i, res in enumerate(causal.get(m, [])):
+                    if res is not None:
+                        out.held_causal.setdefault(m, [[] for _ in runs])[i].append(res[b.start:b.stop])
+            out.rows.append({"recording": Path(path).stem, "method": m, "branch": k, "direction": b.direction,
+                             "from_c": b.from_c, "to_c": b.to_c, "role": "test" if held_out else "train",
+                             out.drift_key: float(np.median([x["drift_rms"] for x in s])),
                              rms_key: float(np.median([x["rms"] for x in s])), "restarts": len(runs)})
-        if own:
-            residuals = {m: runs[0] for m, runs in every.items()}
-    table = pd.DataFrame(rows)
-    summary, about = _ranked(table, held, held_raw, steps, cfg, unit, drift_key)
-    about["per_part"] = _per_part(held, held_raw, steps, held_labels, cfg)
-    if steps and held_causal:
-        about["streamed"] = _streamed_drift(held_causal, steps, cfg)
-    about |= _floor(held, held_raw, held_t, steps, cfg)
-    about |= _about(cfg, rec, split, unit, own_hash)
+    if whole is not None:
+        out.residuals = {m: runs[0] for m, runs in every.items()}
+
+
+def _summarised(training: _Training, scored: _Scores, whole: Any, fitted: dict[str, list[Any]], unit: str,
+                own_hash: str) -> tuple[Any, dict[str, Any]]:
+    """The held-out summary (one row per method) and what ``calibration.json`` holds."""
+    cfg, screening = training.cfg, training.screening
+    summary, about = _ranked(scored.table, scored.held, scored.held_raw, scored.steps, cfg, unit, scored.drift_key)
+    about["per_part"] = _per_part(scored.held, scored.held_raw, scored.steps, scored.held_labels, cfg)
+    if scored.steps and scored.held_causal:
+        about["streamed"] = _streamed_drift(scored.held_causal, scored.steps, cfg)
+    about |= _floor(scored.held, scored.held_raw, scored.held_t, scored.steps, cfg)
+    about |= _about(cfg, training.rec, training.split, unit, own_hash)
     about["screening"] = screening.as_dict() | {"line": screening.describe(), "enabled": cfg.screen}
-    about["range"] = _range(screening.pieces, held_temp)
+    about["range"] = _range(screening.pieces, scored.held_temp)
     about["training"] = _training(fitted)
     about["export"] = _export_fit(whole, cfg.screen)
-    about["device"] = _device_specs(fitted, rec.time_s)
+    about["device"] = _device_specs(fitted, training.rec.time_s)
+    return summary, about
+
+
+def _staged(cfg: CalibrateConfig, rec: Any, split: Split, scored: _Scores, summary: Any, about: dict[str, Any],
+            unit: str, diagnosis: Any) -> dict[str, Path]:
+    """Every file written into a staging folder, then moved into OUT/ all together (never over an
+    input; what ``overwrite=true`` replaced said in one line); the files by key."""
     out = Path(cfg.out)
     replaced: list[Path] = []
-    try:
+    with writing_errors(out, "the calibration", overwrite_hint="out="):
         with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)], cfg.overwrite, replaced) as tmp:
-            written = _write(tmp, cfg, rec, split, residuals, table, summary, about, unit)
+            written = _write(tmp, cfg, rec, split, scored.residuals, scored.table, summary, about, unit)
             if diagnosis is not None:
                 from tcbench.diagnose.report import write_report
 
                 report = write_report(diagnosis[0], tmp / "diagnosis", with_plots=False)
                 written |= {f"diagnosis {k}": v for k, v in report.items()}
-    except InputOverwriteError as exc:
-        raise CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out=") \
-            from None
-    except OutputRefusedError as exc:
-        raise refused_output(exc) from None
-    except OSError as exc:
-        raise cannot_write(out, exc, "the calibration") from None
     written = moved(written, tmp, out)
     say_replaced(replaced)
-    _print_summary(summary, about, unit, written)
-    return CalibrationOutcome(table, written, str(rec.meta.sensor), summary, about)
+    return written
 
 
 def _ranked(table: Any, held: dict[str, list[list[np.ndarray]]], held_raw: list[np.ndarray], steps: list[float],
@@ -511,7 +629,7 @@ def _training(fitted: dict[str, list[Any]]) -> dict[str, Any]:
     for m, runs in fitted.items():
         if runs and runs[0].training:
             out[m] = {"line": describe(m, [r.training for r in runs]), "runs": [r.training for r in runs]}
-        elif m == "model" and runs:
+        elif runs and runs[0].sensor_model is not None:
             dropped = dropped_terms(runs[0].sensor_model)
             out[m] = {"line": "model: tcbench diagnose on the screened training parts (least squares); compensates "
                               "with its temperature terms only, not with "
@@ -722,6 +840,11 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | 
         raise CommandError(f"methods: model: the training parts cannot be diagnosed ({exc}); fit on more parts, "
                            "or leave model out of methods") from None
     return diag, to_sensor_model(model_spec(diag))
+
+
+# The methods calibrate fits itself (every other through tcbench.compensation.calibration.fit): the
+# diagnosed model, which needs a full diagnosis's duration and writes the diagnosis into OUT/diagnosis/
+OWN_FITS: dict[str, OwnFit] = {"model": OwnFit(_fit_diagnosed, _too_short_to_diagnose, ("diagnosis",))}
 
 
 def _slug(unit: str) -> str:

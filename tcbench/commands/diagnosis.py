@@ -21,14 +21,12 @@ from tcbench.commands.schemas import DiagnoseConfig
 from tcbench.sensors import kinds
 from tcbench.commands.errors import (
     CommandError,
-    cannot_write,
     checked_store,
     free_outputs,
-    overwrite_error,
     read_recording_arg,
-    refused_output,
     say_replaced,
     writable_folder,
+    writing_errors,
 )
 
 log = logging.getLogger(__name__)
@@ -203,18 +201,11 @@ def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
     """``writer(report, out, inputs, overwrite=, replaced=)``, its failures as one line (never over
     an input, nor over a file without ``overwrite``); says what it replaced."""
     from tcbench.sensors.recording import sidecar_path
-    from tcbench.staging import InputOverwriteError, OutputRefusedError
 
     inputs = [cfg.recording, sidecar_path(cfg.recording), *([cfg.model] if cfg.model else [])]
     replaced: list[Path] = []
-    try:
+    with writing_errors(cfg.out, "the report"):
         written = writer(report, cfg.out, inputs, overwrite=cfg.overwrite, replaced=replaced)
-    except InputOverwriteError as exc:
-        raise overwrite_error(exc) from None
-    except OutputRefusedError as exc:
-        raise refused_output(exc) from None
-    except OSError as exc:
-        raise cannot_write(cfg.out, exc, "the report") from None
     say_replaced(replaced)
     return dict(written)
 

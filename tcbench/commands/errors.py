@@ -3,6 +3,8 @@ checks of their output folder, file names, output files and tracking store, made
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -42,10 +44,10 @@ def file_stem(name: str, key: str = "name", suffix: str = "") -> str:
     return name
 
 
-def overwrite_error(exc: Any) -> CommandError:
-    """The one-line error for output that would replace one of the command's inputs."""
-    return CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another out= "
-                        "or name=")
+def overwrite_error(exc: Any, hint: str = "out= or name=") -> CommandError:
+    """The one-line error for output that would replace one of the command's inputs (``hint``:
+    what the user can change)."""
+    return CommandError(f"the output {exc.target} would overwrite the input {exc.source}; choose another {hint}")
 
 
 def refused_output(exc: Any, hint: str = "out=") -> CommandError:
@@ -55,6 +57,29 @@ def refused_output(exc: Any, hint: str = "out=") -> CommandError:
     from tcbench.staging import refusal_line
 
     return CommandError(refusal_line(exc, hint))
+
+
+@contextlib.contextmanager
+def writing_errors(out: str | Path, what: str = "the recording", hint: str = "out=",
+                   overwrite_hint: str = "out= or name=",
+                   said: tuple[type[Exception], ...] = ()) -> Iterator[None]:
+    """Around the writing of a command's outputs into ``out``: each failure as its one-line
+    :class:`CommandError`. Output over an input (:func:`overwrite_error`, ``overwrite_hint``),
+    output the staging refused (:func:`refused_output`, ``hint``), files that cannot be written
+    (:func:`cannot_write`, ``what``), and the errors ``said`` (their message is the line, e.g. a
+    :class:`~tcbench.sensors.recording.RecordingError`)."""
+    from tcbench.staging import InputOverwriteError, OutputRefusedError
+
+    try:
+        yield
+    except said as exc:
+        raise CommandError(str(exc)) from None
+    except InputOverwriteError as exc:
+        raise overwrite_error(exc, overwrite_hint) from None
+    except OutputRefusedError as exc:
+        raise refused_output(exc, hint) from None
+    except OSError as exc:
+        raise cannot_write(out, exc, what) from None
 
 
 def free_outputs(out: str | Path, names: list[str], overwrite: bool, hint: str = "out=",

@@ -28,11 +28,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tcbench.commands.errors import CommandError, cannot_write, free_outputs, refused_output, say_replaced, writable_folder
+from tcbench.commands.errors import CommandError, free_outputs, say_replaced, writable_folder, writing_errors
 from tcbench.commands.schemas import ExportConfig
 from tcbench.errors import unknown_name
 from tcbench.sensors import kinds
-from tcbench.staging import OutputRefusedError, moved, staged_dir
+from tcbench.staging import moved, staged_dir
 
 FORMATS = ("px4", "ardupilot", "c")
 FILES = {"px4": "px4_tc_params.txt", "ardupilot": "ardupilot_tcal.parm"}  # the file of each format in OUT/
@@ -270,10 +270,22 @@ def device_id(cfg: ExportConfig, sensor: str, axes: dict[str, AxisCalibration]) 
                        "parameter, or the log's), or formats=[ardupilot]")
 
 
+def cubic_comments(by_sensor: dict[str, dict[str, AxisCalibration]]) -> tuple[list[str], list[str]]:
+    """The lines saying what the autopilots' cubic leaves where the best held-out method is not the
+    cubic, and the comments the parameter files carry (those lines, and which methods C can run)."""
+    from tcbench.compensation.c_export import EXPORTED
+
+    notes = [ln for axes in by_sensor.values() for c in axes.values() if (ln := c.cubic_line())]
+    bests = {(c.held_out or {}).get("best") for axes in by_sensor.values() for c in axes.values() if c.cubic_line()}
+    comments = [f"tcbench: these are the cubic's coefficients; {ln}" for ln in notes]
+    if exportable := sorted(bests & set(EXPORTED)):
+        comments.append(f"tcbench export formats=[c] writes {', '.join(exportable)} as C for a sensor's own processor")
+    return notes, comments
+
+
 def export(cfg: ExportConfig) -> dict[str, Path]:
     """Write the parameter files; print what each holds."""
     from tcbench.compensation.ardupilot import ardupilot_parameters, write_parm
-    from tcbench.compensation.c_export import EXPORTED
     from tcbench.compensation.px4 import common_range, px4_factor, px4_parameters, px4_polynomial, write_parameters
 
     by_sensor = check_export(cfg)
@@ -296,37 +308,26 @@ def export(cfg: ExportConfig) -> dict[str, Path]:
                   f"{first.tmin_c:.2f}..{first.tmax_c:.2f} degC, where every axis was fitted")
     out = Path(cfg.out)
     replaced: list[Path] = []
-    try:
-        with staged_dir(out, [], cfg.overwrite, replaced) as tmp:
-            written: dict[str, Path] = {}
-            notes = [ln for axes in by_sensor.values() for c in axes.values() if (ln := c.cubic_line())]
-            bests = {(c.held_out or {}).get("best") for axes in by_sensor.values() for c in axes.values()
-                     if c.cubic_line()}
-            comments = [f"tcbench: these are the cubic's coefficients; {ln}" for ln in notes]
-            if exportable := sorted(bests & set(EXPORTED)):
-                comments.append(f"tcbench export formats=[c] writes {', '.join(exportable)} as C for a sensor's own "
-                                "processor")
-            if "px4" in cfg.formats:
-                params: dict[str, float | int] = {}
-                for sensor, axes in polys.items():
-                    levels = static_levels(sensor, by_sensor[sensor])
-                    px4_axes = {a: px4_polynomial(p, sensor, levels.get(a, 0.0)) for a, p in axes.items()}
-                    params |= px4_parameters(px4_axes, sensor, cfg.px4_instance,
-                                             device_id(cfg, sensor, by_sensor[sensor]), to_px4_unit=to_si[sensor])
-                written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys), comments)
-            if "ardupilot" in cfg.formats:
-                try:
-                    ap = ardupilot_parameters(polys, cfg.ardupilot_imu, to_si)
-                except ValueError as exc:
-                    raise CommandError(f"ardupilot: {exc}") from None
-                written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"], comments)
-            if "c" in cfg.formats:
-                written |= {f"c {p.name}": p for p in write_c_files(by_sensor, tmp)}
-                written |= {f"c {p.name}": p for p in write_run_c_files(networks, tmp)}
-    except OutputRefusedError as exc:
-        raise refused_output(exc) from None
-    except OSError as exc:
-        raise cannot_write(out, exc, "the parameter files") from None
+    with writing_errors(out, "the parameter files"), staged_dir(out, [], cfg.overwrite, replaced) as tmp:
+        written: dict[str, Path] = {}
+        notes, comments = cubic_comments(by_sensor)
+        if "px4" in cfg.formats:
+            params: dict[str, float | int] = {}
+            for sensor, axes in polys.items():
+                levels = static_levels(sensor, by_sensor[sensor])
+                px4_axes = {a: px4_polynomial(p, sensor, levels.get(a, 0.0)) for a, p in axes.items()}
+                params |= px4_parameters(px4_axes, sensor, cfg.px4_instance,
+                                         device_id(cfg, sensor, by_sensor[sensor]), to_px4_unit=to_si[sensor])
+            written["px4"] = write_parameters(params, tmp / FILES["px4"], list(polys), comments)
+        if "ardupilot" in cfg.formats:
+            try:
+                ap = ardupilot_parameters(polys, cfg.ardupilot_imu, to_si)
+            except ValueError as exc:
+                raise CommandError(f"ardupilot: {exc}") from None
+            written["ardupilot"] = write_parm(ap, tmp / FILES["ardupilot"], comments)
+        if "c" in cfg.formats:
+            written |= {f"c {p.name}": p for p in write_c_files(by_sensor, tmp)}
+            written |= {f"c {p.name}": p for p in write_run_c_files(networks, tmp)}
     written = moved(written, tmp, out)
     say_replaced(replaced)
     if any(f in written for f in AUTOPILOTS):

@@ -14,18 +14,17 @@ from typing import Any
 from tcbench.commands.schemas import ImportConfig, MetricsConfig, SimulateConfig
 from tcbench.commands.errors import (
     CommandError,
-    cannot_write,
     checked_store,
     file_stem,
     free_outputs,
     overwrite_error,
     read_recording_arg,
-    refused_output,
     say_replaced,
     writable_folder,
+    writing_errors,
 )
 from tcbench.errors import unknown_name
-from tcbench.staging import InputOverwriteError, OutputRefusedError, moved, staged_dir
+from tcbench.staging import InputOverwriteError, moved, staged_dir
 
 
 @dataclass
@@ -60,7 +59,8 @@ def _fitted_model(cfg: SimulateConfig) -> Any:
 
 def simulated_protocol(cfg: SimulateConfig) -> str:
     """The protocol a simulation runs: ``protocol``, else its sensor kind's default (the kind of
-    ``sensor``, of the model file when ``sensor`` is null, msra without either)."""
+    ``sensor``, of the model file when ``sensor`` is null, :data:`~tcbench.sensors.kinds.DEFAULT`
+    without either)."""
     if cfg.protocol is not None:
         return cfg.protocol
     from tcbench.sensors import kinds
@@ -74,7 +74,7 @@ def simulated_protocol(cfg: SimulateConfig) -> str:
         except ModelFileError as exc:
             raise CommandError(str(exc)) from None
     try:
-        return str(kinds.get(sensor or "msra").default_protocol)
+        return str(kinds.get(sensor or kinds.DEFAULT).default_protocol)
     except ValueError as exc:
         raise CommandError(str(exc)) from None
 
@@ -85,10 +85,12 @@ def simulation_stem(cfg: SimulateConfig) -> str:
     replays another's power-on."""
     if cfg.name is not None:
         return cfg.name
+    from tcbench.sensors import kinds
+
     replay = "" if cfg.power_on is None else f"-poweron{cfg.power_on}"
     if cfg.model:
         return f"{Path(str(cfg.model)).stem}-{simulated_protocol(cfg)}-seed{cfg.seed}{replay}"
-    return f"{cfg.sensor or 'msra'}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}{replay}"
+    return f"{cfg.sensor or kinds.DEFAULT}-{simulated_protocol(cfg)}-dev{cfg.device_seed}-seed{cfg.seed}{replay}"
 
 
 def check_simulate(cfg: SimulateConfig) -> Any:
@@ -97,7 +99,7 @@ def check_simulate(cfg: SimulateConfig) -> Any:
     from tcbench.sensors import kinds
 
     fitted = _fitted_model(cfg) if cfg.model else None
-    cfg.sensor = cfg.sensor or "msra"
+    cfg.sensor = cfg.sensor or kinds.DEFAULT
     try:
         kind = kinds.get(cfg.sensor)
     except ValueError as exc:
@@ -137,19 +139,12 @@ def simulate(cfg: SimulateConfig) -> RecordingOutcome:
     inputs = [cfg.model] if cfg.model else []
     report = None
     replaced: list[Path] = []
-    try:
-        with staged_dir(out, inputs, cfg.overwrite, replaced) as tmp:  # the recording and its metrics, all or nothing
-            write_recording(rec, tmp / path.name)
-            if cfg.metrics:
-                report = _analysed(path, rec, tmp / f"{stem}_metrics", None)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except InputOverwriteError as exc:
-        raise overwrite_error(exc) from None
-    except OutputRefusedError as exc:
-        raise refused_output(exc, "out= or name=") from None
-    except OSError as exc:
-        raise cannot_write(out, exc, "the recording and its metrics" if cfg.metrics else "the recording") from None
+    what = "the recording and its metrics" if cfg.metrics else "the recording"
+    with writing_errors(out, what, "out= or name=", said=(RecordingError,)), \
+            staged_dir(out, inputs, cfg.overwrite, replaced) as tmp:  # the recording and its metrics, all or nothing
+        write_recording(rec, tmp / path.name)
+        if cfg.metrics:
+            report = _analysed(path, rec, tmp / f"{stem}_metrics", None)
     print(f"tcbench: wrote {path} ({len(rec.data)} samples at {rec.meta.sample_rate_hz:g} Hz, "
           f"{rec.time_s[-1] / 3600:.2f} h) and its sidecar {path.with_suffix('.json')}")
     say_replaced(replaced)
@@ -192,15 +187,9 @@ def metrics(cfg: MetricsConfig) -> RecordingOutcome:
     rec = check_metrics(cfg)
     path, out = Path(cfg.recording), metrics_folder(cfg)
     replaced: list[Path] = []
-    try:
-        with staged_dir(out, [path, sidecar_path(path)], cfg.overwrite, replaced) as tmp:  # a failure leaves nothing behind
-            report = _analysed(path, rec, tmp, cfg.scale_factor_hz_per_g)
-    except InputOverwriteError as exc:
-        raise overwrite_error(exc) from None
-    except OutputRefusedError as exc:
-        raise refused_output(exc) from None
-    except OSError as exc:
-        raise cannot_write(out, exc, "the metrics") from None
+    with writing_errors(out, "the metrics"), \
+            staged_dir(out, [path, sidecar_path(path)], cfg.overwrite, replaced) as tmp:  # a failure leaves nothing behind
+        report = _analysed(path, rec, tmp, cfg.scale_factor_hz_per_g)
     report.files = moved(report.files, tmp, out)
     show(path, rec, report)
     say_replaced(replaced)
@@ -327,16 +316,8 @@ def import_recording(cfg: ImportConfig) -> RecordingOutcome:
     csv = Path(cfg.csv)
     recs = _ulog_recordings(cfg, drop) if is_ulog(cfg) else _table_recordings(cfg, drop).items()
     replaced: list[Path] = []
-    try:
+    with writing_errors(cfg.out, hint="out= or name=", said=(RecordingError,)):
         written = save_each(recs, cfg.out, inputs=[csv], overwrite=cfg.overwrite, replaced=replaced)
-    except RecordingError as exc:
-        raise CommandError(str(exc)) from None
-    except InputOverwriteError as exc:
-        raise overwrite_error(exc) from None
-    except OutputRefusedError as exc:
-        raise refused_output(exc, "out= or name=") from None
-    except OSError as exc:
-        raise cannot_write(cfg.out, exc) from None
     outcomes = [RecordingOutcome(w.path, w) for w in written]
     for o in outcomes:
         source, seg = o.rec.meta.extra["source"], o.rec.meta.extra["segments"]

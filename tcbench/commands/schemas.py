@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tcbench.diagnose.settings import DiagnoseSettings
+from tcbench.sensors import kinds
 from tcbench.tracking.config import TrackingConfig
 
 
@@ -232,7 +233,7 @@ class QuickstartConfig:
     seeds: int = 5
     budget: int = 510
     epochs: int = 1000
-    diagnose_sensor: str = "msra"
+    diagnose_sensor: str = kinds.DEFAULT
     diagnose_effect: str = "thermal_lag"
     diagnose_seed: int = 0
     out: str = "tcbench-quickstart"

@@ -24,7 +24,7 @@ one per (task, method, seed).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -172,18 +172,21 @@ PROBE_FAILS = 10.0  # a ±0.5 g error this many times the oracle's: the method l
 
 
 def _notes(table: pd.DataFrame, protocol: str) -> list[str]:
-    """Flag what a median alone hides. Below the physical limit: the upper end of the 95 % interval
-    of the method's paired ratio to the oracle (each run over the oracle on its own draw,
-    :mod:`tcbench.leaderboard.paired`) is under 1; below the thermometer-limited oracle likewise.
-    One draw: a method's runs all met one draw of power-ons, so its interval is over restarts only.
-    Fails the ±0.5 g probe (fulltemp): its error is over :data:`PROBE_FAILS` times the oracle's —
-    a model of the trained acceleration levels, not of the sensor, whatever its Table 2 figure.
-    And (fulltemp) when the paper's pick, the best of the restarts by training RMSE, fails the
-    probe worse than the median restart."""
+    """Flag what a median alone hides, by the notes of ``protocol`` (:data:`NOTES`; the others:
+    :func:`_limit_notes`). One draw: a method's runs all met one draw of power-ons, so its interval
+    is over restarts only (the only note of a board without its oracle)."""
     if table.loc[table["method"] == "oracle"].empty:
         return [_one_draw(row) for row in table.to_dict("records")]
-    if protocol == "gyro":
-        return _gyro_notes(table)
+    return NOTES.get(protocol, _limit_notes)(table)
+
+
+def _limit_notes(table: pd.DataFrame) -> list[str]:
+    """Below the physical limit: the upper end of the 95 % interval of the method's paired ratio
+    to the oracle (each run over the oracle on its own draw, :mod:`tcbench.leaderboard.paired`)
+    is under 1; below the thermometer-limited oracle likewise. Fails the ±0.5 g probe (fulltemp):
+    its error is over :data:`PROBE_FAILS` times the oracle's — a model of the trained acceleration
+    levels, not of the sensor, whatever its Table 2 figure. And (fulltemp) when the paper's pick,
+    the best of the restarts by training RMSE, fails the probe worse than the median restart."""
     oracle = table.loc[table["method"] == "oracle"]
     probe_limit = float(oracle["median_halfg_ug"].iloc[0]) if "median_halfg_ug" in oracle else np.nan
     notes = []
@@ -314,6 +317,10 @@ def _gyro_notes(table: pd.DataFrame) -> list[str]:
                          f"{row['_high_x_oracle']:.3g}): {why}")
         notes.append("; ".join(p for p in (*parts, _one_draw(row)) if p))
     return notes
+
+
+# The notes of a protocol's board whose limits are not the accelerometers' (:func:`_limit_notes`)
+NOTES: dict[str, Callable[[pd.DataFrame], list[str]]] = {"gyro": _gyro_notes}
 
 
 def boards(runs: pd.DataFrame, protocol_of: dict[str, str]) -> list[CompensationBoard]:

@@ -333,18 +333,30 @@ def summary_page(pages: list[Page], boards: list[CompensationBoard]) -> Page:
 
 
 def family_pages(root: Path, family: Family) -> tuple[list[Page], list[CompensationBoard]]:
-    """The pages of one folder, and its compensation boards."""
-    if family.kind == "compensation":
-        boards = compensation_boards(family, root)
-        pages = [compensation_page(root, b) for b in boards]
-        pages += [p for p in (devices_page(root, family), claims_page(root, family)) if p is not None]
-        return pages, boards
-    if family.kind == "optimisation":
-        return [optimisation_page(root, family)], []
-    if family.kind == "bbob":
-        return [bbob_page(root, family)], []
+    """The pages of one folder, and its compensation boards: by its kind (:data:`KIND_PAGES`)."""
+    return KIND_PAGES[family.kind](root, family)
+
+
+def _compensation_pages(root: Path, family: Family) -> tuple[list[Page], list[CompensationBoard]]:
+    """A page per compensation board, the devices' and the claims' pages; and the boards."""
+    boards = compensation_boards(family, root)
+    pages = [compensation_page(root, b) for b in boards]
+    pages += [p for p in (devices_page(root, family), claims_page(root, family)) if p is not None]
+    return pages, boards
+
+
+def _calibration_pages(root: Path, family: Family) -> tuple[list[Page], list[CompensationBoard]]:
     page = calibration_page(root, family)
     return ([page] if page else []), []
+
+
+# The pages of a folder of each kind (Family.kind), and its compensation boards
+KIND_PAGES: dict[str, Callable[[Path, Family], tuple[list[Page], list[CompensationBoard]]]] = {
+    "compensation": _compensation_pages,
+    "optimisation": lambda root, family: ([optimisation_page(root, family)], []),
+    "bbob": lambda root, family: ([bbob_page(root, family)], []),
+    "calibration": _calibration_pages,
+}
 
 
 def known(root: Path) -> list[str]:
