@@ -421,8 +421,8 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         held = ("the temperature held to its training range, {:g} to {:g} degC".format(*spec["temp_range_c"])
                 if np.all(np.isfinite(spec["temp_range_c"])) else "the temperature not held")
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns the",
-                   f" * network's estimate of the input ({spec['input_quantity']}, in {spec['input_unit']}) from the raw "
-                   "output and the temperature",
+                   f" * network's estimate of the input ({spec['input_quantity']}, in {spec['input_unit']}) "
+                   "from the raw output and the temperature",
                    f" * ({held}), not a corrected output."]
     else:
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",

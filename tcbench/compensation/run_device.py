@@ -44,9 +44,9 @@ def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
     low, high = data.input_range(env._x) if env.clamp_inputs else (None, None)
     unit = meta.units.get("output", "")
     if form == "inverse":  # [raw, T] -> the input
+        measured = meta.units.get("input", "")
         spec = inverse_spec(learner, fitted, None if low is None else (low[0], high[0]),
-                            None if low is None else (low[1], high[1]), QUANTITY.get(meta.units.get("input", ""), "input"),
-                            meta.units.get("input", ""))
+                            None if low is None else (low[1], high[1]), QUANTITY.get(measured, "input"), measured)
         return base | {"sensor": meta.sensor, "unit": unit, "device": {learner: spec}}
     fullest = max(window_samples(r.time_s, data.rate_window_s) for r in recordings)
     spec = network_spec(learner, fitted, None if low is None else (low[0], high[0]),
