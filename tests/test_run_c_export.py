@@ -2,7 +2,9 @@
 (:mod:`tcbench.compensation.run_device`) and exported by ``tcbench export runs=[...] formats=[c]``:
 compiled with the system C compiler and run sample by sample over the run's test record, it gives
 the run's own compensation (the task's learner compensator) to 1e-9 (double build) and 1e-4 (float
-build), relative to the larger of the output and the record's largest raw reading."""
+build), relative to the larger of the output and the record's largest raw reading. The
+full-temperature task's network (``msra_fulltemp``: ``[raw, T]`` to the input) runs too, and
+returns the task's own estimate of the input in g to the same tolerances, relative to its largest."""
 
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ from tcbench.runner.loop import compensate
 CC = shutil.which("cc")
 TOLERANCE = {"double": 1e-9, "float": 1e-4}
 ENV = "tcbench/Accel-Chamber-v0"
+FULLTEMP = "tcbench/MSRA-FullTemp-v0"
 HOST = Path(__file__).with_name("test_c_export.py").read_text().split('HOST = r"""')[1].split('"""')[0]
 
 
@@ -88,12 +91,74 @@ def test_the_compiled_run_network_gives_the_runs_compensation(trained: dict, lea
     assert np.ptp(want - raw) > 10 * TOLERANCE["float"] * np.max(np.abs(raw))  # the network corrects something
 
 
-def test_a_run_whose_network_no_device_runs_says_why() -> None:
-    env = gym.make("tcbench/MSRA-FullTemp-v0", learner="bp", learner_params={"training": "gd", "epochs": 2},
-                   n_train=1, n_test=1, recordings_seed=0).unwrapped
-    compensate(env, "bp", "none", {}, 1, 0)
-    doc = device_document(env, "bp", "random-BP-gd")
-    assert doc["device"] == {} and "maps the output and the temperature to the input" in doc["left_out"]["bp"]
+@pytest.fixture(scope="module")
+def fulltemp() -> dict[str, tuple[object, dict]]:
+    """The full-temperature task (one run to train, one to test) with each network trained once as
+    a run trains it (few epochs), and the ``device.json`` the run keeps."""
+    class Lazy(dict):
+        def __missing__(self, learner: str) -> tuple[object, dict]:
+            params = {"training": "gd", "epochs": 50} if learner == "bp" else {"epochs": 5}
+            env = gym.make(FULLTEMP, learner=learner, learner_params=params, n_train=1, n_test=1,
+                           recordings_seed=0).unwrapped
+            compensate(env, learner, "none", {}, 1, 0)
+            self[learner] = env, device_document(env, learner, f"random-{learner}")
+            return self[learner]
+
+    return Lazy()
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize("learner", ["bp", pytest.param("elman", marks=pytest.mark.slow)])
+def test_the_compiled_fulltemp_network_estimates_the_input_as_the_task_does(fulltemp: dict, learner: str,
+                                                                           build: str, tmp_path: Path) -> None:
+    """msra_fulltemp's network maps [raw, T] to the input: ``tcbench export runs=[device.json]``
+    writes it as C whose update returns the estimate in g, the temperature held to the training
+    range (the test run goes below it), as the task compensates, to the tolerance in both builds."""
+    env, doc = fulltemp[learner]
+    assert doc["sensor"] == "msra" and doc["unit"] == "Hz" and "left_out" not in doc
+    spec = doc["device"][learner]
+    assert spec["form"] == "inverse" and spec["inputs"] == ["raw", "temperature_c"]
+    assert (spec["input_quantity"], spec["input_unit"]) == ("acceleration", "g")
+    kept = tmp_path / "0123456789abcdef" / "artifacts" / "device.json"  # where a run keeps it
+    kept.parent.mkdir(parents=True)
+    kept.write_text(json.dumps(doc, indent=1))
+    done = _tcbench("export", f"runs=[{kept}]", "formats=[c]", "out=c", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    name = f"tc_msra_{learner}_01234567"
+    header, source = ((tmp_path / "c" / f"{name}.{e}").read_text() for e in "hc")
+    assert "estimate of the input (acceleration, in g)" in header and "not a corrected output" in header
+    assert "RATE_CAPACITY" not in header and "alloc" not in source  # no rate window, no allocation
+    (tmp_path / "c" / "host.c").write_text(HOST.replace("UPNAME", name.upper()).replace("NAME", name))
+    exe = tmp_path / name
+    flags = [f"-D{name.upper()}_FLOAT"] if build == "float" else []
+    subprocess.run([CC, "-std=c99", "-O2", *flags, str(tmp_path / "c" / "host.c"), str(tmp_path / "c" / f"{name}.c"),
+                    "-lm", "-o", str(exe)], check=True)
+    tr = env.data.test[0]
+    rec = tr.recording
+    temp_c, raw = rec.temperature_c, rec.output
+    dt_s = np.r_[0.0, np.diff(rec.time_s)]
+    lines = "".join(f"{a.hex()} {b.hex()} {c.hex()}\n" for a, b, c in zip(temp_c.tolist(), raw.tolist(), dt_s.tolist()))
+    done = subprocess.run([str(exe)], input=lines, capture_output=True, text=True, check=True)
+    got = np.array([float.fromhex(v) for v in done.stdout.split()])
+    box = env.data.input_range(env._x)
+    want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)  # the task's own compensation, g
+    assert got.size == want.size
+    bound = TOLERANCE[build] * np.max(np.abs(want))  # the estimate crosses 0 g: relative to its largest
+    worst = int(np.argmax(np.abs(got - want)))
+    assert np.all(np.abs(got - want) <= bound), (worst, got[worst], want[worst])
+    below = temp_c < box[0][1]  # the clamp acts: the unclamped network differs there
+    free = env.learner.predict(np.column_stack([raw, temp_c]))
+    assert below.any() and np.max(np.abs(free - want)[below]) > 5 * bound
+    if learner == "bp":  # the network estimates the input (better than a constant 0 g)
+        assert np.sqrt(np.mean((want - rec.input) ** 2)) < np.sqrt(np.mean(rec.input ** 2))
+
+
+def test_a_run_whose_model_no_device_runs_says_why() -> None:
+    env = gym.make(FULLTEMP, learner="poly", n_train=1, n_test=1, recordings_seed=0).unwrapped
+    compensate(env, "poly", "none", {}, 1, 0)
+    doc = device_document(env, "poly", "poly")
+    assert doc["device"] == {} and doc["left_out"] == {"poly": "not a BP or Elman network"}
 
 
 def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:

@@ -33,6 +33,11 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   the network's output for the mean of its bin so far, from the context the previous complete
   bin left (at a bin's last sample the two agree): that causal form is what
   :func:`streamed_offset` computes and the compiled code is checked against.
+- an ``inverse`` network (:func:`inverse_spec`: a ``tcbench run`` network of ``msra_fulltemp``,
+  seed 000's IFA-BP of Table 2, BP or Elman): the network on ``[raw, T]``, the temperature held to
+  its training range and the raw output free, scaled as it was trained; ``update`` returns its
+  output, the estimate of the input (acceleration, g), not raw minus an offset; no rate window.
+  An Elman steps once per sample, as it was trained (:func:`streamed_corrected` is the reference).
 
 - ``model``: the diagnosed model as its compensator runs it
   (:func:`~tcbench.compensation.fitted_model.compensator`: without the terms keyed to the
@@ -102,24 +107,18 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
                         model.bin_s)
 
 
-def network_spec(method: str, learner: Any, temp_range_c: Any, rate_range: Any, rate_window_s: float, capacity: int,
-                 bin_s: float | None) -> dict[str, Any]:
-    """A fitted BP or Elman network on ``[T, dT/dt]`` as plain data: its weights, scaling and input
-    box (``None``: unbounded); ``capacity``: the rate ring's samples; ``bin_s``: the time bins an
-    Elman steps once per (0: once per sample, as a network trained on every sample runs)."""
+def _network_weights(method: str, learner: Any, bin_s: float | None) -> dict[str, Any]:
+    """A fitted 2-input BP or Elman network's weights, activations and scaling as plain data."""
     if learner.x_scaler is None or learner.y_scaler is None:
         raise ValueError(f"{method}: the network has no normalisation (not fitted)")
     h, m = learner.params.hidden, learner.n_inputs
     if m != 2:
-        raise ValueError(f"{method}: a network on {m} inputs; the device runs one on [T, dT/dt]")
+        raise ValueError(f"{method}: a network on {m} inputs; the device runs one on two")
     p = learner.get_params()
     spec = {"method": method, "hidden": h, "hidden_activation": learner.params.hidden_activation,
             "output_activation": learner.params.output_activation,
             "x_low": learner.x_scaler.low.tolist(), "x_high": learner.x_scaler.high.tolist(),
-            "y_low": float(learner.y_scaler.low[0]), "y_high": float(learner.y_scaler.high[0]),
-            "temp_range_c": [float(v) for v in (temp_range_c if temp_range_c is not None else (-np.inf, np.inf))],
-            "rate_range": [float(v) for v in (rate_range if rate_range is not None else (-np.inf, np.inf))],
-            "rate_window_s": rate_window_s, "rate_capacity": capacity}
+            "y_low": float(learner.y_scaler.low[0]), "y_high": float(learner.y_scaler.high[0])}
     if learner.sequential:
         i, j = h * m, h * m + h * h
         spec |= {"wx": p[:i].reshape(h, m).tolist(), "wc": p[i:j].reshape(h, h).tolist(), "b1": p[j:j + h].tolist(),
@@ -130,6 +129,35 @@ def network_spec(method: str, learner: Any, temp_range_c: Any, rate_range: Any, 
         spec |= {"w1": p[:h * m].reshape(h, m).tolist(), "b1": p[h * m:h * m + h].tolist(),
                  "w2": p[h * m + h:h * m + 2 * h].tolist(), "b2": float(p[-1])}
     return spec
+
+
+def _bounds(box: Any) -> list[float]:
+    return [float(v) for v in (box if box is not None else (-np.inf, np.inf))]
+
+
+def network_spec(method: str, learner: Any, temp_range_c: Any, rate_range: Any, rate_window_s: float, capacity: int,
+                 bin_s: float | None) -> dict[str, Any]:
+    """A fitted BP or Elman network on ``[T, dT/dt]`` as plain data: its weights, scaling and input
+    box (``None``: unbounded); ``capacity``: the rate ring's samples; ``bin_s``: the time bins an
+    Elman steps once per (0: once per sample, as a network trained on every sample runs)."""
+    return _network_weights(method, learner, bin_s) | {
+        "temp_range_c": _bounds(temp_range_c), "rate_range": _bounds(rate_range),
+        "rate_window_s": rate_window_s, "rate_capacity": capacity}
+
+
+def inverse_spec(method: str, learner: Any, raw_range: Any, temp_range_c: Any, quantity: str,
+                 unit: str) -> dict[str, Any]:
+    """A fitted BP or Elman network that maps ``[raw, T]`` to the input (``quantity`` in ``unit``,
+    the ``inverse`` form of ``msra_fulltemp``) as plain data: its weights, scaling and input box
+    (``None``: unbounded); an Elman steps once per sample, as it was trained."""
+    return _network_weights(method, learner, 0.0) | {
+        "form": "inverse", "inputs": ["raw", "temperature_c"], "input_quantity": quantity, "input_unit": unit,
+        "raw_range": _bounds(raw_range), "temp_range_c": _bounds(temp_range_c)}
+
+
+def is_inverse(spec: dict[str, Any]) -> bool:
+    """Whether ``spec`` returns the input estimated from ``[raw, T]`` (else raw minus an offset)."""
+    return spec.get("form") == "inverse"
 
 
 def model_spec(sensor_model: Any) -> dict[str, Any]:
@@ -155,7 +183,11 @@ def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.nda
                        rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """What the exported code returns at each sample, in numpy: ``raw`` minus
     :func:`streamed_offset`, over the diagnosed model's scale factor where it has one (the input
-    that explains the reading)."""
+    that explains the reading); for an ``inverse`` network (:func:`inverse_spec`) the network's
+    estimate of the input from ``[raw, T]``."""
+    if is_inverse(spec):
+        t = np.asarray(clock_s, dtype=np.float64)
+        return _network_out(spec, t, np.asarray(raw, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
     corrected = np.asarray(raw, dtype=np.float64) - streamed_offset(spec, clock_s, temp_c, rate_c_per_s)
     if spec["method"] != "model" or "scale_factor" not in spec:
         return corrected
@@ -239,9 +271,18 @@ def _sigma(a: np.ndarray, kind: str) -> np.ndarray:
     return np.tanh(a) if kind == "tanh" else 0.5 * (1.0 + np.tanh(0.5 * a))
 
 
-def _scaled_inputs(spec: dict[str, Any], temp_c: np.ndarray, rate: np.ndarray) -> np.ndarray:
-    """``[T, dT/dt]`` held to the training box and mapped to [-1, 1] as the network was trained."""
-    x = np.column_stack([np.clip(temp_c, *spec["temp_range_c"]), np.clip(rate, *spec["rate_range"])])
+def _input_ranges(spec: dict[str, Any]) -> tuple[list[float], list[float]]:
+    """The box each of the network's two inputs is held to, in its input order: ``[T, dT/dt]``, or
+    ``[raw, T]`` for an ``inverse`` network."""
+    if is_inverse(spec):
+        return spec["raw_range"], spec["temp_range_c"]
+    return spec["temp_range_c"], spec["rate_range"]
+
+
+def _scaled_inputs(spec: dict[str, Any], first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The network's two inputs held to the training box and mapped to [-1, 1] as it was trained."""
+    box = _input_ranges(spec)
+    x = np.column_stack([np.clip(first, *box[0]), np.clip(second, *box[1])])
     low, high = np.asarray(spec["x_low"]), np.asarray(spec["x_high"])
     span = np.where(high - low > 0, high - low, 1.0)
     return 2.0 * (x - low) / span - 1.0
@@ -259,7 +300,9 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
     """The offset the exported code computes at each sample, in numpy: ``clock_s`` the device's
     clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
     ``rate_c_per_s``: :func:`~tcbench.compensation.features.temperature_rate_c_per_s` of them when
-    already computed."""
+    already computed. An ``inverse`` network has no offset (:func:`streamed_corrected`)."""
+    if is_inverse(spec):
+        raise ValueError(f"{spec['method']}: an inverse network returns the input, not an offset (streamed_corrected)")
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     method = spec["method"]
@@ -273,16 +316,21 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
         dt = np.clip(temp, spec["tmin_c"], spec["tmax_c"]) - spec["tref_c"]
         off = x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]))
         return off + spec["rate_coef"] * rate if method == "poly3_rate" else off
+    return _network_out(spec, t, temp, rate)
+
+
+def _network_out(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The network's output on its two inputs (:func:`_input_ranges`' order) at each sample."""
     if "wc" not in spec:
-        x = _scaled_inputs(spec, temp, rate)
+        x = _scaled_inputs(spec, first, second)
         h = _sigma(x @ np.asarray(spec["w1"]).T + np.asarray(spec["b1"]), spec["hidden_activation"])
         return _unscaled(spec, h @ np.asarray(spec["w2"]) + spec["b2"])
-    return _elman_streamed(spec, t, temp, rate)
+    return _elman_streamed(spec, t, first, second)
 
 
-def _elman_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray) -> np.ndarray:
-    """The causal Elman: each sample the output for its bin's mean so far, from the context of the
-    previous complete bin (see the module doc)."""
+def _elman_streamed(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """The causal Elman: each sample the output for its bin's mean inputs so far, from the context
+    of the previous complete bin (see the module doc)."""
     wx, wc = np.asarray(spec["wx"]), np.asarray(spec["wc"])
     b1, w2 = np.asarray(spec["b1"]), np.asarray(spec["w2"])
     index = np.floor(t / spec["bin_s"]).astype(np.int64) if spec["bin_s"] > 0 else np.arange(t.size)
@@ -292,7 +340,7 @@ def _elman_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate:
     context = np.zeros(wc.shape[0])
     for a, b in zip(starts, stops):
         count = np.arange(1, b - a + 1)
-        means = np.column_stack([np.cumsum(temp[a:b]) / count, np.cumsum(rate[a:b]) / count])
+        means = np.column_stack([np.cumsum(first[a:b]) / count, np.cumsum(second[a:b]) / count])
         drive = wc @ context + b1
         h = _sigma(_scaled_inputs(spec, means[:, 0], means[:, 1]) @ wx.T + drive, spec["hidden_activation"])
         out[a:b] = _unscaled(spec, h @ w2 + spec["b2"])
@@ -326,6 +374,12 @@ def _array(values: Any) -> str:
     return "{" + ", ".join(_lit(v) for v in flat) + "}"
 
 
+def _clamped(var: str, lo: float, hi: float) -> str:
+    """C for ``var`` held to ``[lo, hi]`` (an infinite bound: not held on that side)."""
+    above = f"({var} > (R){_lit(hi)} ? (R){_lit(hi)} : {var})" if np.isfinite(hi) else var
+    return f"({var} < (R){_lit(lo)} ? (R){_lit(lo)} : {above})" if np.isfinite(lo) else above
+
+
 def _state_bytes(doubles: int, reals: int, ints: int, real_size: int) -> int:
     size = 8 * doubles + real_size * reals + 4 * ints
     return -(-size // 8) * 8
@@ -338,7 +392,8 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         raise ValueError(f"{name!r} is not a C identifier (letters, digits, _; not starting with a digit)")
     method = spec["method"]
     up = name.upper()
-    rated = method not in ("poly3", "model")
+    inverse = is_inverse(spec)
+    rated = method not in ("poly3", "model") and not inverse
     recurrent = "wc" in spec
     slots = _model_slots(spec) if method == "model" else []
     h = int(spec.get("hidden", 0))
@@ -355,22 +410,29 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
     elif method == "poly3_rate":
         flops, body = f"10 + 9 n, n the samples in the rate window (at most {cap}: {10 + 9 * cap})", _cubic_body(spec)
     else:
-        per = 8 + 4 * h + 2 * h + 6
+        per = 8 + 4 * h + 2 * h + 6 + (6 if recurrent else 0)
+        flops = (f"{per} and {h} tanh" if inverse else
+                 f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})")
         if recurrent:
-            per += 6
-            flops = (f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap}); "
-                     f"and {2 * h * h + h} more once per "
-                     + (f"{spec['bin_s']:g}-s bin)" if spec["bin_s"] > 0 else "sample)"))
-        else:
-            flops = f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})"
+            flops += (f"; and {2 * h * h + h} more once per "
+                      + (f"{spec['bin_s']:g}-s bin" if spec["bin_s"] > 0 else "sample"))
         body = ""
+    if inverse:
+        held = ("the temperature held to its training range, {:g} to {:g} degC".format(*spec["temp_range_c"])
+                if np.all(np.isfinite(spec["temp_range_c"])) else "the temperature not held")
+        returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns the",
+                   f" * network's estimate of the input ({spec['input_quantity']}, in {spec['input_unit']}) "
+                   "from the raw output and the temperature",
+                   f" * ({held}), not a corrected output."]
+    else:
+        returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
+                   (" * the offset, over the scale factor s(T_die) (the input that explains the reading)."
+                    if method == "model" and "scale_factor" in spec else " * the offset.")]
     lines = [f"/* {name}.h: temperature compensation by the {method} method, exported by tcbench export formats=[c].",
              *([f" * {about}"] if about else []),
              " *",
-             f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
-             (" * the offset, over the scale factor s(T_die) (the input that explains the reading). dt_s is the"
-              if method == "model" and "scale_factor" in spec else " * the offset. dt_s is the"),
-             " * time since the previous sample (> 0; the first sample's is ignored).",
+             *returns,
+             " * dt_s is the time since the previous sample (> 0; the first sample's is ignored).",
              f" * Build: double by default; define {up}_FLOAT for float (the clock stays a double).",
              f" * State: {sizes['double']} bytes (double build), {sizes['float']} bytes (float build); no allocation.",
              f" * Floating-point operations per sample: {flops}.",
@@ -397,7 +459,7 @@ typedef struct {{
 """ if rated else "") + (f"""    {name}_real context[{h}];  /* the hidden state the last complete bin left */
     {name}_real drive[{h}];  /* W_c context + b1, once per bin */
     {name}_real pending[{h}];  /* the hidden state of the bin so far */
-    {name}_real bin_temp_sum, bin_rate_sum;
+    {name}_real bin_sum[2];  /* the bin's sums of the network's inputs ({'raw, T' if inverse else 'T, dT/dt'}) */
 """ if recurrent else "") + (f"""    {name}_real memory[{len(slots)}];  /* {', '.join(slots)} */
 """ if slots else "") + """    int samples;  /* samples seen (saturates) */
 """ + ("""    int head, count;  /* the ring's oldest sample, samples in it */
@@ -486,6 +548,8 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
 
 def _source(spec: dict[str, Any], name: str, up: str, body: str, rated: bool, recurrent: bool, h: int) -> str:
     method = spec["method"]
+    inverse = is_inverse(spec)  # the network's inputs, and what update returns
+    names, result = (("raw", "temperature_c"), "estimate") if inverse else (("temperature_c", "rate"), "offset")
     parts = [f"/* {name}.c: see {name}.h. */\n#include <math.h>\n#include \"{name}.h\"\n\ntypedef {name}_real R;\n"
              f"#ifdef {up}_FLOAT\n#define TC_EXP expf\n#define TC_TANH tanhf\n#else\n#define TC_EXP exp\n"
              "#define TC_TANH tanh\n#endif\n"]
@@ -535,8 +599,7 @@ static R rate_c_per_s({name}_state *s, R temperature_c)
         span = [hi - lo if hi - lo > 0 else 1.0 for lo, hi in zip(low, high)]
         y_span = spec["y_high"] - spec["y_low"]
         y_span = y_span if y_span > 0 else 1.0
-        t_lo, t_hi = spec["temp_range_c"]
-        r_lo, r_hi = spec["rate_range"]
+        (a_lo, a_hi), (b_lo, b_hi) = _input_ranges(spec)
         act = "TC_TANH(a)" if spec["hidden_activation"] == "tanh" else "(R)0.5 * ((R)1 + TC_TANH((R)0.5 * a))"
         out = "TC_TANH(z)" if spec["output_activation"] == "tanh" else "z"
         w_in = spec["wx"] if recurrent else spec["w1"]
@@ -547,15 +610,14 @@ static const R W2[{h}] = {_array(spec['w2'])};
 static const R B2 = {_lit(spec['b2'])};
 """ + (f"static const R W_C[{h}][{h}] = {{{', '.join(_array(row) for row in spec['wc'])}}};\n" if recurrent else "")
                      + f"""
-/* The network's output (the offset) for [T, dT/dt], held to the training box, scaled to [-1, 1];
+/* The network's output ({'the input estimate' if inverse else 'the offset'}) for \
+{'[raw, T]' if inverse else '[T, dT/dt]'}, held to the training box, scaled to [-1, 1];
    hidden: its hidden outputs, drive: W_c context + b1 (Elman) or b1. */
-static R network(R temperature_c, R rate, const R *drive, R *hidden)
+static R network(R {names[0]}, R {names[1]}, const R *drive, R *hidden)
 {{
     int j;
-    R t = temperature_c < (R){_lit(t_lo)} ? (R){_lit(t_lo)} : (temperature_c > (R){_lit(t_hi)} ? (R){_lit(t_hi)} : temperature_c);
-    R r = rate < (R){_lit(r_lo)} ? (R){_lit(r_lo)} : (rate > (R){_lit(r_hi)} ? (R){_lit(r_hi)} : rate);
-    R x0 = (R)2 * (t - (R){_lit(low[0])}) / (R){_lit(span[0])} - (R)1;
-    R x1 = (R)2 * (r - (R){_lit(low[1])}) / (R){_lit(span[1])} - (R)1;
+    R x0 = (R)2 * ({_clamped(names[0], a_lo, a_hi)} - (R){_lit(low[0])}) / (R){_lit(span[0])} - (R)1;
+    R x1 = (R)2 * ({_clamped(names[1], b_lo, b_hi)} - (R){_lit(low[1])}) / (R){_lit(span[1])} - (R)1;
     R z = 0;
     for (j = 0; j < {h}; j++) {{
         R a = x0 * W_IN[j][0] + x1 * W_IN[j][1] + drive[j];
@@ -572,8 +634,8 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
     if recurrent:
         init += ["    {", "        int j;", f"        for (j = 0; j < {h}; j++) {{",
                  "            s->context[j] = 0;", "            s->pending[j] = 0;", "            s->drive[j] = B1[j];",
-                 "        }", "    }", "    s->bin = 0;", "    s->bin_count = 0;", "    s->bin_temp_sum = 0;",
-                 "    s->bin_rate_sum = 0;"]
+                 "        }", "    }", "    s->bin = 0;", "    s->bin_count = 0;", "    s->bin_sum[0] = 0;",
+                 "    s->bin_sum[1] = 0;"]
     parts.append("\n" + "\n".join(init) + "\n}\n")
     update = [f"\n{name}_real {name}_update({name}_state *s, {name}_real temperature_c, {name}_real raw, {name}_real dt_s)",
               "{",
@@ -590,9 +652,9 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
         if method == "poly3_rate":
             update.append(f"    offset = offset + (R){_lit(spec['rate_coef'])} * rate;")
     elif not recurrent:
-        update += [f"    R hidden[{h}];", "    R offset = network(temperature_c, rate, B1, hidden);"]
+        update += [f"    R hidden[{h}];", f"    R {result} = network({names[0]}, {names[1]}, B1, hidden);"]
     else:
-        update += [f"    R offset;",
+        update += [f"    R {result};",
                    (f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});" if spec["bin_s"] > 0
                     else "    int bin = s->samples;  /* a network trained on every sample steps every sample */"),
                    "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
@@ -604,17 +666,19 @@ static R network(R temperature_c, R rate, const R *drive, R *hidden)
                    "            s->drive[i] = a + B1[i];",
                    "        }",
                    "        s->bin_count = 0;",
-                   "        s->bin_temp_sum = 0;",
-                   "        s->bin_rate_sum = 0;",
+                   "        s->bin_sum[0] = 0;",
+                   "        s->bin_sum[1] = 0;",
                    "    }",
                    "    s->bin = bin;",
                    "    s->bin_count++;",
-                   "    s->bin_temp_sum += temperature_c;",
-                   "    s->bin_rate_sum += rate;",
-                   "    offset = network(s->bin_temp_sum / (R)s->bin_count, s->bin_rate_sum / (R)s->bin_count, "
+                   f"    s->bin_sum[0] += {names[0]};",
+                   f"    s->bin_sum[1] += {names[1]};",
+                   f"    {result} = network(s->bin_sum[0] / (R)s->bin_count, s->bin_sum[1] / (R)s->bin_count, "
                    "s->drive, s->pending);"]
     scaled = method == "model" and "scale_factor" in spec
-    update += ["    return (raw - offset) / scale;" if scaled else "    return raw - offset;", "    }", "}\n"]
+    back = ("    return estimate;  /* the network's estimate of the input */" if inverse else
+            "    return (raw - offset) / scale;" if scaled else "    return raw - offset;")
+    update += [back, "    }", "}\n"]
     parts.append("\n".join(update))
     return "".join(parts)
 
