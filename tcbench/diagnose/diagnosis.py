@@ -54,10 +54,10 @@ from tcbench.diagnose.screens import (
 )
 from tcbench.diagnose.screens.flicker import ID as FLICKER
 from tcbench.diagnose.screens.flicker import Flicker, flicker_evidence, flicker_test
-from tcbench.diagnose.screens.glitches import GlitchScreen, ThermometerGlitches, glitches
-from tcbench.diagnose.screens.outliers import OutliersScreen, Spikes
+from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, ThermometerGlitches, glitches
+from tcbench.diagnose.screens.spikes import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
-from tcbench.diagnose.screens.variance import relative_sigma
+from tcbench.diagnose.screens.noise_level import relative_sigma
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,

@@ -62,7 +62,7 @@ from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quanti
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens import FINDINGS_ORDER
-from tcbench.diagnose.screens.glitches import glitches
+from tcbench.diagnose.screens.thermometer_glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError
 from tcbench.sensors.recording import Recording

@@ -41,7 +41,7 @@ from tcbench.diagnose.glitches import repaired
 from tcbench.diagnose.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
 from tcbench.diagnose.plan import min_full_duration_s
 from tcbench.diagnose.screens import FINDINGS_ORDER
-from tcbench.diagnose.screens.glitches import glitches
+from tcbench.diagnose.screens.thermometer_glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.short_tests import (
     NOT_RUN,

@@ -1,4 +1,4 @@
-"""The screens of a diagnosis (:mod:`~tcbench.diagnose.screens.base`): the tests whose structure is
+"""The screens of a diagnosis (:mod:`~tcbench.diagnose.screens.screen`): the tests whose structure is
 not an additive term of the mean model, by stage, and the order their parts take in the report.
 
 - ``prepare``: thermometer glitches (held at the previous reading, their samples given zero
@@ -14,12 +14,12 @@ Each screen holds the settings it tests with (:class:`~tcbench.diagnose.settings
 
 from __future__ import annotations
 
-from tcbench.diagnose.screens.base import Screen, ScreenInput, ScreenResult, Screened, run_screens
+from tcbench.diagnose.screens.screen import Screen, ScreenInput, ScreenResult, Screened, run_screens
 from tcbench.diagnose.screens.flicker import FlickerScreen
-from tcbench.diagnose.screens.outliers import OutliersScreen
+from tcbench.diagnose.screens.spikes import OutliersScreen
 from tcbench.diagnose.screens.output import QuantisationScreen, SaturationScreen
 from tcbench.diagnose.screens.thermometer import ThermometerScreen, smoothing
-from tcbench.diagnose.screens.variance import NoiseLevelScreen, VarianceScreen
+from tcbench.diagnose.screens.noise_level import NoiseLevelScreen, VarianceScreen
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 
 

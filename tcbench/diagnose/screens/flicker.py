@@ -28,7 +28,7 @@ from tcbench.diagnose.library_findings import Extent, library_finding
 from tcbench.diagnose.locate import AllanExcess, allan_excess, why_no_allan
 from tcbench.diagnose.reference import Reference
 from tcbench.diagnose.result import Confusion, rmse
-from tcbench.diagnose.screens.base import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.screen import AFTER, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.terms import terms
 from tcbench.diagnose.thermometer import propagated_noise

@@ -13,7 +13,7 @@ from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.outliers import without
 from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
 from tcbench.diagnose.saturation import Saturation, find_saturation
-from tcbench.diagnose.screens.base import BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
 

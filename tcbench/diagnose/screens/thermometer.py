@@ -8,7 +8,7 @@ from typing import Any
 
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.quantisation import ThermometerSteps, thermometer_steps
-from tcbench.diagnose.screens.base import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.screen import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.signals import fitted_window_s
 from tcbench.sensors.recording import Recording

@@ -8,7 +8,7 @@ from typing import Any
 
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.glitches import ID, Glitches, find_glitches
-from tcbench.diagnose.screens.base import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.screen import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.sensors.recording import Recording
 

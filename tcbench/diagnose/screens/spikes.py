@@ -12,8 +12,8 @@ import numpy as np
 from tcbench.diagnose.design import Designer
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.outliers import Outliers, find_outliers, without
-from tcbench.diagnose.screens.base import BEFORE, Screen, ScreenInput, ScreenResult
-from tcbench.diagnose.screens.variance import relative_sigma
+from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.noise_level import relative_sigma
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import DiagnosisData
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from tcbench.diagnose.design import Designer, Model
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.screens.base import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.screen import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.output import QuantisationScreen, clear_of_clipping
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings, VarianceSettings
 from tcbench.diagnose.signals import DiagnosisData
