@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
-from tcbench.diagnose.attribute import CONFUSABLE
-from tcbench.diagnose.design import DETERMINISTIC, Designer
+from tcbench.diagnose.select.attribute import CONFUSABLE
+from tcbench.diagnose.select.design import DETERMINISTIC, Designer
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.findings import WHERE_KEYS, check_finding
 from tcbench.diagnose.terms import (

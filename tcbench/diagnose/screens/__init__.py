@@ -8,6 +8,12 @@ not an additive term of the mean model, by stage, and the order their parts take
 - ``after`` the final fit (:func:`after_fit`): flicker (with the recheck of the kept effects) and
   the variance of the final residual.
 
+The tests the screens run are modules of their own: :mod:`~.glitches` (thermometer glitches),
+:mod:`~.outliers` (isolated outliers), :mod:`~.saturation`, :mod:`~.quantisation` (of the output
+and of the thermometer) and :mod:`~.variance` (noise whose level changes); each screen module
+(:mod:`~.thermometer_glitches`, :mod:`~.thermometer`, :mod:`~.output`, :mod:`~.noise_level`,
+:mod:`~.spikes`, :mod:`~.flicker`) wraps one or two of them as a :class:`~.screen.Screen`.
+
 Each screen holds the settings it tests with (:class:`~tcbench.diagnose.settings.ScreenSettings`);
 :data:`BEFORE_FIT` and :data:`AFTER_FIT` are the stages at the defaults.
 """

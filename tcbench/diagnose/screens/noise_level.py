@@ -1,4 +1,4 @@
-"""Noise whose level changes with temperature or time (:mod:`~tcbench.diagnose.variance`), tested
+"""Noise whose level changes with temperature or time (:mod:`~tcbench.diagnose.screens.variance`), tested
 twice:
 
 - before any fit (:class:`NoiseLevelScreen`), on the residual of the minimal model: where the
@@ -17,13 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.design import Designer, Model
+from tcbench.diagnose.select.design import Designer, Model
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.screens.screen import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.output import QuantisationScreen, clear_of_clipping
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings, VarianceSettings
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.diagnose.variance import Variance, find_variance
+from tcbench.diagnose.screens.variance import Variance, find_variance
 
 ID = "variance"
 

@@ -1,5 +1,5 @@
 """Isolated outliers of the starting model's in-sample residual
-(:mod:`~tcbench.diagnose.outliers`), judged at the local noise level: zero weight in every fit,
+(:mod:`~tcbench.diagnose.screens.outliers`), judged at the local noise level: zero weight in every fit,
 score and test after it."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.design import Designer
+from tcbench.diagnose.select.design import Designer
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.outliers import Outliers, find_outliers, without
+from tcbench.diagnose.screens.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.noise_level import relative_sigma
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings

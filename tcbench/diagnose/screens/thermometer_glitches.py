@@ -1,4 +1,4 @@
-"""Thermometer glitches (:mod:`~tcbench.diagnose.glitches`), read from the raw reading before it is
+"""Thermometer glitches (:mod:`~tcbench.diagnose.screens.glitches`), read from the raw reading before it is
 smoothed: found, said in the report and given zero weight."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.glitches import ID, Glitches, find_glitches
+from tcbench.diagnose.screens.glitches import ID, Glitches, find_glitches
 from tcbench.diagnose.screens.screen import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.sensors.recording import Recording

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import bin_width, duty_phase, line_window, why_no_lines
+from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import why_no_steps
+from tcbench.diagnose.terms.detectors import why_no_steps
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3

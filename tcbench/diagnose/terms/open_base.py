@@ -1,6 +1,6 @@
 """The base of an open-world term: structure outside the effect library (docs/concepts/diagnosis-report.md, shapes) as
-regressors, found by the detectors of :mod:`tcbench.diagnose.detectors` and scored by
-:mod:`tcbench.diagnose.discover`.
+regressors, found by the detectors of :mod:`tcbench.diagnose.terms.detectors` and scored by
+:mod:`tcbench.diagnose.select.discover`.
 
 An open-world term has an id (its key in ``model.yaml`` ``effects``, simulated by the effect of
 the same id in :mod:`tcbench.sensors.effects`), a ``shape`` of the report contract, nonlinear
@@ -27,7 +27,7 @@ from typing import Any, ClassVar, Protocol, TypeVar
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.detectors import line_periods, step_times
+from tcbench.diagnose.terms.detectors import line_periods, step_times
 from tcbench.diagnose.findings import SHAPES, Finding
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import bump_centres, why_no_bumps
+from tcbench.diagnose.terms.detectors import bump_centres, why_no_bumps
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData, lagged
 from tcbench.diagnose.terms.base import g3, term

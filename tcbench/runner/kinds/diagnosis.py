@@ -51,7 +51,7 @@ class DiagnoseKind(JobKind):
         return diagnose_recording(self.config(c))
 
     def record(self, run: Any, outcome: DiagnosisOutcome, c: dict[str, Any], where: Path) -> list[Path]:
-        from tcbench.diagnose.short_record import ShortRecordReport  # loaded by execute already
+        from tcbench.diagnose.short.short_record import ShortRecordReport  # loaded by execute already
 
         diag = outcome.diagnosis
         run.set_tag("tcbench.verdict", str(diag.verdict)[:4900])

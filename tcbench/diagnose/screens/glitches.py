@@ -4,12 +4,12 @@ A bus or logging glitch can hand the thermometer a reading of 0.0 degC, or the c
 floor (-40 degC), for a sample or a few. The smoothed temperature every term of the model is
 driven by would carry it over a whole smoothing window, and the thermometer's noise estimate
 would grow with its square. :func:`find_glitches` finds them the way
-:mod:`tcbench.diagnose.outliers` finds output spikes, on the raw reading: the reading minus the
+:mod:`tcbench.diagnose.screens.outliers` finds output spikes, on the raw reading: the reading minus the
 median of its ``window_samples`` - 1 neighbours (past the ends, the readings reflected through a
 robust line, so a ramp's last readings are judged against the ramp), over a robust scale
 (1.4826 MAD of that difference; on a lattice, where the MAD reads 0, the RMS of the departures
 without their largest 1 %, and at least half the typical non-zero step), above the Bonferroni
-bound of the record's length (:func:`~tcbench.diagnose.outliers.z_bound`), in runs of at most
+bound of the record's length (:func:`~tcbench.diagnose.screens.outliers.z_bound`), in runs of at most
 ``max_run_samples``. A thermometer with little noise bends at a ramp's corner by many times its
 noise, so a glitch must also lie outside the band its neighbours span (their
 ``max_run_samples`` most extreme readings on either side left out, so a run's own readings do
@@ -19,7 +19,7 @@ never called a glitch. The numbers are the outliers'
 
 A glitch gets zero weight: before the thermometer is smoothed its reading is replaced by the
 previous good one (:func:`repaired`, so it moves neither the smoothing nor the lattice), and
-its sample is left out of every fit and test (:func:`~tcbench.diagnose.outliers.without`).
+its sample is left out of every fit and test (:func:`~tcbench.diagnose.screens.outliers.without`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ import numpy as np
 from scipy.ndimage import median_filter, rank_filter
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.outliers import MAX_LISTED, z_bound
+from tcbench.diagnose.screens.outliers import MAX_LISTED, z_bound
 from tcbench.diagnose.settings import DEFAULTS, OutlierSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA
 from tcbench.sensors.recording import Recording
