@@ -128,7 +128,7 @@ def diagnose(
     :data:`~tcbench.diagnose.settings.DEFAULTS`). Raises
     :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a recording that cannot show
     anything, or that is shorter than ``min_duration_s`` (default
-    :func:`~tcbench.diagnose.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short_record`
+    :func:`~tcbench.diagnose.select.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short.short_record`
     tells what a shorter one can).
 
     Where the thermometer smoothing fitted to the profile (:func:`~tcbench.diagnose.signals.fitted_window_s`)
@@ -140,7 +140,7 @@ def diagnose(
     nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
     paid for like a term, is the judge the diagnosis uses for everything else.
 
-    Thermometer glitches (:mod:`~tcbench.diagnose.glitches`) are found first on the raw reading:
+    Thermometer glitches (:mod:`~tcbench.diagnose.screens.glitches`) are found first on the raw reading:
     held at the previous reading before anything is smoothed, their samples given zero weight and
     reported (``thermometer_glitches``)."""
     settings = DEFAULTS if settings is None else settings

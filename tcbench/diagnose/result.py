@@ -79,7 +79,7 @@ class Noise:
 
 @dataclass(frozen=True)
 class ReferenceSummary:
-    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.reference`) beside the final model."""
+    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.select.reference`) beside the final model."""
 
     rmse_heldout: float
     rmse_fit: float
@@ -204,7 +204,7 @@ class Diagnosis:
 
     def preface(self) -> list[str]:
         """report.md's lines after the verdict, before the fit: none for a record diagnosed as it
-        was recorded (:mod:`tcbench.diagnose.native_rate` says what it averaged there)."""
+        was recorded (:mod:`tcbench.diagnose.rate.native_rate` says what it averaged there)."""
         return []
 
     def to_json(self) -> dict[str, Any]:

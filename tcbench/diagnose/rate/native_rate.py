@@ -173,7 +173,7 @@ class FullRate:
 
 @dataclass(frozen=True)
 class _Stream:
-    """The full-rate arrays :func:`~tcbench.diagnose.saturation.find_saturation` reads."""
+    """The full-rate arrays :func:`~tcbench.diagnose.screens.saturation.find_saturation` reads."""
 
     t_s: np.ndarray
     temp_c: np.ndarray

@@ -261,7 +261,7 @@ def _default(key: str) -> Any:
 
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
-    the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
+    the report (as returned by :func:`tcbench.diagnose.report.plots.write_plots`)."""
     sigma = float(d.noise.white_sigma)
     settings = d.statistics.settings
     t0 = float(d.series.t_s[0]) if len(d.series.t_s) else 0.0

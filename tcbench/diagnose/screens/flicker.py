@@ -116,7 +116,7 @@ class FlickerScreen(Screen):
     """The Allan test of the final residual; when it finds flicker behind kept effects, they are
     tested again with that flicker in the noise model, the weakest dropped first and the flicker
     measured again on what remains after each drop, never past where the reference shows
-    deterministic structure (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`); the test
+    deterministic structure (:func:`~tcbench.diagnose.select.attribute.recheck_with_flicker`); the test
     is run again on what remains (``settings.screens.flicker``, its shortest tau
     ``settings.locate.min_allan_samples``), and the flicker it names is the one the kept effects
     were judged against."""

@@ -65,7 +65,7 @@ class Glitches:
 
     def finding(self) -> Finding:
         """The report.json ``effects`` entry (``id`` ``thermometer_glitches``, shape ``outliers``):
-        how many, and the :data:`~tcbench.diagnose.outliers.MAX_LISTED` largest by time, reading
+        how many, and the :data:`~tcbench.diagnose.screens.outliers.MAX_LISTED` largest by time, reading
         and the level they departed from."""
         keep = np.sort(np.argsort(-np.abs(self.z), kind="stable")[:MAX_LISTED])
         times = [round(float(t), 6) for t in self.time_s[keep]]

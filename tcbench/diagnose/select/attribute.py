@@ -178,8 +178,8 @@ def attribute(
     """Forward selection of the library's deterministic effects onto ``base`` (see module doc),
     its thresholds, penalty and most effects ``settings.selection``, the surrogate test's
     generator seeded with ``settings.surrogate.seed``; ``plan`` the blocks, clusters and test
-    (default: sized to the recording by :func:`~tcbench.diagnose.plan.plan_for`); with
-    ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the library's
+    (default: sized to the recording by :func:`~tcbench.diagnose.select.plan.plan_for`); with
+    ``open_world`` the terms of :mod:`tcbench.diagnose.select.discover` compete with the library's
     effects in every round, kept above ``open_threshold`` (default the selection's)."""
     selection = settings.selection
     threshold, max_effects = selection.detection_threshold_sigma2, selection.max_effects

@@ -83,7 +83,7 @@ def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: Signifi
               detectors: DetectorSettings = DEFAULTS.detectors) -> tuple[str, float, tuple[float, ...]] | None:
     """One round: the open-world term that adds most to ``model`` above ``threshold`` and
     passes ``test`` (``(id, gain, value)``), or None; every term's
-    :class:`~tcbench.diagnose.evidence.Evidence` is written into ``evidence``."""
+    :class:`~tcbench.diagnose.select.evidence.Evidence` is written into ``evidence``."""
     tried: dict[str, tuple[float, tuple[float, ...], list[tuple[float, ...]]]] = {}
     screen = _Screen(scorer, model, detectors)
     for term_id, values in proposals(scorer, model, detectors).items():

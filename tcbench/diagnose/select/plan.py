@@ -42,7 +42,7 @@ __all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan
 class StatsPlan:
     """Block length (s) and fold count of the cross-validation, cluster length (s) and count of
     the robust test, and the significance test the recording supports (the robust Wald test or
-    the surrogate test, :mod:`tcbench.diagnose.significance`)."""
+    the surrogate test, :mod:`tcbench.diagnose.select.significance`)."""
 
     block_s: float
     k: int

@@ -30,7 +30,7 @@ Judgement = tuple[bool, float, float, str]  # (passed, robust Wald, surrogate p-
 
 
 class Scorer(Protocol):
-    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.attribute._Scorer`)."""
+    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.select.attribute._Scorer`)."""
 
     def removes_most(self, base: Any, model: Any) -> bool: ...
 
@@ -69,7 +69,7 @@ class SignificanceTest(ABC):
 
 @dataclass(frozen=True)
 class SpectralSurrogate(SignificanceTest):
-    """The surrogate test (:func:`~tcbench.diagnose.surrogate.surrogate_test`) at p <= ``settings.level``."""
+    """The surrogate test (:func:`~tcbench.diagnose.select.surrogate.surrogate_test`) at p <= ``settings.level``."""
 
     settings: SurrogateSettings = DEFAULTS.surrogate
     name: ClassVar[str] = SURROGATE

@@ -68,7 +68,7 @@ OF_BINS = ("the temperature slope, the level step and the Allan deviation of thi
 
 @dataclass
 class ShortRecordReport:
-    """The report of a short record: the tests run (:class:`~tcbench.diagnose.short_tests.ShortTest`)
+    """The report of a short record: the tests run (:class:`~tcbench.diagnose.short.short_tests.ShortTest`)
     and those it needs more time for (``{id, needs_s, what}``), and the settings they ran with."""
 
     sensor: str

@@ -26,7 +26,7 @@ DUTY_BRACKET = 41  # a square cycle's drop has side maxima in the period: this g
 def windows(search: Search) -> list[tuple[float, float, float]]:
     """``(period_s, start_s, end_s)`` of each line short enough to hold :data:`DUTY_MIN_CYCLES`
     inside :data:`GATED_MAX_PART` of the span, with where it is present
-    (:func:`~tcbench.diagnose.detectors.line_window`); once per round."""
+    (:func:`~tcbench.diagnose.terms.detectors.line_window`); once per round."""
     d, r, span = search.data, search.residual, search.span_s
     return search.shared("line_windows", lambda: [(p, *line_window(d.t_s, r, p, search.detectors))
                                                   for p in search.lines if DUTY_MIN_CYCLES * p < GATED_MAX_PART * span])

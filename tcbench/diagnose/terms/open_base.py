@@ -89,13 +89,13 @@ class Search:
 
     @cached_property
     def steps(self) -> list[float]:
-        """Change points of the residual (:func:`~tcbench.diagnose.detectors.step_times`) where a step is testable."""
+        """Change points of the residual (:func:`~tcbench.diagnose.terms.detectors.step_times`) where a step is testable."""
         lo, hi = self.testable
         return [t for t in step_times(self.data.t_s, self.residual, self.detectors) if lo < t < hi]
 
     @cached_property
     def lines(self) -> list[float]:
-        """Periods of the residual's spectral lines (:func:`~tcbench.diagnose.detectors.line_periods`)."""
+        """Periods of the residual's spectral lines (:func:`~tcbench.diagnose.terms.detectors.line_periods`)."""
         return line_periods(self.data.t_s, self.residual, self.detectors)
 
 
