@@ -16,8 +16,8 @@ import pytest
 import yaml
 
 from tcbench.cli import main
-from tcbench.diagnose.rate import native_rate
 from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.rate import native_rate
 from tcbench.diagnose.rate.native_rate import bin_means, full_rate_noise, plan_bins, plan_for
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.sensors.recording import Recording, make_recording, write_recording

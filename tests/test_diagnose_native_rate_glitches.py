@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tcbench.diagnose.report.markdown import render_markdown
 from tcbench.diagnose.rate.native_rate import diagnose_any_rate
+from tcbench.diagnose.report.markdown import render_markdown
 from tcbench.diagnose.report.write import _plain
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.sensors.recording import Recording, make_recording

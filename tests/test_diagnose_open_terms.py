@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from tcbench.datasets.concealed import concealed_recording, minimal_columns, unexplained
-from tcbench.diagnose.terms.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import check_finding
 from tcbench.diagnose.model_file import parse_model, to_sensor_model
+from tcbench.diagnose.terms.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.terms.open_base import step_range
 from tcbench.sensors.effects import make_effect
 from tcbench.sensors.recording import make_recording

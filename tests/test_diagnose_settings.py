@@ -17,8 +17,8 @@ from tcbench.cli import help as cli_help
 from tcbench.cli import main
 from tcbench.commands.registry import SPECS
 from tcbench.commands.schemas import DiagnoseConfig
-from tcbench.diagnose.select.locate import locate
 from tcbench.diagnose.screens.outliers import find_outliers
+from tcbench.diagnose.select.locate import locate
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,

@@ -13,7 +13,6 @@ import pytest
 
 from tcbench.diagnose.select.evidence import not_significant
 from tcbench.diagnose.select.plan import plan_for
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, PlanSettings, SelectionSettings, SurrogateSettings
 from tcbench.diagnose.select.significance import (
     ROBUST_WALD,
     SURROGATE,
@@ -21,6 +20,7 @@ from tcbench.diagnose.select.significance import (
     SpectralSurrogate,
     significance_tests,
 )
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, PlanSettings, SelectionSettings, SurrogateSettings
 from tcbench.diagnose.signals import DiagnosisData
 
 ROBUST_WALD_TEST, SURROGATE_TEST = significance_tests(DEFAULTS)

@@ -20,17 +20,7 @@ from typing import Any
 import numpy as np
 from joblib import Parallel, delayed
 
-from tcbench.diagnose.select.attribute import Attribution, Evidence, attribute
-from tcbench.diagnose.select.crossval import Fit
-from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model
-from tcbench.diagnose.select.discover import why_untestable
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.screens.glitches import repaired
-from tcbench.diagnose.select.library_findings import Extent, library_finding
-from tcbench.diagnose.select.locate import Mismatch, locate
-from tcbench.diagnose.screens.outliers import without
-from tcbench.diagnose.select.plan import min_full_duration_s
-from tcbench.diagnose.select.reference import reference_fit
 from tcbench.diagnose.result import (
     Confusion,
     Diagnosis,
@@ -54,10 +44,21 @@ from tcbench.diagnose.screens import (
 )
 from tcbench.diagnose.screens.flicker import ID as FLICKER
 from tcbench.diagnose.screens.flicker import Flicker, flicker_evidence, flicker_test
-from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, ThermometerGlitches, glitches
+from tcbench.diagnose.screens.glitches import repaired
+from tcbench.diagnose.screens.noise_level import relative_sigma
+from tcbench.diagnose.screens.outliers import without
 from tcbench.diagnose.screens.spikes import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
-from tcbench.diagnose.screens.noise_level import relative_sigma
+from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, ThermometerGlitches, glitches
+from tcbench.diagnose.select.attribute import Attribution, Evidence, attribute
+from tcbench.diagnose.select.crossval import Fit
+from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model
+from tcbench.diagnose.select.discover import why_untestable
+from tcbench.diagnose.select.library_findings import Extent, library_finding
+from tcbench.diagnose.select.locate import Mismatch, locate
+from tcbench.diagnose.select.plan import min_full_duration_s
+from tcbench.diagnose.select.reference import reference_fit
+from tcbench.diagnose.select.thermometer_noise import propagated_noise, thermometer_sigma
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,
@@ -66,7 +67,6 @@ from tcbench.diagnose.settings import (
 )
 from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.terms import is_open, open_finding, report_order, term
-from tcbench.diagnose.select.thermometer_noise import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
 __all__ = ["DiagnoseSettings", "Diagnosis", "Series", "base_model", "diagnose"]

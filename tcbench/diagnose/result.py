@@ -9,15 +9,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.select.crossval import Fit
 from tcbench.diagnose.select.design import DETERMINISTIC
 from tcbench.diagnose.select.evidence import Evidence
-from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.select.locate import AllanExcess, Mismatch
 from tcbench.diagnose.select.plan import StatsPlan
 from tcbench.diagnose.select.reference import Reference
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.select.significance import SignificanceTest
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.terms import term
 
 if TYPE_CHECKING:  # a field's type only: the screens import this module (screens/flicker.py), not the reverse

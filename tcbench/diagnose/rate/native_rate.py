@@ -55,13 +55,13 @@ import pandas as pd
 
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.result import Diagnosis
+from tcbench.diagnose.screens import FINDINGS_ORDER
 from tcbench.diagnose.screens.glitches import ID as GLITCHES
 from tcbench.diagnose.screens.glitches import Glitches, repaired
 from tcbench.diagnose.screens.outliers import Outliers, find_outliers, z_bound
 from tcbench.diagnose.screens.quantisation import OutputQuantisation, find_output_quantisation
-from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.screens.saturation import Saturation, find_saturation
-from tcbench.diagnose.screens import FINDINGS_ORDER
 from tcbench.diagnose.screens.thermometer_glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError

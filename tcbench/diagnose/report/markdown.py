@@ -15,11 +15,11 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from tcbench.diagnose.select.attribute import Evidence
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.result import Diagnosis
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
+from tcbench.diagnose.select.attribute import Evidence
 from tcbench.diagnose.select.significance import SURROGATE
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
 
 PLOT_CAPTIONS = {
     "residuals": "Held-out residual of the starting and the final model against time and temperature "

@@ -20,12 +20,12 @@ Each screen holds the settings it tests with (:class:`~tcbench.diagnose.settings
 
 from __future__ import annotations
 
-from tcbench.diagnose.screens.screen import Screen, ScreenInput, ScreenResult, Screened, run_screens
 from tcbench.diagnose.screens.flicker import FlickerScreen
-from tcbench.diagnose.screens.spikes import OutliersScreen
-from tcbench.diagnose.screens.output import QuantisationScreen, SaturationScreen
-from tcbench.diagnose.screens.thermometer import ThermometerScreen, smoothing
 from tcbench.diagnose.screens.noise_level import NoiseLevelScreen, VarianceScreen
+from tcbench.diagnose.screens.output import QuantisationScreen, SaturationScreen
+from tcbench.diagnose.screens.screen import Screen, ScreenInput, ScreenResult, Screened, run_screens
+from tcbench.diagnose.screens.spikes import OutliersScreen
+from tcbench.diagnose.screens.thermometer import ThermometerScreen, smoothing
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 
 

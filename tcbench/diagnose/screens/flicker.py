@@ -19,19 +19,19 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.result import Confusion, rmse
+from tcbench.diagnose.screens.screen import AFTER, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.select.attribute import Attribution, recheck_with_flicker
 from tcbench.diagnose.select.crossval import Fit
 from tcbench.diagnose.select.design import Model
 from tcbench.diagnose.select.evidence import Evidence
-from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.select.library_findings import Extent, library_finding
 from tcbench.diagnose.select.locate import AllanExcess, allan_excess, why_no_allan
 from tcbench.diagnose.select.reference import Reference
-from tcbench.diagnose.result import Confusion, rmse
-from tcbench.diagnose.screens.screen import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.select.thermometer_noise import propagated_noise
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.terms import terms
-from tcbench.diagnose.select.thermometer_noise import propagated_noise
 
 ID = "bias_instability"
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b

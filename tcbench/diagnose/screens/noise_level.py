@@ -17,13 +17,13 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.select.design import Designer, Model
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.screens.screen import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.screens.output import QuantisationScreen, clear_of_clipping
+from tcbench.diagnose.screens.screen import AFTER, BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.variance import Variance, find_variance
+from tcbench.diagnose.select.design import Designer, Model
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings, VarianceSettings
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.diagnose.screens.variance import Variance, find_variance
 
 ID = "variance"
 

@@ -9,11 +9,11 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.select.design import Designer
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.screens.noise_level import relative_sigma
 from tcbench.diagnose.screens.outliers import Outliers, find_outliers, without
 from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
-from tcbench.diagnose.screens.noise_level import relative_sigma
+from tcbench.diagnose.select.design import Designer
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import DiagnosisData
 

@@ -43,16 +43,16 @@ from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model, grid_
 from tcbench.diagnose.select.discover import best_open
 from tcbench.diagnose.select.evidence import Evidence, not_significant
 from tcbench.diagnose.select.plan import StatsPlan, plan_for
+from tcbench.diagnose.select.significance import SURROGATE, SignificanceTest
+from tcbench.diagnose.select.surrogate import surrogate_test
+from tcbench.diagnose.select.thermometer_noise import thermometer_variance
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,
     SelectionSettings,
     SurrogateSettings,
 )
-from tcbench.diagnose.select.significance import SURROGATE, SignificanceTest
-from tcbench.diagnose.select.surrogate import surrogate_test
 from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
-from tcbench.diagnose.select.thermometer_noise import thermometer_variance
 from tcbench.sensors.noise import flicker_score_variance
 
 CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}

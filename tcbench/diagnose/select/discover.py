@@ -25,9 +25,9 @@ import numpy as np
 
 from tcbench.diagnose.select.design import Model
 from tcbench.diagnose.select.evidence import Evidence, not_significant
+from tcbench.diagnose.select.significance import SignificanceTest
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.diagnose.select.significance import SignificanceTest
 from tcbench.diagnose.terms import Search, open_term, terms
 
 

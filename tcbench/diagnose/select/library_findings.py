@@ -14,8 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tcbench.diagnose.select.attribute import CONFUSABLE
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.select.attribute import CONFUSABLE
 from tcbench.diagnose.terms import Extent, is_term, term, terms
 
 SHAPE = {t.id: t.shape for t in terms()}  # the shape of each library effect, by id

@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.select.significance import ROBUST_WALD, SURROGATE, SignificanceTest, significance_tests
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.signals import DiagnosisData
 
 __all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan_for"]

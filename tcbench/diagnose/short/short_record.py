@@ -36,12 +36,12 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.rate.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
+from tcbench.diagnose.screens import FINDINGS_ORDER
 from tcbench.diagnose.screens.glitches import ID as GLITCHES
 from tcbench.diagnose.screens.glitches import repaired
-from tcbench.diagnose.rate.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
-from tcbench.diagnose.select.plan import min_full_duration_s
-from tcbench.diagnose.screens import FINDINGS_ORDER
 from tcbench.diagnose.screens.thermometer_glitches import glitches
+from tcbench.diagnose.select.plan import min_full_duration_s
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
 from tcbench.diagnose.short.short_tests import (
     NOT_RUN,

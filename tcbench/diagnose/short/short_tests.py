@@ -36,9 +36,9 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.select.locate import allan_excess, why_no_allan
-from tcbench.diagnose.settings import DEFAULTS, ShortSettings
 from tcbench.diagnose.select.spectral_se import SpectralError, spectral_error
 from tcbench.diagnose.select.surrogate import CHUNK, phase_surrogates
+from tcbench.diagnose.settings import DEFAULTS, ShortSettings
 
 SHORT = DEFAULTS.short
 SIGNIFICANT, NOT_SIGNIFICANT, NOT_RUN = "significant", "not significant", "not run"

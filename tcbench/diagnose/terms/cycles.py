@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
+from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log
 from tcbench.sensors.effects import DutyCycle, Effect, GatedPeriodic, Periodic
 

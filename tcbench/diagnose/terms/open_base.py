@@ -27,11 +27,11 @@ from typing import Any, ClassVar, Protocol, TypeVar
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.terms.detectors import line_periods, step_times
 from tcbench.diagnose.findings import SHAPES, Finding
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import _NO_DRAW, Extent, Term, signals, term, terms
+from tcbench.diagnose.terms.detectors import line_periods, step_times
 from tcbench.sensors.effects import MAX_REPEATS, Effect
 
 Value = tuple[float, ...]

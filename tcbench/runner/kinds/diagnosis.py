@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tcbench.commands.schemas import DiagnoseConfig, as_schema
 from tcbench.commands.diagnosis import DiagnosisOutcome, check_diagnose, diagnose_recording
+from tcbench.commands.schemas import DiagnoseConfig, as_schema
 from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
