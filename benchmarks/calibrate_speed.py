@@ -103,8 +103,8 @@ def method_step(method: str, rec: Any, branches: list[Any], train: int,
 def _diagnosed(rec: Any, b: Any) -> Any:
     from tcbench.diagnose.diagnosis import diagnose
     from tcbench.diagnose.model_file import to_sensor_model
-    from tcbench.diagnose.plan import min_full_duration_s
-    from tcbench.diagnose.report import model_spec
+    from tcbench.diagnose.report.write import model_spec
+    from tcbench.diagnose.select.plan import min_full_duration_s
     from tcbench.sensors.recording import make_recording
 
     part = make_recording(rec.time_s[b.start:b.stop], rec.temperature_c[b.start:b.stop], rec.input[b.start:b.stop],

@@ -1,6 +1,6 @@
 """Logs at their native rate (issue 46): ``tcbench diagnose`` on a record of millions of rows,
 its thermal terms fitted on bin means and its noise measured on every sample
-(:mod:`tcbench.diagnose.native_rate`), against the targets and against the same record averaged
+(:mod:`tcbench.diagnose.rate.native_rate`), against the targets and against the same record averaged
 by hand.
 
 Each case is a simulated gyro oven run (device 0, run 0) sampled at the case's rate and cut to
@@ -48,7 +48,7 @@ ENV = {"JOBLIB_MULTIPROCESSING": "0", "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THRE
 def write_records(case: str, folder: Path) -> tuple[Path, Path, dict[str, Any]]:
     """The full-rate record of ``case`` and its hand-averaged copy (means of the bin the front
     stage plans for it), as Parquet in ``folder``, and the plan."""
-    from tcbench.diagnose.native_rate import plan_for
+    from tcbench.diagnose.rate.native_rate import plan_for
     from tcbench.sensors.recording import make_recording, write_recording
     from tcbench.sensors.simulate import simulate_recording
 

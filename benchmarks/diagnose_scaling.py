@@ -1,5 +1,5 @@
 """How the time of one diagnosis grows with the rows of the record: the measurement behind
-``tcbench diagnose``'s estimate and its ``max_rows`` limit (:mod:`tcbench.diagnose.cost`).
+``tcbench diagnose``'s estimate and its ``max_rows`` limit (:mod:`tcbench.diagnose.rate.cost`).
 
 Each size is a simulated gyro oven run (device 0, run 0, 50-min holds) cut to ``--hours`` and
 sampled so that it holds the given number of rows, diagnosed once in a fresh process, its two

@@ -53,7 +53,7 @@ def main() -> None:
     add_json(p, DEFAULT_JSON)
     args = p.parse_args()
     from tcbench.diagnose.diagnosis import diagnose
-    from tcbench.diagnose.report import write_report
+    from tcbench.diagnose.report.write import write_report
 
     blas = blas_threads()
     env = environment("scipy")

@@ -10,8 +10,8 @@ import pytest
 
 from tcbench.cli import main
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.diagnose.crossval import block_folds, fit_cv
 from tcbench.diagnose.diagnosis import diagnose
+from tcbench.diagnose.select.crossval import block_folds, fit_cv
 from tcbench.diagnose.signals import (
     DiagnosisDataError,
     local_linear,

@@ -22,14 +22,14 @@ import numpy as np
 import pytest
 
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.diagnose.attribute import CONFUSABLE
 from tcbench.diagnose.diagnosis import Diagnosis, Series, diagnose
-from tcbench.diagnose.explain import explain
 from tcbench.diagnose.findings import SHAPES, Finding, check_finding
-from tcbench.diagnose.library_findings import SHAPE, Extent, library_finding
-from tcbench.diagnose.markdown import format_where, render_markdown
-from tcbench.diagnose.plots import mark_bands, mark_levels, mark_times, residual_spectrum, write_plots
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.explain import explain
+from tcbench.diagnose.report.markdown import format_where, render_markdown
+from tcbench.diagnose.report.plots import mark_bands, mark_levels, mark_times, residual_spectrum, write_plots
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.select.attribute import CONFUSABLE
+from tcbench.diagnose.select.library_findings import SHAPE, Extent, library_finding
 from tcbench.sensors.recording import Recording
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

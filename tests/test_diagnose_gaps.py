@@ -17,11 +17,11 @@ import pytest
 
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.datasets.real import tofupilot_gyro
-from tcbench.diagnose import lomb
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
-from tcbench.diagnose.glitches import find_glitches, repaired
-from tcbench.diagnose.locate import allan_excess, why_no_allan
-from tcbench.diagnose.plots import residual_spectrum
+from tcbench.diagnose.report import lomb
+from tcbench.diagnose.report.plots import residual_spectrum
+from tcbench.diagnose.screens.glitches import find_glitches, repaired
+from tcbench.diagnose.select.locate import allan_excess, why_no_allan
 from tcbench.sensors.noise import flicker
 from tcbench.sensors.recording import Recording, make_recording
 from tcbench.sensors.segments import segments
@@ -223,9 +223,9 @@ def test_a_few_samples_between_two_gaps_are_smoothed_across_their_own_gaps() -> 
     smoothed temperature follows the ramp, and the thermometer noise read from the spread about it
     is the reading's own (the record's mean segment spacing, 5 h, made it a line over 15 h that
     missed the ramp by degrees: 0.2 degC of thermometer noise read where 0.02 was put in)."""
-    from tcbench.diagnose.design import Designer
+    from tcbench.diagnose.select.design import Designer
+    from tcbench.diagnose.select.thermometer_noise import thermometer_sigma
     from tcbench.diagnose.signals import prepare, smooth_temperature
-    from tcbench.diagnose.thermometer import thermometer_sigma
 
     rng = np.random.default_rng(12)
     t = np.arange(0.0, 6 * 3600.0)

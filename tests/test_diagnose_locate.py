@@ -1,11 +1,11 @@
-"""Where a residual departs from white noise (tcbench.diagnose.locate)."""
+"""Where a residual departs from white noise (tcbench.diagnose.select.locate)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tcbench.diagnose.locate import locate
+from tcbench.diagnose.select.locate import locate
 
 N = 20000
 

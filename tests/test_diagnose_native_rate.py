@@ -1,5 +1,5 @@
 """A record of more rows than a diagnosis takes: thermal terms on bin means, noise on every sample
-(:mod:`tcbench.diagnose.native_rate`), through the API, ``tcbench diagnose`` and ``calibrate``."""
+(:mod:`tcbench.diagnose.rate.native_rate`), through the API, ``tcbench diagnose`` and ``calibrate``."""
 
 from __future__ import annotations
 
@@ -16,9 +16,9 @@ import pytest
 import yaml
 
 from tcbench.cli import main
-from tcbench.diagnose import native_rate
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.native_rate import bin_means, full_rate_noise, plan_bins, plan_for
+from tcbench.diagnose.rate import native_rate
+from tcbench.diagnose.rate.native_rate import bin_means, full_rate_noise, plan_bins, plan_for
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 from averaging import by_hand
@@ -110,8 +110,8 @@ def test_a_clipped_output_is_found_on_every_sample_and_its_clipped_samples_enter
 def averaged() -> tuple[dict[str, Any], str, dict[str, Any]]:
     """The diagnosis of the 200 Hz record with ``settings.rate.max_rows`` lowered: report.json,
     report.md (without plots) and model.yaml's mapping."""
-    from tcbench.diagnose.markdown import render_markdown
-    from tcbench.diagnose.report import _plain
+    from tcbench.diagnose.report.markdown import render_markdown
+    from tcbench.diagnose.report.write import _plain
 
     diag = native_rate.diagnose_any_rate(_record(), settings=replace(DEFAULTS, rate=RateSettings(max_rows=BUDGET)))
     return _plain(diag.to_json()), render_markdown(diag, {}), _plain(diag.model)

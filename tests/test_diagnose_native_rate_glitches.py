@@ -1,5 +1,5 @@
 """Thermometer glitches in a record over ``settings.rate.max_rows``
-(:func:`tcbench.diagnose.native_rate.diagnose_any_rate`): found on every sample before binning
+(:func:`tcbench.diagnose.rate.native_rate.diagnose_any_rate`): found on every sample before binning
 (a 1 s bin mean of 200 samples hides a 0.0 degC reading in a 200th of its size), reported as the
 ``thermometer_glitches`` finding, and given zero weight (their samples enter no bin), so the
 diagnosis names what the clean record's names."""
@@ -12,9 +12,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tcbench.diagnose.markdown import render_markdown
-from tcbench.diagnose.native_rate import diagnose_any_rate
-from tcbench.diagnose.report import _plain
+from tcbench.diagnose.rate.native_rate import diagnose_any_rate
+from tcbench.diagnose.report.markdown import render_markdown
+from tcbench.diagnose.report.write import _plain
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
 from tcbench.sensors.recording import Recording, make_recording
 

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from tcbench.datasets.concealed import concealed_recording, minimal_columns, unexplained
-from tcbench.diagnose.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import check_finding
 from tcbench.diagnose.model_file import parse_model, to_sensor_model
+from tcbench.diagnose.terms.detectors import bump_centres, line_periods, line_window, step_times
 from tcbench.diagnose.terms.open_base import step_range
 from tcbench.sensors.effects import make_effect
 from tcbench.sensors.recording import make_recording
@@ -77,7 +77,7 @@ def _hidden_step(seed: int, at: tuple[float, ...] = (0.55,), sizes: tuple[float,
 
 
 def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    from tcbench.diagnose.report import write_report
+    from tcbench.diagnose.report.write import write_report
 
     rec, t0, sigma = _hidden_step(1)
     d = diagnose(rec, sensor="gyro")
@@ -97,7 +97,7 @@ def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_p
 
 def test_duty_phase_reads_a_switched_load_hand_worked() -> None:
     """A load on for 30 % of every 600 s from phase 120 s, inside [2000, 8000) s, in unit noise."""
-    from tcbench.diagnose.detectors import duty_phase
+    from tcbench.diagnose.terms.detectors import duty_phase
 
     t = np.arange(10_000.0)
     on = (np.mod(t - 120.0, 600.0) < 180.0) & (t >= 2000.0) & (t < 8000.0)

@@ -21,11 +21,11 @@ import pytest
 from tcbench.datasets.concealed import concealed_profile, concealed_recording
 from tcbench.diagnose import diagnosis as dg
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.model_file import read_model, to_sensor_model
-from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
-from tcbench.diagnose.report import write_report
-from tcbench.diagnose.screens import outliers as outlier_screen
+from tcbench.diagnose.report.markdown import render_markdown
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.screens import spikes as outlier_screen
+from tcbench.diagnose.screens.outliers import Outliers, find_outliers, z_bound
 from tcbench.sensors.recording import Recording
 
 def _with_spikes(rec: Recording, index: list[int], sizes: list[float]) -> Recording:

@@ -17,13 +17,13 @@ from tcbench.cli import main
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model
-from tcbench.diagnose.quantisation import (
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens
+from tcbench.diagnose.screens.quantisation import (
     find_output_quantisation,
     lattice_step,
     thermometer_steps,
 )
-from tcbench.diagnose.report import write_report
-from tcbench.diagnose.screens import BEFORE_FIT, MODEL_ORDER, ScreenInput, run_screens
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors.recording import Recording, read_recording
 from tcbench.sensors.simulate import simulate_recording

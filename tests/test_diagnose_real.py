@@ -12,8 +12,8 @@ import pytest
 
 from tcbench.datasets.real import tofupilot_gyro
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.plan import SURROGATE
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.select.plan import SURROGATE
 
 TEMPERATURE_EFFECTS = {"thermal_lag", "hysteresis", "temperature_cubic", "temperature_rate"}
 WITHIN_REFERENCE = 1.25  # the target: final held-out RMSE within this factor of the reference

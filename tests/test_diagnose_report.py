@@ -1,4 +1,4 @@
-"""Plots and markdown report of a diagnosis (tcbench.diagnose.plots, tcbench.diagnose.markdown)."""
+"""Plots and markdown report of a diagnosis (tcbench.diagnose.report.plots, tcbench.diagnose.report.markdown)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
-from tcbench.diagnose.markdown import render_markdown
-from tcbench.diagnose.plots import plot_allan, plot_evidence, write_plots
+from tcbench.diagnose.report.markdown import render_markdown
+from tcbench.diagnose.report.plots import plot_allan, plot_evidence, write_plots
 from tcbench.diagnose.result import Confusion
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

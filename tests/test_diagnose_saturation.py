@@ -16,8 +16,8 @@ import pytest
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, to_sensor_model
-from tcbench.diagnose.report import write_report
-from tcbench.diagnose.saturation import find_saturation
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.screens.saturation import find_saturation
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording

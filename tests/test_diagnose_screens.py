@@ -10,8 +10,8 @@ import pytest
 
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.screens import AFTER_FIT, BEFORE_FIT, FINDINGS_ORDER, MODEL_ORDER, ThermometerScreen, smoothing
-from tcbench.diagnose.screens.base import AFTER, BEFORE, PREPARE, Screen, ScreenInput, ScreenResult, run_screens
-from tcbench.diagnose.screens.glitches import GlitchScreen, glitches
+from tcbench.diagnose.screens.screen import AFTER, BEFORE, PREPARE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, glitches
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.diagnose.signals import DiagnosisData, prepare
 

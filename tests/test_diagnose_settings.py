@@ -17,8 +17,8 @@ from tcbench.cli import help as cli_help
 from tcbench.cli import main
 from tcbench.commands.registry import SPECS
 from tcbench.commands.schemas import DiagnoseConfig
-from tcbench.diagnose.locate import locate
-from tcbench.diagnose.outliers import find_outliers
+from tcbench.diagnose.screens.outliers import find_outliers
+from tcbench.diagnose.select.locate import locate
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,
@@ -166,7 +166,7 @@ def test_a_diagnosis_runs_with_its_settings_and_its_report_records_them() -> Non
     report.md names the ones changed."""
     from tcbench.datasets.concealed import concealed_recording
     from tcbench.diagnose.diagnosis import diagnose
-    from tcbench.diagnose.markdown import render_markdown
+    from tcbench.diagnose.report.markdown import render_markdown
 
     rec, _ = concealed_recording("msra", "thermal_lag", 1)
     default = diagnose(rec, name="lag")

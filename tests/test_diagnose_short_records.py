@@ -14,17 +14,17 @@ import pytest
 
 from tcbench.cli import main
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.diagnose.crossval import block_folds
-from tcbench.diagnose.design import Designer
-from tcbench.diagnose.detectors import why_no_bumps, why_no_lines, why_no_steps
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.discover import why_untestable
-from tcbench.diagnose.locate import why_no_allan
-from tcbench.diagnose.markdown import not_tested_section
-from tcbench.diagnose.plan import plan_for
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.markdown import not_tested_section
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.select.crossval import block_folds
+from tcbench.diagnose.select.design import Designer
+from tcbench.diagnose.select.discover import why_untestable
+from tcbench.diagnose.select.locate import why_no_allan
+from tcbench.diagnose.select.plan import plan_for
 from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.terms import term, terms
+from tcbench.diagnose.terms.detectors import why_no_bumps, why_no_lines, why_no_steps
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
 TempFn = Callable[[np.ndarray, np.random.Generator], np.ndarray]

@@ -1,4 +1,4 @@
-"""The significance tests as objects (tcbench.diagnose.significance): which one the statistics
+"""The significance tests as objects (tcbench.diagnose.select.significance): which one the statistics
 plan holds for a record, how the robust Wald test hands an effect to the surrogate test, and what
 each says in the report, at the settings' thresholds and level."""
 
@@ -11,16 +11,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tcbench.diagnose.evidence import not_significant
-from tcbench.diagnose.plan import plan_for
-from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, PlanSettings, SelectionSettings, SurrogateSettings
-from tcbench.diagnose.significance import (
+from tcbench.diagnose.select.evidence import not_significant
+from tcbench.diagnose.select.plan import plan_for
+from tcbench.diagnose.select.significance import (
     ROBUST_WALD,
     SURROGATE,
     RobustWald,
     SpectralSurrogate,
     significance_tests,
 )
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, PlanSettings, SelectionSettings, SurrogateSettings
 from tcbench.diagnose.signals import DiagnosisData
 
 ROBUST_WALD_TEST, SURROGATE_TEST = significance_tests(DEFAULTS)

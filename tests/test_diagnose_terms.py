@@ -9,11 +9,12 @@ from collections.abc import Mapping
 import numpy as np
 import pytest
 
+from tcbench.compensation.fitted_model import RIG_EFFECTS
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
-from tcbench.diagnose.attribute import CONFUSABLE
-from tcbench.diagnose.design import DETERMINISTIC, Designer
-from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.findings import WHERE_KEYS, check_finding
+from tcbench.diagnose.select.attribute import CONFUSABLE
+from tcbench.diagnose.select.design import DETERMINISTIC, Designer
+from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import (
     OpenTerm,
     Term,
@@ -28,7 +29,6 @@ from tcbench.diagnose.terms import (
 from tcbench.diagnose.terms.base import signals
 from tcbench.sensors.effects import EFFECTS, Signals, make_effect, repeatable_effects
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
-from tcbench.compensation.fitted_model import RIG_EFFECTS
 
 COLUMN_TERMS = [t.id for t in terms() if t.deterministic and t.id != "thermal_lag"]
 VALUES = {"hysteresis": 1.5, "warmup": 900.0}

@@ -17,9 +17,9 @@ import pytest
 from tcbench.datasets.concealed import concealed_profile, concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.model_file import ModelFileError, parse_model, read_model, to_sensor_model
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.screens.variance import find_variance, paired_differences
 from tcbench.diagnose.settings import DEFAULTS
-from tcbench.diagnose.variance import find_variance, paired_differences
 from tcbench.sensors.protocols import Profile
 from tcbench.sensors.recording import Recording
 

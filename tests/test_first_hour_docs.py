@@ -42,7 +42,7 @@ def test_seed_001_is_cited_with_its_authors_title_and_doi_everywhere() -> None:
 
 def test_the_quickstart_page_explains_what_the_quickstart_prints() -> None:
     from tcbench.cli.quickstart import TABLE_LEGEND, TEST_LEGEND
-    from tcbench.diagnose.significance import ROBUST_WALD
+    from tcbench.diagnose.select.significance import ROBUST_WALD
 
     text = INDEX.read_text(encoding="utf-8")
     assert TABLE_LEGEND in text  # the legend under the table, as printed

@@ -1,4 +1,4 @@
-"""The flicker recheck of the kept effects (:func:`tcbench.diagnose.attribute.recheck_with_flicker`)
+"""The flicker recheck of the kept effects (:func:`tcbench.diagnose.select.attribute.recheck_with_flicker`)
 takes the variance of each effect's score under the residual's flicker exactly
 (:func:`tcbench.sensors.noise.flicker_score_variance`), not as the mean over 16 seeded draws as
 long as the record: those spread the Wald statistic by chi-squared with 16 degrees of freedom
@@ -59,7 +59,7 @@ def _tag25h(tmp_path: Path) -> Recording:
 
 @pytest.mark.slow
 def test_six_samples_fewer_change_no_finding(tmp_path: Path) -> None:
-    from tcbench.diagnose.native_rate import diagnose_any_rate
+    from tcbench.diagnose.rate.native_rate import diagnose_any_rate
 
     rec = _tag25h(tmp_path)
     assert rec.time_s.size == 93_035
@@ -80,7 +80,7 @@ def test_a_20_minute_logging_gap_changes_no_finding(tmp_path: Path) -> None:
     model's residual: the step read 9.8 with the other kept effects in, was judged after they were
     dropped and read above 25; the trend read 25.7 against that flicker and 15.6 against the
     larger one measured once the dropped effects no longer took part of it."""
-    from tcbench.diagnose.native_rate import diagnose_any_rate
+    from tcbench.diagnose.rate.native_rate import diagnose_any_rate
 
     rec = _tag25h(tmp_path)
     gapped = Recording(rec.data[~((rec.time_s >= 45_000.0) & (rec.time_s < 46_200.0))].reset_index(drop=True),

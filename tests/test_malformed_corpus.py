@@ -218,7 +218,7 @@ BIG_FILES: dict[str, tuple[Callable[[Path], None], tuple[str, ...]]] = {
 }
 RSS_PROBE = """
 import json, resource, sys
-import tcbench.cli, tcbench.diagnose.diagnosis, tcbench.diagnose.report, tcbench.sensors.importer
+import tcbench.cli, tcbench.diagnose.diagnosis, tcbench.diagnose.report.write, tcbench.sensors.importer
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 codes = [tcbench.cli.main(args.split()) for args in sys.argv[1:]]
 print(json.dumps({"codes": codes, "growth_mb": (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) / 1024}))

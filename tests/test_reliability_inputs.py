@@ -91,7 +91,7 @@ def test_calibrate_diagnoses_more_rows_than_the_budget_on_bin_means(workdir: Pat
     """calibrate's ``model`` method diagnoses the fitted parts: more rows than a diagnosis takes
     (the budget lowered here to 3000) are diagnosed on bin means as ``tcbench diagnose`` does (they
     left the model out before), and the diagnosis's report says so."""
-    from tcbench.diagnose import native_rate
+    from tcbench.diagnose.rate import native_rate
     from tcbench.diagnose.settings import DEFAULTS, RateSettings
 
     monkeypatch.setattr(native_rate, "DEFAULTS", replace(DEFAULTS, rate=RateSettings(max_rows=3000)))

@@ -15,10 +15,10 @@ import pytest
 from scipy.signal import lfilter
 
 from tcbench.cli import main
-from tcbench.diagnose.crossval import block_folds
-from tcbench.diagnose.plan import min_full_duration_s
+from tcbench.diagnose.select.crossval import block_folds
+from tcbench.diagnose.select.plan import min_full_duration_s
 from tcbench.diagnose.settings import DEFAULTS
-from tcbench.diagnose.short_record import short_record
+from tcbench.diagnose.short.short_record import short_record
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
 FOLDS = DEFAULTS.plan.folds

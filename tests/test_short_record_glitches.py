@@ -1,4 +1,4 @@
-"""Thermometer glitches in a short record (:func:`tcbench.diagnose.short_record.short_record`): five
+"""Thermometer glitches in a short record (:func:`tcbench.diagnose.short.short_record.short_record`): five
 0.0 degC and one -40 degC bus samples are found as a diagnosis finds them, reported (count, times,
 readings) and given zero weight, so the tests say what they say on the clean record; a clean
 record reports none. At the rate recorded and on bin means (over ``settings.rate.max_rows``)."""
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
-from tcbench.diagnose.short_record import short_record
-from tcbench.diagnose.short_report import render_short_markdown
+from tcbench.diagnose.short.short_record import short_record
+from tcbench.diagnose.short.short_report import render_short_markdown
 from tcbench.sensors.recording import Recording, make_recording
 
 RATE_HZ, DURATION_S = 100.0, 600.0  # 60 000 rows, 10 min

@@ -1,7 +1,7 @@
 """A short record of more rows than ``settings.rate.max_rows``: its slope, step and Allan deviation
 tested on the bin means a diagnosis would use, its noise terms (white sigma, lattice, clipping,
 outliers) on every sample, and its report saying what was averaged, to what rate and why
-(:func:`tcbench.diagnose.short_record.short_record`, :mod:`tcbench.diagnose.native_rate`)."""
+(:func:`tcbench.diagnose.short.short_record.short_record`, :mod:`tcbench.diagnose.rate.native_rate`)."""
 
 from __future__ import annotations
 
@@ -16,8 +16,8 @@ import pytest
 
 from tcbench.cli import main
 from tcbench.diagnose.settings import DEFAULTS, RateSettings
-from tcbench.diagnose.short_record import short_record
-from tcbench.diagnose.short_report import render_short_markdown
+from tcbench.diagnose.short.short_record import short_record
+from tcbench.diagnose.short.short_report import render_short_markdown
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 from averaging import by_hand
 

@@ -2,7 +2,7 @@
 continuous and in bursts.
 
 Each control, diagnosed as ``tcbench diagnose`` does (a record over the row budget on its bin means,
-:mod:`tcbench.diagnose.native_rate`), is the minimal model plus white noise (:func:`tcbench.datasets.controls.control_recording`:
+:mod:`tcbench.diagnose.rate.native_rate`), is the minimal model plus white noise (:func:`tcbench.datasets.controls.control_recording`:
 the open-world controls' staircase, device and thermometer, sized to the record's length and
 sampled at its rate), so any finding in ``report.json`` ``effects`` is a false alarm (the rule of
 :func:`tcbench.datasets.open_world_scoring.score` for a control). A diagnosis that raises is a crash,
@@ -28,7 +28,7 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from tcbench.datasets.controls import Form, bursts_for, control_recording
-from tcbench.diagnose.native_rate import diagnose_any_rate
+from tcbench.diagnose.rate.native_rate import diagnose_any_rate
 from tcbench.diagnose.signals import DiagnosisDataError
 
 PROOF_SEED = 45_300_000  # 45 000 000 + i was the first proof run (README), before the thermometer window rule

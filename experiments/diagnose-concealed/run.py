@@ -27,9 +27,9 @@ import pandas as pd
 from joblib import Parallel, delayed
 
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR, concealed_recording
-from tcbench.diagnose.design import DETERMINISTIC
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.write import write_report
+from tcbench.diagnose.select.design import DETERMINISTIC
 
 FIRST_SEED = 31_000_000
 RMSE_TARGET = 1.15  # held-out RMSE after refit / true noise sigma, for deterministic effects

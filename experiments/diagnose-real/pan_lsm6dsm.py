@@ -21,7 +21,7 @@ import pandas as pd
 
 from tcbench.data_paths import REAL_DATA
 from tcbench.diagnose.diagnosis import diagnose
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.write import write_report
 from tcbench.sensors.recording import Recording, make_recording, write_recording
 
 DATA = REAL_DATA / "pan_lsm6dsm_tvac_cooling"

@@ -29,8 +29,8 @@ from pan_lsm6dsm import convert as pan_gyro
 
 from tcbench.datasets.real import TOFUPILOT_CSV, tofupilot_gyro
 from tcbench.diagnose.diagnosis import Diagnosis, diagnose
-from tcbench.diagnose.markdown import format_where
-from tcbench.diagnose.report import write_report
+from tcbench.diagnose.report.markdown import format_where
+from tcbench.diagnose.report.write import write_report
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.sensors.recording import Recording
 

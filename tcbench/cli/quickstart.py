@@ -28,7 +28,7 @@ from typing import Any
 
 from tcbench.cli.app import hydra_string
 from tcbench.commands.schemas import QuickstartConfig
-from tcbench.diagnose.significance import ROBUST_WALD, SURROGATE
+from tcbench.diagnose.select.significance import ROBUST_WALD, SURROGATE
 from tcbench.errors import ConfigError
 from tcbench.papers import SEED_000
 from tcbench.staging import REPLACED

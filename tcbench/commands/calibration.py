@@ -478,7 +478,7 @@ def _staged(cfg: CalibrateConfig, rec: Any, split: Split, scored: _Scores, summa
         with staged_dir(out, [Path(cfg.recording), *map(Path, cfg.test_recordings)], cfg.overwrite, replaced) as tmp:
             written = _write(tmp, cfg, rec, split, scored.residuals, scored.table, summary, about, unit)
             if diagnosis is not None:
-                from tcbench.diagnose.report import write_report
+                from tcbench.diagnose.report.write import write_report
 
                 report = write_report(diagnosis[0], tmp / "diagnosis", with_plots=False)
                 written |= {f"diagnosis {k}": v for k, v in report.items()}
@@ -803,7 +803,7 @@ def _best_line(about: dict[str, Any], unit: str) -> str:
 
 def _too_short_to_diagnose(rec: Any, split: Split) -> str | None:
     """Why the fitted parts are too short for the ``model`` method's diagnosis, or None."""
-    from tcbench.diagnose.plan import min_full_duration_s
+    from tcbench.diagnose.select.plan import min_full_duration_s
 
     t = rec.time_s
     fitted_s = sum(float(t[split.parts[k].stop - 1] - t[split.parts[k].start]) for k in split.train)
@@ -821,10 +821,10 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | 
     (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min); more rows than a diagnosis takes
     are diagnosed on bin means, their noise measured on every row (:mod:`tcbench.diagnose.native_rate`,
     as ``tcbench diagnose`` does)."""
-    from tcbench.diagnose import native_rate
+    from tcbench.diagnose.rate import native_rate
     from tcbench.diagnose.model_file import to_sensor_model
-    from tcbench.diagnose.plan import min_full_duration_s
-    from tcbench.diagnose.report import model_spec
+    from tcbench.diagnose.select.plan import min_full_duration_s
+    from tcbench.diagnose.report.write import model_spec
     from tcbench.diagnose.signals import DiagnosisDataError
     from tcbench.sensors.recording import make_recording
 

@@ -111,7 +111,7 @@ def check_bins(path: str, rec: Any, max_rows: int | None, settings: Any) -> None
     """A record diagnosed on bin means (:mod:`tcbench.diagnose.native_rate`) whose bins would
     still be more than ``max_rows`` rows (bins no longer than ``settings.rate.max_bin_s``) refused
     as :func:`check_size` refuses one diagnosed as recorded."""
-    from tcbench.diagnose.native_rate import plan_for
+    from tcbench.diagnose.rate.native_rate import plan_for
 
     plan = plan_for(rec, settings.rate)
     if plan.averaged and max_rows is not None and plan.diagnosed_rows > max_rows:
@@ -120,7 +120,7 @@ def check_bins(path: str, rec: Any, max_rows: int | None, settings: Any) -> None
 
 def _too_many(path: str, rows: int, diagnosed: int, max_rows: int, bins: str = "") -> CommandError:
     """The one line refusing ``rows`` rows whose diagnosis would run on ``diagnosed`` rows, over ``max_rows``."""
-    from tcbench.diagnose.cost import duration_text, estimated_bytes, estimated_s, size_text
+    from tcbench.diagnose.rate.cost import duration_text, estimated_bytes, estimated_s, size_text
 
     return CommandError(f"{path}: {rows} rows{bins} would take about {duration_text(estimated_s(diagnosed))} and "
                         f"{size_text(estimated_bytes(diagnosed))} to diagnose (one core, estimated from the rows; "
@@ -135,7 +135,7 @@ def progress(name: str, rows: int) -> Iterator[None]:
     """Around the diagnosis of ``rows`` rows: when it is estimated to take longer than
     :data:`PROGRESS_AFTER_S`, one line on stderr with the rows and the estimate before it starts,
     and on a terminal a bar of the time spent against the estimate, updated every second."""
-    from tcbench.diagnose.cost import duration_text, estimated_s
+    from tcbench.diagnose.rate.cost import duration_text, estimated_s
 
     estimate = estimated_s(rows)
     if estimate < PROGRESS_AFTER_S:
@@ -169,9 +169,9 @@ def progress(name: str, rows: int) -> Iterator[None]:
 
 def diagnose_recording(cfg: DiagnoseConfig) -> DiagnosisOutcome:
     """Diagnose the recording, write its report and print the verdict."""
-    from tcbench.diagnose.native_rate import diagnose_any_rate, plan_for, white_sigma
-    from tcbench.diagnose.plan import min_full_duration_s
-    from tcbench.diagnose.report import write_report
+    from tcbench.diagnose.rate.native_rate import diagnose_any_rate, plan_for, white_sigma
+    from tcbench.diagnose.select.plan import min_full_duration_s
+    from tcbench.diagnose.report.write import write_report
     from tcbench.diagnose.signals import DiagnosisDataError
 
     rec, sensor, declared = check_diagnose(cfg)
@@ -213,9 +213,9 @@ def _written(writer: Any, report: Any, cfg: DiagnoseConfig) -> dict[str, Path]:
 def _short_record(cfg: DiagnoseConfig, rec: Any, sensor: str, settings: Any) -> DiagnosisOutcome:
     """The short-record report of ``rec`` (its tests at ``settings``), written to ``out``; prints
     what ran and what needs more time."""
-    from tcbench.diagnose.native_rate import plan_for
-    from tcbench.diagnose.short_record import short_record
-    from tcbench.diagnose.short_report import write_short_report
+    from tcbench.diagnose.rate.native_rate import plan_for
+    from tcbench.diagnose.short.short_record import short_record
+    from tcbench.diagnose.short.short_report import write_short_report
     from tcbench.diagnose.signals import DiagnosisDataError
 
     plan = plan_for(rec, settings.rate)

@@ -3,8 +3,8 @@
 The diagnosis is a pipeline of stages, each a function of typed inputs and outputs
 (:func:`_diagnose`): prepare the record (its thermometer smoothed as the thermometer screen says),
 the screens before the fit (:mod:`tcbench.diagnose.screens`: output grid, clipping, noise level,
-outliers), forward selection (:mod:`tcbench.diagnose.attribute`), where the starting model
-misses (:mod:`tcbench.diagnose.locate`), the screens after the final fit (flicker and the recheck
+outliers), forward selection (:mod:`tcbench.diagnose.select.attribute`), where the starting model
+misses (:mod:`tcbench.diagnose.select.locate`), the screens after the final fit (flicker and the recheck
 of the kept effects, the variance of the residual) and the report. The :class:`Diagnosis` it
 returns is the report: :meth:`Diagnosis.to_json` is the ``report.json`` of docs/concepts/diagnosis-report.md. Every stage is
 given its section of the :class:`~tcbench.diagnose.settings.DiagnoseSettings` the diagnosis runs
@@ -20,17 +20,7 @@ from typing import Any
 import numpy as np
 from joblib import Parallel, delayed
 
-from tcbench.diagnose.attribute import Attribution, Evidence, attribute
-from tcbench.diagnose.crossval import Fit
-from tcbench.diagnose.design import DETERMINISTIC, Designer, Model
-from tcbench.diagnose.discover import why_untestable
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.glitches import repaired
-from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.locate import Mismatch, locate
-from tcbench.diagnose.outliers import without
-from tcbench.diagnose.plan import min_full_duration_s
-from tcbench.diagnose.reference import reference_fit
 from tcbench.diagnose.result import (
     Confusion,
     Diagnosis,
@@ -54,10 +44,21 @@ from tcbench.diagnose.screens import (
 )
 from tcbench.diagnose.screens.flicker import ID as FLICKER
 from tcbench.diagnose.screens.flicker import Flicker, flicker_evidence, flicker_test
-from tcbench.diagnose.screens.glitches import GlitchScreen, ThermometerGlitches, glitches
-from tcbench.diagnose.screens.outliers import OutliersScreen, Spikes
+from tcbench.diagnose.screens.glitches import repaired
+from tcbench.diagnose.screens.noise_level import relative_sigma
+from tcbench.diagnose.screens.outliers import without
+from tcbench.diagnose.screens.spikes import OutliersScreen, Spikes
 from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, smoothing
-from tcbench.diagnose.screens.variance import relative_sigma
+from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, ThermometerGlitches, glitches
+from tcbench.diagnose.select.attribute import Attribution, Evidence, attribute
+from tcbench.diagnose.select.crossval import Fit
+from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model
+from tcbench.diagnose.select.discover import why_untestable
+from tcbench.diagnose.select.library_findings import Extent, library_finding
+from tcbench.diagnose.select.locate import Mismatch, locate
+from tcbench.diagnose.select.plan import min_full_duration_s
+from tcbench.diagnose.select.reference import reference_fit
+from tcbench.diagnose.select.thermometer_noise import propagated_noise, thermometer_sigma
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,
@@ -66,7 +67,6 @@ from tcbench.diagnose.settings import (
 )
 from tcbench.diagnose.signals import DiagnosisData, prepare
 from tcbench.diagnose.terms import is_open, open_finding, report_order, term
-from tcbench.diagnose.thermometer import propagated_noise, thermometer_sigma
 from tcbench.sensors.recording import Recording
 
 __all__ = ["DiagnoseSettings", "Diagnosis", "Series", "base_model", "diagnose"]
@@ -128,7 +128,7 @@ def diagnose(
     :data:`~tcbench.diagnose.settings.DEFAULTS`). Raises
     :class:`~tcbench.diagnose.signals.DiagnosisDataError` for a recording that cannot show
     anything, or that is shorter than ``min_duration_s`` (default
-    :func:`~tcbench.diagnose.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short_record`
+    :func:`~tcbench.diagnose.select.plan.min_full_duration_s`; :mod:`tcbench.diagnose.short.short_record`
     tells what a shorter one can).
 
     Where the thermometer smoothing fitted to the profile (:func:`~tcbench.diagnose.signals.fitted_window_s`)
@@ -140,7 +140,7 @@ def diagnose(
     nothing hidden the wide window's bias at the corners offers chance gains; held-out error,
     paid for like a term, is the judge the diagnosis uses for everything else.
 
-    Thermometer glitches (:mod:`~tcbench.diagnose.glitches`) are found first on the raw reading:
+    Thermometer glitches (:mod:`~tcbench.diagnose.screens.glitches`) are found first on the raw reading:
     held at the previous reading before anything is smoothed, their samples given zero weight and
     reported (``thermometer_glitches``)."""
     settings = DEFAULTS if settings is None else settings

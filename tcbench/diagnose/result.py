@@ -5,21 +5,23 @@ behind the plots ride along in :class:`Series`."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tcbench.diagnose.crossval import Fit
-from tcbench.diagnose.design import DETERMINISTIC
-from tcbench.diagnose.evidence import Evidence
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.locate import AllanExcess, Mismatch
-from tcbench.diagnose.outliers import Outliers
-from tcbench.diagnose.plan import StatsPlan
-from tcbench.diagnose.reference import Reference
+from tcbench.diagnose.select.crossval import Fit
+from tcbench.diagnose.select.design import DETERMINISTIC
+from tcbench.diagnose.select.evidence import Evidence
+from tcbench.diagnose.select.locate import AllanExcess, Mismatch
+from tcbench.diagnose.select.plan import StatsPlan
+from tcbench.diagnose.select.reference import Reference
+from tcbench.diagnose.select.significance import SignificanceTest
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
-from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import term
+
+if TYPE_CHECKING:  # a field's type only: the screens import this module (screens/flicker.py), not the reverse
+    from tcbench.diagnose.screens.outliers import Outliers
 
 REFERENCE_WHAT = ("ridge regression on the smoothed thermometer temperature, its powers, first-order lags at "
                   "several time constants, dT/dt and time, under the same blocked folds")
@@ -77,7 +79,7 @@ class Noise:
 
 @dataclass(frozen=True)
 class ReferenceSummary:
-    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.reference`) beside the final model."""
+    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.select.reference`) beside the final model."""
 
     rmse_heldout: float
     rmse_fit: float
@@ -202,7 +204,7 @@ class Diagnosis:
 
     def preface(self) -> list[str]:
         """report.md's lines after the verdict, before the fit: none for a record diagnosed as it
-        was recorded (:mod:`tcbench.diagnose.native_rate` says what it averaged there)."""
+        was recorded (:mod:`tcbench.diagnose.rate.native_rate` says what it averaged there)."""
         return []
 
     def to_json(self) -> dict[str, Any]:

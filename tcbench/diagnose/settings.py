@@ -94,7 +94,7 @@ class SelectionSettings:
 @dataclass(frozen=True)
 class PlanSettings:
     """The cross-validation blocks and the robust test's clusters, sized to the record
-    (:mod:`tcbench.diagnose.plan`)."""
+    (:mod:`tcbench.diagnose.select.plan`)."""
 
     folds: int = setting(5, "cross-validation folds (interleaved blocks)", TWO)
     block_windows: float = setting(
@@ -112,7 +112,7 @@ class PlanSettings:
 
 @dataclass(frozen=True)
 class SurrogateSettings:
-    """The spectral surrogate test (:mod:`tcbench.diagnose.surrogate`)."""
+    """The spectral surrogate test (:mod:`tcbench.diagnose.select.surrogate`)."""
 
     draws: int = setting(199, "surrogates drawn at most (the draws stop once the p-value exceeds the level)",
                          COUNT)
@@ -123,7 +123,7 @@ class SurrogateSettings:
 
 @dataclass(frozen=True)
 class ReferenceSettings:
-    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.reference`)."""
+    """The physics-agnostic reference fit (:mod:`tcbench.diagnose.select.reference`)."""
 
     structure_ratio: float = setting(
         1.25, "final / reference held-out RMSE above which deterministic structure remains (flicker not judged)")
@@ -152,7 +152,7 @@ class DataSettings:
 
 @dataclass(frozen=True)
 class LocateSettings:
-    """Where a residual departs from white noise: the ``mismatch`` scan (:mod:`tcbench.diagnose.locate`)."""
+    """Where a residual departs from white noise: the ``mismatch`` scan (:mod:`tcbench.diagnose.select.locate`)."""
 
     false_alarm: float = setting(0.01, "family-wise false-alarm probability of the scan on white noise",
                                  PROBABILITY)
@@ -173,7 +173,7 @@ class LocateSettings:
 
 @dataclass(frozen=True)
 class DetectorSettings:
-    """The detectors that propose open-world terms (:mod:`tcbench.diagnose.detectors`)."""
+    """The detectors that propose open-world terms (:mod:`tcbench.diagnose.terms.detectors`)."""
 
     max_bins: int = setting(3000, "most time bins of the residual the change-point search reads", COUNT)
     line_bins: int = setting(1200, "most time bins of the periodogram (periods down to three bins)", COUNT)
@@ -195,7 +195,7 @@ class DetectorSettings:
 
 @dataclass(frozen=True)
 class OutlierSettings:
-    """Isolated outliers (:mod:`tcbench.diagnose.outliers`)."""
+    """Isolated outliers (:mod:`tcbench.diagnose.screens.outliers`)."""
 
     alpha: float = setting(0.01, "family-wise false-alarm probability over the whole record", PROBABILITY)
     min_z: float = setting(4.5, "the bound never drops below this many robust sigmas (short records)")
@@ -209,7 +209,7 @@ class OutlierSettings:
 
 @dataclass(frozen=True)
 class SaturationSettings:
-    """Clipping at a ceiling or a floor (:mod:`tcbench.diagnose.saturation`)."""
+    """Clipping at a ceiling or a floor (:mod:`tcbench.diagnose.screens.saturation`)."""
 
     alpha: float = setting(0.01, "family-wise false-alarm probability over the two sides", PROBABILITY)
     density_ratio: float = setting(3.0, "density at the extreme over the next cell's that an unclipped output "
@@ -226,7 +226,7 @@ class SaturationSettings:
 
 @dataclass(frozen=True)
 class QuantisationSettings:
-    """The output (and thermometer) read on a grid (:mod:`tcbench.diagnose.quantisation`)."""
+    """The output (and thermometer) read on a grid (:mod:`tcbench.diagnose.screens.quantisation`)."""
 
     tolerance_steps: float = setting(0.02, "how far a jump may sit from an integer multiple of the step",
                                      PROBABILITY)
@@ -241,7 +241,7 @@ class QuantisationSettings:
 
 @dataclass(frozen=True)
 class ThermometerSettings:
-    """The thermometer's staircase and the smoothing it needs (:func:`~tcbench.diagnose.quantisation.thermometer_steps`)."""
+    """The thermometer's staircase and the smoothing it needs (:func:`~tcbench.diagnose.screens.quantisation.thermometer_steps`)."""
 
     min_step_c: float = setting(0.05, "a thermometer lattice finer than this is not reported")
     dither_spread_steps: float = setting(0.36, "reading spread about its smoothed value above which it "
@@ -254,7 +254,7 @@ class ThermometerSettings:
 
 @dataclass(frozen=True)
 class VarianceSettings:
-    """Noise whose level changes with temperature or time (:mod:`tcbench.diagnose.variance`)."""
+    """Noise whose level changes with temperature or time (:mod:`tcbench.diagnose.screens.variance`)."""
 
     alpha: float = setting(0.01, "family-wise false-alarm probability over the temperature and the time test",
                            PROBABILITY)
@@ -290,7 +290,7 @@ class ScreenSettings:
 
 @dataclass(frozen=True)
 class ShortSettings:
-    """The tests of a record too short for a full diagnosis (:mod:`tcbench.diagnose.short_record`)."""
+    """The tests of a record too short for a full diagnosis (:mod:`tcbench.diagnose.short.short_record`)."""
 
     alpha: float = setting(0.01, "level of every short-record test; intervals are 1 - alpha", PROBABILITY)
     min_fit_samples: int = setting(30, "a slope and its noise's autocorrelation need this many samples", COUNT)
@@ -309,13 +309,13 @@ class ShortSettings:
 @dataclass(frozen=True)
 class RateSettings:
     """A record of more rows than a diagnosis takes in time and memory: its thermal terms fitted on
-    bin means, its noise terms measured on every sample (:mod:`tcbench.diagnose.native_rate`). Not a
+    bin means, its noise terms measured on every sample (:mod:`tcbench.diagnose.rate.native_rate`). Not a
     statistic of the tests: it decides which record they are given, so report.json's
     ``statistics.settings`` leaves it out and the report's ``native_rate`` says what it did."""
 
     max_rows: int = setting(
         100_000, "a record of more rows is diagnosed on bin means (25-50 s of one core and 550 MB at this many "
-                 "rows, tcbench/diagnose/cost.py, where 2.7 M rows would take 10-20 min and 8 GB)", COUNT)
+                 "rows, tcbench/diagnose/rate/cost.py, where 2.7 M rows would take 10-20 min and 8 GB)", COUNT)
     max_bin_s: float = setting(
         1.0, "the bin of a record averaged: the 1 s clock of the lag filter, a twentieth of the shortest thermal lag "
              "searched (20 s) and a tenth of the detectors' narrowest bin (10 s)")

@@ -146,7 +146,7 @@ def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
     while the bias it puts on the smoothed temperature exceeds ``bias_to_noise`` of the
     thermometer noise it leaves (a deterministic error, e.g. at the corners of a fast ramp
     through a short package lag, is read by the output's temperature and acceleration terms as
-    structure; the noise is accounted for by :mod:`tcbench.diagnose.thermometer`). A quadratic
+    structure; the noise is accounted for by :mod:`tcbench.diagnose.select.thermometer_noise`). A quadratic
     smoother's bias scales as W^4, so halving takes it down 16x: the bias of ``W`` is estimated
     from the difference between the readings smoothed over ``W`` and ``W/2``, less that
     difference's noise share; the noise of each, from the same smoothing of white noise with the
@@ -256,7 +256,7 @@ def prepare(
     """Arrays for diagnosing ``rec``; ``sensor`` overrides the sidecar's kind.
 
     Raises :class:`DiagnosisDataError` (one line) when the recording is shorter than
-    ``min_duration_s`` (``diagnose`` asks :func:`tcbench.diagnose.plan.min_full_duration_s`) or
+    ``min_duration_s`` (``diagnose`` asks :func:`tcbench.diagnose.select.plan.min_full_duration_s`) or
     ``min_samples``, its temperature spans less than ``min_span_c``, or
     its output has no noise to measure.
     """

@@ -1,6 +1,6 @@
 """The diagnosed model as a compensator (``learner=model``, the board row ``diagnosed``).
 
-``tcbench diagnose`` (any rate: :func:`tcbench.diagnose.native_rate.diagnose_any_rate`, as
+``tcbench diagnose`` (any rate: :func:`tcbench.diagnose.rate.native_rate.diagnose_any_rate`, as
 ``tcbench calibrate``'s ``model`` method runs it) fits a sensor model (polynomial core, thermal
 lag, hysteresis, second node ...) to each training run, and the compensator is the mean of those
 models run as a shipped compensator runs them
@@ -34,8 +34,8 @@ from tcbench.compensation.fitted_model import deterministic_output
 from tcbench.compensation.methods import Compensator
 from tcbench.diagnose.diagnosis import Diagnosis
 from tcbench.diagnose.model_file import to_sensor_model
-from tcbench.diagnose.native_rate import diagnose_any_rate
-from tcbench.diagnose.report import model_spec
+from tcbench.diagnose.rate.native_rate import diagnose_any_rate
+from tcbench.diagnose.report.write import model_spec
 from tcbench.diagnose.settings import DEFAULTS
 from tcbench.diagnose.signals import DiagnosisDataError
 from tcbench.sensors.fitted import PolynomialModel

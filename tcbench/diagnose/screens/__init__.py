@@ -1,4 +1,4 @@
-"""The screens of a diagnosis (:mod:`~tcbench.diagnose.screens.base`): the tests whose structure is
+"""The screens of a diagnosis (:mod:`~tcbench.diagnose.screens.screen`): the tests whose structure is
 not an additive term of the mean model, by stage, and the order their parts take in the report.
 
 - ``prepare``: thermometer glitches (held at the previous reading, their samples given zero
@@ -8,18 +8,24 @@ not an additive term of the mean model, by stage, and the order their parts take
 - ``after`` the final fit (:func:`after_fit`): flicker (with the recheck of the kept effects) and
   the variance of the final residual.
 
+The tests the screens run are modules of their own: :mod:`~.glitches` (thermometer glitches),
+:mod:`~.outliers` (isolated outliers), :mod:`~.saturation`, :mod:`~.quantisation` (of the output
+and of the thermometer) and :mod:`~.variance` (noise whose level changes); each screen module
+(:mod:`~.thermometer_glitches`, :mod:`~.thermometer`, :mod:`~.output`, :mod:`~.noise_level`,
+:mod:`~.spikes`, :mod:`~.flicker`) wraps one or two of them as a :class:`~.screen.Screen`.
+
 Each screen holds the settings it tests with (:class:`~tcbench.diagnose.settings.ScreenSettings`);
 :data:`BEFORE_FIT` and :data:`AFTER_FIT` are the stages at the defaults.
 """
 
 from __future__ import annotations
 
-from tcbench.diagnose.screens.base import Screen, ScreenInput, ScreenResult, Screened, run_screens
 from tcbench.diagnose.screens.flicker import FlickerScreen
-from tcbench.diagnose.screens.outliers import OutliersScreen
+from tcbench.diagnose.screens.noise_level import NoiseLevelScreen, VarianceScreen
 from tcbench.diagnose.screens.output import QuantisationScreen, SaturationScreen
+from tcbench.diagnose.screens.screen import Screen, ScreenInput, ScreenResult, Screened, run_screens
+from tcbench.diagnose.screens.spikes import OutliersScreen
 from tcbench.diagnose.screens.thermometer import ThermometerScreen, smoothing
-from tcbench.diagnose.screens.variance import NoiseLevelScreen, VarianceScreen
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 
 

@@ -19,19 +19,19 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.attribute import Attribution, recheck_with_flicker
-from tcbench.diagnose.crossval import Fit
-from tcbench.diagnose.design import Model
-from tcbench.diagnose.evidence import Evidence
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.library_findings import Extent, library_finding
-from tcbench.diagnose.locate import AllanExcess, allan_excess, why_no_allan
-from tcbench.diagnose.reference import Reference
 from tcbench.diagnose.result import Confusion, rmse
-from tcbench.diagnose.screens.base import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.screen import AFTER, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.select.attribute import Attribution, recheck_with_flicker
+from tcbench.diagnose.select.crossval import Fit
+from tcbench.diagnose.select.design import Model
+from tcbench.diagnose.select.evidence import Evidence
+from tcbench.diagnose.select.library_findings import Extent, library_finding
+from tcbench.diagnose.select.locate import AllanExcess, allan_excess, why_no_allan
+from tcbench.diagnose.select.reference import Reference
+from tcbench.diagnose.select.thermometer_noise import propagated_noise
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.terms import terms
-from tcbench.diagnose.thermometer import propagated_noise
 
 ID = "bias_instability"
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
@@ -116,7 +116,7 @@ class FlickerScreen(Screen):
     """The Allan test of the final residual; when it finds flicker behind kept effects, they are
     tested again with that flicker in the noise model, the weakest dropped first and the flicker
     measured again on what remains after each drop, never past where the reference shows
-    deterministic structure (:func:`~tcbench.diagnose.attribute.recheck_with_flicker`); the test
+    deterministic structure (:func:`~tcbench.diagnose.select.attribute.recheck_with_flicker`); the test
     is run again on what remains (``settings.screens.flicker``, its shortest tau
     ``settings.locate.min_allan_samples``), and the flicker it names is the one the kept effects
     were judged against."""

@@ -1,5 +1,5 @@
-"""The output read on a grid (:mod:`~tcbench.diagnose.quantisation`) and clipped
-(:mod:`~tcbench.diagnose.saturation`), before any fit: the clipped samples get zero weight and the
+"""The output read on a grid (:mod:`~tcbench.diagnose.screens.quantisation`) and clipped
+(:mod:`~tcbench.diagnose.screens.saturation`), before any fit: the clipped samples get zero weight and the
 white sigma is measured again, on the grid from the RMS of differences."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.outliers import without
-from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
-from tcbench.diagnose.saturation import Saturation, find_saturation
-from tcbench.diagnose.screens.base import BEFORE, Screen, ScreenInput, ScreenResult
+from tcbench.diagnose.screens.outliers import without
+from tcbench.diagnose.screens.quantisation import OutputQuantisation, find_output_quantisation
+from tcbench.diagnose.screens.saturation import Saturation, find_saturation
+from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
 

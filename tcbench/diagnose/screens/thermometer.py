@@ -1,5 +1,5 @@
 """The thermometer's quantisation, read from the raw reading before it is smoothed: it sets the
-smoothing window (:func:`~tcbench.diagnose.quantisation.thermometer_steps`)."""
+smoothing window (:func:`~tcbench.diagnose.screens.quantisation.thermometer_steps`)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.quantisation import ThermometerSteps, thermometer_steps
-from tcbench.diagnose.screens.base import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
+from tcbench.diagnose.screens.quantisation import ThermometerSteps, thermometer_steps
+from tcbench.diagnose.screens.screen import PREPARE, Screen, ScreenInput, ScreenResult, run_screens
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.signals import fitted_window_s
 from tcbench.sensors.recording import Recording

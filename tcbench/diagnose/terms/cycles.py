@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
+from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log
 from tcbench.sensors.effects import DutyCycle, Effect, GatedPeriodic, Periodic
 
@@ -26,7 +26,7 @@ DUTY_BRACKET = 41  # a square cycle's drop has side maxima in the period: this g
 def windows(search: Search) -> list[tuple[float, float, float]]:
     """``(period_s, start_s, end_s)`` of each line short enough to hold :data:`DUTY_MIN_CYCLES`
     inside :data:`GATED_MAX_PART` of the span, with where it is present
-    (:func:`~tcbench.diagnose.detectors.line_window`); once per round."""
+    (:func:`~tcbench.diagnose.terms.detectors.line_window`); once per round."""
     d, r, span = search.data, search.residual, search.span_s
     return search.shared("line_windows", lambda: [(p, *line_window(d.t_s, r, p, search.detectors))
                                                   for p in search.lines if DUTY_MIN_CYCLES * p < GATED_MAX_PART * span])

@@ -8,10 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.detectors import why_no_steps
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
+from tcbench.diagnose.terms.detectors import why_no_steps
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log, step_range
 from tcbench.sensors.effects import BiasStep, Effect, Transient
 

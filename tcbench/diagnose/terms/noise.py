@@ -10,7 +10,7 @@ from tcbench.sensors.effects import BiasInstability
 
 class BiasInstabilityTerm(Term):
     """Flicker bias noise: not a column of the design, judged from the residual's Allan
-    deviation (:mod:`tcbench.diagnose.locate`); ``b`` in output units."""
+    deviation (:mod:`tcbench.diagnose.select.locate`); ``b`` in output units."""
 
     id = "bias_instability"
     effect = BiasInstability

@@ -1,6 +1,6 @@
 """The base of an open-world term: structure outside the effect library (docs/concepts/diagnosis-report.md, shapes) as
-regressors, found by the detectors of :mod:`tcbench.diagnose.detectors` and scored by
-:mod:`tcbench.diagnose.discover`.
+regressors, found by the detectors of :mod:`tcbench.diagnose.terms.detectors` and scored by
+:mod:`tcbench.diagnose.select.discover`.
 
 An open-world term has an id (its key in ``model.yaml`` ``effects``, simulated by the effect of
 the same id in :mod:`tcbench.sensors.effects`), a ``shape`` of the report contract, nonlinear
@@ -27,11 +27,11 @@ from typing import Any, ClassVar, Protocol, TypeVar
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.detectors import line_periods, step_times
 from tcbench.diagnose.findings import SHAPES, Finding
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import _NO_DRAW, Extent, Term, signals, term, terms
+from tcbench.diagnose.terms.detectors import line_periods, step_times
 from tcbench.sensors.effects import MAX_REPEATS, Effect
 
 Value = tuple[float, ...]
@@ -89,13 +89,13 @@ class Search:
 
     @cached_property
     def steps(self) -> list[float]:
-        """Change points of the residual (:func:`~tcbench.diagnose.detectors.step_times`) where a step is testable."""
+        """Change points of the residual (:func:`~tcbench.diagnose.terms.detectors.step_times`) where a step is testable."""
         lo, hi = self.testable
         return [t for t in step_times(self.data.t_s, self.residual, self.detectors) if lo < t < hi]
 
     @cached_property
     def lines(self) -> list[float]:
-        """Periods of the residual's spectral lines (:func:`~tcbench.diagnose.detectors.line_periods`)."""
+        """Periods of the residual's spectral lines (:func:`~tcbench.diagnose.terms.detectors.line_periods`)."""
         return line_periods(self.data.t_s, self.residual, self.detectors)
 
 

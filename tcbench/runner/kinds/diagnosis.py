@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tcbench.commands.schemas import DiagnoseConfig, as_schema
 from tcbench.commands.diagnosis import DiagnosisOutcome, check_diagnose, diagnose_recording
+from tcbench.commands.schemas import DiagnoseConfig, as_schema
 from tcbench.runner.kinds import JobKind, JobNames, announce
 
 
@@ -51,7 +51,7 @@ class DiagnoseKind(JobKind):
         return diagnose_recording(self.config(c))
 
     def record(self, run: Any, outcome: DiagnosisOutcome, c: dict[str, Any], where: Path) -> list[Path]:
-        from tcbench.diagnose.short_record import ShortRecordReport  # loaded by execute already
+        from tcbench.diagnose.short.short_record import ShortRecordReport  # loaded by execute already
 
         diag = outcome.diagnosis
         run.set_tag("tcbench.verdict", str(diag.verdict)[:4900])

@@ -20,9 +20,9 @@ effect                 column(s)                        searched
 =====================  ===============================  =====================
 
 ``bias_instability`` is noise, not a regressor; it is judged from the residual's Allan
-deviation (:mod:`tcbench.diagnose.attribute`). An open-world term
+deviation (:mod:`tcbench.diagnose.select.attribute`). An open-world term
 (:class:`~tcbench.diagnose.terms.OpenTerm`) adds its columns at a tuple of nonlinear
-parameters found by :mod:`tcbench.diagnose.discover`.
+parameters found by :mod:`tcbench.diagnose.select.discover`.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ slowest measurement on the fitted slope), so the estimate errs long. The peak me
 diagnosis grows by :data:`BYTES_PER_ROW` per row.
 
 A record of more rows than ``settings.rate.max_rows`` (10^5) is diagnosed on 1 s bin means, its
-noise measured on every sample (:mod:`tcbench.diagnose.native_rate`), so these figures apply to
+noise measured on every sample (:mod:`tcbench.diagnose.rate.native_rate`), so these figures apply to
 the bins. :data:`tcbench.commands.schemas.DIAGNOSE_MAX_ROWS` is the most rows ``tcbench diagnose``
 runs on unless ``max_rows=`` says otherwise: about 8 min of one core and 3 GB, where 10^7 rows would
 take 1.2 h and 30 GB (more than most machines have; the two thermometer windows a diagnosis may

@@ -17,10 +17,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar
 
-from tcbench.diagnose.attribute import Attribution
-from tcbench.diagnose.design import Model
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.reference import Reference
+from tcbench.diagnose.select.attribute import Attribution
+from tcbench.diagnose.select.design import Model
+from tcbench.diagnose.select.reference import Reference
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.sensors.recording import Recording
 

@@ -1,8 +1,8 @@
-"""The tests a record too short for a full diagnosis still supports (:mod:`tcbench.diagnose.short_record`).
+"""The tests a record too short for a full diagnosis still supports (:mod:`tcbench.diagnose.short.short_record`).
 
 - **temperature slope** (:func:`temperature_slope`): the output's least-squares slope against the
   smoothed thermometer, beside an intercept (and the input, and a significant level step); its
-  standard error from the residual's spectrum (:mod:`tcbench.diagnose.spectral_se`), so
+  standard error from the residual's spectrum (:mod:`tcbench.diagnose.select.spectral_se`), so
   correlated samples do not count as independent ones; a two-sided t test and the ``1 - alpha``
   interval. Along a one-way ramp it is also a drift in time: the report says so.
 - **level step** (:func:`level_step`): the one step of the output's level, under the same
@@ -12,7 +12,7 @@
   the step at sample ``k``, the drop is ``(sum_{i>=k} e_i)^2 / (n - k - |sum_{i>=k} Q_i|^2)``.
   The step found is studentised, ``t^2 = (size / se)^2`` with the spectral standard error, and
   its p-value repeats search and studentisation on phase-randomised surrogates of the base
-  fit's residual, step included (:func:`tcbench.diagnose.surrogate.phase_surrogates`), so the
+  fit's residual, step included (:func:`tcbench.diagnose.select.surrogate.phase_surrogates`), so the
   largest step of 100 000 positions is judged against the largest that noise as slow as the
   record's makes. Surrogates of the residual without the step found are quieter than the noise
   (that step takes out its largest slow excursion): on 200 s at 500 Hz of noise correlated over
@@ -22,7 +22,7 @@
   The size's interval is the spectral one at the step found.
 - **white noise** (:func:`white_noise`): the white sigma from first differences and the Allan
   deviation of the residual at the taus the record allows (10 samples to a tenth of it) against
-  the white line (:func:`tcbench.diagnose.locate.allan_excess`).
+  the white line (:func:`tcbench.diagnose.select.locate.allan_excess`).
 
 Each returns a :class:`ShortTest`; a test the record cannot support is ``not run`` with the reason.
 The level, the fewest samples and the step's margins are :class:`~tcbench.diagnose.settings.ShortSettings`.
@@ -35,10 +35,10 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.locate import allan_excess, why_no_allan
+from tcbench.diagnose.select.locate import allan_excess, why_no_allan
+from tcbench.diagnose.select.spectral_se import SpectralError, spectral_error
+from tcbench.diagnose.select.surrogate import CHUNK, phase_surrogates
 from tcbench.diagnose.settings import DEFAULTS, ShortSettings
-from tcbench.diagnose.spectral_se import SpectralError, spectral_error
-from tcbench.diagnose.surrogate import CHUNK, phase_surrogates
 
 SHORT = DEFAULTS.short
 SIGNIFICANT, NOT_SIGNIFICANT, NOT_RUN = "significant", "not significant", "not run"

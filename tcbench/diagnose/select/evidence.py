@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from tcbench.diagnose.significance import SignificanceTest
+from tcbench.diagnose.select.significance import SignificanceTest
 
 
 @dataclass

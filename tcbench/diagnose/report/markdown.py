@@ -15,11 +15,11 @@ import math
 from collections.abc import Iterable, Sequence
 from typing import Any
 
-from tcbench.diagnose.attribute import Evidence
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.result import Diagnosis
+from tcbench.diagnose.select.attribute import Evidence
+from tcbench.diagnose.select.significance import SURROGATE
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
-from tcbench.diagnose.significance import SURROGATE
 
 PLOT_CAPTIONS = {
     "residuals": "Held-out residual of the starting and the final model against time and temperature "
@@ -261,7 +261,7 @@ def _default(key: str) -> Any:
 
 def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
     """The human-readable report of ``d``; ``plots`` maps plot name to its file name, relative to
-    the report (as returned by :func:`tcbench.diagnose.plots.write_plots`)."""
+    the report (as returned by :func:`tcbench.diagnose.report.plots.write_plots`)."""
     sigma = float(d.noise.white_sigma)
     settings = d.statistics.settings
     t0 = float(d.series.t_s[0]) if len(d.series.t_s) else 0.0

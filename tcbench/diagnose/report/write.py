@@ -12,10 +12,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from tcbench.diagnose.result import Diagnosis
-from tcbench.diagnose.markdown import render_markdown
 from tcbench.diagnose.model_file import ModelSpec, parse_model, write_model
-from tcbench.diagnose.plots import write_plots
+from tcbench.diagnose.report.markdown import render_markdown
+from tcbench.diagnose.report.plots import write_plots
+from tcbench.diagnose.result import Diagnosis
 from tcbench.staging import staged_dir
 
 

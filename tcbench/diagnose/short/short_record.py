@@ -1,9 +1,9 @@
 """What a record too short for a full diagnosis can tell (shorter than
-:func:`tcbench.diagnose.plan.min_full_duration_s`).
+:func:`tcbench.diagnose.select.plan.min_full_duration_s`).
 
 A full diagnosis scores every effect held out by five-fold blocked cross-validation, and needs a
 block of two thermometer-smoothing windows per fold. A 200 s record cannot give that, but it
-still answers three questions (:mod:`tcbench.diagnose.short_tests`): does the output move with
+still answers three questions (:mod:`tcbench.diagnose.short.short_tests`): does the output move with
 temperature (the slope), does its level step (at the start of a temperature ramp or anywhere),
 and how large and how white is its noise. :func:`short_record` runs the tests the record's
 samples and temperature allow and lists, with the duration each needs, the ones it cannot run.
@@ -16,14 +16,14 @@ residual the noise test reads. The numbers are the settings' ``short`` section
 full diagnosis needs.
 
 A record of more rows than ``settings.rate.max_rows`` (15 min at 1 kHz is 900 000) is tested as a
-diagnosis takes it (:mod:`tcbench.diagnose.native_rate`): the slope, the step and the Allan
+diagnosis takes it (:mod:`tcbench.diagnose.rate.native_rate`): the slope, the step and the Allan
 deviation on bin means of the same plan, the noise terms on every sample (white sigma and
 density, the output's lattice, clipping and isolated outliers, reported as findings; clipped
 samples and outliers enter no bin), and report.json's ``native_rate`` (report.md's section
 "Native rate") says what was averaged, to what rate and why.
 
 Thermometer glitches (a bus sample of 0.0 or -40 degC) are found on the raw reading of every
-sample as a diagnosis finds them (:mod:`tcbench.diagnose.glitches`), reported as its
+sample as a diagnosis finds them (:mod:`tcbench.diagnose.screens.glitches`), reported as its
 ``thermometer_glitches`` finding and given zero weight: held at the previous reading before the
 thermometer is smoothed, their samples left out of every test (and of every bin).
 """
@@ -36,14 +36,14 @@ from typing import Any
 import numpy as np
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.glitches import ID as GLITCHES
-from tcbench.diagnose.glitches import repaired
-from tcbench.diagnose.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
-from tcbench.diagnose.plan import min_full_duration_s
+from tcbench.diagnose.rate.native_rate import NativeRate, bin_means, full_rate_noise, plan_for
 from tcbench.diagnose.screens import FINDINGS_ORDER
-from tcbench.diagnose.screens.glitches import glitches
+from tcbench.diagnose.screens.glitches import ID as GLITCHES
+from tcbench.diagnose.screens.glitches import repaired
+from tcbench.diagnose.screens.thermometer_glitches import glitches
+from tcbench.diagnose.select.plan import min_full_duration_s
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, report_mapping
-from tcbench.diagnose.short_tests import (
+from tcbench.diagnose.short.short_tests import (
     NOT_RUN,
     SIGNIFICANT,
     ShortTest,
@@ -61,14 +61,14 @@ from tcbench.sensors.segments import segments
 DRIFT = ("a drift in time (ageing, warm-up, a random walk): the temperature moves one way on this record; "
          "one that heats and cools tells them apart")
 _WORDS = {1: "one", 2: "two", 3: "three", 4: "four"}  # a small count in words
-# what a short record's report reads from the bin means (:class:`~tcbench.diagnose.native_rate.NativeRate`'s ``of_bins``)
+# what a short record's report reads from the bin means (:class:`~tcbench.diagnose.rate.native_rate.NativeRate`'s ``of_bins``)
 OF_BINS = ("the temperature slope, the level step and the Allan deviation of this report",
            "The temperature slope, the level step and the Allan deviation below")
 
 
 @dataclass
 class ShortRecordReport:
-    """The report of a short record: the tests run (:class:`~tcbench.diagnose.short_tests.ShortTest`)
+    """The report of a short record: the tests run (:class:`~tcbench.diagnose.short.short_tests.ShortTest`)
     and those it needs more time for (``{id, needs_s, what}``), and the settings they ran with."""
 
     sensor: str

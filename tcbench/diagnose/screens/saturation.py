@@ -21,7 +21,7 @@ output has one maximum and its density falls towards it. :func:`find_saturation`
 
 The clipped samples, and the unclipped ones between clipped samples less than
 ``episode_gap_samples`` samples apart (they are the truncated lower part of the same distribution,
-biased away from the clip), get zero weight in every fit (:func:`~tcbench.diagnose.outliers.without`),
+biased away from the clip), get zero weight in every fit (:func:`~tcbench.diagnose.screens.outliers.without`),
 unless that would remove more than ``max_episode_share`` of the record, in which case only
 the clipped samples are. ``model.yaml`` gets ``saturation: {upper, lower}`` so that
 ``tcbench simulate model=`` clips its output the same way. The numbers are

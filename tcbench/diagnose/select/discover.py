@@ -1,8 +1,8 @@
 """Open-world discovery: model what the effect library does not hold.
 
-In every round of the forward selection (:func:`tcbench.diagnose.attribute.attribute`), beside
+In every round of the forward selection (:func:`tcbench.diagnose.select.attribute.attribute`), beside
 the library's effects, :func:`best_open` reads the in-sample residual of the current model, lets the detectors of
-:mod:`tcbench.diagnose.detectors` propose values for every open-world term
+:mod:`tcbench.diagnose.terms.detectors` propose values for every open-world term
 (:class:`~tcbench.diagnose.terms.OpenTerm`, its ``propose``: a step at each change point, a line at each
 periodogram peak, a transient from each change point at several time constants, a bump at each
 matched temperature, a second thermal node at several time constants), scores each proposal by the
@@ -23,11 +23,11 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.design import Model
-from tcbench.diagnose.evidence import Evidence, not_significant
+from tcbench.diagnose.select.design import Model
+from tcbench.diagnose.select.evidence import Evidence, not_significant
+from tcbench.diagnose.select.significance import SignificanceTest
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
-from tcbench.diagnose.significance import SignificanceTest
 from tcbench.diagnose.terms import Search, open_term, terms
 
 
@@ -83,7 +83,7 @@ def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: Signifi
               detectors: DetectorSettings = DEFAULTS.detectors) -> tuple[str, float, tuple[float, ...]] | None:
     """One round: the open-world term that adds most to ``model`` above ``threshold`` and
     passes ``test`` (``(id, gain, value)``), or None; every term's
-    :class:`~tcbench.diagnose.evidence.Evidence` is written into ``evidence``."""
+    :class:`~tcbench.diagnose.select.evidence.Evidence` is written into ``evidence``."""
     tried: dict[str, tuple[float, tuple[float, ...], list[tuple[float, ...]]]] = {}
     screen = _Screen(scorer, model, detectors)
     for term_id, values in proposals(scorer, model, detectors).items():

@@ -1,16 +1,16 @@
 """The significance tests an effect with a gain above the threshold must pass, as objects.
 
-:class:`~tcbench.diagnose.plan.StatsPlan` holds the one a recording supports
-(:func:`~tcbench.diagnose.plan.plan_for`, from the settings' thresholds and level); the forward
+:class:`~tcbench.diagnose.select.plan.StatsPlan` holds the one a recording supports
+(:func:`~tcbench.diagnose.select.plan.plan_for`, from the settings' thresholds and level); the forward
 selection asks it through :meth:`SignificanceTest.judge`, and every
-:class:`~tcbench.diagnose.evidence.Evidence` names the test that decided by its
+:class:`~tcbench.diagnose.select.evidence.Evidence` names the test that decided by its
 :attr:`~SignificanceTest.name` (report.json's ``test`` and ``statistics.significance_test``);
 :meth:`SignificanceTest.decided_by` finds that test again from the plan's:
 
 - :class:`RobustWald`: the cluster-robust Wald statistic above its threshold; an effect that
   removes most of the held-out error above the noise and fails it is tried by the surrogate test
   instead (its cluster variance then counts the structure still unexplained as noise);
-- :class:`SpectralSurrogate`: the parametric bootstrap of :mod:`tcbench.diagnose.surrogate`, at
+- :class:`SpectralSurrogate`: the parametric bootstrap of :mod:`tcbench.diagnose.select.surrogate`, at
   p <= its settings' ``level``.
 """
 
@@ -30,7 +30,7 @@ Judgement = tuple[bool, float, float, str]  # (passed, robust Wald, surrogate p-
 
 
 class Scorer(Protocol):
-    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.attribute._Scorer`)."""
+    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.select.attribute._Scorer`)."""
 
     def removes_most(self, base: Any, model: Any) -> bool: ...
 
@@ -69,7 +69,7 @@ class SignificanceTest(ABC):
 
 @dataclass(frozen=True)
 class SpectralSurrogate(SignificanceTest):
-    """The surrogate test (:func:`~tcbench.diagnose.surrogate.surrogate_test`) at p <= ``settings.level``."""
+    """The surrogate test (:func:`~tcbench.diagnose.select.surrogate.surrogate_test`) at p <= ``settings.level``."""
 
     settings: SurrogateSettings = DEFAULTS.surrogate
     name: ClassVar[str] = SURROGATE

@@ -6,7 +6,7 @@ in a residual (docs/concepts/diagnosis-report.md, shapes), where it shows (the r
 temperature term, ``time_s`` 0 for the warm-up, nothing for the others) and its explanation;
 ``confirm_with`` names the measurement or test profile that would confirm the effect and, when
 the recording cannot tell it from another effect, the test of
-:data:`~tcbench.diagnose.attribute.CONFUSABLE` that would separate the two.
+:data:`~tcbench.diagnose.select.attribute.CONFUSABLE` that would separate the two.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tcbench.diagnose.attribute import CONFUSABLE
 from tcbench.diagnose.findings import Finding
+from tcbench.diagnose.select.attribute import CONFUSABLE
 from tcbench.diagnose.terms import Extent, is_term, term, terms
 
 SHAPE = {t.id: t.shape for t in terms()}  # the shape of each library effect, by id

@@ -10,10 +10,10 @@ slow noise. Both need time spans that fit the recording:
   five of 15 min, so leaving one fold out never removes a whole branch of the temperature cycle.
 - **Clusters** of the robust Wald test: ``cluster_s`` a 32nd of the recording, within
   2.5 smoothing windows and 15 min.
-- **The significance test** (an object of :mod:`tcbench.diagnose.significance`): the
+- **The significance test** (an object of :mod:`tcbench.diagnose.select.significance`): the
   cluster-robust Wald statistic needs many clusters to estimate the variance of slow noise; with
   fewer than ``min_clusters`` the recording cannot support it and the diagnosis uses a
-  surrogate test instead (:func:`tcbench.diagnose.surrogate.surrogate_test`): a parametric
+  surrogate test instead (:func:`tcbench.diagnose.select.surrogate.surrogate_test`): a parametric
   bootstrap under a noise model with the spectrum of the candidate model's own residual.
 - **The shortest record** (:func:`min_full_duration_s`): five folds of one block each, a block
   two smoothing windows long: 20 min at the default 120 s window.
@@ -22,7 +22,7 @@ The numbers (folds, blocks and clusters per record, windows per block and cluste
 block, the fewest clusters) are :class:`~tcbench.diagnose.settings.PlanSettings`. Shorter, a fold holds less
   than one whole block, or none, and its held-out samples are predicted by the smoothed
   thermometer of their own neighbours. A shorter record gets the tests its length allows
-  (:mod:`tcbench.diagnose.short_record`).
+  (:mod:`tcbench.diagnose.short.short_record`).
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.diagnose.select.significance import ROBUST_WALD, SURROGATE, SignificanceTest, significance_tests
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
-from tcbench.diagnose.significance import ROBUST_WALD, SURROGATE, SignificanceTest, significance_tests
 from tcbench.diagnose.signals import DiagnosisData
 
 __all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan_for"]
@@ -42,7 +42,7 @@ __all__ = ["ROBUST_WALD", "SURROGATE", "StatsPlan", "min_full_duration_s", "plan
 class StatsPlan:
     """Block length (s) and fold count of the cross-validation, cluster length (s) and count of
     the robust test, and the significance test the recording supports (the robust Wald test or
-    the surrogate test, :mod:`tcbench.diagnose.significance`)."""
+    the surrogate test, :mod:`tcbench.diagnose.select.significance`)."""
 
     block_s: float
     k: int

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tcbench.diagnose.design import Designer, Model
+from tcbench.diagnose.select.design import Designer, Model
 from tcbench.diagnose.signals import lagged, smoothed_value
 
 DELTA_C = 0.01  # step of the numerical temperature slope

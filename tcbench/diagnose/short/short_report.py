@@ -1,4 +1,4 @@
-"""Write a short-record report (:class:`~tcbench.diagnose.short_record.ShortRecordReport`) to a
+"""Write a short-record report (:class:`~tcbench.diagnose.short.short_record.ShortRecordReport`) to a
 directory: ``report.json`` and ``report.md``, staged and moved into ``out`` only when both exist."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from tcbench.diagnose.markdown import _g, _table
-from tcbench.diagnose.report import _plain
-from tcbench.diagnose.short_record import ShortRecordReport
-from tcbench.diagnose.short_tests import ShortTest
+from tcbench.diagnose.report.markdown import _g, _table
+from tcbench.diagnose.report.write import _plain
+from tcbench.diagnose.short.short_record import ShortRecordReport
+from tcbench.diagnose.short.short_tests import ShortTest
 from tcbench.staging import staged_dir
 
 

@@ -5,12 +5,12 @@ Each round tries every effect not yet in the model at every value of its grid, s
     gain = (SSE_heldout(model) - SSE_heldout(model + effect)) / v - 2 * extra parameters
 
 (the held-out SSE from blocked cross-validation with blocks sized to the recording,
-:mod:`tcbench.diagnose.plan`; ``v`` the variance of the noise along the added signal: white
+:mod:`tcbench.diagnose.select.plan`; ``v`` the variance of the noise along the added signal: white
 output noise plus the thermometer's noise carried through the model; the ``2`` per parameter is
 Akaike's penalty; the numbers, thresholds, penalty, share of the excess and most effects, are
 :class:`~tcbench.diagnose.settings.SelectionSettings`). The effect with the largest gain is kept
 when its gain exceeds ``threshold`` and it is significant against the residual's slow noise, by the strongest test the recording
-supports (the :class:`~tcbench.diagnose.significance.SignificanceTest` its plan holds):
+supports (the :class:`~tcbench.diagnose.select.significance.SignificanceTest` its plan holds):
 
 - with enough clusters, a Wald statistic with a variance robust to slow noise (cluster scores
   with Bartlett-weighted neighbours, never above the known-noise Wald) above
@@ -19,7 +19,7 @@ supports (the :class:`~tcbench.diagnose.significance.SignificanceTest` its plan 
 - with few clusters (a short recording), or when the effect removes at least half of the
   held-out error above the noise and the Wald test still rejects it (its cluster variance then
   counts the structure still unexplained as noise), the spectral surrogate test of
-  :mod:`tcbench.diagnose.surrogate` at p <= its level.
+  :mod:`tcbench.diagnose.select.surrogate` at p <= its level.
 
 Each effect's evidence says which test decided. Its nonlinear parameter is then refined
 between its grid neighbours. After the forward pass each kept effect must still earn its place,
@@ -38,21 +38,21 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.crossval import Fit, block_folds, fit_cv, robust_wald
-from tcbench.diagnose.design import DETERMINISTIC, Designer, Model, grid_values
-from tcbench.diagnose.discover import best_open
-from tcbench.diagnose.evidence import Evidence, not_significant
-from tcbench.diagnose.plan import StatsPlan, plan_for
+from tcbench.diagnose.select.crossval import Fit, block_folds, fit_cv, robust_wald
+from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model, grid_values
+from tcbench.diagnose.select.discover import best_open
+from tcbench.diagnose.select.evidence import Evidence, not_significant
+from tcbench.diagnose.select.plan import StatsPlan, plan_for
+from tcbench.diagnose.select.significance import SURROGATE, SignificanceTest
+from tcbench.diagnose.select.surrogate import surrogate_test
+from tcbench.diagnose.select.thermometer_noise import thermometer_variance
 from tcbench.diagnose.settings import (
     DEFAULTS,
     DiagnoseSettings,
     SelectionSettings,
     SurrogateSettings,
 )
-from tcbench.diagnose.significance import SURROGATE, SignificanceTest
-from tcbench.diagnose.surrogate import surrogate_test
 from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
-from tcbench.diagnose.thermometer import thermometer_variance
 from tcbench.sensors.noise import flicker_score_variance
 
 CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}
@@ -178,8 +178,8 @@ def attribute(
     """Forward selection of the library's deterministic effects onto ``base`` (see module doc),
     its thresholds, penalty and most effects ``settings.selection``, the surrogate test's
     generator seeded with ``settings.surrogate.seed``; ``plan`` the blocks, clusters and test
-    (default: sized to the recording by :func:`~tcbench.diagnose.plan.plan_for`); with
-    ``open_world`` the terms of :mod:`tcbench.diagnose.discover` compete with the library's
+    (default: sized to the recording by :func:`~tcbench.diagnose.select.plan.plan_for`); with
+    ``open_world`` the terms of :mod:`tcbench.diagnose.select.discover` compete with the library's
     effects in every round, kept above ``open_threshold`` (default the selection's)."""
     selection = settings.selection
     threshold, max_effects = selection.detection_threshold_sigma2, selection.max_effects

@@ -1,7 +1,7 @@
 """A record of any rate and length: the thermal terms fitted on bin means, the noise terms
 measured on every sample.
 
-The cost of a diagnosis grows with its rows (:mod:`tcbench.diagnose.cost`: 25-50 s of one core
+The cost of a diagnosis grows with its rows (:mod:`tcbench.diagnose.rate.cost`: 25-50 s of one core
 and 550 MB at 10^5 rows, 10-20 min and 8 GB at 2.7 M), while the physics it searches is slow: the
 shortest thermal lag tried is 20 s, the open-world detectors bin the residual in 10 s or more and
 the lag filter and play operator run on a 1 s clock. A record of more rows than
@@ -24,12 +24,12 @@ weight, so that every row averages about the same noise.
 **The noise, on every sample** (:func:`full_rate_noise`), in pieces of :data:`CHUNK_ROWS` where a
 filter runs: the white sigma from first differences inside runs (as
 :func:`~tcbench.diagnose.signals.prepare` does), the output's lattice and clipping (the screens'
-own tests, :mod:`tcbench.diagnose.quantisation` and :mod:`tcbench.diagnose.saturation`, on the
-full-rate output) and isolated outliers (:func:`~tcbench.diagnose.outliers.find_outliers` on
+own tests, :mod:`tcbench.diagnose.screens.quantisation` and :mod:`tcbench.diagnose.screens.saturation`, on the
+full-rate output) and isolated outliers (:func:`~tcbench.diagnose.screens.outliers.find_outliers` on
 the output against its running median, the Bonferroni bound taken over every sample of the
 record). Clipped samples and outliers get zero weight: they never enter a bin mean, where a
 50-sigma spike would become a step of 50/k sigma the thermal terms would have to explain.
-Thermometer glitches (:mod:`tcbench.diagnose.glitches`) are found on every sample too, before
+Thermometer glitches (:mod:`tcbench.diagnose.screens.glitches`) are found on every sample too, before
 binning (a 0.0 degC reading is a 200th of its size in a 200-sample mean, below any bound there):
 held at the previous reading, their samples entering no bin, reported as the
 ``thermometer_glitches`` finding.
@@ -55,14 +55,14 @@ import pandas as pd
 
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.glitches import ID as GLITCHES
-from tcbench.diagnose.glitches import Glitches, repaired
-from tcbench.diagnose.outliers import Outliers, find_outliers, z_bound
-from tcbench.diagnose.quantisation import OutputQuantisation, find_output_quantisation
 from tcbench.diagnose.result import Diagnosis
-from tcbench.diagnose.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens import FINDINGS_ORDER
-from tcbench.diagnose.screens.glitches import glitches
+from tcbench.diagnose.screens.glitches import ID as GLITCHES
+from tcbench.diagnose.screens.glitches import Glitches, repaired
+from tcbench.diagnose.screens.outliers import Outliers, find_outliers, z_bound
+from tcbench.diagnose.screens.quantisation import OutputQuantisation, find_output_quantisation
+from tcbench.diagnose.screens.saturation import Saturation, find_saturation
+from tcbench.diagnose.screens.thermometer_glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
 from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError
 from tcbench.sensors.recording import Recording
@@ -173,7 +173,7 @@ class FullRate:
 
 @dataclass(frozen=True)
 class _Stream:
-    """The full-rate arrays :func:`~tcbench.diagnose.saturation.find_saturation` reads."""
+    """The full-rate arrays :func:`~tcbench.diagnose.screens.saturation.find_saturation` reads."""
 
     t_s: np.ndarray
     temp_c: np.ndarray

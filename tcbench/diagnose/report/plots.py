@@ -29,10 +29,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.signal import periodogram
 
-from tcbench.diagnose.attribute import Evidence
+from tcbench.diagnose.report.lomb import lombscargle_chunked
 from tcbench.diagnose.result import Diagnosis
-from tcbench.diagnose.locate import AllanExcess
-from tcbench.diagnose.lomb import lombscargle_chunked
+from tcbench.diagnose.select.attribute import Evidence
+from tcbench.diagnose.select.locate import AllanExcess
 from tcbench.sensors.segments import segments, within_rate_hz
 
 BEFORE_COLOUR, AFTER_COLOUR = "tab:red", "tab:blue"

@@ -3,7 +3,7 @@
 Each detector reads the in-sample residual of the current model and proposes a few values of
 the nonlinear parameters of open-world terms (:mod:`tcbench.diagnose.terms`, each term's
 ``propose``); the held-out
-scoring of :mod:`tcbench.diagnose.discover` decides. They work on the residual averaged in
+scoring of :mod:`tcbench.diagnose.select.discover` decides. They work on the residual averaged in
 time bins (:func:`binned`: a few thousand bins however long or fast the record, gaps left
 empty), so a 24 h record at 100 Hz costs what a 1 Hz one does.
 
