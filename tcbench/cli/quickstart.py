@@ -58,7 +58,7 @@ TABLE_LEGEND = """\
   to test). 95% CI = bootstrap interval of the median over the draws; x physical limit = median over
   the draws of this row ÷ the oracle on the same draw; gain over raw = median over the draws of
   raw ÷ this row."""
-# what each significance test a diagnosis names in its evidence means (tcbench.diagnose.significance)
+# what each significance test a diagnosis names in its evidence means (tcbench.diagnose.select.significance)
 TEST_LEGEND = {
     ROBUST_WALD: "the effect's coefficients against their uncertainty, estimated from blocks of the record "
                  "(clusters) so that slow, correlated noise is not taken for an effect",

@@ -818,8 +818,8 @@ def _diagnosed(rec: Any, split: Split, cfg: CalibrateConfig, keep: np.ndarray | 
     """``tcbench diagnose`` on the training parts (their rows, in time order, gaps between them
     kept as gaps; ``keep``: the rows screening kept, per training row) and the model it fitted,
     for the ``model`` method. The parts must be as long as any full diagnosis
-    (:func:`tcbench.diagnose.plan.min_full_duration_s`: 20 min); more rows than a diagnosis takes
-    are diagnosed on bin means, their noise measured on every row (:mod:`tcbench.diagnose.native_rate`,
+    (:func:`tcbench.diagnose.select.plan.min_full_duration_s`: 20 min); more rows than a diagnosis takes
+    are diagnosed on bin means, their noise measured on every row (:mod:`tcbench.diagnose.rate.native_rate`,
     as ``tcbench diagnose`` does)."""
     from tcbench.diagnose.rate import native_rate
     from tcbench.diagnose.model_file import to_sensor_model

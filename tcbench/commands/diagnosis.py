@@ -1,7 +1,7 @@
 """What ``tcbench diagnose`` does with its config: the checks made before any work
 (:func:`check_diagnose`: the settings first, :func:`diagnose_settings`) and the diagnosis with
 its report (:func:`diagnose_recording`); a record shorter than a full diagnosis needs gets the
-short-record report of the tests its length allows (:mod:`tcbench.diagnose.short_record`). It runs as a job of :mod:`tcbench.runner.kinds.diagnosis`
+short-record report of the tests its length allows (:mod:`tcbench.diagnose.short.short_record`). It runs as a job of :mod:`tcbench.runner.kinds.diagnosis`
 through :func:`tcbench.runner.job.run_job`."""
 
 from __future__ import annotations
@@ -98,7 +98,7 @@ def check_size(path: str, max_rows: int | None, budget_rows: int | None = None) 
     """A record of more than ``max_rows`` rows that will be diagnosed as recorded (at most
     ``budget_rows``, ``settings.rate.max_rows``: a longer one is diagnosed on bin means,
     :func:`check_bins`) refused from its row count, before it is read: one line with the rows, the
-    time they are estimated to take (:mod:`tcbench.diagnose.cost`) and what to do."""
+    time they are estimated to take (:mod:`tcbench.diagnose.rate.cost`) and what to do."""
     from tcbench.sensors.recording_files import table_rows
 
     rows = table_rows(path)
@@ -108,7 +108,7 @@ def check_size(path: str, max_rows: int | None, budget_rows: int | None = None) 
 
 
 def check_bins(path: str, rec: Any, max_rows: int | None, settings: Any) -> None:
-    """A record diagnosed on bin means (:mod:`tcbench.diagnose.native_rate`) whose bins would
+    """A record diagnosed on bin means (:mod:`tcbench.diagnose.rate.native_rate`) whose bins would
     still be more than ``max_rows`` rows (bins no longer than ``settings.rate.max_bin_s``) refused
     as :func:`check_size` refuses one diagnosed as recorded."""
     from tcbench.diagnose.rate.native_rate import plan_for

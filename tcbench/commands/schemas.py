@@ -91,7 +91,7 @@ class ImportConfig:
     tracking: TrackingConfig = field(default_factory=lambda: TrackingConfig(experiment="recordings"))
 
 
-# the most rows tcbench diagnose takes by default: about 8 min of one core and 3 GB (tcbench.diagnose.cost)
+# the most rows tcbench diagnose takes by default: about 8 min of one core and 3 GB (tcbench.diagnose.rate.cost)
 DIAGNOSE_MAX_ROWS = 1_000_000
 
 
@@ -125,7 +125,7 @@ DiagnoseSettingsConfig = _mutable(DiagnoseSettings)
 class DiagnoseConfig:
     """``tcbench diagnose``: the recording, the output directory, the sensor kind for a recording
     without a sidecar, the model file of effects already modelled, the most rows diagnosed
-    (:mod:`tcbench.diagnose.cost`) and the statistics of the diagnosis (``settings``, checked by
+    (:mod:`tcbench.diagnose.rate.cost`) and the statistics of the diagnosis (``settings``, checked by
     :func:`tcbench.diagnose.settings.from_mapping`)."""
 
     kind: str = "diagnose"

@@ -16,7 +16,7 @@ on the thermometer of each training part:
    the level misses).
 3. **Bound**: ``|z| > max(TAIL * Phi^-1(1 - ALPHA / (2 n)), MIN_Z)`` (Bonferroni over the
    part's ``n`` samples at family-wise false-alarm :data:`ALPHA`, as the diagnosis's outlier test:
-   :mod:`tcbench.diagnose.outliers`), at least :data:`MIN_Z` robust sigmas since a real record's
+   :mod:`tcbench.diagnose.screens.outliers`), at least :data:`MIN_Z` robust sigmas since a real record's
    structure (a chamber's lines, a lag's loop) is not white.
 4. **Guard**: each flagged run widened by :data:`GUARD_S` on both sides (a handling event's
    start and end lie below the bound but not within the noise).
