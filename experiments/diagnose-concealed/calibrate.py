@@ -3,7 +3,9 @@
 Diagnoses ``--controls`` concealed controls per sensor (seeds from ``--first-seed``, a range
 kept for tuning and never used by ``run.py``) and reports, over the library's deterministic
 effects, the largest penalised held-out gain and robust Wald statistic each control offers, and
-how many controls would name an effect at the thresholds of ``DiagnoseSettings().selection``.
+how many controls would name an effect at the thresholds of ``DiagnoseSettings().selection``. The
+open-world terms (:mod:`tcbench.diagnose.select.discover`) are judged by their own thresholds, not
+these: they are left out of the statistics and counted apart where a control names one.
 
 With ``--write-settings PATH`` it also writes the thresholds these controls calibrate, as a
 fragment of ``conf/diagnose.yaml``'s ``settings:`` block (commented, with the equivalent
@@ -30,6 +32,7 @@ from joblib import Parallel, delayed
 from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, from_mapping, yaml_lines
+from tcbench.diagnose.terms import is_open
 
 SENSORS = ("msra", "gyro")
 CALIBRATED = ("selection.detection_threshold_sigma2", "selection.wald_threshold")
@@ -37,11 +40,12 @@ CALIBRATED = ("selection.detection_threshold_sigma2", "selection.wald_threshold"
 
 def _one(sensor: str, seed: int) -> tuple[str, float, float, list[str], float]:
     """``(sensor, largest gain, largest joint ratio to the thresholds, effects named, largest
-    robust Wald)`` of one control, over its deterministic candidates."""
+    robust Wald)`` of one control, over its library's deterministic candidates (no open-world term)."""
     selection = DEFAULTS.selection
     rec, _ = concealed_recording(sensor, None, seed)
     d = diagnose(rec)
-    det = [e for e in d.candidates if e.effect != "bias_instability" and np.isfinite(e.gain)]
+    det = [e for e in d.candidates
+           if e.effect != "bias_instability" and not is_open(e.effect) and np.isfinite(e.gain)]
     gains = np.array([e.gain for e in det])
     walds = np.array([e.wald for e in det])
     joint = max((min(g / selection.detection_threshold_sigma2, w / selection.wald_threshold)
@@ -108,12 +112,14 @@ def main() -> None:
         sub = [r for r in rows if sensor in ("all", r[0])]
         gains = np.array([r[1] for r in sub])
         joint = np.array([r[2] for r in sub])
-        named = sum(bool(r[3]) for r in sub)
+        named = sum(any(not is_open(e) for e in r[3]) for r in sub)
         flick = sum("bias_instability" in r[3] for r in sub)
+        open_named = sum(any(is_open(e) for e in r[3]) for r in sub)
         q = np.quantile(gains, [0.5, 0.9, 0.99])
         print(f"  {sensor:4s}: n={len(sub)}  max gain median/90%/99% = {q[0]:.1f}/{q[1]:.1f}/{q[2]:.1f};  "
               f"deterministic effect would pass both thresholds: {int((joint > 1).sum())}; "
-              f"named anything: {named} ({100 * named / len(sub):.1f} %), bias_instability: {flick}")
+              f"named a library effect: {named} ({100 * named / len(sub):.1f} %), bias_instability: {flick}; "
+              f"an open-world term (its own thresholds): {open_named}")
     if args.write_settings is not None:
         text, settings = settings_fragment(rows, args.false_alarm, seeds)
         args.write_settings.write_text(text, encoding="utf-8")

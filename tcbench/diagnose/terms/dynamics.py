@@ -7,11 +7,14 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from tcbench.diagnose.settings import DEFAULTS
 from tcbench.diagnose.signals import DiagnosisData, hysteresis_state
 from tcbench.diagnose.terms.base import Term, g3
 from tcbench.sensors.effects import Effect, Hysteresis, TemperatureRate, ThermalLag
 
-MIN_RATE_C_PER_S = 0.05 / 60.0  # slower than this the temperature counts as still
+# slower than this the temperature counts as still: the soak/ramp boundary the locator uses
+# (``settings.locate.still_rate_c_per_min``, its default; a term sees the record, not the settings)
+MIN_RATE_C_PER_S = DEFAULTS.locate.still_rate_c_per_min / 60.0
 
 
 def _moves(data: DiagnosisData) -> tuple[np.ndarray, np.ndarray]:
