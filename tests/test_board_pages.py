@@ -250,3 +250,14 @@ def test_the_generated_folder_is_rewritten_only_where_it_changed(tmp_path: Path)
     assert (tmp_path / "a.md").stat().st_mtime_ns == stamp and not (tmp_path / "old").exists()
     assert sync_files({**files, PurePosixPath("a.md"): b"A"}, tmp_path) == (1, 0)
     assert (tmp_path / "a.md").read_bytes() == b"A"
+
+
+def test_a_board_paired_by_draw_is_a_compensation_board(tmp_path: Path) -> None:
+    """Boards over draws carry a ``draws`` column after ``runs``; the pages take them as the others."""
+    from tcbench.leaderboard.pages.boards import is_compensation_csv
+
+    paired, single, other = tmp_path / "p.csv", tmp_path / "s.csv", tmp_path / "o.csv"
+    paired.write_text("rank,method,runs,draws,failed,median_drift_ug,x_oracle,x_thermo\n1,raw,30,30,0,5,9,3\n")
+    single.write_text("rank,method,runs,failed,median_drift_ug,x_oracle,x_thermo\n1,raw,1,0,5,9,3\n")
+    other.write_text("rank,method,runs,median_f\n1,fa,30,0.1\n")
+    assert is_compensation_csv(paired) and is_compensation_csv(single) and not is_compensation_csv(other)

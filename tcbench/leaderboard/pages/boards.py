@@ -16,7 +16,7 @@ from tcbench.compensation.scoring import METRIC_NAMES, PRIMARY
 from tcbench.leaderboard.compensation import SHORT, SPLIT_LINES
 from tcbench.leaderboard.pages.catalogue import Family
 
-COMPENSATION_HEAD = ("rank", "method", "runs", "failed")  # how a compensation board's CSV starts
+COMPENSATION_HEAD = ("rank", "method", "runs")  # how a compensation board's CSV starts (then draws, if paired, and failed)
 TIER_HEADING = re.compile(r"^# Compensation leaderboard: (?P<task>.+?)(?: — split (?P<tier>.+))?$")
 
 
@@ -64,7 +64,7 @@ def is_compensation_csv(path: Path) -> bool:
     """True when ``path`` is a compensation board's table (its columns start as the boards' do)."""
     with path.open(encoding="utf-8") as f:
         head = f.readline().strip().split(",")
-    return tuple(head[:4]) == COMPENSATION_HEAD and "x_thermo" in head
+    return tuple(head[:3]) == COMPENSATION_HEAD and "failed" in head and "x_thermo" in head
 
 
 def protocol_of(table: pd.DataFrame) -> str:
