@@ -80,8 +80,8 @@ def best_table(runs: pd.DataFrame, task: str, methods: list[str]) -> pd.DataFram
                 g = runs[runs["method"] == method]
                 if g.empty or col not in g or key not in g:
                     continue
-                gains = g[key].to_numpy(float) / g[col].to_numpy(float)
                 if method in LIMITS:
+                    gains = g[key].to_numpy(float) / g[col].to_numpy(float)
                     row[method] = _with_gain(float(g[col].median()), float(np.median(gains)))
                 else:
                     best = _best(g)
@@ -156,7 +156,8 @@ def claims(runs: pd.DataFrame, fa: str, ifa: str) -> pd.DataFrame:
         out.append({"claim": claim, "metric": metric, "selection": f"{ifa} median over {gains.size} restarts",
                     "worst-test gain": f"{_fmt(median)} [{_fmt(low)}, {_fmt(high)}]", "reproduced": verdict})
         if not sel.empty:
-            pick = float(gains.loc[int(_best(sel)["seed"])]) if int(_best(sel)["seed"]) in gains.index else float("nan")
+            seed = int(_best(sel)["seed"])
+            pick = float(gains.loc[seed]) if seed in gains.index else float("nan")
             out.append({"claim": claim, "metric": metric, "selection": f"{ifa} best of N by training RMSE",
                         "worst-test gain": _fmt(pick),
                         "reproduced": f"a pick, not a test ({'reaches' if pick >= need else 'short of'} {need:g}x)"})
