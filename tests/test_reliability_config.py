@@ -146,6 +146,13 @@ SLEEPY = ("import os, time\nfrom tcbench.optimisers.fa import FireflyAlgorithm\n
           "    def ask(self):\n        time.sleep(600)\n")
 
 
+def _ctrl_c_default() -> None:
+    """In the child before it runs tcbench: SIGINT at its default, so Python installs its Ctrl-C
+    handler. A test run started in the background of a shell without job control inherits SIGINT
+    ignored, and a tcbench started so rightly ignores Ctrl-C (the test then waited in vain)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.skipif(sys.platform != "linux", reason="signals as on Linux")
 def test_ctrl_c_of_a_parallel_sweep_marks_the_workers_runs_killed(tmp_path: Path) -> None:
     """Ctrl-C of a sweep on two workers left the runs the workers held RUNNING for ever."""
@@ -159,7 +166,8 @@ def test_ctrl_c_of_a_parallel_sweep_marks_the_workers_runs_killed(tmp_path: Path
     env = {k: v for k, v in os.environ.items() if k != "MLFLOW_TRACKING_URI"} | {"PYTHONPATH": str(site)}
     proc = subprocess.Popen([sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "optimiser=fa",
                              "optimiser.name=sleepy", "seed=range(3)", "budget=60", "hydra.launcher.n_jobs=2"],
-                            cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_ctrl_c_default)
 
     def running() -> int:
         try:

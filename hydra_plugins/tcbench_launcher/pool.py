@@ -28,6 +28,13 @@ log = logging.getLogger(__name__)
 Job = Callable[[dict[str, Any]], tuple[bool, Any]]
 
 
+# How often the sweep's main loop wakes with nothing to read. The kernel may hand a Ctrl-C (a
+# process-directed SIGINT) to any thread that does not block it; Python then runs its handler in
+# the main thread only when that thread next runs, which a wait with no timeout would put off until
+# a worker next reports (the end of a job, for a sweep of long jobs).
+SIGNAL_CHECK_S = 0.5
+
+
 class WorkerDied(RuntimeError):
     """The worker process running a job ended before the job did."""
 
@@ -161,7 +168,7 @@ def run_jobs(configs: Sequence[dict[str, Any]], n_workers: int, job: Job,
             start()
         while busy:
             sentinels = {proc.sentinel: conn for conn, (proc, _, _) in busy.items()}
-            for ready in wait([*busy, *sentinels]):
+            for ready in wait([*busy, *sentinels], timeout=SIGNAL_CHECK_S):
                 conn = ready if isinstance(ready, Connection) else sentinels[ready]
                 if conn not in busy:
                     continue

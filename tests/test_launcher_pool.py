@@ -1,0 +1,49 @@
+"""The sweep's worker pool (:mod:`hydra_plugins.tcbench_launcher.pool`) in-process."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from hydra_plugins.tcbench_launcher.pool import run_jobs
+
+
+def _sleep_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
+    Path(cfg["started"]).touch()
+    time.sleep(cfg["sleep_s"])
+    return True, cfg["sleep_s"]
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="signals as on Linux")
+def test_a_ctrl_c_taken_by_another_thread_still_ends_the_sweep(tmp_path: Path) -> None:
+    """The kernel may hand a Ctrl-C to any thread of the sweep that does not block SIGINT; the main
+    thread, waiting on its workers with no timeout, then ran the handler only when a worker next
+    reported (a sweep of long jobs ignored Ctrl-C until one ended)."""
+    started = tmp_path / "started"
+
+    def ctrl_c_on_this_thread() -> None:
+        deadline = time.monotonic() + 120
+        while not started.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        time.sleep(0.5)  # the main thread is back in its wait
+        signal.pthread_kill(threading.get_ident(), signal.SIGINT)
+
+    other = threading.Thread(target=ctrl_c_on_this_thread, daemon=True)
+    other.start()
+    t0 = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        run_jobs([{"started": str(started), "sleep_s": 300.0}], 1, _sleep_job)
+    assert started.exists()
+    assert time.monotonic() - t0 < 100, "the Ctrl-C waited for the job to end"
+    other.join(5)
+
+
+def test_every_job_ends_in_order(tmp_path: Path) -> None:
+    outcomes = run_jobs([{"started": str(tmp_path / f"s{i}"), "sleep_s": 0.01 * i} for i in range(3)], 2, _sleep_job)
+    assert outcomes == [(True, 0.0), (True, 0.01), (True, 0.02)]
