@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -11,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from hydra_plugins.tcbench_launcher.pool import run_jobs
+from hydra_plugins.tcbench_launcher.pool import BLAS_THREAD_VARS, blas_threads_per_worker, run_jobs
 
 
 def _sleep_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
@@ -47,3 +48,36 @@ def test_a_ctrl_c_taken_by_another_thread_still_ends_the_sweep(tmp_path: Path) -
 def test_every_job_ends_in_order(tmp_path: Path) -> None:
     outcomes = run_jobs([{"started": str(tmp_path / f"s{i}"), "sleep_s": 0.01 * i} for i in range(3)], 2, _sleep_job)
     assert outcomes == [(True, 0.0), (True, 0.01), (True, 0.02)]
+
+
+def _blas_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
+    import os
+
+    import numpy  # noqa: F401 - its BLAS loaded, as in a job
+    from threadpoolctl import threadpool_info
+
+    return True, ({v: os.environ.get(v) for v in BLAS_THREAD_VARS},
+                  sorted({p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"}))
+
+
+def test_workers_share_the_cores_between_their_blas_threads(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two workers of a two-core machine each ran OpenBLAS on every core: their spinning threads
+    made a Gram 340x slower. Each gets its share, the user's own setting wins, and the sweep's
+    process keeps its environment."""
+    for var in BLAS_THREAD_VARS:
+        monkeypatch.delenv(var, raising=False)
+    share = blas_threads_per_worker(2)
+    outcomes = run_jobs([{}, {}], 2, _blas_job)
+    for ok, (env, threads) in outcomes:
+        assert ok and set(env.values()) == {str(share)} and threads == [share]
+    assert all(var not in os.environ for var in BLAS_THREAD_VARS)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "1")  # one worker would get every core
+    [(ok, (env, threads))] = run_jobs([{}], 1, _blas_job)
+    assert env["OPENBLAS_NUM_THREADS"] == "1" and env["OMP_NUM_THREADS"] is None and threads == [1]
+
+
+def test_the_blas_share_never_drops_below_one_thread() -> None:
+    cores = len(os.sched_getaffinity(0))
+    assert blas_threads_per_worker(1) == cores
+    assert blas_threads_per_worker(cores + 5) == 1
+    assert blas_threads_per_worker(0) == cores

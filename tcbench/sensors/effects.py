@@ -113,9 +113,15 @@ def play_operator(temp_c: np.ndarray, width_c: float, start_state: float = 0.0) 
     thermal samples (1 Hz or slower in the protocols), not over output samples."""
     out = np.empty_like(temp_c)
     y = float(temp_c[0]) - float(np.clip(start_state, -1.0, 1.0)) * width_c
-    for i, x in enumerate(temp_c.tolist()):
-        y = min(max(y, x - width_c), x + width_c)
-        out[i] = y
+    w = float(width_c)
+    values = []
+    for x in temp_c.tolist():  # y = min(max(y, x - w), x + w), without two calls per sample
+        if y < x - w:
+            y = x - w
+        elif y > x + w:
+            y = x + w
+        values.append(y)
+    out[:] = values
     return out
 
 

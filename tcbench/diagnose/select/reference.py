@@ -84,25 +84,41 @@ def reference_terms(data: DiagnosisData, settings: ReferenceSettings = DEFAULTS.
     return np.column_stack(cols), names
 
 
-def _ridge_heldout(xs: np.ndarray, y: np.ndarray, fold: np.ndarray, k: int, alpha: float
-                   ) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class _Gram:
+    """What every penalty's fit shares: the design with its intercept column, its Gram and
+    right-hand side, and each non-empty fold's samples with their own Gram, right-hand side and
+    share of the samples (computed once, not once per penalty)."""
+
+    x1: np.ndarray
+    gram: np.ndarray
+    rhs: np.ndarray
+    folds: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float], ...]
+
+    @classmethod
+    def of(cls, xs: np.ndarray, y: np.ndarray, fold: np.ndarray, k: int) -> _Gram:
+        x1 = np.column_stack([np.ones(xs.shape[0]), xs])
+        folds = []
+        for f in range(k):
+            m = fold == f
+            if m.any():
+                xf = x1[m]
+                folds.append((m, xf, xf.T @ xf, xf.T @ y[m], float(m.mean())))
+        return cls(x1, x1.T @ x1, x1.T @ y, tuple(folds))
+
+
+def _ridge_heldout(g: _Gram, y: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     """Held-out residual and in-sample residual of ridge (intercept unpenalised, columns
     already standardised) at relative penalty ``alpha``."""
-    n, p = xs.shape
-    x1 = np.column_stack([np.ones(n), xs])
-    pen = np.full(p + 1, alpha * n)
+    n, q = g.x1.shape
+    pen = np.full(q, alpha * n)
     pen[0] = 0.0
-    gram, rhs = x1.T @ x1, x1.T @ y
-    beta = np.linalg.solve(gram + np.diag(pen), rhs)
+    beta = np.linalg.solve(g.gram + np.diag(pen), g.rhs)
     heldout = np.empty_like(y)
-    for f in range(k):
-        m = fold == f
-        if not m.any():
-            continue
-        xf = x1[m]
-        b = np.linalg.solve(gram - xf.T @ xf + np.diag(pen * (1.0 - m.mean())), rhs - xf.T @ y[m])
+    for m, xf, gram_f, rhs_f, share in g.folds:
+        b = np.linalg.solve(g.gram - gram_f + np.diag(pen * (1.0 - share)), g.rhs - rhs_f)
         heldout[m] = y[m] - xf @ b
-    return heldout, y - x1 @ beta
+    return heldout, y - g.x1 @ beta
 
 
 def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int,
@@ -113,9 +129,10 @@ def reference_fit(data: DiagnosisData, fold: np.ndarray, k: int,
     sd[sd == 0] = 1.0
     xs = (x - mu) / sd
     y = data.output
+    gram = _Gram.of(xs, y, fold, k)
     best: tuple[float, float, np.ndarray, np.ndarray] | None = None
     for alpha in ALPHAS:
-        heldout, resid = _ridge_heldout(xs, y, fold, k, float(alpha))
+        heldout, resid = _ridge_heldout(gram, y, float(alpha))
         sse = float(heldout @ heldout)
         if best is None or sse < best[0]:
             best = (sse, float(alpha), heldout, resid)
