@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import gymnasium as gym
@@ -154,11 +155,71 @@ def test_the_compiled_fulltemp_network_estimates_the_input_as_the_task_does(full
         assert np.sqrt(np.mean((want - rec.input) ** 2)) < np.sqrt(np.mean(rec.input ** 2))
 
 
-def test_a_run_whose_model_no_device_runs_says_why() -> None:
-    env = gym.make(FULLTEMP, learner="poly", n_train=1, n_test=1, recordings_seed=0).unwrapped
+def _streamed_by_c(spec: dict, name: str, rec: object, build: str, folder: Path) -> np.ndarray:
+    """``spec`` written as C, compiled in ``build`` and run sample by sample over ``rec``."""
+    write_c(spec, name, folder)
+    (folder / "host.c").write_text(HOST.replace("UPNAME", name.upper()).replace("NAME", name))
+    exe = folder / name
+    flags = [f"-D{name.upper()}_FLOAT"] if build == "float" else []
+    subprocess.run([CC, "-std=c99", "-O2", *flags, str(folder / "host.c"), str(folder / f"{name}.c"), "-lm",
+                    "-o", str(exe)], check=True)
+    dt_s = np.r_[0.0, np.diff(rec.time_s)]
+    lines = "".join(f"{a.hex()} {b.hex()} {c.hex()}\n"
+                    for a, b, c in zip(rec.temperature_c.tolist(), rec.output.tolist(), dt_s.tolist()))
+    done = subprocess.run([str(exe)], input=lines, capture_output=True, text=True, check=True)
+    return np.array([float.fromhex(v) for v in done.stdout.split()])
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize(("task", "offsets"), [(ENV, "shared"), (ENV, "per_run"), ("tcbench/MSRA-ZeroBias-v0", "per_run")])
+def test_a_runs_cubic_runs_on_the_device_as_the_task_compensates(task: str, offsets: str, build: str,
+                                                                  tmp_path: Path) -> None:
+    """A run's poly learner (the boards' poly3 and poly3_runs: a Chebyshev series in the scaled
+    temperature) is kept as the device's cubic about the middle of the training range, held to it:
+    compiled, it gives the task's own compensation in both builds."""
+    env = gym.make(task, learner="poly", learner_params={"offsets": offsets}, n_train=2, n_test=1,
+                   recordings_seed=0).unwrapped
+    compensate(env, "poly", "none", {}, 1, 0)
+    doc = device_document(env, "poly", "poly3")
+    spec = json.loads(json.dumps(doc["device"]["poly"]))
+    box = env.data.input_range(env._x)
+    assert spec["method"] == "poly3" and (spec["tmin_c"], spec["tmax_c"]) == (box[0][0], box[1][0])
+    test = env.data.test[0]
+    data = test.recording.data.copy()
+    data["temperature_c"] += box[1][0] - np.median(data["temperature_c"])  # half the record above the training range
+    warmer = replace(test, recording=replace(test.recording, data=data))
+    for tr in (test, warmer):
+        raw = tr.recording.output
+        got = _streamed_by_c(spec, "tc_poly", tr.recording, build, tmp_path)
+        want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)
+        bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
+        assert np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
+        assert np.ptp(want - raw) > 10 * TOLERANCE["float"] * np.max(np.abs(raw))  # the cubic corrects something
+    assert np.any(warmer.recording.temperature_c > box[1][0])  # the clamp is exercised
+
+
+@pytest.mark.parametrize(("learner_params", "why"), [
+    ({}, "poly of form 'inverse': it solves for the input from [raw, T]"),
+])
+def test_a_run_whose_model_no_device_runs_says_why(learner_params: dict, why: str) -> None:
+    env = gym.make(FULLTEMP, learner="poly", learner_params=learner_params, n_train=1, n_test=1,
+                   recordings_seed=0).unwrapped
     compensate(env, "poly", "none", {}, 1, 0)
     doc = device_document(env, "poly", "poly")
-    assert doc["device"] == {} and doc["left_out"] == {"poly": "not a BP or Elman network"}
+    assert doc["device"] == {} and doc["left_out"]["poly"].startswith(why)
+
+
+@pytest.mark.parametrize(("learner_params", "why"), [
+    ({"form": "bias_rate"}, "poly of form 'bias_rate': its rate term is a polynomial in T"),
+    ({"degree": 4}, "poly of degree 4: the device's cubic takes degree 3 at most"),
+])
+def test_a_runs_other_cubics_say_why_they_are_left_out(learner_params: dict, why: str) -> None:
+    env = gym.make(ENV, learner="poly", learner_params=learner_params, n_train=2, n_test=1,
+                   recordings_seed=0).unwrapped
+    compensate(env, "poly", "none", {}, 1, 0)
+    doc = device_document(env, "poly", "poly")
+    assert doc["device"] == {} and doc["left_out"]["poly"].startswith(why)
 
 
 def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:

@@ -16,7 +16,9 @@ in the float build; the networks' sigmoid is ``(1 + tanh(a / 2)) / 2``).
 What each method runs (:func:`device_spec` gives its parameters, :func:`streamed_offset` runs the
 same arithmetic in numpy, the reference the compiled code is checked against):
 
-- ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range.
+- ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range (a
+  ``tcbench run``'s cubic too, :func:`run_cubic_spec`: its Chebyshev series expanded about the
+  middle of the training range).
 - ``poly3_rate``: that cubic plus the rate coefficient times the temperature rate, the
   least-squares slope over the trailing :data:`~tcbench.compensation.calibration.RATE_WINDOW_S`
   window ``t_i - w < t_j <= t_i``, each window's moments centred on its own means: the estimator
@@ -153,6 +155,35 @@ def inverse_spec(method: str, learner: Any, raw_range: Any, temp_range_c: Any, q
     return _network_weights(method, learner, 0.0) | {
         "form": "inverse", "inputs": ["raw", "temperature_c"], "input_quantity": quantity, "input_unit": unit,
         "raw_range": _bounds(raw_range), "temp_range_c": _bounds(temp_range_c)}
+
+
+def run_cubic_spec(learner: Any, temp_range_c: Any) -> dict[str, Any]:
+    """A ``tcbench run``'s fitted ``poly`` learner of the ``bias`` form (``poly3``, ``poly3_runs``:
+    a Chebyshev series of degree <= 3 in the temperature scaled to [-1, 1] over the training runs,
+    its output scaled back) as the ``poly3`` cubic a device runs: the same polynomial expanded in
+    powers of ``T - T_ref``, ``T_ref`` the middle of the training range, the temperature held to
+    ``temp_range_c`` (``None``: not held). ``ValueError`` naming why another form or degree is
+    not exported."""
+    from numpy.polynomial import chebyshev
+
+    form = learner.describe().get("fitted_form")
+    if form != "bias":
+        why = {"bias_rate": "its rate term is a polynomial in T (the device's poly3_rate has a constant one)",
+               "inverse": "it solves for the input from [raw, T] (the device's cubics return raw minus an offset)"}
+        raise ValueError(f"poly of form {form!r}: {why.get(str(form), 'not fitted')}")
+    coef = np.asarray(learner.get_params(), dtype=np.float64)
+    if coef.size > 4:
+        raise ValueError(f"poly of degree {coef.size - 1}: the device's cubic takes degree 3 at most")
+    xs, ys = learner.x_scaler, learner.y_scaler
+    half_c = 0.5 * float(xs._span[0])
+    y_half = 0.5 * float(ys._span[0])
+    power = np.zeros(4)
+    power[:coef.size] = chebyshev.cheb2poly(coef)  # in u = (T - T_ref) / half_c
+    x = y_half * power / half_c ** np.arange(4)
+    x[0] += float(ys.low[0]) + y_half
+    low, high = (-np.inf, np.inf) if temp_range_c is None else (float(temp_range_c[0]), float(temp_range_c[1]))
+    return {"method": "poly3", "x": [float(v) for v in x], "tref_c": float(xs.low[0]) + half_c,
+            "tmin_c": low, "tmax_c": high}
 
 
 def is_inverse(spec: dict[str, Any]) -> bool:

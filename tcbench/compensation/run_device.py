@@ -9,7 +9,9 @@ slope, the inputs held to the training box where the task clamps them. It runs t
 full-temperature task's network too (``msra_fulltemp``, seed 000's IFA-BP of Table 2: the
 ``inverse`` form, :func:`~tcbench.compensation.c_export.inverse_spec`): the network's estimate of
 the input (acceleration, g) from ``[raw, T]``, the temperature held to its training range where
-the task clamps it and the raw output free, as the task scores it. The gyro task's runs keep the
+the task clamps it and the raw output free, as the task scores it. A run's ``poly`` learner of the bias form (the boards' ``poly3``, ``poly3_runs``)
+is kept as the device's cubic (:func:`~tcbench.compensation.c_export.run_cubic_spec`); its other
+forms say why they are left out. The gyro task's runs keep the
 reason none is written (``left_out``): its pipeline decomposes the whole record before its drift
 learner runs (not per sample).
 """
@@ -22,6 +24,20 @@ import numpy as np
 
 FILE = "device.json"
 QUANTITY = {"g": "acceleration", "deg/s": "angular rate"}  # the input an inverse network estimates, by its unit
+
+
+def _cubic_document(env: Any, data: Any, fitted: Any, learner: str, label: str) -> dict[str, Any]:
+    """``device.json``'s body for a run's ``poly`` learner: the cubic of the bias form
+    (:func:`~tcbench.compensation.c_export.run_cubic_spec`), or why another form is left out."""
+    from tcbench.compensation.c_export import run_cubic_spec
+
+    low, high = data.input_range(env._x) if env.clamp_inputs else (None, None)
+    try:
+        spec = run_cubic_spec(fitted, None if low is None else (low[0], high[0]))
+    except ValueError as exc:
+        return {"device": {}, "left_out": {learner: str(exc)}}
+    meta = data.train[0].recording.meta
+    return {"sensor": meta.sensor, "unit": meta.units.get("output", ""), "device": {learner: spec}}
 
 
 def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
@@ -37,6 +53,8 @@ def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
     if data is None or fitted is None or form not in ("bias", "inverse"):
         why = "the task's pipeline decomposes the whole record before its drift learner runs (not per sample)"
         return base | {"device": {}, "left_out": {learner: why}}
+    if getattr(fitted, "name", "") == "poly":
+        return base | _cubic_document(env, data, fitted, learner, label)
     if not getattr(fitted, "searchable", False) or not hasattr(fitted.params, "hidden"):
         return base | {"device": {}, "left_out": {learner: "not a BP or Elman network"}}
     recordings = [tr.recording for tr in data.train + data.test]
