@@ -63,6 +63,7 @@ same arithmetic in numpy, the reference the compiled code is checked against):
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -95,18 +96,32 @@ def device_spec(model: OffsetModel, max_window_samples: int, rate_window_s: floa
     if model.method not in EXPORTED:
         raise ValueError(f"{model.method}: {NOT_EXPORTED.get(model.method, 'not a method a device runs')}")
     capacity = max(2, int(np.ceil(CAPACITY_MARGIN * max_window_samples)))
-    if model.method == "model":
-        return model_spec(model.sensor_model)
-    if model.method in ("poly3", "poly3_rate"):
-        c = model.cubic
-        assert c is not None
-        spec: dict[str, Any] = {"method": model.method, "x": [float(v) for v in c.x], "tref_c": c.tref_c,
-                                "tmin_c": c.tmin_c, "tmax_c": c.tmax_c}
-        if model.method == "poly3_rate":
-            spec |= {"rate_coef": float(model.rate_coef), "rate_window_s": rate_window_s, "rate_capacity": capacity}
-        return spec
+    return _SPEC_OF.get(model.method, _network_device_spec)(model, rate_window_s, capacity)
+
+
+def _cubic_device_spec(model: OffsetModel, rate_window_s: float, capacity: int) -> dict[str, Any]:
+    c = model.cubic
+    assert c is not None
+    return {"method": model.method, "x": [float(v) for v in c.x], "tref_c": c.tref_c, "tmin_c": c.tmin_c,
+            "tmax_c": c.tmax_c}
+
+
+def _cubic_rate_device_spec(model: OffsetModel, rate_window_s: float, capacity: int) -> dict[str, Any]:
+    return _cubic_device_spec(model, rate_window_s, capacity) | {
+        "rate_coef": float(model.rate_coef), "rate_window_s": rate_window_s, "rate_capacity": capacity}
+
+
+def _network_device_spec(model: OffsetModel, rate_window_s: float, capacity: int) -> dict[str, Any]:
     return network_spec(model.method, model.learner, model.temp_range_c, model.rate_range, rate_window_s, capacity,
                         model.bin_s)
+
+
+# each method's spec from calibrate's fit (a network's by default)
+_SPEC_OF: dict[str, Callable[[OffsetModel, float, int], dict[str, Any]]] = {
+    "model": lambda model, rate_window_s, capacity: model_spec(model.sensor_model),
+    "poly3": _cubic_device_spec,
+    "poly3_rate": _cubic_rate_device_spec,
+}
 
 
 def _network_weights(method: str, learner: Any, bin_s: float | None) -> dict[str, Any]:
@@ -332,22 +347,25 @@ def streamed_offset(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarra
     clock (:func:`device_clock_s`), ``temp_c`` its thermometer, from ``init`` on;
     ``rate_c_per_s``: :func:`~tcbench.compensation.features.temperature_rate_c_per_s` of them when
     already computed. An ``inverse`` network has no offset (:func:`streamed_corrected`)."""
-    if is_inverse(spec):
-        raise ValueError(f"{spec['method']}: an inverse network returns the input, not an offset (streamed_corrected)")
     t = np.asarray(clock_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
-    method = spec["method"]
-    if method == "model":
-        return _model_streamed(spec, t, temp)
-    if method != "poly3" and rate_c_per_s is None:
-        rate_c_per_s = temperature_rate_c_per_s(t, temp, spec["rate_window_s"])
-    rate = np.asarray(rate_c_per_s, dtype=np.float64)
-    if method in ("poly3", "poly3_rate"):
-        x = spec["x"]
-        dt = np.clip(temp, spec["tmin_c"], spec["tmax_c"]) - spec["tref_c"]
-        off = x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]))
-        return off + spec["rate_coef"] * rate if method == "poly3_rate" else off
-    return _network_out(spec, t, temp, rate)
+    kind = _kind(spec)
+    rate = None
+    if kind.rated:
+        if rate_c_per_s is None:
+            rate_c_per_s = temperature_rate_c_per_s(t, temp, spec["rate_window_s"])
+        rate = np.asarray(rate_c_per_s, dtype=np.float64)
+    return kind.offset(spec, t, temp, rate)
+
+
+def _cubic_offset(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray | None) -> np.ndarray:
+    x = spec["x"]
+    dt = np.clip(temp, spec["tmin_c"], spec["tmax_c"]) - spec["tref_c"]
+    return x[0] + dt * (x[1] + dt * (x[2] + dt * x[3]))
+
+
+def _cubic_rate_offset(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray | None) -> np.ndarray:
+    return _cubic_offset(spec, t, temp, rate) + spec["rate_coef"] * rate
 
 
 def _network_out(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -377,6 +395,33 @@ def _elman_streamed(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, seco
         out[a:b] = _unscaled(spec, h @ w2 + spec["b2"])
         context = h[-1]
     return out
+
+
+# -- what each kind of spec runs -------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Kind:
+    """How the export runs one kind of spec: whether it reads the trailing rate window, its
+    operations per sample and the update's lines that compute ``offset`` (or, for an inverse
+    network, ``estimate``), its numpy reference (:func:`streamed_offset`), its state slots
+    besides the clock and the counters, and whether it is a network (whose weights the source
+    holds)."""
+
+    rated: bool
+    code: Callable[[dict[str, Any]], tuple[str, list[str]]]
+    offset: Callable[[dict[str, Any], np.ndarray, np.ndarray, np.ndarray | None], np.ndarray]
+    slots: Callable[[dict[str, Any]], list[str]] = lambda spec: []
+    network: bool = False
+
+
+def _kind(spec: dict[str, Any]) -> _Kind:
+    """The kind of ``spec``: by its method, a network (on ``[T, dT/dt]``, or ``inverse``) otherwise."""
+    return _INVERSE if is_inverse(spec) else _KINDS.get(spec["method"], _NETWORK)
+
+
+def _no_offset(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray | None) -> np.ndarray:
+    raise ValueError(f"{spec['method']}: an inverse network returns the input, not an offset (streamed_corrected)")
 
 
 # -- the C sources ----------------------------------------------------------------------------------
@@ -424,9 +469,10 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
     method = spec["method"]
     up = name.upper()
     inverse = is_inverse(spec)
-    rated = method not in ("poly3", "model") and not inverse
+    kind = _kind(spec)
+    rated = kind.rated
     recurrent = "wc" in spec
-    slots = _model_slots(spec) if method == "model" else []
+    slots = kind.slots(spec)
     h = int(spec.get("hidden", 0))
     cap = int(spec.get("rate_capacity", 0))
     # the state: doubles (clock, ring times), reals (ring temperatures, Elman's), int32 counters
@@ -434,20 +480,7 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
     reals = (cap if rated else 0) + (3 * h + 2 if recurrent else 0) + len(slots)
     ints = 1 + (3 if rated else 0) + (2 if recurrent else 0)
     sizes = {"double": _state_bytes(doubles, reals, ints, 8), "float": _state_bytes(doubles, reals, ints, 4)}
-    if method == "model":
-        flops, body = _model_body(spec)
-    elif method == "poly3":
-        flops, body = "8", _cubic_body(spec)
-    elif method == "poly3_rate":
-        flops, body = f"10 + 9 n, n the samples in the rate window (at most {cap}: {10 + 9 * cap})", _cubic_body(spec)
-    else:
-        per = 8 + 4 * h + 2 * h + 6 + (6 if recurrent else 0)
-        flops = (f"{per} and {h} tanh" if inverse else
-                 f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})")
-        if recurrent:
-            flops += (f"; and {2 * h * h + h} more once per "
-                      + (f"{spec['bin_s']:g}-s bin" if spec["bin_s"] > 0 else "sample"))
-        body = ""
+    flops, body = kind.code(spec)
     if inverse:
         held = ("the temperature held to its training range, {:g} to {:g} degC".format(*spec["temp_range_c"])
                 if np.all(np.isfinite(spec["temp_range_c"])) else "the temperature not held")
@@ -458,7 +491,7 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
     else:
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
                    (" * the offset, over the scale factor s(T_die) (the input that explains the reading)."
-                    if method == "model" and "scale_factor" in spec else " * the offset.")]
+                    if "scale_factor" in spec else " * the offset.")]
     lines = [f"/* {name}.h: temperature compensation by the {method} method, exported by tcbench export formats=[c].",
              *([f" * {about}"] if about else []),
              " *",
@@ -503,8 +536,63 @@ void {name}_init({name}_state *s);
 
 #endif
 """
-    source = _source(spec, name, up, body, rated, recurrent, h)
+    source = _source(spec, name, up, body, kind)
     return CSource(header, source, sizes, flops)
+
+
+def _cubic_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    return "8", [_cubic_body(spec).rstrip("\n")]
+
+
+def _cubic_rate_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    cap = int(spec["rate_capacity"])
+    return (f"10 + 9 n, n the samples in the rate window (at most {cap}: {10 + 9 * cap})",
+            [_cubic_body(spec).rstrip("\n"), f"    offset = offset + (R){_lit(spec['rate_coef'])} * rate;"])
+
+
+def _model_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    flops, body = _model_body(spec)
+    return flops, [body.rstrip("\n")]
+
+
+def _network_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    """A network's operations per sample, and the update's lines that run it (an Elman once per
+    time bin or sample, from the context of the previous one)."""
+    h, cap = int(spec["hidden"]), int(spec.get("rate_capacity", 0))
+    recurrent = "wc" in spec
+    names, result = _NETWORK_IO[is_inverse(spec)]
+    per = 8 + 4 * h + 2 * h + 6 + (6 if recurrent else 0)
+    flops = (f"{per} and {h} tanh" if is_inverse(spec) else
+             f"{per} + 9 n and {h} tanh, n the samples in the rate window (at most {cap}: {per + 9 * cap})")
+    if not recurrent:
+        return flops, [f"    R hidden[{h}];", f"    R {result} = network({names[0]}, {names[1]}, B1, hidden);"]
+    flops += f"; and {2 * h * h + h} more once per " + (f"{spec['bin_s']:g}-s bin" if spec["bin_s"] > 0 else "sample")
+    return flops, [
+        f"    R {result};",
+        (f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});" if spec["bin_s"] > 0
+         else "    int bin = s->samples;  /* a network trained on every sample steps every sample */"),
+        "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
+        "        int i, j;",
+        f"        for (j = 0; j < {h}; j++) s->context[j] = s->pending[j];",
+        f"        for (i = 0; i < {h}; i++) {{",
+        "            R a = 0;",
+        f"            for (j = 0; j < {h}; j++) a += W_C[i][j] * s->context[j];",
+        "            s->drive[i] = a + B1[i];",
+        "        }",
+        "        s->bin_count = 0;",
+        "        s->bin_sum[0] = 0;",
+        "        s->bin_sum[1] = 0;",
+        "    }",
+        "    s->bin = bin;",
+        "    s->bin_count++;",
+        f"    s->bin_sum[0] += {names[0]};",
+        f"    s->bin_sum[1] += {names[1]};",
+        f"    {result} = network(s->bin_sum[0] / (R)s->bin_count, s->bin_sum[1] / (R)s->bin_count, "
+        "s->drive, s->pending);"]
+
+
+# a network's two inputs and what its update computes, by whether it is an inverse one
+_NETWORK_IO = {False: (("temperature_c", "rate"), "offset"), True: (("raw", "temperature_c"), "estimate")}
 
 
 def _cubic_body(spec: dict[str, Any]) -> str:
@@ -577,10 +665,10 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
 
 
-def _source(spec: dict[str, Any], name: str, up: str, body: str, rated: bool, recurrent: bool, h: int) -> str:
-    method = spec["method"]
+def _source(spec: dict[str, Any], name: str, up: str, body: list[str], kind: _Kind) -> str:
+    rated, recurrent, h = kind.rated, "wc" in spec, int(spec.get("hidden", 0))
     inverse = is_inverse(spec)  # the network's inputs, and what update returns
-    names, result = (("raw", "temperature_c"), "estimate") if inverse else (("temperature_c", "rate"), "offset")
+    names, _ = _NETWORK_IO[inverse]
     parts = [f"/* {name}.c: see {name}.h. */\n#include <math.h>\n#include \"{name}.h\"\n\ntypedef {name}_real R;\n"
              f"#ifdef {up}_FLOAT\n#define TC_EXP expf\n#define TC_TANH tanhf\n#else\n#define TC_EXP exp\n"
              "#define TC_TANH tanh\n#endif\n"]
@@ -625,7 +713,7 @@ static R rate_c_per_s({name}_state *s, R temperature_c)
     return sxx > 0 ? sxy / sxx : 0;
 }}
 """)
-    if method not in ("poly3", "poly3_rate", "model"):
+    if kind.network:
         low, high = spec["x_low"], spec["x_high"]
         span = [hi - lo if hi - lo > 0 else 1.0 for lo, hi in zip(low, high)]
         y_span = spec["y_high"] - spec["y_low"]
@@ -676,42 +764,22 @@ static R network(R {names[0]}, R {names[1]}, const R *drive, R *hidden)
         update.append("    {\n    R rate = rate_c_per_s(s, temperature_c);")
     else:
         update.append("    {")
-    if method == "model":
-        update.append(body.rstrip("\n"))
-    elif method in ("poly3", "poly3_rate"):
-        update.append(body.rstrip("\n"))
-        if method == "poly3_rate":
-            update.append(f"    offset = offset + (R){_lit(spec['rate_coef'])} * rate;")
-    elif not recurrent:
-        update += [f"    R hidden[{h}];", f"    R {result} = network({names[0]}, {names[1]}, B1, hidden);"]
-    else:
-        update += [f"    R {result};",
-                   (f"    int bin = (int)floor(s->clock_s / {_lit(spec['bin_s'])});" if spec["bin_s"] > 0
-                    else "    int bin = s->samples;  /* a network trained on every sample steps every sample */"),
-                   "    if (s->bin_count > 0 && bin != s->bin) {  /* the previous bin is complete: its state is the context */",
-                   "        int i, j;",
-                   f"        for (j = 0; j < {h}; j++) s->context[j] = s->pending[j];",
-                   f"        for (i = 0; i < {h}; i++) {{",
-                   "            R a = 0;",
-                   f"            for (j = 0; j < {h}; j++) a += W_C[i][j] * s->context[j];",
-                   "            s->drive[i] = a + B1[i];",
-                   "        }",
-                   "        s->bin_count = 0;",
-                   "        s->bin_sum[0] = 0;",
-                   "        s->bin_sum[1] = 0;",
-                   "    }",
-                   "    s->bin = bin;",
-                   "    s->bin_count++;",
-                   f"    s->bin_sum[0] += {names[0]};",
-                   f"    s->bin_sum[1] += {names[1]};",
-                   f"    {result} = network(s->bin_sum[0] / (R)s->bin_count, s->bin_sum[1] / (R)s->bin_count, "
-                   "s->drive, s->pending);"]
-    scaled = method == "model" and "scale_factor" in spec
+    update += body
+    scaled = "scale_factor" in spec
     back = ("    return estimate;  /* the network's estimate of the input */" if inverse else
             "    return (raw - offset) / scale;" if scaled else "    return raw - offset;")
     update += [back, "    }", "}\n"]
     parts.append("\n".join(update))
     return "".join(parts)
+
+
+_KINDS = {
+    "poly3": _Kind(False, _cubic_code, _cubic_offset),
+    "poly3_rate": _Kind(True, _cubic_rate_code, _cubic_rate_offset),
+    "model": _Kind(False, _model_code, lambda spec, t, temp, rate: _model_streamed(spec, t, temp), _model_slots),
+}
+_NETWORK = _Kind(True, _network_code, lambda spec, t, temp, rate: _network_out(spec, t, temp, rate), network=True)
+_INVERSE = _Kind(False, _network_code, _no_offset, network=True)
 
 
 def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = "") -> list[Path]:
