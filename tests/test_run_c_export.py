@@ -63,21 +63,12 @@ def test_the_compiled_run_network_gives_the_runs_compensation(trained: dict, lea
     env, doc = trained[learner]
     assert doc["sensor"] == "accel" and doc["unit"] == "g" and list(doc["device"]) == [learner]
     spec = json.loads(json.dumps(doc["device"][learner]))  # as the artifact holds it
-    name = f"tc_accel_{learner}"
-    write_c(spec, name, tmp_path)
-    (tmp_path / "host.c").write_text(HOST.replace("UPNAME", name.upper()).replace("NAME", name))
-    exe = tmp_path / name
-    flags = [f"-D{name.upper()}_FLOAT"] if build == "float" else []
-    subprocess.run([CC, "-std=c99", "-O2", *flags, str(tmp_path / "host.c"), str(tmp_path / f"{name}.c"), "-lm",
-                    "-o", str(exe)], check=True)
     tr = env.data.test[0]
     rec = tr.recording
     t_s, temp_c, raw = rec.time_s, rec.temperature_c, rec.output
     dt_s = np.r_[0.0, np.diff(t_s)]
-    lines = "".join(f"{a.hex()} {b.hex()} {c.hex()}\n" for a, b, c in zip(temp_c.tolist(), raw.tolist(), dt_s.tolist()))
-    done = subprocess.run([str(exe)], input=lines, capture_output=True, text=True, check=True)
-    got = np.array([float.fromhex(v) for v in done.stdout.split()])
-    assert "dropped 0" in done.stderr
+    got, stderr = _streamed_by_c(spec, f"tc_accel_{learner}", rec, build, tmp_path)
+    assert "dropped 0" in stderr
     box = env.data.input_range(env._x)
     want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)  # the run's own compensation
     bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
@@ -155,8 +146,9 @@ def test_the_compiled_fulltemp_network_estimates_the_input_as_the_task_does(full
         assert np.sqrt(np.mean((want - rec.input) ** 2)) < np.sqrt(np.mean(rec.input ** 2))
 
 
-def _streamed_by_c(spec: dict, name: str, rec: object, build: str, folder: Path) -> np.ndarray:
-    """``spec`` written as C, compiled in ``build`` and run sample by sample over ``rec``."""
+def _streamed_by_c(spec: dict, name: str, rec: object, build: str, folder: Path) -> tuple[np.ndarray, str]:
+    """``spec`` written as C, compiled in ``build`` and run sample by sample over ``rec``: its
+    outputs, and what the host program printed on stderr."""
     write_c(spec, name, folder)
     (folder / "host.c").write_text(HOST.replace("UPNAME", name.upper()).replace("NAME", name))
     exe = folder / name
@@ -167,7 +159,7 @@ def _streamed_by_c(spec: dict, name: str, rec: object, build: str, folder: Path)
     lines = "".join(f"{a.hex()} {b.hex()} {c.hex()}\n"
                     for a, b, c in zip(rec.temperature_c.tolist(), rec.output.tolist(), dt_s.tolist()))
     done = subprocess.run([str(exe)], input=lines, capture_output=True, text=True, check=True)
-    return np.array([float.fromhex(v) for v in done.stdout.split()])
+    return np.array([float.fromhex(v) for v in done.stdout.split()]), done.stderr
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
@@ -191,7 +183,7 @@ def test_a_runs_cubic_runs_on_the_device_as_the_task_compensates(task: str, offs
     warmer = replace(test, recording=replace(test.recording, data=data))
     for tr in (test, warmer):
         raw = tr.recording.output
-        got = _streamed_by_c(spec, "tc_poly", tr.recording, build, tmp_path)
+        got, _ = _streamed_by_c(spec, "tc_poly", tr.recording, build, tmp_path)
         want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)
         bound = TOLERANCE[build] * np.maximum(np.abs(want), np.max(np.abs(raw)))
         assert np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
