@@ -85,6 +85,9 @@ class SelectionSettings:
         2.0, "Akaike's penalty per added parameter, subtracted from the held-out gain", NONNEGATIVE)
     wald_threshold: float = setting(
         25.0, "cluster-robust Wald statistic a kept effect must exceed; calibrated with the gain threshold")
+    wald_lags: int = setting(
+        4, "neighbouring Wald clusters whose score covariances enter the robust variance (Bartlett weights): "
+           "noise correlated over up to this many clusters (an hour at 900 s) is not taken for an effect", COUNT)
     most_of_excess: float = setting(
         0.5, "an effect removing this share of the held-out error above the noise is tried by the surrogate "
              "test when the Wald test rejects it", SHARE)
