@@ -251,8 +251,13 @@ class ThermometerSettings:
                                                "is dithered")
     periods: float = setting(3.0, "staircase periods the widened smoothing window spans")
     rate_window_s: float = setting(1800.0, "window of the local line that gives the typical ramp rate")
-    moving_share: float = setting(0.2, "a sample is on a ramp when its |rate| is above this share of the 90th "
-                                       "percentile", SHARE)
+    max_window_share: float = setting(
+        0.25, "the rate window and the widened smoothing window are at most this share of the record, so a "
+              "short record is not rated or smoothed over most of its length", SHARE)
+    fast_quantile: float = setting(0.9, "quantile of |rate| that stands for the fast ramps (a quantile, not the "
+                                        "largest: one fast corner does not set it)", PROBABILITY)
+    moving_share: float = setting(0.2, "a sample is on a ramp when its |rate| is above this share of the "
+                                       "fast_quantile of |rate|", SHARE)
 
 
 @dataclass(frozen=True)
