@@ -11,7 +11,7 @@ import numpy as np
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
-from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
+from tcbench.diagnose.terms.detectors import MIN_PERIOD_BINS, bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log
 from tcbench.sensors.effects import DutyCycle, Effect, GatedPeriodic, Periodic
 
@@ -46,7 +46,7 @@ def _why_no_part(t_s: np.ndarray, min_cycles: float, what: str, detectors: Detec
     the whole record."""
     span = float(t_s[-1] - t_s[0])
     longest = GATED_MAX_PART * span / min_cycles
-    shortest = 3.0 * bin_width(t_s, detectors.line_bins, detectors.min_bin_s)
+    shortest = MIN_PERIOD_BINS * bin_width(t_s, detectors.line_bins, detectors.min_bin_s)
     if longest >= shortest:
         return None
     return (f"{what} present in part of the record needs {min_cycles:g} cycles inside "
