@@ -183,3 +183,50 @@ def test_a_diagnosis_runs_with_its_settings_and_its_report_records_them() -> Non
     assert "Settings that differ" not in render_markdown(default, {})
     assert ("`selection.detection_threshold_sigma2 = 1000000.0` (default 10.0)"
             in render_markdown(high, {}))
+
+
+def test_the_wald_lags_reach_the_selections_robust_wald_test() -> None:
+    """settings.selection.wald_lags is robust_wald's default and the scorer of the selection passes
+    its own: on noise correlated over many clusters (a random walk) the lags add the clusters'
+    covariances to the variance, so the statistic changes with them."""
+    from tcbench.diagnose.select.attribute import _Scorer
+    from tcbench.diagnose.select.crossval import block_folds, robust_wald
+    from tcbench.diagnose.select.design import Designer, Model
+    from tcbench.diagnose.signals import DiagnosisData
+
+    rng = np.random.default_rng(5)
+    n = 3200
+    t = np.arange(n, dtype=float)
+    temp = 30.0 + 20.0 * np.sin(2.0 * np.pi * t / 3600.0)
+    walk = np.cumsum(rng.standard_normal(n))
+    data = DiagnosisData("msra", "Hz", t, temp, temp, np.gradient(temp, t), np.zeros(n), 0.002 * t + walk,
+                         np.zeros(n, dtype=int), 1.0, 1.0, 120.0)
+    fold, cluster = block_folds(t, 160.0, 5), (t // 100.0).astype(np.int64)
+    base, model = Model(), Model().with_effect("aging_drift", None)
+    scorers = {lags: _Scorer(Designer(data), fold, 5, cluster, replace(DEFAULTS.selection, wald_lags=lags))
+               for lags in (0, DEFAULTS.selection.wald_lags)}
+    walds = {lags: robust_wald(s.fit(base), s.fit(model), cluster, lags) for lags, s in scorers.items()}
+    default = scorers[DEFAULTS.selection.wald_lags]
+    assert robust_wald(default.fit(base), default.fit(model), cluster) == walds[DEFAULTS.selection.wald_lags]
+    assert walds[0] != pytest.approx(walds[DEFAULTS.selection.wald_lags], rel=0.05)
+    for lags, scorer in scorers.items():
+        assert scorer.wald(base, model) == walds[lags]  # below the known-noise statistic: the robust one decides
+
+
+def test_the_thermometer_windows_share_and_quantile_reach_the_staircase_screen() -> None:
+    """screens.thermometer.max_window_share caps the widened smoothing window at that share of the
+    record; fast_quantile picks the |rate| that stands for the ramps (a quantile in the soak reads none)."""
+    from tcbench.diagnose.screens.quantisation import thermometer_steps
+
+    rng = np.random.default_rng(24)
+    t = np.arange(0.0, 6 * 3600.0)
+    rate = 0.1 / 60.0  # degC/s: a whole degree every 600 s
+    reading = np.round(10.3 + np.minimum(t, 3 * 3600.0) * rate + 0.02 * rng.standard_normal(t.size))
+    thermo = DEFAULTS.screens.thermometer
+    default = thermometer_steps(t, reading, 120.0)
+    capped = thermometer_steps(t, reading, 120.0, replace(thermo, max_window_share=0.01))
+    soak = thermometer_steps(t, reading, 120.0, replace(thermo, fast_quantile=0.3))
+    assert default is not None and capped is not None and soak is not None
+    assert default.smooth_s == pytest.approx(thermo.periods * 600.0, rel=0.05)
+    assert capped.smooth_s == pytest.approx(0.01 * t[-1])
+    assert default.rate_c_per_s == pytest.approx(rate, rel=0.05) and soak.rate_c_per_s < 0.5 * rate

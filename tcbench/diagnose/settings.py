@@ -85,6 +85,9 @@ class SelectionSettings:
         2.0, "Akaike's penalty per added parameter, subtracted from the held-out gain", NONNEGATIVE)
     wald_threshold: float = setting(
         25.0, "cluster-robust Wald statistic a kept effect must exceed; calibrated with the gain threshold")
+    wald_lags: int = setting(
+        4, "neighbouring Wald clusters whose score covariances enter the robust variance (Bartlett weights): "
+           "noise correlated over up to this many clusters (an hour at 900 s) is not taken for an effect", COUNT)
     most_of_excess: float = setting(
         0.5, "an effect removing this share of the held-out error above the noise is tried by the surrogate "
              "test when the Wald test rejects it", SHARE)
@@ -248,8 +251,13 @@ class ThermometerSettings:
                                                "is dithered")
     periods: float = setting(3.0, "staircase periods the widened smoothing window spans")
     rate_window_s: float = setting(1800.0, "window of the local line that gives the typical ramp rate")
-    moving_share: float = setting(0.2, "a sample is on a ramp when its |rate| is above this share of the 90th "
-                                       "percentile", SHARE)
+    max_window_share: float = setting(
+        0.25, "the rate window and the widened smoothing window are at most this share of the record, so a "
+              "short record is not rated or smoothed over most of its length", SHARE)
+    fast_quantile: float = setting(0.9, "quantile of |rate| that stands for the fast ramps (a quantile, not the "
+                                        "largest: one fast corner does not set it)", PROBABILITY)
+    moving_share: float = setting(0.2, "a sample is on a ramp when its |rate| is above this share of the "
+                                       "fast_quantile of |rate|", SHARE)
 
 
 @dataclass(frozen=True)

@@ -22,9 +22,11 @@ from tcbench.sensors.effects import play_operator
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments
 
-MAD_TO_SIGMA = 1.4826
+MAD_TO_SIGMA = 1.4826  # standard deviation of a normal sample from its median absolute deviation
 GRID_S = 1.0  # clock of the lag filter and the play operator
 MAX_GRID_SAMPLES = 5_000_000  # that clock over the recording: 58 days at 1 s
+MIN_NOISE_DIFFS = 10  # first differences at constant input a white sigma is measured from, at least
+INPUT_CHANGE_TOL = 1e-9  # relative to the largest |input| (or 1): a smaller change is float rounding, not a new level
 
 
 class DiagnosisDataError(ValueError):
@@ -54,6 +56,9 @@ def local_linear(t_s: np.ndarray, x: np.ndarray, window_s: float | np.ndarray) -
 
 
 MIN_WINDOW_SAMPLES = 10  # a fitted smoothing window never holds fewer samples than this
+MIN_SAVGOL_SAMPLES = 5  # the local quadratic needs this many samples in its window: three would interpolate them
+SPARSE_SPACINGS = 3.0  # a sparse segment's local line spans this many of its own spacings, to reach its neighbours
+NOISE_SEED = 0  # the white noise that measures a window's noise share: fixed, so a diagnosis is repeatable
 FFT_WINDOW = 255  # longer Savitzky-Golay windows convolve by FFT (a 120 s window at 100 Hz holds 12001 samples)
 
 
@@ -115,7 +120,7 @@ def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
         w = round(window_s * fs) | 1
         if MIN_WINDOW_SAMPLES <= n < w:  # a burst: its own samples, not a line across the gaps
             w = n if n % 2 else n - 1
-        if n >= w >= 5:
+        if n >= w >= MIN_SAVGOL_SAMPLES:
             value[a:b] = savgol(temp_c[a:b], w)
             if rate is not None:
                 rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
@@ -136,7 +141,7 @@ def _sparse_window_s(t_s: np.ndarray, bounds: np.ndarray, window_s: float) -> np
         return np.full(t_s.size, float(window_s))
     gap = first[1:] - last[:-1]
     wider = np.maximum(np.concatenate(([gap[0]], gap)), np.concatenate((gap, [gap[-1]])))
-    per_segment = np.maximum(window_s, 3.0 * (last - first + wider))
+    per_segment = np.maximum(window_s, SPARSE_SPACINGS * (last - first + wider))
     return np.repeat(per_segment, np.diff(bounds))
 
 
@@ -162,7 +167,7 @@ def fitted_window_s(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
     starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
     ends = np.append(starts[1:], t_s.size) - 1
     longest_s = float(np.max(t_s[ends] - t_s[starts]))  # a burst shorter than the window is smoothed whole
-    rng = np.random.default_rng(0)
+    rng = np.random.default_rng(NOISE_SEED)
     white = rng.standard_normal(t_s.size)
     w = float(min(window_s, longest_s)) if longest_s * rate_hz >= 2 * MIN_WINDOW_SAMPLES else float(window_s)
     while w / 2.0 * rate_hz >= MIN_WINDOW_SAMPLES:
@@ -275,11 +280,11 @@ def prepare(
             f"temperature varies by only {span:.3g} degC (need at least {min_span_c:g} degC): "
             "a temperature model cannot be identified at constant temperature")
     gap = np.diff(segments(t)) > 0
-    changed = np.abs(np.diff(u)) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
+    changed = np.abs(np.diff(u)) > INPUT_CHANGE_TOL * max(1.0, float(np.max(np.abs(u))))
     run_id = np.concatenate(([0], np.cumsum(gap | changed)))
     same = ~(gap | changed)
     d = np.diff(y)[same]
-    if d.size < 10:
+    if d.size < MIN_NOISE_DIFFS:
         raise DiagnosisDataError("too few consecutive samples at constant input to measure the noise")
     sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
     if not sigma > 0:  # most steps zero: an output on a coarse grid; the RMS of the steps still measures it

@@ -64,7 +64,7 @@ from tcbench.diagnose.screens.quantisation import OutputQuantisation, find_outpu
 from tcbench.diagnose.screens.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens.thermometer_glitches import glitches
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, RateSettings
-from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisDataError
+from tcbench.diagnose.signals import INPUT_CHANGE_TOL, MAD_TO_SIGMA, MIN_NOISE_DIFFS, DiagnosisDataError
 from tcbench.sensors.recording import Recording
 from tcbench.sensors.segments import segments, within_rate_hz
 
@@ -185,7 +185,7 @@ def run_starts(t_s: np.ndarray, input_: np.ndarray) -> np.ndarray:
     """Per sample, whether it starts a run: the first sample, one after a gap
     (:func:`~tcbench.sensors.segments.segments`) or one whose input differs from the one before."""
     gap = np.diff(segments(t_s)) > 0
-    changed = np.abs(np.diff(input_)) > 1e-9 * max(1.0, float(np.max(np.abs(input_))) if input_.size else 1.0)
+    changed = np.abs(np.diff(input_)) > INPUT_CHANGE_TOL * max(1.0, float(np.max(np.abs(input_))) if input_.size else 1.0)
     return np.concatenate(([True], gap | changed))
 
 
@@ -194,7 +194,7 @@ def _sigma(y: np.ndarray, same: np.ndarray, step: float, clip_sigma: float, fall
     run, both kept): the MAD's, or on a lattice of ``step`` the RMS of differences clipped at
     ``clip_sigma`` times the larger of it and the step (as the quantisation screen measures it)."""
     d = np.diff(y)[same]
-    if d.size < 10:
+    if d.size < MIN_NOISE_DIFFS:
         return fallback
     sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
     if not sigma > 0:

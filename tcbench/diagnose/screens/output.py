@@ -15,7 +15,7 @@ from tcbench.diagnose.screens.quantisation import OutputQuantisation, find_outpu
 from tcbench.diagnose.screens.saturation import Saturation, find_saturation
 from tcbench.diagnose.screens.screen import BEFORE, Screen, ScreenInput, ScreenResult
 from tcbench.diagnose.settings import DEFAULTS, ScreenSettings
-from tcbench.diagnose.signals import MAD_TO_SIGMA, DiagnosisData
+from tcbench.diagnose.signals import MAD_TO_SIGMA, MIN_NOISE_DIFFS, DiagnosisData
 
 
 def _differences(data: DiagnosisData) -> np.ndarray:
@@ -29,7 +29,7 @@ def white_sigma(data: DiagnosisData) -> float:
     """The white sigma from first differences of consecutive kept samples in one run (as
     :func:`~tcbench.diagnose.signals.prepare` does, after samples were removed)."""
     d = _differences(data)
-    if d.size < 10:
+    if d.size < MIN_NOISE_DIFFS:
         return data.white_sigma
     sigma = float(MAD_TO_SIGMA * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
     return sigma if sigma > 0 else data.white_sigma
@@ -42,7 +42,7 @@ def quantised_sigma(data: DiagnosisData, step: float,
     the MAD estimate and the step. The MAD of differences that take a few lattice values is
     not a sigma (for noise of sigma 1 on a grid of 1.5 it reads 1.57 where the truth is 1.09)."""
     d = _differences(data)
-    if d.size < 10:
+    if d.size < MIN_NOISE_DIFFS:
         return data.white_sigma
     bound = clip_sigma * max(data.white_sigma, step)
     return float(np.sqrt(np.mean(np.minimum(np.abs(d), bound) ** 2) / 2.0))

@@ -20,9 +20,9 @@ it (the reading's spread about its smoothed value at least ``dither_spread_steps
 staircase averages out in the diagnosis' smoothing; without it, a window shorter than a few
 staircase periods ``q / |dT/dt|`` follows the steps, up to ``q / 2`` off. :func:`thermometer_steps`
 then reports the staircase (id ``thermometer_quantisation``) and widens the smoothing window to
-``periods`` staircase periods at the record's typical ramp rate (capped at a quarter of the
-record). Measured on a 0-40 degC triangle read in whole degrees with 0.02 degC of noise, the
-smoothed temperature's RMS error: 0.26 degC with the 120 s window at 0.1 degC/min, 0.020 with
+``periods`` staircase periods at the record's typical ramp rate (capped at ``max_window_share``,
+a quarter, of the record). Measured on a 0-40 degC triangle read in whole degrees with 0.02 degC
+of noise, the smoothed temperature's RMS error: 0.26 degC with the 120 s window at 0.1 degC/min, 0.020 with
 3 periods (1800 s), and 0.22 vs 0.029 at 0.3 degC/min; wider windows lose at the ramps' corners.
 Through a soak at a temperature between two steps the undithered reading stays up to ``q / 2``
 off for the whole soak, which no window recovers: on the concealed MSRA profile (soaks of 35-50
@@ -47,6 +47,8 @@ from tcbench.diagnose.settings import (
 )
 from tcbench.diagnose.signals import local_linear
 
+JUMP_FLOOR = 1e-9  # relative to the largest |value|: a smaller jump is float rounding, not a step of the lattice
+
 OUTPUT_EXPLANATION = ("the output sits on a grid: the resolution of the converter or frequency counter, or a "
                       "fixed-point register; below about one step of noise the grid adds q^2/12 of variance and, "
                       "without dither, a staircase the model cannot follow")
@@ -69,7 +71,7 @@ def lattice_step(values: np.ndarray, settings: QuantisationSettings = DEFAULTS.s
     y = y[np.isfinite(y)]
     if y.size < 2:
         return None
-    floor = 1e-9 * max(float(np.max(np.abs(y))), 1e-300)
+    floor = JUMP_FLOOR * max(float(np.max(np.abs(y))), 1e-300)
     jumps = np.abs(np.diff(y))
     jumps = jumps[jumps > floor]
     if jumps.size < settings.min_jumps:
@@ -174,13 +176,14 @@ def thermometer_steps(t_s: np.ndarray, temp_c: np.ndarray, default_smooth_s: flo
     duration_s = float(t_s[-1] - t_s[0])
     value, _ = local_linear(t_s, temp_c, min(default_smooth_s, duration_s))
     spread = float(np.std(temp_c - value)) / q
-    _, slow_rate = local_linear(t_s, temp_c, min(settings.rate_window_s, 0.25 * duration_s))
+    _, slow_rate = local_linear(t_s, temp_c, min(settings.rate_window_s, settings.max_window_share * duration_s))
     speed = np.abs(slow_rate)
-    top = float(np.quantile(speed, 0.9))
+    top = float(np.quantile(speed, settings.fast_quantile))
     typical = float(np.median(speed[speed >= settings.moving_share * top])) if top > 0 else 0.0
     period = q / typical if typical > 0 else np.inf
     staircase = spread < settings.dither_spread_steps
     window = default_smooth_s
     if staircase:
-        window = float(np.clip(settings.periods * period, default_smooth_s, max(default_smooth_s, 0.25 * duration_s)))
+        window = float(np.clip(settings.periods * period, default_smooth_s,
+                               max(default_smooth_s, settings.max_window_share * duration_s)))
     return ThermometerSteps(q, spread, typical, float(period), window, default_smooth_s, staircase, settings)

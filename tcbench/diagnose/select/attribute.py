@@ -118,7 +118,7 @@ class _Scorer:
     def wald(self, base: Model, model: Model) -> float:
         """Robust Wald statistic (cluster covariance), never above the one with the known
         white-plus-thermometer variance."""
-        robust = robust_wald(self.fit(base), self.fit(model), self.cluster)
+        robust = robust_wald(self.fit(base), self.fit(model), self.cluster, self.selection.wald_lags)
         z = self.fit(base).residual - self.fit(model).residual
         known = float(z @ self.fit(base).residual) ** 2 / max(self._noise(base, model)[1], 1e-300)
         return min(robust, known)

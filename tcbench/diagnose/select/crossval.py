@@ -12,6 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcbench.diagnose.settings import DEFAULTS
+
 RIDGE = 1e-10  # relative to the Gram's mean diagonal, for numerically rank-deficient designs
 
 
@@ -59,17 +61,17 @@ def fit_cv(x: np.ndarray, y: np.ndarray, fold: np.ndarray, k: int) -> Fit:
     return Fit(beta / scale, float(resid_fit @ resid_fit), float(heldout @ heldout), resid_fit, heldout)
 
 
-def robust_wald(base: Fit, model: Fit, cluster: np.ndarray, lags: int = 4) -> float:
+def robust_wald(base: Fit, model: Fit, cluster: np.ndarray, lags: int = DEFAULTS.selection.wald_lags) -> float:
     """Wald statistic of what ``model`` adds to the nested ``base``, with a variance robust to
     slow noise: ``z = r_base - r_model`` is the added fitted signal, ``s_c = z_c' e_c`` its
     score per cluster ``c`` (contiguous time spans, ``e`` the model's held-out residual), and
 
         W = (z' r_base)^2 / (sum_c s_c^2 + 2 sum_{l=1..L} (1 - l / (L + 1)) sum_c s_c s_{c+l})
 
-    (Bartlett-weighted covariances of neighbouring clusters, L = ``lags``). Under white noise
-    it is about chi-square(1); noise that is correlated over minutes to hours (flicker, a
-    smoothed thermometer) inflates the denominator as much as the numerator, where a
-    white-noise test would call it significant."""
+    (Bartlett-weighted covariances of neighbouring clusters, L = ``lags``, by default
+    ``settings.selection.wald_lags``). Under white noise it is about chi-square(1); noise that is
+    correlated over minutes to hours (flicker, a smoothed thermometer) inflates the denominator
+    as much as the numerator, where a white-noise test would call it significant."""
     z = base.residual - model.residual
     num = float(z @ base.residual) ** 2
     score = np.bincount(cluster, weights=z * model.heldout_residual)

@@ -42,12 +42,16 @@ import numpy as np
 from scipy.stats import chi2, norm
 
 from tcbench.diagnose.settings import DEFAULTS, LocateSettings
+from tcbench.diagnose.signals import MAD_TO_SIGMA
 from tcbench.sensors.segments import bounds, segments, within_rate_hz
 from tcbench.signal.allan import allan_deviation
 
 N_FAMILIES = 5  # time spans, temperature bands, heating/cooling, soak/ramp, frequency band
-MAD_TO_SIGMA = 1.4826
 SIGMA2_REL_VAR = 7.0  # N * var(sigma_hat^2 / sigma^2) for the MAD of first differences (measured)
+MAX_LAG1 = 0.99  # the residual's lag-1 autocorrelation is capped here: at 1 a group's effective count would vanish
+# the longest Allan tau is the record (in samples) over this: at N / 10 the overlapping estimator keeps about 13
+# degrees of freedom (``_edf``), enough for its chi-square bound
+ALLAN_RECORD_TAUS = 10
 
 
 @dataclass(frozen=True)
@@ -231,7 +235,7 @@ def _two_group_z(
 def _lag1(r: np.ndarray) -> float:
     e = r - r.mean()
     rho = float(np.dot(e[1:], e[:-1]) / np.dot(e, e)) if np.dot(e, e) > 0 else 0.0
-    return min(max(rho, 0.0), 0.99)
+    return min(max(rho, 0.0), MAX_LAG1)
 
 
 def _group_tests(
@@ -286,14 +290,14 @@ def why_no_allan(t: np.ndarray, min_samples: int = DEFAULTS.locate.min_allan_sam
     ``min_samples`` samples, inside one continuous segment), or None."""
     n = t.size
     longest, gaps = _longest_run(t)
-    if min(n // 10, (longest - 1) // 2) >= min_samples:
+    if min(n // ALLAN_RECORD_TAUS, (longest - 1) // 2) >= min_samples:
         return None
-    if gaps and (n - 1) // 2 >= min_samples and n // 10 >= min_samples:
+    if gaps and (n - 1) // 2 >= min_samples and n // ALLAN_RECORD_TAUS >= min_samples:
         return (f"the Allan deviation needs clusters of {min_samples} samples inside a continuous segment; the "
                 f"longest of this record's {gaps + 1} segments (gaps of more than five sample intervals: bursts, "
                 f"or samples given zero weight) holds {longest}")
     return (f"the Allan deviation needs clusters of {min_samples} samples at a tenth of the record "
-            f"({10 * min_samples} samples); this record has {n}")
+            f"({ALLAN_RECORD_TAUS * min_samples} samples); this record has {n}")
 
 
 def _edf(n: np.ndarray | int, m: np.ndarray) -> np.ndarray:
@@ -333,7 +337,7 @@ def allan_excess(
     if why_no_allan(t, min_samples) is not None:
         return None
     longest, gaps = _longest_run(t)
-    m_max = min(n // 10, (longest - 1) // 2)
+    m_max = min(n // ALLAN_RECORD_TAUS, (longest - 1) // 2)
     m = min_samples * 2 ** np.arange(int(np.log2(m_max / min_samples)) + 1)
     if gaps:
         fs = within_rate_hz(t)

@@ -22,7 +22,16 @@ import numpy as np
 from tcbench.diagnose.settings import DEFAULTS, ReferenceSettings
 from tcbench.diagnose.signals import DiagnosisData, lagged
 
+# ridge penalties tried (relative to the mean diagonal of the standardised Gram): from 1e-8, a plain least
+# squares kept solvable, to 0.1, which shrinks every column; 15 log-spaced, two per decade
 ALPHAS = np.geomspace(1e-8, 1e-1, 15)
+DEGREE = 3  # powers of u up to this: the library's polynomial (temperature_cubic) and no further
+MIN_HALF_RANGE_C = 1.0  # u's half range (degC) at least this: a record spanning less is not scaled up
+# the shortest lag (s): half the smoothing window (a faster lag is what the smoothing already blurs), and at
+# least this many sample intervals
+MIN_LAG_WINDOWS = 0.5
+MIN_LAG_SAMPLES = 2.0
+MIN_LAG_RATIO = 2.0  # the longest lag at least this many times the shortest, on a short record
 
 
 @dataclass(frozen=True)
@@ -52,8 +61,8 @@ def lag_grid_s(data: DiagnosisData, settings: ReferenceSettings = DEFAULTS.refer
     """Time constants (s) of the reference's lags: from the smoothing window to ``max_lag_share``
     of the recording, ``n_lags`` log-spaced."""
     span = float(data.t_s[-1] - data.t_s[0])
-    lo = max(data.smooth_s / 2.0, 2.0 / data.sample_rate_hz)
-    hi = max(settings.max_lag_share * span, 2.0 * lo)
+    lo = max(data.smooth_s * MIN_LAG_WINDOWS, MIN_LAG_SAMPLES / data.sample_rate_hz)
+    hi = max(settings.max_lag_share * span, MIN_LAG_RATIO * lo)
     return np.geomspace(lo, hi, settings.n_lags)
 
 
@@ -62,10 +71,10 @@ def reference_terms(data: DiagnosisData, settings: ReferenceSettings = DEFAULTS.
     """Columns (n, p) of the reference library (without the intercept) and their names."""
     temp = data.temp_c
     centre = 0.5 * (temp.min() + temp.max())
-    half = max(0.5 * float(np.ptp(temp)), 1.0)
+    half = max(0.5 * float(np.ptp(temp)), MIN_HALF_RANGE_C)
     cols, names = [], []
     u = (temp - centre) / half
-    for p in (1, 2, 3):
+    for p in range(1, DEGREE + 1):
         cols.append(u**p)
         names.append(f"u^{p}")
     for tau in lag_grid_s(data, settings):

@@ -52,7 +52,7 @@ from tcbench.diagnose.short.short_tests import (
     temperature_slope,
     white_noise,
 )
-from tcbench.diagnose.signals import MAD_TO_SIGMA, fitted_window_s, smooth_temperature
+from tcbench.diagnose.signals import INPUT_CHANGE_TOL, MAD_TO_SIGMA, fitted_window_s, smooth_temperature
 from tcbench.diagnose.terms.temperature_shapes import NODE_SPANS, NODE_TAU_S
 from tcbench.sensors import kinds
 from tcbench.sensors.recording import Recording
@@ -230,8 +230,8 @@ def _tested(rec: Recording, sensor: str | None, name: str, settings: DiagnoseSet
         t, temp_s, rate, u, y = t[keep], temp_s[keep], rate[keep], u[keep], y[keep]
         n = t.size
     span_c = float(np.ptp(temp_s)) if n else 0.0
-    moves = n > 1 and np.ptp(u) > 1e-9 * max(1.0, float(np.max(np.abs(u))))
-    same = (np.diff(segments(t)) == 0) & (np.abs(np.diff(u)) <= 1e-9 * max(1.0, float(np.max(np.abs(u)))))
+    moves = n > 1 and np.ptp(u) > INPUT_CHANGE_TOL * max(1.0, float(np.max(np.abs(u))))
+    same = (np.diff(segments(t)) == 0) & (np.abs(np.diff(u)) <= INPUT_CHANGE_TOL * max(1.0, float(np.max(np.abs(u)))))
     sigma = _white_sigma(y, same) if n > 1 else 0.0
     columns = [np.ones(n), *([u] if moves else [])]
     starts = ramp_starts(t, rate, short.ramp_share) if span_c >= short.min_slope_span_c else np.empty(0)

@@ -19,6 +19,9 @@ class WarmupTerm(Term):
     effect = Warmup
     shape = "transient"
     param = "tau_s"
+    # tau_s (s): 2 min to 2 h, 14 log-spaced (1.37x apart; the selection's bounded search refines the best
+    # between its neighbours): a faster settling is over in the first minutes of a record, and a warm-up
+    # settles within the hour after power-on, so a slower decay is ageing's trend
     grid = np.geomspace(120.0, 7200.0, 14)
     flicker_mimics = True
     confirm_with = (

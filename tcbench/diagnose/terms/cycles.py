@@ -11,16 +11,19 @@ import numpy as np
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms.base import g3
-from tcbench.diagnose.terms.detectors import bin_width, duty_phase, line_window, why_no_lines
+from tcbench.diagnose.terms.detectors import MIN_PERIOD_BINS, bin_width, duty_phase, line_window, why_no_lines
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log
 from tcbench.sensors.effects import DutyCycle, Effect, GatedPeriodic, Periodic
 
 GATED_HARMONICS = 5  # a switched load (a compressor's duty cycle) is not a sinusoid: its level and harmonics
 GATED_MIN_CYCLES = 4.0  # a line present in part of the run must hold this many cycles there: flicker makes one or two
+GATED_MAX_PART = 0.8  # ... and be absent from more than this share of the span (else it is a periodic line)
 DUTY_MIN_CYCLES = 3.0  # a switched load's square cycle is a sharper shape than a line's: flicker does not mimic three
-GATED_MAX_PART = 0.8  # ... and be absent from more than this fraction of the span
 PERIOD_BAND = (0.9, 1.1)  # a period is refined within these factors of the detected one
-DUTY_BRACKET = 41  # a square cycle's drop has side maxima in the period: this grid brackets the best first
+DUTY_BRACKET = 41  # a square cycle's drop has side maxima in the period: this grid (points) brackets the best first
+EDGE_STEPS_PER_PERIOD = 16  # a gated span's edges are moved in steps of a period over this ...
+EDGE_REACH_PERIODS = 1.5  # ... within this many periods: demodulation places an edge only to about a period
+EDGE_GRID = 17  # points within one phase bin either way where a switched load's on and off instants are tried
 
 
 def windows(search: Search) -> list[tuple[float, float, float]]:
@@ -46,7 +49,7 @@ def _why_no_part(t_s: np.ndarray, min_cycles: float, what: str, detectors: Detec
     the whole record."""
     span = float(t_s[-1] - t_s[0])
     longest = GATED_MAX_PART * span / min_cycles
-    shortest = 3.0 * bin_width(t_s, detectors.line_bins, detectors.min_bin_s)
+    shortest = MIN_PERIOD_BINS * bin_width(t_s, detectors.line_bins, detectors.min_bin_s)
     if longest >= shortest:
         return None
     return (f"{what} present in part of the record needs {min_cycles:g} cycles inside "
@@ -56,11 +59,13 @@ def _why_no_part(t_s: np.ndarray, min_cycles: float, what: str, detectors: Detec
 
 def _refine_window(screen: Screen, term_id: str, value: Value, min_cycles: float) -> Value:
     """A gated line's value with each edge of its span (the last two entries) moved, on a grid
-    of a 16th of the period within 1.5 periods, to the largest in-sample drop: the demodulated
+    of a 16th of the period within 1.5 periods (:data:`EDGE_STEPS_PER_PERIOD`,
+    :data:`EDGE_REACH_PERIODS`), to the largest in-sample drop: the demodulated
     envelope places the edges only to about a period, and a switched load's level inside the
     span makes a misplaced edge costly. The span keeps ``min_cycles`` cycles."""
     period = value[0]
-    offsets = period * np.arange(-24, 25) / 16.0
+    reach = int(EDGE_REACH_PERIODS * EDGE_STEPS_PER_PERIOD)
+    offsets = period * np.arange(-reach, reach + 1) / float(EDGE_STEPS_PER_PERIOD)
     for edge in (len(value) - 2, len(value) - 1):
         moved = [(*value[:edge], float(value[edge] + off), *value[edge + 1:]) for off in offsets]
         moved = [v for v in moved if v[-1] - v[-2] >= min_cycles * period]
@@ -218,7 +223,7 @@ class DutyCycleTerm(_CycleInPart):
         cycle, which the Allan test would take for flicker."""
         period, on_s, duty, start, end = value
         step = period / screen.detectors.duty_phases
-        grid = np.linspace(-step, step, 17)
+        grid = np.linspace(-step, step, EDGE_GRID)
         on_s = max((on_s + g for g in grid), key=lambda x: screen.drop(self.id, (period, x, duty, start, end)))
         off = on_s + duty * period
         off = max((off + g for g in grid if 0.0 < off + g - on_s < period),

@@ -33,6 +33,17 @@ from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 
 DETECTORS = DEFAULTS.detectors
 
+# the detectors' own numbers, not settings: how finely they search, not what counts as found (the held-out
+# scoring decides that)
+MIN_SEGMENT_BINS = 2  # a change point leaves at least this many bins on either side (a single bin is an outlier)
+BINS_PER_CHANGE = 4  # at most one change point per this many bins of a short record
+MIN_PERIOD_BINS = 3.0  # the shortest period searched spans this many time bins (two is the bins' Nyquist limit)
+FREQS_PER_FOURIER_BIN = 2.0  # the periodogram's frequency step, per 1 / span: the scorer refines the period
+PEAK_DISTANCE = 4  # periodogram peaks (and the low edge against its neighbours) this many steps apart: 2 Fourier bins
+ENVELOPE_PERIODS = 2.0  # a line's demodulated amplitude is averaged over this many periods
+PRESENT_SHARE = 0.5  # a line is present where that amplitude is above this share of its peak
+BUMP_STEPS_PER_WIDTH = 8.0  # bump centres are tried a width over this apart (or one temperature bin, if wider)
+
 
 def binned(t_s: np.ndarray, r: np.ndarray, max_bins: int = DETECTORS.max_bins, min_bin_s: float = DETECTORS.min_bin_s
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
@@ -73,8 +84,8 @@ def step_times(t_s: np.ndarray, r: np.ndarray, settings: DetectorSettings = DETE
     out: list[float] = []
     cum = np.concatenate(([0.0], np.cumsum(r)))
     if mean.size >= settings.min_step_bins:
-        n_bkps = min(settings.n_changes, mean.size // 4)
-        algo = ruptures.Binseg(model="l2", min_size=2).fit(mean)
+        n_bkps = min(settings.n_changes, mean.size // BINS_PER_CHANGE)
+        algo = ruptures.Binseg(model="l2", min_size=MIN_SEGMENT_BINS).fit(mean)
         for b in algo.predict(n_bkps=n_bkps)[:-1]:
             around = 0.5 * (centre[b - 1] + centre[b])
             out.append(float(t_s[_refine_step(t_s, cum, around, width)]))
@@ -92,16 +103,17 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, settings: DetectorSettings = DE
     span = float(t_s[-1] - t_s[0])
     if mean.size < settings.min_line_bins:
         return []
-    f_lo, f_hi = settings.line_cycles / span, 1.0 / (3.0 * width)
+    f_lo, f_hi = settings.line_cycles / span, 1.0 / (MIN_PERIOD_BINS * width)
     if f_hi <= f_lo:
         return []
-    df = 0.5 / span  # two frequencies per Fourier bin; the period is refined by the scorer
+    df = 1.0 / (FREQS_PER_FOURIER_BIN * span)
     freq = np.arange(f_lo, f_hi, df)
     power = lombscargle(centre - centre[0], mean - np.average(mean, weights=count), 2.0 * np.pi * freq,
                         normalize=False)
-    peaks, _ = find_peaks(power, distance=4)
+    peaks, _ = find_peaks(power, distance=PEAK_DISTANCE)
     best = list(peaks[np.argsort(-power[peaks])][:settings.n_lines])
-    if power.size > 4 and power[0] > power[1:5].max():  # a slow line (under two cycles) peaks at the low edge
+    # a slow line (under two cycles) peaks at the low edge
+    if power.size > PEAK_DISTANCE and power[0] > power[1:PEAK_DISTANCE + 1].max():
         best.append(0)
     return [float(1.0 / freq[i]) for i in best]
 
@@ -109,15 +121,15 @@ def line_periods(t_s: np.ndarray, r: np.ndarray, settings: DetectorSettings = DE
 def line_window(t_s: np.ndarray, r: np.ndarray, period_s: float, settings: DetectorSettings = DETECTORS
                 ) -> tuple[float, float]:
     """``(start_s, end_s)`` where a line of ``period_s`` is present in ``r``: the contiguous span
-    around its strongest part where the complex-demodulated amplitude, averaged over two
-    periods, stays above half its peak."""
+    around its strongest part where the complex-demodulated amplitude, averaged over
+    :data:`ENVELOPE_PERIODS` periods, stays above :data:`PRESENT_SHARE` of its peak."""
     centre, mean, count, width = binned(t_s, r, settings.line_bins, settings.min_bin_s)
     z = mean * count * np.exp(-2j * np.pi * centre / period_s)
-    m = min(max(int(round(2.0 * period_s / width)), 1), centre.size)  # 'same' would return the longer
+    m = min(max(int(round(ENVELOPE_PERIODS * period_s / width)), 1), centre.size)  # 'same' would return the longer
     kernel = np.ones(m)
     envelope = np.abs(np.convolve(z, kernel, "same")) / np.maximum(np.convolve(count, kernel, "same"), 1.0)
     peak = int(np.argmax(envelope))
-    above = envelope >= 0.5 * envelope[peak]
+    above = envelope >= PRESENT_SHARE * envelope[peak]
     lo = peak - int(np.argmin(above[peak::-1])) if not above[: peak + 1].all() else 0
     hi = peak + int(np.argmin(above[peak:])) if not above[peak:].all() else centre.size
     start = float(t_s[0]) if lo == 0 else float(centre[lo] + 0.5 * width)
@@ -164,7 +176,7 @@ def bump_centres(temp_c: np.ndarray, r: np.ndarray, settings: DetectorSettings =
     gram = core.T @ (core * count[:, None])
     found: list[tuple[float, float, float]] = []
     for w in (w for w in settings.bump_widths_c if settings.bump_spans * w <= span):
-        centres = np.arange(lo + w, hi - w + 1e-9, max(bin_c, w / 8.0))
+        centres = np.arange(lo + w, hi - w + 1e-9, max(bin_c, w / BUMP_STEPS_PER_WIDTH))
         if centres.size == 0:
             continue
         g = np.exp(-0.5 * ((tb[:, None] - centres[None, :]) / w) ** 2)  # (bins, centres)
@@ -199,10 +211,10 @@ def why_no_lines(t_s: np.ndarray, settings: DetectorSettings = DETECTORS) -> str
     if n < settings.min_line_bins:
         return (f"spectral lines need at least {settings.min_line_bins} bins of {width:.4g} s of the residual; "
                 f"this record has {n}")
-    longest, shortest = float(t_s[-1] - t_s[0]) / settings.line_cycles, 3.0 * width
+    longest, shortest = float(t_s[-1] - t_s[0]) / settings.line_cycles, MIN_PERIOD_BINS * width
     if longest <= shortest:
-        return (f"a line needs {settings.line_cycles:g} cycles inside the record and 3 bins per cycle: the longest "
-                f"testable period ({longest:.4g} s) is below the shortest ({shortest:.4g} s)")
+        return (f"a line needs {settings.line_cycles:g} cycles inside the record and {MIN_PERIOD_BINS:g} bins per "
+                f"cycle: the longest testable period ({longest:.4g} s) is below the shortest ({shortest:.4g} s)")
     return None
 
 

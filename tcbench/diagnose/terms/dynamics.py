@@ -48,6 +48,9 @@ class ThermalLagTerm(Term):
     effect = ThermalLag
     shape = "temperature_dynamics"
     param = "tau_s"
+    # tau_s (s): 20 s (twenty steps of the 1 s filter clock, signals.GRID_S) to 1 h, 16 log-spaced (1.41x
+    # apart; the selection's bounded search refines the best between its neighbours, not past 1 h): a slower
+    # node behind the thermometer is the open-world second_node's (NODE_TAU_S, to 4 h)
     grid = np.geomspace(20.0, 3600.0, 16)
     confirm_with = (
         "heat and cool through the same temperatures at two ramp rates, each ramp followed by a soak of at least "
@@ -117,6 +120,8 @@ class HysteresisTerm(Term):
     effect = Hysteresis
     shape = "temperature_dynamics"
     param = "width_c"
+    # width_c (degC): 0.2 to 8 degC, 12 log-spaced (1.40x apart; refined between neighbours by the selection's
+    # bounded search, and past 8 degC up to half the temperature span, :meth:`past_grid`)
     grid = np.geomspace(0.2, 8.0, 12)
     cached = True
     confirm_with = (

@@ -15,8 +15,11 @@ from tcbench.diagnose.terms.detectors import why_no_steps
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value, search_log, step_range
 from tcbench.sensors.effects import BiasStep, Effect, Transient
 
+# time constants (s) proposed at each change point: 5 min to 4 h (which needs AFTER_TAUS x 4 h of record after
+# its step), 8 log-spaced (1.74x apart: refine_tau moves each within TAU_FACTOR either way, so they cover the range)
 TRANSIENT_TAU_S = np.geomspace(300.0, 4.0 * 3600.0, 8)
 TAU_FACTOR = 1.6  # a time constant is refined within this factor of its grid value
+AFTER_TAUS = 2.0  # a transient is proposed where the record holds this many time constants after its step
 
 
 def why_no_step(t_s: np.ndarray, fold: np.ndarray | None, detectors: DetectorSettings = DEFAULTS.detectors
@@ -90,7 +93,7 @@ class TransientTerm(OpenTerm):
 
     def propose(self, search: Search) -> list[Value]:
         end = search.data.t_s[-1]
-        return [(t, tau) for t in search.steps for tau in TRANSIENT_TAU_S if tau < 0.5 * (end - t)]
+        return [(t, tau) for t in search.steps for tau in TRANSIENT_TAU_S if tau < (end - t) / AFTER_TAUS]
 
     def refine(self, screen: Screen, value: Value) -> Value:
         return refine_tau(screen, self.id, value)
@@ -98,14 +101,14 @@ class TransientTerm(OpenTerm):
     def skip(self, data: DiagnosisData, fold: np.ndarray | None = None,
              detectors: DetectorSettings = DEFAULTS.detectors) -> str | None:
         """Why no transient can be proposed: no step can, or its shortest time constant needs
-        twice its length of record after a testable step."""
+        :data:`AFTER_TAUS` times its length of record after a testable step."""
         why = why_no_step(data.t_s, fold, detectors)
         if why is not None or fold is None:
             return why
         t_s = data.t_s
         lo, hi = step_range(t_s, fold)
         after = float(t_s[-1]) - lo
-        need = 2.0 * float(TRANSIENT_TAU_S[0])
+        need = AFTER_TAUS * float(TRANSIENT_TAU_S[0])
         if after > need and hi > lo:
             return None
         return (f"a transient of time constant {TRANSIENT_TAU_S[0]:.0f} s needs {need:.0f} s of record after a "

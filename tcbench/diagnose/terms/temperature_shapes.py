@@ -15,8 +15,11 @@ from tcbench.diagnose.terms.events import refine_tau
 from tcbench.diagnose.terms.open_base import OpenTerm, Screen, Search, Value
 from tcbench.sensors.effects import Effect, SecondNode, TemperatureBump
 
+# time constants (s) of a second node proposed: 10 min (faster is the thermal lag's grid, up to 1 h) to 4 h,
+# 9 log-spaced (1.49x apart: refine_tau moves each within events.TAU_FACTOR either way)
 NODE_TAU_S = np.geomspace(600.0, 4.0 * 3600.0, 9)
 NODE_SPANS = 4.0  # a second node's time constant is searched below the span over this
+BUMP_EXTENT_WIDTHS = 2.0  # a bump's report ``where``: its centre +- this many widths (95 % of a Gaussian's area)
 
 
 class TemperatureBumpTerm(OpenTerm):
@@ -36,8 +39,8 @@ class TemperatureBumpTerm(OpenTerm):
         return {"centre_c": value[0], "width_c": value[1], "amplitude": float(coef[0])}
 
     def located(self, params: Mapping[str, float]) -> dict[str, Any]:
-        return {"temperature_c": [params["centre_c"] - 2.0 * params["width_c"],
-                                  params["centre_c"] + 2.0 * params["width_c"]]}
+        return {"temperature_c": [params["centre_c"] - BUMP_EXTENT_WIDTHS * params["width_c"],
+                                  params["centre_c"] + BUMP_EXTENT_WIDTHS * params["width_c"]]}
 
     def explanation(self, params: Mapping[str, float], unit: str) -> str:
         return (
