@@ -55,6 +55,10 @@ from tcbench.diagnose.settings import (
 from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
 from tcbench.sensors.noise import flicker_score_variance
 
+# the refinement of a term's parameter between its best grid neighbours, on the log scale: 0.02
+# in ln(value) is the value to 2 %, finer than any term's parameter is determined by a record
+REFINE_XATOL = 0.02
+
 CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}
 
 
@@ -160,7 +164,7 @@ class _Scorer:
         if i == len(values) - 1 and (top := term(effect).past_grid(self.designer.data)) is not None:
             hi = max(hi, float(np.log(top)))  # best at the grid's edge: search on, as far as the term allows
         res = minimize_scalar(lambda z: -self.gain(base, base.with_effect(effect, float(np.exp(z)))),
-                              bounds=(lo, hi), method="bounded", options={"xatol": 0.02})
+                              bounds=(lo, hi), method="bounded", options={"xatol": REFINE_XATOL})
         if -res.fun > gains[i]:
             return float(-res.fun), float(np.exp(res.x))
         return gains[i], values[i]

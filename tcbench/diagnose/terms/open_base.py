@@ -36,6 +36,9 @@ from tcbench.sensors.effects import MAX_REPEATS, Effect
 
 Value = tuple[float, ...]
 T = TypeVar("T")
+# search_log's tolerance on its log-scale parameter: 5e-4 in ln(period) is a period to 0.05 %,
+# which keeps a line of hundreds of cycles over the record in phase at its ends
+SEARCH_LOG_XATOL = 5e-4
 
 
 class Screen(Protocol):
@@ -208,5 +211,5 @@ def search_log(screen: Screen, term_id: str, value: Value, lo: float, hi: float,
         lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
     # a line holding many cycles needs its period to a fraction of a cycle over the span
     res = minimize_scalar(lambda z: -screen.drop(term_id, make(z)), bounds=(lo, hi), method="bounded",
-                          options={"xatol": 5e-4})
+                          options={"xatol": SEARCH_LOG_XATOL})
     return make(res.x) if -res.fun > screen.drop(term_id, value) else value
