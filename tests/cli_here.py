@@ -1,0 +1,86 @@
+"""``tcbench ARGS`` run in the test's own process, with what it writes to stdout and stderr.
+
+A command started as ``python -m tcbench`` pays its imports (Hydra, MLflow, pandas, matplotlib)
+anew, 5 to 7 s, before its first job; here they are paid once per test process. Each command
+of :mod:`tcbench.commands.registry` keeps one test through a real ``python -m tcbench`` (the
+command-line smoke tests), and the tests of what the commands do call :func:`tcbench` here.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator, Mapping
+from pathlib import Path
+
+
+@contextlib.contextmanager
+def _fd_captured() -> Iterator[dict[str, str]]:
+    """File descriptors 1 and 2 (and ``sys.stdout``/``sys.stderr`` over them) sent to two
+    temporary files, also what the worker processes a sweep starts write; their text, in the
+    dict yielded (``out``, ``err``), once the block ends."""
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        for stream in (sys.stdout, sys.stderr):
+            stream.flush()
+        saved_fds = os.dup(1), os.dup(2)
+        saved_streams = sys.stdout, sys.stderr
+        os.dup2(out.fileno(), 1)
+        os.dup2(err.fileno(), 2)
+        sys.stdout = open(1, "w", encoding="utf-8", errors="replace", closefd=False, buffering=1)  # noqa: SIM115
+        sys.stderr = open(2, "w", encoding="utf-8", errors="replace", closefd=False, buffering=1)  # noqa: SIM115
+        texts: dict[str, str] = {}
+        try:
+            yield texts
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            sys.stdout, sys.stderr = saved_streams
+            os.dup2(saved_fds[0], 1)
+            os.dup2(saved_fds[1], 2)
+            os.close(saved_fds[0])
+            os.close(saved_fds[1])
+            for name, file in (("out", out), ("err", err)):
+                file.seek(0)
+                texts[name] = file.read().decode("utf-8", "replace")
+
+
+@contextlib.contextmanager
+def _as_a_fresh_process(cwd: Path, env: Mapping[str, str] | None) -> Iterator[None]:
+    """The working folder ``cwd``, the environment with ``env`` over it, and logging as a fresh
+    process has it (no handler a Hydra run of an earlier call left); all restored after."""
+    old_cwd, old_env = Path.cwd(), dict(os.environ)
+    root = logging.getLogger()
+    handlers, level = root.handlers[:], root.level
+    loggers = {name: (lg.handlers[:], lg.level, lg.propagate, lg.disabled)
+               for name, lg in logging.Logger.manager.loggerDict.items() if isinstance(lg, logging.Logger)}
+    root.handlers, root.level = [], logging.WARNING
+    os.environ.update(env or {})
+    os.chdir(cwd)
+    try:
+        yield
+    finally:
+        os.chdir(old_cwd)
+        os.environ.clear()
+        os.environ.update(old_env)
+        root.handlers, root.level = handlers, level
+        for name, lg in logging.Logger.manager.loggerDict.items():
+            if isinstance(lg, logging.Logger):
+                lg.handlers, lg.level, lg.propagate, lg.disabled = loggers.get(name, ([], logging.NOTSET, True, False))
+
+
+def tcbench(*args: str, cwd: Path, env: Mapping[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """``tcbench ARGS`` in the folder ``cwd`` (with ``env`` over the environment), run by
+    :func:`tcbench.cli.main` here: its exit code and its output, as :func:`subprocess.run` gives
+    them for ``python -m tcbench ARGS``."""
+    from hydra.core.global_hydra import GlobalHydra
+
+    from tcbench.cli import main
+
+    with _as_a_fresh_process(cwd, env), _fd_captured() as texts:
+        GlobalHydra.instance().clear()
+        code = main(list(args))
+    return subprocess.CompletedProcess(["tcbench", *args], code, texts["out"], texts["err"])
