@@ -17,6 +17,8 @@ import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
+import pytest
+
 
 @contextlib.contextmanager
 def _fd_captured() -> Iterator[dict[str, str]]:
@@ -49,16 +51,19 @@ def _fd_captured() -> Iterator[dict[str, str]]:
 
 
 @contextlib.contextmanager
-def _as_a_fresh_process(cwd: Path, env: Mapping[str, str] | None) -> Iterator[None]:
-    """The working folder ``cwd``, the environment with ``env`` over it, and logging as a fresh
-    process has it (no handler a Hydra run of an earlier call left); all restored after."""
+def _as_a_fresh_process(cwd: Path, env: Mapping[str, str | None] | None) -> Iterator[None]:
+    """The working folder ``cwd``, the environment with ``env`` over it (a None value unsets its
+    variable), and the root logger as a fresh process has it (no handler a Hydra run of an
+    earlier call left); all restored after (the other loggers keep what imports set on them)."""
     old_cwd, old_env = Path.cwd(), dict(os.environ)
     root = logging.getLogger()
     handlers, level = root.handlers[:], root.level
-    loggers = {name: (lg.handlers[:], lg.level, lg.propagate, lg.disabled)
-               for name, lg in logging.Logger.manager.loggerDict.items() if isinstance(lg, logging.Logger)}
     root.handlers, root.level = [], logging.WARNING
-    os.environ.update(env or {})
+    for name, value in (env or {}).items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value
     os.chdir(cwd)
     try:
         yield
@@ -67,13 +72,10 @@ def _as_a_fresh_process(cwd: Path, env: Mapping[str, str] | None) -> Iterator[No
         os.environ.clear()
         os.environ.update(old_env)
         root.handlers, root.level = handlers, level
-        for name, lg in logging.Logger.manager.loggerDict.items():
-            if isinstance(lg, logging.Logger):
-                lg.handlers, lg.level, lg.propagate, lg.disabled = loggers.get(name, ([], logging.NOTSET, True, False))
 
 
-def tcbench(*args: str, cwd: Path, env: Mapping[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    """``tcbench ARGS`` in the folder ``cwd`` (with ``env`` over the environment), run by
+def tcbench(*args: str, cwd: Path, env: Mapping[str, str | None] | None = None) -> subprocess.CompletedProcess[str]:
+    """``tcbench ARGS`` in the folder ``cwd`` (with ``env`` over the environment, None unsetting), run by
     :func:`tcbench.cli.main` here: its exit code and its output, as :func:`subprocess.run` gives
     them for ``python -m tcbench ARGS``."""
     from hydra.core.global_hydra import GlobalHydra
@@ -84,3 +86,24 @@ def tcbench(*args: str, cwd: Path, env: Mapping[str, str] | None = None) -> subp
         GlobalHydra.instance().clear()
         code = main(list(args))
     return subprocess.CompletedProcess(["tcbench", *args], code, texts["out"], texts["err"])
+
+
+def install_here(monkeypatch: pytest.MonkeyPatch, site: Path) -> None:
+    """The plugins of the folder ``site`` (modules and their ``*.dist-info`` entry points), as a
+    process started with ``PYTHONPATH=site`` has them: on ``sys.path`` here and in the worker
+    processes a sweep starts, and the optimiser and learner registries read anew (all undone
+    after the test)."""
+    import importlib
+
+    from tcbench.learners.registry import REGISTRY as LEARNERS
+    from tcbench.optimisers.registry import REGISTRY as OPTIMISERS
+
+    monkeypatch.syspath_prepend(str(site))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(site), os.environ.get("PYTHONPATH")])))
+    for registry in (OPTIMISERS, LEARNERS):
+        monkeypatch.setattr(registry, "_points", None)
+        monkeypatch.setattr(registry, "_entries", dict(registry._entries))
+        monkeypatch.setattr(registry, "_broken", dict(registry._broken))
+    for module in [p.stem for p in site.glob("*.py")]:
+        monkeypatch.delitem(sys.modules, module, raising=False)
+    importlib.invalidate_caches()
