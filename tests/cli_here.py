@@ -84,7 +84,10 @@ def tcbench(*args: str, cwd: Path, env: Mapping[str, str | None] | None = None) 
 
     with _as_a_fresh_process(cwd, env), _fd_captured() as texts:
         GlobalHydra.instance().clear()
-        code = main(list(args))
+        try:
+            code = main(list(args))
+        finally:  # as after a process: no Hydra left initialised for the next test
+            GlobalHydra.instance().clear()
     return subprocess.CompletedProcess(["tcbench", *args], code, texts["out"], texts["err"])
 
 

@@ -144,3 +144,26 @@ def test_help_and_import_load_no_heavy_library() -> None:
     import tcbench.tasks
 
     assert tcbench.tasks.GyroDriftNoiseEnv.__name__ == "GyroDriftNoiseEnv"  # the lazy name resolves
+
+
+def test_diagnose_from_the_command_line(workdir: Path) -> None:
+    """``python -m tcbench diagnose`` (its smoke test: every other diagnosis runs in-process) on a
+    record too short for a full diagnosis, which gets the short-record report."""
+    import json
+
+    import numpy as np
+
+    from tcbench.sensors.recording import make_recording, write_recording
+
+    t_s = np.arange(0.0, 300.0, 0.1)
+    rng = np.random.default_rng(3)
+    temp_c = 25.0 + 10.0 * t_s / t_s[-1]
+    rec = make_recording(t_s, temp_c, np.zeros_like(t_s), 0.002 * (temp_c - 25.0) + 0.01 * rng.standard_normal(t_s.size),
+                         sensor="gyro", sample_rate_hz=10.0, device_id="smoke")
+    write_recording(rec, workdir / "short.csv")
+    out = tcbench("diagnose", "recording=short.csv", "out=d", "tracking.enabled=false", cwd=workdir)
+    assert out.returncode == 0, out.stderr
+    assert "short record (299.9 s of the 1200 s a full diagnosis needs)" in out.stdout, out.stdout
+    assert "ran: temperature_slope (significant)" in out.stdout  # the slope put in the output
+    report = json.loads((workdir / "d" / "report.json").read_text())
+    assert report["report"] == "short_record" and report["samples"] == t_s.size
