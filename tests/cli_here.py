@@ -1,9 +1,12 @@
 """``tcbench ARGS`` run in the test's own process, with what it writes to stdout and stderr.
 
 A command started as ``python -m tcbench`` pays its imports (Hydra, MLflow, pandas, matplotlib)
-anew, 5 to 7 s, before its first job; here they are paid once per test process. Each command
-of :mod:`tcbench.commands.registry` keeps one test through a real ``python -m tcbench`` (the
-command-line smoke tests), and the tests of what the commands do call :func:`tcbench` here.
+anew, 5 to 7 s, before its first job; here they are paid once per test process. The tests of
+what the commands do call :func:`tcbench` here; a few keep a real ``python -m tcbench`` (the
+command-line smoke tests: ``run``, ``run -m`` and ``leaderboard`` in tests/test_cli.py with
+``diagnose``, ``simulate`` and ``metrics`` in tests/test_simulate.py, ``list`` with plugins in
+tests/test_plugins.py, ``export`` in tests/test_run_c_export.py), and so do the tests of what
+only a process of its own shows (signals, kill -9, memory caps, sweeps racing on one store).
 """
 
 from __future__ import annotations
