@@ -1,16 +1,16 @@
 """The accelerometer chamber task: an ordinary IMU's accelerometer at rest through chamber cycles,
-compensated by the baselines, the learners and the diagnosed model, on simulated and on files."""
+compensated by the baselines, the learners and the diagnosed model, on simulated and on files
+(the commands in this process: :mod:`cli_here`)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pandas as pd
 import pytest
+from cli_here import tcbench as here
 from gymnasium.utils.env_checker import check_env
 
 import tcbench  # noqa: F401 - registers the envs
@@ -100,15 +100,12 @@ def test_recordings_from_files_are_compensated_and_checked(tmp_path: Path) -> No
 
 def test_a_sweep_and_its_board_from_the_command_line(tmp_path: Path) -> None:
     """Baselines and the two polynomials (named apart) in one sweep, then the board with both limits."""
-    run = subprocess.run([sys.executable, "-m", "tcbench", "run", "-m", "task=accel_chamber",
-                          "learner=raw,oracle,oracle_thermometer,poly", "seed=0"],
-                         cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    run = here("run", "-m", "task=accel_chamber", "learner=raw,oracle,oracle_thermometer,poly", "seed=0",
+                  cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
-    rate = subprocess.run([sys.executable, "-m", "tcbench", "run", "task=accel_chamber", "learner=poly",
-                           "learner.form=bias_rate"], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    rate = here("run", "task=accel_chamber", "learner=poly", "learner.form=bias_rate", cwd=tmp_path)
     assert rate.returncode == 0 and "poly3_rate-accel_chamber-dev0-s0" in rate.stdout + rate.stderr
-    board = subprocess.run([sys.executable, "-m", "tcbench", "leaderboard"], cwd=tmp_path,
-                           capture_output=True, text=True, timeout=600)
+    board = here("leaderboard", cwd=tmp_path)
     assert board.returncode == 0, board.stdout + board.stderr
     table = pd.read_csv(tmp_path / "leaderboards" / "accel_chamber-dev0.csv").set_index("method")
     assert list(table.index[:2]) == ["oracle", "oracle_thermometer"] and table.index[-1] == "raw"
@@ -121,8 +118,7 @@ def test_a_record_the_diagnosis_refuses_is_one_line(tmp_path: Path) -> None:
     """The diagnosed row on runs too short to diagnose: the job fails with one line naming the run."""
     short = [_write(tmp_path, f"s{i}", simulate_recording("accel", "chamber", 0, i, soak_s=60.0, room_s=60.0,
                                                           ramp_c_per_min=20.0)) for i in range(2)]
-    run = subprocess.run([sys.executable, "-m", "tcbench", "run", "task=accel_chamber", "learner=model",
-                          f"task.train_files=[{short[0]}]", f"task.test_files=[{short[1]}]"],
-                         cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    run = here("run", "task=accel_chamber", "learner=model", f"task.train_files=[{short[0]}]",
+                  f"task.test_files=[{short[1]}]", cwd=tmp_path)
     assert run.returncode == 1 and "Traceback" not in run.stdout + run.stderr, run.stdout + run.stderr
     assert "training recording s0 cannot be diagnosed (recording too short" in run.stdout + run.stderr

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import warnings
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import gymnasium as gym
 import ioh
 import numpy as np
 import pytest
+from cli_here import tcbench as here
 from gymnasium.utils.env_checker import check_env
 
 import tcbench  # noqa: F401  (registers the envs)
@@ -31,8 +31,8 @@ from tcbench.tasks.bbob_env import BBOBEnv
 
 
 def tcbench_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=300, check=False)
+    """``tcbench ARGS`` run in this process (:mod:`cli_here`)."""
+    return here(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize("function", [1, 8, 17, 24])

@@ -1,22 +1,17 @@
-"""Compensation from the command line: one IFA-BP job, baselines and a leaderboard, bad input."""
+"""Compensation from the command line: one IFA-BP job, baselines and a leaderboard, bad input
+(the commands run in this process: :mod:`cli_here`)."""
 
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import mlflow
 import pytest
+from cli_here import tcbench
 
 from tcbench.sensors.recording import write_recording
 from tcbench.sensors.simulate import simulate_recording
-
-
-def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=600)
 
 
 def test_ifa_bp_job_is_tracked_with_figures(workdir: Path) -> None:

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_here import tcbench
 
 from tcbench.optimisers import registry
 from tcbench.runner.loop import run_optimisation
@@ -28,9 +29,9 @@ def test_same_seeds_give_a_byte_identical_recording(tmp_path: Path, sensor: str,
     assert other.read_bytes() != paths[0].read_bytes()
 
 
-# ngopt's determinism (~20 s here) is in the default suite twice already: the contract run of
-# test_every_registered_optimiser_passes[ngopt] and test_peers_nevergrad's same-seed test.
-SLOW_DETERMINISM = {"ngopt"}
+# In the slow suite only: ngopt's determinism (~20 s here) is in the default suite as
+# test_peers_nevergrad's same-seed test, tpe's (~17 s) as test_peers_optuna's.
+SLOW_DETERMINISM = {"ngopt", "tpe"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_DETERMINISM else n
@@ -71,7 +72,7 @@ def test_sweep_killed_and_resumed_runs_every_job_once(workdir: Path) -> None:
     proc.wait()
     before = _finished(workdir / "mlflow.db")
     assert 4 <= len(before) < 16, "the sweep was not caught in the middle"
-    again = subprocess.run([*args, "tracking.resume=true"], cwd=workdir, capture_output=True, text=True, timeout=300)
+    again = tcbench(*args[3:], "tracking.resume=true", cwd=workdir)  # the resume in this process
     assert again.returncode in (0, 1), again.stderr  # 1: the killed job's RUNNING run is reported
     seeds = _finished(workdir / "mlflow.db")
     assert sorted(seeds) == list(range(16))  # every job FINISHED exactly once

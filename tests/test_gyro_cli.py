@@ -3,17 +3,17 @@
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import mlflow
+from cli_here import tcbench as here
 
 SMALL = ["task.sample_rate_hz=1", "task.hold_s=1800"]
 
 
 def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=600)
+    """``tcbench ARGS`` run in this process (:mod:`cli_here`)."""
+    return here(*args, cwd=cwd)
 
 
 def test_tuned_bas_elman_job_is_tracked_with_the_seed_figures(workdir: Path) -> None:

@@ -5,13 +5,13 @@ from __future__ import annotations
 import errno
 import os
 import subprocess
-import sys
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_here import tcbench as here
 
 from tcbench.outputs import folder_problem, name_problem, overwritten_input
 from tcbench.sensors.recording import make_recording, write_recording
@@ -47,8 +47,8 @@ def test_an_unwritable_folder_is_named(tmp_path: Path, monkeypatch: pytest.Monke
 
 
 def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], check=False, cwd=cwd, capture_output=True,
-                          text=True, timeout=300)
+    """``tcbench ARGS`` run in this process (:mod:`cli_here`)."""
+    return here(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize(

@@ -32,9 +32,9 @@ def test_registered_through_the_entry_point(name: str) -> None:
     assert entry.cls.single_objective and not entry.cls.multi_objective
 
 
-# ngopt's contract run (~17 s) is already in the default suite as test_check_optimizer's
-# test_every_registered_optimiser_passes[ngopt], and test_no_helper_thread_outlives_a_call checks
-# its threads: here it runs again only in the slow suite.
+# ngopt's contract run (~17 s) is in the slow suite (here and as test_check_optimizer's
+# test_every_registered_optimiser_passes[ngopt]): ng_de's runs the same nevergrad wrapper in the
+# default suite, and test_no_helper_thread_outlives_a_call checks ngopt's threads.
 @pytest.mark.parametrize("name", [pytest.param("ngopt", marks=pytest.mark.slow), "ng_de"])
 def test_contract_leaves_no_helper_thread(name: str) -> None:
     start = set(threading.enumerate())

@@ -61,6 +61,7 @@ def test_nsga2_covers_the_zdt1_front() -> None:
         assert 1.0 - r.best_f >= 0.95, seed
 
 
+@pytest.mark.slow  # 43 s; the adapter's runs are pymoo's own: test_the_adapters_reproduce_pymoos_own_runs
 def test_moead_covers_the_zdt1_front() -> None:
     shares = []
     for seed in (0, 1, 2):

@@ -3,20 +3,18 @@ any job; Hydra's information flags work after overrides; a leaderboard creates n
 
 from __future__ import annotations
 
-import os
 import socket
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
+from cli_here import tcbench as here
 
 
-def tcbench(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess[str]:
-    env = {k: v for k, v in os.environ.items() if k != "MLFLOW_TRACKING_URI"}
-    return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=timeout)
+def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """``tcbench ARGS`` run in this process (:mod:`cli_here`) without a tracking URI set."""
+    return here(*args, cwd=cwd, env={"MLFLOW_TRACKING_URI": None})
 
 
 def one_line_error(out: subprocess.CompletedProcess[str], *words: str) -> None:

@@ -10,12 +10,12 @@ from __future__ import annotations
 import dataclasses
 import math
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import optimiser_runs
 import pytest
+from cli_here import tcbench as here
 
 from tcbench.optimisers.sa import (
     SAParams,
@@ -315,8 +315,7 @@ def test_sa_bp_initialises_and_compensates() -> None:
 
 def test_command_line(workdir: Path) -> None:
     def tcbench(*args: str) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=workdir,
-                              capture_output=True, text=True, timeout=300)
+        return here(*args, cwd=workdir)  # in this process (cli_here)
 
     listed = tcbench("list")
     assert listed.returncode == 0 and "tcbench.optimisers.sa.SimulatedAnnealing" in listed.stdout

@@ -10,6 +10,7 @@ from pathlib import Path
 import mlflow
 import numpy as np
 import pytest
+from cli_here import tcbench as here
 
 from tcbench.metrics.report import analyse
 from tcbench.sensors.recording import read_recording, write_recording
@@ -19,6 +20,7 @@ MALFORMED = Path(__file__).parent / "data" / "malformed"
 
 
 def tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """``python -m tcbench ARGS``: the smoke test of simulate and metrics."""
     return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=cwd, capture_output=True,
                           text=True, timeout=300)
 
@@ -94,7 +96,7 @@ def test_cli_simulate_then_metrics(workdir: Path) -> None:
     ],
 )
 def test_cli_simulate_bad_input(workdir: Path, args: list[str], message: str) -> None:
-    out = tcbench("simulate", "out=rec", *args, cwd=workdir)
+    out = here("simulate", "out=rec", *args, cwd=workdir)
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], out.stderr
@@ -103,7 +105,7 @@ def test_cli_simulate_bad_input(workdir: Path, args: list[str], message: str) ->
 
 @pytest.mark.parametrize("name", ["truncated_last_line.csv", "text_in_numeric.csv", "unknown_unit.csv", "empty.csv"])
 def test_cli_metrics_on_malformed_files(workdir: Path, name: str) -> None:
-    out = tcbench("metrics", str(MALFORMED / name), "tracking.enabled=false", cwd=workdir)
+    out = here("metrics", str(MALFORMED / name), "tracking.enabled=false", cwd=workdir)
     assert out.returncode == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and Path(name).stem in lines[0], out.stderr
@@ -125,14 +127,14 @@ def test_effects_changed_added_and_removed() -> None:
 
 
 def test_cli_effect_arguments(workdir: Path) -> None:
-    out = tcbench("simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=600",
-                  "protocol_params.sample_rate_hz=10", "effects.warmup.amplitude=0.01",
-                  "without=[bias_instability]", "metrics=false", "out=rec", cwd=workdir)
+    out = here("simulate", "sensor=gyro", "protocol=static", "protocol_params.duration_s=600",
+               "protocol_params.sample_rate_hz=10", "effects.warmup.amplitude=0.01",
+               "without=[bias_instability]", "metrics=false", "out=rec", cwd=workdir)
     assert out.returncode == 0, out.stderr
     meta = json.loads((workdir / "rec" / "gyro-static-dev0-seed0.json").read_text())
     assert meta["extra"]["device"]["effects"]["warmup"]["amplitude"] == 0.01
     assert "bias_instability" not in meta["extra"]["device"]["effects"]
-    bad = tcbench("simulate", "effects.hysteresis.colour=1", "out=rec2", cwd=workdir)
+    bad = here("simulate", "effects.hysteresis.colour=1", "out=rec2", cwd=workdir)
     assert bad.returncode == 2 and "has no parameter colour" in bad.stderr
 
 

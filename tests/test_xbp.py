@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from cli_here import install_here
+from cli_here import tcbench as here
 
 from tcbench.learners import available
 from tcbench.learners.bp import BPNetwork
@@ -103,7 +105,9 @@ class Linear(Learner):
 '''
 
 
-def test_learner_plugin_from_another_package(tmp_path: Path) -> None:
+def test_learner_plugin_from_another_package(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``tcbench list`` with the plugin on PYTHONPATH in a process of its own; the run in this
+    one with the plugin installed here (:func:`cli_here.install_here`)."""
     site = tmp_path / "site"
     info = site / "linear_plugin-0.1.dist-info"
     info.mkdir(parents=True)
@@ -119,6 +123,8 @@ def test_learner_plugin_from_another_package(tmp_path: Path) -> None:
 
     listed = tcbench("list")
     assert "linear     linear_mod.Linear  (from linear-plugin; closed form)" in listed.stdout
-    run = tcbench("run", "task=msra_fulltemp", "learner=raw", "learner.name=linear", "optimiser=none")
+    install_here(monkeypatch, site)
+    run = here("run", "task=msra_fulltemp", "learner=raw", "learner.name=linear", "optimiser=none", cwd=tmp_path,
+               env={"MLFLOW_TRACKING_URI": None})
     assert run.returncode == 0, run.stderr
     assert "1 finished, 0 failed" in run.stdout
