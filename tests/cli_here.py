@@ -95,24 +95,20 @@ def tcbench(*args: str, cwd: Path, env: Mapping[str, str | None] | None = None) 
 
 
 def install_here(monkeypatch: pytest.MonkeyPatch, site: Path) -> None:
-    """The plugins of the folder ``site`` (modules and their ``*.dist-info`` entry points), as a
-    process started with ``PYTHONPATH=site`` has them: on ``sys.path`` here and in the worker
-    processes a sweep starts, and the registries of optimisers, learners, effects and diagnosis
-    terms read anew (all undone after the test)."""
+    """The optimiser and learner plugins of the folder ``site`` (modules and their ``*.dist-info``
+    entry points), as a process started with ``PYTHONPATH=site`` has them: on ``sys.path`` here and
+    in the worker processes a sweep starts, and the registries of optimisers and learners read anew
+    (all undone after the test). Not effect or term plugins: the diagnosis reads its term lists
+    once, at import (``select.design.DETERMINISTIC``), so tests/test_term_plugins.py starts
+    processes of their own."""
     import importlib
 
-    from tcbench.diagnose.terms import base as terms
     from tcbench.learners.registry import REGISTRY as LEARNERS
     from tcbench.optimisers.registry import REGISTRY as OPTIMISERS
-    from tcbench.sensors.effects import PLUGINS as EFFECTS
 
     monkeypatch.syspath_prepend(str(site))
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(site), os.environ.get("PYTHONPATH")])))
-    terms._registry()  # the built-in terms and those installed before, the plugins' read anew below
-    monkeypatch.setattr(terms, "_REGISTRY", {k: v for k, v in terms._REGISTRY.items()
-                                             if type(v).__module__.startswith("tcbench.")})
-    monkeypatch.setattr(terms, "_loaded", False)
-    for registry in (OPTIMISERS, LEARNERS, EFFECTS, terms._PLUGINS):
+    for registry in (OPTIMISERS, LEARNERS):
         monkeypatch.setattr(registry, "_points", None)
         monkeypatch.setattr(registry, "_entries", dict(registry._entries))
         monkeypatch.setattr(registry, "_broken", dict(registry._broken))

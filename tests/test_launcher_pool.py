@@ -35,11 +35,17 @@ def test_a_ctrl_c_taken_by_another_thread_still_ends_the_sweep(tmp_path: Path) -
         time.sleep(0.5)  # the main thread is back in its wait
         signal.pthread_kill(threading.get_ident(), signal.SIGINT)
 
+    # Python's Ctrl-C handler, as a process started in the foreground has it (a test run started in
+    # a shell's background inherits SIGINT ignored)
+    saved = signal.signal(signal.SIGINT, signal.default_int_handler)
     other = threading.Thread(target=ctrl_c_on_this_thread, daemon=True)
     other.start()
     t0 = time.monotonic()
-    with pytest.raises(KeyboardInterrupt):
-        run_jobs([{"started": str(started), "sleep_s": 300.0}], 1, _sleep_job)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_jobs([{"started": str(started), "sleep_s": 300.0}], 1, _sleep_job)
+    finally:
+        signal.signal(signal.SIGINT, saved)
     assert started.exists()
     assert time.monotonic() - t0 < 100, "the Ctrl-C waited for the job to end"
     other.join(5)

@@ -1,7 +1,4 @@
-"""Diagnosis terms from other packages: the example plugin-term package end to end, and broken ones.
-``tcbench list`` runs as ``python -m tcbench`` with the plugin on PYTHONPATH (its command-line
-smoke test); the simulations and diagnoses run in this process with the plugin installed here
-(:func:`cli_here.install_here`)."""
+"""Diagnosis terms from other packages: the example plugin-term package end to end, and broken ones."""
 
 from __future__ import annotations
 
@@ -12,8 +9,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from cli_here import install_here
-from cli_here import tcbench as here
 from plugin_site import fake_distribution, install_example, tcbench
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "plugin-term"
@@ -27,23 +22,16 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return install_example("plugin-term", tmp_path_factory)
 
 
-@pytest.fixture
-def installed(site: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """The example plugin installed in this process too, for this test."""
-    install_here(monkeypatch, site)
-    return site
-
-
-def _simulate(coef: float, name: str, cwd: Path) -> Path:
-    run = here("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "seed=2",
-               f"effects.{TERM}.coef_per_c2_per_min2={coef}", OTHERS, "protocol_params.sample_rate_hz=1",
-               "out=rec", f"name={name}", "metrics=false", "tracking.enabled=false", cwd=cwd)
+def _simulate(coef: float, name: str, cwd: Path, site: Path) -> Path:
+    run = tcbench("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "seed=2",
+                  f"effects.{TERM}.coef_per_c2_per_min2={coef}", OTHERS, "protocol_params.sample_rate_hz=1",
+                  "out=rec", f"name={name}", "metrics=false", "tracking.enabled=false", cwd=cwd, path=site)
     assert run.returncode == 0, run.stderr
     return cwd / "rec" / f"{name}.csv"
 
 
-def _diagnose(recording: Path, out: str, cwd: Path) -> dict:
-    run = here("diagnose", f"recording={recording}", f"out={out}", "tracking.enabled=false", cwd=cwd)
+def _diagnose(recording: Path, out: str, cwd: Path, site: Path) -> dict:
+    run = tcbench("diagnose", f"recording={recording}", f"out={out}", "tracking.enabled=false", cwd=cwd, path=site)
     assert run.returncode == 0, run.stderr
     return json.loads((cwd / out / "report.json").read_text())
 
@@ -60,18 +48,18 @@ def test_listed_with_its_shape(site: Path, tmp_path: Path) -> None:
     assert listed.stdout.splitlines().index(line) < listed.stdout.splitlines().index(open_world[0])
 
 
-def test_diagnose_names_the_plugin_effect_only_where_it_is(installed: Path, tmp_path: Path) -> None:
-    report = _diagnose(_simulate(0.05, "with", tmp_path), "with", tmp_path)
+def test_diagnose_names_the_plugin_effect_only_where_it_is(site: Path, tmp_path: Path) -> None:
+    report = _diagnose(_simulate(0.05, "with", tmp_path, site), "with", tmp_path, site)
     found = {e["id"]: e for e in report["effects"]}
     assert TERM in found and found[TERM]["library"] is True
     assert found[TERM]["params"]["coef_per_c2_per_min2"] == pytest.approx(0.05, rel=0.2)
     assert "(degC/min)^2" in found[TERM]["explanation"]
-    without = _diagnose(_simulate(0.0, "without", tmp_path), "without", tmp_path)
+    without = _diagnose(_simulate(0.0, "without", tmp_path, site), "without", tmp_path, site)
     assert TERM not in {e["id"] for e in without["effects"]}
     assert TERM in {c["id"] for c in without["candidates"]}  # tried like a library term, rejected
     # the fitted model simulates with the plugin's effect, and without the plugin says what is missing
-    again = here("simulate", "model=with/model.yaml", "protocol=oven", "out=again", "metrics=false",
-                 "tracking.enabled=false", cwd=tmp_path)
+    again = tcbench("simulate", "model=with/model.yaml", "protocol=oven", "out=again", "metrics=false",
+                    "tracking.enabled=false", cwd=tmp_path, path=site)
     assert again.returncode == 0, again.stderr
     bare = tcbench("simulate", "model=with/model.yaml", "protocol=oven", "out=bare", "metrics=false",
                    "tracking.enabled=false", cwd=tmp_path, path=tmp_path / "nothing")
