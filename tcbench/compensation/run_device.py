@@ -9,11 +9,11 @@ slope, the inputs held to the training box where the task clamps them. It runs t
 full-temperature task's network too (``msra_fulltemp``, seed 000's IFA-BP of Table 2: the
 ``inverse`` form, :func:`~tcbench.compensation.c_export.inverse_spec`): the network's estimate of
 the input (acceleration, g) from ``[raw, T]``, the temperature held to its training range where
-the task clamps it and the raw output free, as the task scores it. A run's ``poly`` learner of the bias form (the boards' ``poly3``, ``poly3_runs``)
-is kept as the device's cubic (:func:`~tcbench.compensation.c_export.run_cubic_spec`); its other
-forms say why they are left out. The gyro task's runs keep the
-reason none is written (``left_out``): its pipeline decomposes the whole record before its drift
-learner runs (not per sample).
+the task clamps it and the raw output free, as the task scores it. A run's ``poly`` learner of the
+bias form (the boards' ``poly3``, ``poly3_runs``) is kept as the device's cubic
+(:func:`~tcbench.compensation.c_export.run_cubic_spec`); its other forms say why they are left
+out. The gyro task's runs keep the reason none is written (``left_out``): its pipeline decomposes
+the whole record before its drift learner runs (not per sample).
 """
 
 from __future__ import annotations
@@ -22,11 +22,13 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.learners.polynomial import PolynomialModel
+
 FILE = "device.json"
 QUANTITY = {"g": "acceleration", "deg/s": "angular rate"}  # the input an inverse network estimates, by its unit
 
 
-def _cubic_document(env: Any, data: Any, fitted: Any, learner: str, label: str) -> dict[str, Any]:
+def _cubic_document(env: Any, data: Any, fitted: Any, learner: str) -> dict[str, Any]:
     """``device.json``'s body for a run's ``poly`` learner: the cubic of the bias form
     (:func:`~tcbench.compensation.c_export.run_cubic_spec`), or why another form is left out."""
     from tcbench.compensation.c_export import run_cubic_spec
@@ -53,8 +55,8 @@ def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
     if data is None or fitted is None or form not in ("bias", "inverse"):
         why = "the task's pipeline decomposes the whole record before its drift learner runs (not per sample)"
         return base | {"device": {}, "left_out": {learner: why}}
-    if getattr(fitted, "name", "") == "poly":
-        return base | _cubic_document(env, data, fitted, learner, label)
+    if isinstance(fitted, PolynomialModel):
+        return base | _cubic_document(env, data, fitted, learner)
     if not getattr(fitted, "searchable", False) or not hasattr(fitted.params, "hidden"):
         return base | {"device": {}, "left_out": {learner: "not a BP or Elman network"}}
     recordings = [tr.recording for tr in data.train + data.test]
