@@ -191,23 +191,13 @@ def test_a_runs_cubic_runs_on_the_device_as_the_task_compensates(task: str, offs
     assert np.any(warmer.recording.temperature_c > box[1][0])  # the clamp is exercised
 
 
-@pytest.mark.parametrize(("learner_params", "why"), [
-    ({}, "poly of form 'inverse': it solves for the input from [raw, T]"),
+@pytest.mark.parametrize(("task", "learner_params", "why"), [
+    (FULLTEMP, {}, "poly of form 'inverse': it solves for the input from [raw, T]"),
+    (ENV, {"form": "bias_rate"}, "poly of form 'bias_rate': its rate term is a polynomial in T"),
+    (ENV, {"degree": 4}, "poly of degree 4: the device's cubic takes degree 3 at most"),
 ])
-def test_a_run_whose_model_no_device_runs_says_why(learner_params: dict, why: str) -> None:
-    env = gym.make(FULLTEMP, learner="poly", learner_params=learner_params, n_train=1, n_test=1,
-                   recordings_seed=0).unwrapped
-    compensate(env, "poly", "none", {}, 1, 0)
-    doc = device_document(env, "poly", "poly")
-    assert doc["device"] == {} and doc["left_out"]["poly"].startswith(why)
-
-
-@pytest.mark.parametrize(("learner_params", "why"), [
-    ({"form": "bias_rate"}, "poly of form 'bias_rate': its rate term is a polynomial in T"),
-    ({"degree": 4}, "poly of degree 4: the device's cubic takes degree 3 at most"),
-])
-def test_a_runs_other_cubics_say_why_they_are_left_out(learner_params: dict, why: str) -> None:
-    env = gym.make(ENV, learner="poly", learner_params=learner_params, n_train=2, n_test=1,
+def test_a_runs_cubic_no_device_runs_says_why(task: str, learner_params: dict, why: str) -> None:
+    env = gym.make(task, learner="poly", learner_params=learner_params, n_train=2, n_test=1,
                    recordings_seed=0).unwrapped
     compensate(env, "poly", "none", {}, 1, 0)
     doc = device_document(env, "poly", "poly")

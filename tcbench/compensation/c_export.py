@@ -190,8 +190,8 @@ def run_cubic_spec(learner: Any, temp_range_c: Any) -> dict[str, Any]:
     if coef.size > 4:
         raise ValueError(f"poly of degree {coef.size - 1}: the device's cubic takes degree 3 at most")
     xs, ys = learner.x_scaler, learner.y_scaler
-    half_c = 0.5 * float(xs._span[0])
-    y_half = 0.5 * float(ys._span[0])
+    half_c = 0.5 * float(xs.span[0])
+    y_half = 0.5 * float(ys.span[0])
     power = np.zeros(4)
     power[:coef.size] = chebyshev.cheb2poly(coef)  # in u = (T - T_ref) / half_c
     x = y_half * power / half_c ** np.arange(4)

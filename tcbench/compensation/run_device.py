@@ -28,26 +28,10 @@ FILE = "device.json"
 QUANTITY = {"g": "acceleration", "deg/s": "angular rate"}  # the input an inverse network estimates, by its unit
 
 
-def _cubic_document(env: Any, data: Any, fitted: Any, learner: str) -> dict[str, Any]:
-    """``device.json``'s body for a run's ``poly`` learner: the cubic of the bias form
-    (:func:`~tcbench.compensation.c_export.run_cubic_spec`), or why another form is left out."""
-    from tcbench.compensation.c_export import run_cubic_spec
-
-    low, high = data.input_range(env._x) if env.clamp_inputs else (None, None)
-    try:
-        spec = run_cubic_spec(fitted, None if low is None else (low[0], high[0]))
-    except ValueError as exc:
-        return {"device": {}, "left_out": {learner: str(exc)}}
-    meta = data.train[0].recording.meta
-    return {"sensor": meta.sensor, "unit": meta.units.get("output", ""), "device": {learner: spec}}
-
-
 def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
     """``device.json`` of a compensation run on ``env`` (its learner trained): the sensor, its
-    output unit, the run's method label and ``device`` (the network's spec by learner name), or
+    output unit, the run's method label and ``device`` (the learner's spec by its name), or
     ``left_out`` (learner name: why no device runs it)."""
-    from tcbench.compensation.c_export import CAPACITY_MARGIN, inverse_spec, network_spec, window_samples
-
     data = getattr(env, "data", None)
     fitted = getattr(env, "learner", None)
     base: dict[str, Any] = {"task": str(getattr(env, "task", "")), "method": label}
@@ -55,21 +39,32 @@ def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
     if data is None or fitted is None or form not in ("bias", "inverse"):
         why = "the task's pipeline decomposes the whole record before its drift learner runs (not per sample)"
         return base | {"device": {}, "left_out": {learner: why}}
+    network = getattr(fitted, "searchable", False) and hasattr(fitted.params, "hidden")
+    if not (network or isinstance(fitted, PolynomialModel)):
+        return base | {"device": {}, "left_out": {learner: "not a cubic, a BP or an Elman network"}}
+    box = data.input_range(env._x) if env.clamp_inputs else None
+    try:
+        spec = _spec(data, fitted, learner, form, box)
+    except ValueError as exc:  # a form of the cubic no device runs
+        return base | {"device": {}, "left_out": {learner: str(exc)}}
+    meta = data.train[0].recording.meta
+    return base | {"sensor": meta.sensor, "unit": meta.units.get("output", ""), "device": {learner: spec}}
+
+
+def _spec(data: Any, fitted: Any, learner: str, form: str, box: tuple[np.ndarray, np.ndarray] | None) -> dict[str, Any]:
+    """The spec a device runs of the trained ``fitted``, its inputs held to ``box`` (None: free):
+    a run's cubic (:func:`~tcbench.compensation.c_export.run_cubic_spec`), an inverse network
+    on ``[raw, T]`` or a network on ``[T, dT/dt]`` with its rate window."""
+    from tcbench.compensation.c_export import (CAPACITY_MARGIN, inverse_spec, network_spec, run_cubic_spec,
+                                               window_samples)
+
+    first = None if box is None else (box[0][0], box[1][0])  # the temperature's (or raw's) range
+    second = None if box is None else (box[0][1], box[1][1])
     if isinstance(fitted, PolynomialModel):
-        return base | _cubic_document(env, data, fitted, learner)
-    if not getattr(fitted, "searchable", False) or not hasattr(fitted.params, "hidden"):
-        return base | {"device": {}, "left_out": {learner: "not a BP or Elman network"}}
-    recordings = [tr.recording for tr in data.train + data.test]
-    meta = recordings[0].meta
-    low, high = data.input_range(env._x) if env.clamp_inputs else (None, None)
-    unit = meta.units.get("output", "")
+        return run_cubic_spec(fitted, first)
     if form == "inverse":  # [raw, T] -> the input
-        measured = meta.units.get("input", "")
-        spec = inverse_spec(learner, fitted, None if low is None else (low[0], high[0]),
-                            None if low is None else (low[1], high[1]), QUANTITY.get(measured, "input"), measured)
-        return base | {"sensor": meta.sensor, "unit": unit, "device": {learner: spec}}
-    fullest = max(window_samples(r.time_s, data.rate_window_s) for r in recordings)
-    spec = network_spec(learner, fitted, None if low is None else (low[0], high[0]),
-                        None if low is None else (low[1], high[1]), data.rate_window_s,
+        measured = data.train[0].recording.meta.units.get("input", "")
+        return inverse_spec(learner, fitted, first, second, QUANTITY.get(measured, "input"), measured)
+    fullest = max(window_samples(tr.recording.time_s, data.rate_window_s) for tr in data.train + data.test)
+    return network_spec(learner, fitted, first, second, data.rate_window_s,
                         max(2, int(np.ceil(CAPACITY_MARGIN * fullest))), 0.0)
-    return base | {"sensor": meta.sensor, "unit": unit, "device": {learner: spec}}

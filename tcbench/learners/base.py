@@ -55,7 +55,8 @@ class Scaler:
         return cls(d.min(axis=0), d.max(axis=0))
 
     @property
-    def _span(self) -> np.ndarray:
+    def span(self) -> np.ndarray:
+        """Each column's range (1 where the column is constant)."""
         span = self.high - self.low
         return np.where(span > 0, span, 1.0)
 
@@ -63,13 +64,13 @@ class Scaler:
         """Data in [-1, 1] units (shape kept)."""
         d = np.asarray(data, dtype=np.float64)
         flat = d.reshape(len(d), -1)
-        return (2.0 * (flat - self.low) / self._span - 1.0).reshape(d.shape)
+        return (2.0 * (flat - self.low) / self.span - 1.0).reshape(d.shape)
 
     def inverse(self, scaled: np.ndarray) -> np.ndarray:
         """Back from [-1, 1] units to data units (shape kept)."""
         s = np.asarray(scaled, dtype=np.float64)
         flat = s.reshape(len(s), -1) if s.ndim > 1 else s.reshape(-1, 1)
-        return ((flat + 1.0) * 0.5 * self._span + self.low).reshape(s.shape)
+        return ((flat + 1.0) * 0.5 * self.span + self.low).reshape(s.shape)
 
 
 def check_data(inputs: np.ndarray, targets: np.ndarray | None, n_inputs: int, who: str) -> tuple[np.ndarray, np.ndarray | None]:
