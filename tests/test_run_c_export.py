@@ -23,7 +23,7 @@ import pytest
 import tcbench  # noqa: F401 - registers the envs
 from test_c_export import _stable
 from tcbench.compensation import methods
-from tcbench.compensation.c_export import device_clock_s, write_c
+from tcbench.compensation.c_export import c_sources, device_clock_s, streamed_corrected, write_c
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.run_device import device_document
 from tcbench.runner.loop import compensate
@@ -191,17 +191,65 @@ def test_a_runs_cubic_runs_on_the_device_as_the_task_compensates(task: str, offs
     assert np.any(warmer.recording.temperature_c > box[1][0])  # the clamp is exercised
 
 
-@pytest.mark.parametrize(("task", "learner_params", "why"), [
-    (FULLTEMP, {}, "poly of form 'inverse': it solves for the input from [raw, T]"),
-    (ENV, {"form": "bias_rate"}, "poly of form 'bias_rate': its rate term is a polynomial in T"),
-    (ENV, {"degree": 4}, "poly of degree 4: the device's cubic takes degree 3 at most"),
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize(("task", "learner_params", "method"), [
+    (ENV, {"form": "bias_rate"}, "poly_rate"),
+    ("tcbench/MSRA-ZeroBias-v0", {"form": "bias_rate", "degree": 4, "offsets": "per_run"}, "poly_rate"),
+    (FULLTEMP, {}, "poly"),
+    (ENV, {"degree": 5}, "poly"),
 ])
-def test_a_runs_cubic_no_device_runs_says_why(task: str, learner_params: dict, why: str) -> None:
-    env = gym.make(task, learner="poly", learner_params=learner_params, n_train=2, n_test=1,
+def test_a_runs_poly_of_every_form_and_degree_runs_on_the_device(task: str, learner_params: dict, method: str,
+                                                                 build: str, tmp_path: Path) -> None:
+    """A run's poly learner other than the cubic PX4 runs (the rate term a polynomial in T on the
+    device's trailing rate window, the input solved from [raw, T], a degree above 3) is kept as its
+    Chebyshev series in the scaled inputs: compiled, it gives the task's own compensation (the
+    estimate in g for fulltemp) in both builds, its inputs held to the training box."""
+    n_train = 1 if task == FULLTEMP else 2  # fulltemp's test run then goes below the training range
+    env = gym.make(task, learner="poly", learner_params=learner_params, n_train=n_train, n_test=1,
                    recordings_seed=0).unwrapped
     compensate(env, "poly", "none", {}, 1, 0)
     doc = device_document(env, "poly", "poly")
-    assert doc["device"] == {} and doc["left_out"]["poly"].startswith(why)
+    assert "left_out" not in doc
+    spec = json.loads(json.dumps(doc["device"]["poly"]))
+    assert spec["method"] == method and spec["degree"] == learner_params.get("degree", 3)
+    box = env.data.input_range(env._x)
+    tr = env.data.test[0]
+    raw = tr.recording.output
+    got, stderr = _streamed_by_c(spec, "tc_poly", tr.recording, build, tmp_path)
+    want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)
+    inverse = spec["form"] == "inverse"
+    bound = TOLERANCE[build] * (np.max(np.abs(want)) if inverse else np.maximum(np.abs(want), np.max(np.abs(raw))))
+    assert got.size == want.size and np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
+    header = c_sources(spec, "tc_poly").header
+    if inverse:  # the polynomial's estimate of the input in g, the temperature held to its range
+        assert "polynomial's estimate of the input (acceleration, in g)" in header
+        temp_c = tr.recording.temperature_c
+        free = env.learner.predict(np.column_stack([raw, temp_c]))
+        below = temp_c < box[0][1]
+        assert below.any() and np.max(np.abs(free - want)[below]) > 1e3 * TOLERANCE["double"] * np.max(np.abs(want))
+        assert np.sqrt(np.mean((want - tr.recording.input) ** 2)) < np.sqrt(np.mean(tr.recording.input ** 2))
+    else:
+        assert np.ptp(want - raw) > 10 * TOLERANCE["float"] * np.max(np.abs(raw))  # it corrects something
+    if method == "poly_rate":  # the rate term acts: without it the output differs
+        assert "dropped 0" in stderr and "RATE_CAPACITY" in header
+        flat = spec | {"rate": [0.0] * len(spec["rate"])}
+        clock = device_clock_s(np.r_[0.0, np.diff(tr.recording.time_s)])
+        without = streamed_corrected(flat, clock, tr.recording.temperature_c, raw)
+        assert np.max(np.abs(without - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(raw))
+
+
+GYRO = ("tcbench/Gyro-DriftNoise-v0", {"sample_rate_hz": 1.0, "hold_s": 600.0})  # a cheap gyro task
+
+
+@pytest.mark.parametrize(("task", "learner", "why"), [
+    (GYRO, "bp", "the task's pipeline decomposes the whole record before its drift learner runs"),
+])
+def test_what_no_device_runs_says_why(task: tuple[str, dict], learner: str, why: str) -> None:
+    env = gym.make(task[0], learner=learner, learner_params={"training": "gd", "epochs": 2}, **task[1]).unwrapped
+    compensate(env, learner, "none", {}, 1, 0)
+    doc = device_document(env, learner, learner)
+    assert doc["device"] == {} and doc["left_out"][learner].startswith(why)
 
 
 def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:

@@ -10,9 +10,10 @@ full-temperature task's network too (``msra_fulltemp``, seed 000's IFA-BP of Tab
 ``inverse`` form, :func:`~tcbench.compensation.c_export.inverse_spec`): the network's estimate of
 the input (acceleration, g) from ``[raw, T]``, the temperature held to its training range where
 the task clamps it and the raw output free, as the task scores it. A run's ``poly`` learner of the
-bias form (the boards' ``poly3``, ``poly3_runs``) is kept as the device's cubic
-(:func:`~tcbench.compensation.c_export.run_cubic_spec`); its other forms say why they are left
-out. The gyro task's runs keep the reason none is written (``left_out``): its pipeline decomposes
+bias form and degree 3 at most (the boards' ``poly3``, ``poly3_runs``) is kept as the device's cubic
+(:func:`~tcbench.compensation.c_export.run_cubic_spec`); of another form (``bias_rate``: the rate
+term a polynomial in T; ``inverse``) or degree, as its Chebyshev series
+(:func:`~tcbench.compensation.c_export.run_poly_spec`). The gyro task's runs keep the reason none is written (``left_out``): its pipeline decomposes
 the whole record before its drift learner runs (not per sample).
 """
 
@@ -41,7 +42,7 @@ def device_document(env: Any, learner: str, label: str) -> dict[str, Any]:
         return base | {"device": {}, "left_out": {learner: why}}
     network = getattr(fitted, "searchable", False) and hasattr(fitted.params, "hidden")
     if not (network or isinstance(fitted, PolynomialModel)):
-        return base | {"device": {}, "left_out": {learner: "not a cubic, a BP or an Elman network"}}
+        return base | {"device": {}, "left_out": {learner: "not a polynomial, a BP or an Elman network"}}
     box = data.input_range(env._x) if env.clamp_inputs else None
     try:
         spec = _spec(data, fitted, learner, form, box)
@@ -56,15 +57,17 @@ def _spec(data: Any, fitted: Any, learner: str, form: str, box: tuple[np.ndarray
     a run's cubic (:func:`~tcbench.compensation.c_export.run_cubic_spec`), an inverse network
     on ``[raw, T]`` or a network on ``[T, dT/dt]`` with its rate window."""
     from tcbench.compensation.c_export import (CAPACITY_MARGIN, inverse_spec, network_spec, run_cubic_spec,
-                                               window_samples)
+                                               run_poly_spec, window_samples)
 
     first = None if box is None else (box[0][0], box[1][0])  # the temperature's (or raw's) range
     second = None if box is None else (box[0][1], box[1][1])
-    if isinstance(fitted, PolynomialModel):
-        return run_cubic_spec(fitted, first)
-    if form == "inverse":  # [raw, T] -> the input
-        measured = data.train[0].recording.meta.units.get("input", "")
-        return inverse_spec(learner, fitted, first, second, QUANTITY.get(measured, "input"), measured)
+    measured = data.train[0].recording.meta.units.get("input", "")
     fullest = max(window_samples(tr.recording.time_s, data.rate_window_s) for tr in data.train + data.test)
-    return network_spec(learner, fitted, first, second, data.rate_window_s,
-                        max(2, int(np.ceil(CAPACITY_MARGIN * fullest))), 0.0)
+    capacity = max(2, int(np.ceil(CAPACITY_MARGIN * fullest)))
+    if isinstance(fitted, PolynomialModel):
+        if fitted.describe().get("fitted_form") == "bias" and fitted.settings.degree <= 3:
+            return run_cubic_spec(fitted, first)  # the cubic PX4 runs
+        return run_poly_spec(fitted, box, data.rate_window_s, capacity, QUANTITY.get(measured, "input"), measured)
+    if form == "inverse":  # [raw, T] -> the input
+        return inverse_spec(learner, fitted, first, second, QUANTITY.get(measured, "input"), measured)
+    return network_spec(learner, fitted, first, second, data.rate_window_s, capacity, 0.0)
