@@ -4,7 +4,9 @@ compiled with the system C compiler and run sample by sample over the run's test
 the run's own compensation (the task's learner compensator) to 1e-9 (double build) and 1e-4 (float
 build), relative to the larger of the output and the record's largest raw reading. The
 full-temperature task's network (``msra_fulltemp``: ``[raw, T]`` to the input) runs too, and
-returns the task's own estimate of the input in g to the same tolerances, relative to its largest."""
+returns the task's own estimate of the input in g to the same tolerances, relative to its largest.
+So do a run's ``poly`` of every form and degree, its lag-aware polynomial (``learner=lagpoly``) and
+its diagnosed model (``learner=model``)."""
 
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from test_c_export import _stable
 from tcbench.compensation import methods
 from tcbench.compensation.c_export import c_sources, device_clock_s, streamed_corrected, write_c
 from tcbench.compensation.features import temperature_rate_c_per_s
-from tcbench.compensation.run_device import device_document
+from tcbench.compensation.run_device import BASELINE_FITS, device_document
 from tcbench.runner.loop import compensate
 
 CC = shutil.which("cc")
@@ -239,17 +241,79 @@ def test_a_runs_poly_of_every_form_and_degree_runs_on_the_device(task: str, lear
         assert np.max(np.abs(without - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(raw))
 
 
+def _baseline(task: str, learner: str, n_train: int) -> tuple[object, dict, object]:
+    """``task`` with the baseline ``learner`` scored as a run scores it, the ``device.json`` the
+    run keeps (:func:`~tcbench.runner.kinds.compensation.CompensationKind.record` passes the fit its
+    score keeps), and that fit."""
+    env = gym.make(task, learner=None, n_train=n_train, n_test=1, recordings_seed=0).unwrapped
+    result = compensate(env, learner, "none", {}, 1, 0)
+    key = BASELINE_FITS[learner]
+    fitted = result.score.extra.get(key) if key else None
+    return env, device_document(env, learner, learner, fitted), fitted
+
+
+def _compiled_agrees(spec: dict, env: object, want: np.ndarray, build: str, folder: Path, inverse: bool) -> None:
+    """``spec``'s C over the task's test record gives ``want`` to the build's tolerance."""
+    rec = env.data.test[0].recording
+    got, _ = _streamed_by_c(spec, "tc_run", rec, build, folder)
+    bound = TOLERANCE[build] * (np.max(np.abs(want)) if inverse else np.maximum(np.abs(want), np.max(np.abs(rec.output))))
+    assert got.size == want.size and np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize("task", [ENV, "tcbench/MSRA-ZeroBias-v0", FULLTEMP])
+def test_a_runs_lagpoly_runs_on_the_device_as_the_task_compensates(task: str, build: str, tmp_path: Path) -> None:
+    """learner=lagpoly: its lag the model's streaming first-order filter, its polynomial in the
+    lagged temperature; compiled, it gives the task's own compensation in both builds (fulltemp:
+    the input solved from the reading, in g, as the header says)."""
+    env, doc, fitted = _baseline(task, "lagpoly", 2)
+    spec = json.loads(json.dumps(doc["device"]["lagpoly"]))
+    assert spec["method"] == "lagpoly" and spec["effects"] == [{"id": "thermal_lag", "tau_s": fitted.tau_s}]
+    tr = env.data.test[0]
+    want = methods.lagpoly_compensator(env.data, fitted)(tr, tr.recording.output)
+    inverse = task == FULLTEMP
+    _compiled_agrees(spec, env, want, build, tmp_path, inverse)
+    assert ("the acceleration, in g, not a corrected output" in c_sources(spec, "x").header) == inverse
+    unlagged = spec | {"effects": []}  # the lag acts: without it the output differs
+    clock = device_clock_s(np.r_[0.0, np.diff(tr.recording.time_s)])
+    without = streamed_corrected(unlagged, clock, tr.recording.temperature_c, tr.recording.output)
+    assert np.max(np.abs(without - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(want))
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+def test_a_runs_diagnosed_model_runs_on_the_device_as_the_task_compensates(tmp_path: Path) -> None:
+    """learner=model on the room-temperature task: one model diagnosed per training run (here one
+    with a thermal lag, one without), the mean of their offsets removed; the device runs each on its
+    own state (``model_mean``) and, compiled, gives the task's own compensation in both builds (the
+    models hold only terms the device runs as the task's grid does: the lag and the polynomial)."""
+    env, doc, fitted = _baseline("tcbench/MSRA-ZeroBias-v0", "model", 2)
+    spec = json.loads(json.dumps(doc["device"]["model"]))
+    assert spec["method"] == "model_mean" and len(spec["models"]) == 2
+    assert any(m["effects"] for m in spec["models"])
+    tr = env.data.test[0]
+    rec = tr.recording
+    want = rec.output - fitted.bias(rec.time_s, rec.temperature_c)  # the task's compensator
+    for build in ("double", "float"):
+        _compiled_agrees(spec, env, want, build, tmp_path, False)
+    one = streamed_corrected(spec["models"][0], device_clock_s(np.r_[0.0, np.diff(rec.time_s)]), rec.temperature_c,
+                             rec.output)
+    assert np.max(np.abs(one - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(rec.output))  # the mean acts
+
+
 GYRO = ("tcbench/Gyro-DriftNoise-v0", {"sample_rate_hz": 1.0, "hold_s": 600.0})  # a cheap gyro task
 
 
-@pytest.mark.parametrize(("task", "learner", "why"), [
-    (GYRO, "bp", "the task's pipeline decomposes the whole record before its drift learner runs"),
-])
-def test_what_no_device_runs_says_why(task: tuple[str, dict], learner: str, why: str) -> None:
-    env = gym.make(task[0], learner=learner, learner_params={"training": "gd", "epochs": 2}, **task[1]).unwrapped
-    compensate(env, learner, "none", {}, 1, 0)
-    doc = device_document(env, learner, learner)
-    assert doc["device"] == {} and doc["left_out"][learner].startswith(why)
+def test_what_no_device_runs_says_why() -> None:
+    """The memoriser (a replay of the training runs, not a model) and the gyro task's pipeline
+    (it decomposes the whole record) keep why no device runs them."""
+    _, doc, _ = _baseline(ENV, "memoriser", 1)
+    assert doc["device"] == {} and doc["left_out"]["memoriser"].startswith("a replay of the training runs' mean")
+    env = gym.make(GYRO[0], learner="bp", learner_params={"training": "gd", "epochs": 2}, **GYRO[1]).unwrapped
+    compensate(env, "bp", "none", {}, 1, 0)
+    doc = device_document(env, "bp", "bp")
+    assert doc["device"] == {} and doc["left_out"]["bp"].startswith("the task's pipeline decomposes the whole record")
 
 
 def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -283,3 +347,26 @@ def test_export_takes_a_runs_id_and_refuses_in_one_line(tmp_path: Path) -> None:
     raw_id = [p.name for p in (tmp_path / "mlartifacts" / "tcbench").iterdir() if p.name != run_id][0]
     done = _tcbench("export", f"runs=[{raw_id}]", "formats=[c]", "out=e", cwd=tmp_path)
     assert done.returncode == 2 and "the run kept no device.json" in done.stderr, done.stderr
+
+
+@pytest.mark.slow
+def test_a_baselines_run_keeps_its_model_for_the_device(tmp_path: Path) -> None:
+    """``tcbench run learner=lagpoly`` keeps device.json from its score's fit, which ``tcbench
+    export runs=[ID] formats=[c]`` writes as C; a memoriser's run keeps why no device runs it, and
+    the export says so in one line, exit 2."""
+    ids = {}
+    for learner in ("lagpoly", "memoriser"):
+        before = set((tmp_path / "mlartifacts").rglob("device.json"))
+        done = _tcbench("run", "task=msra_zerobias", "task.n_train=2", "task.n_test=1", "task.recordings_seed=0",
+                        f"learner={learner}", "seed=0", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        found = set((tmp_path / "mlartifacts").rglob("device.json")) - before
+        assert len(found) == 1
+        ids[learner] = found.pop().parent.parent.name
+    done = _tcbench("export", f"runs=[{ids['lagpoly']}]", "formats=[c]", "out=c", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    header = (tmp_path / "c" / f"tc_msra_lagpoly_{ids['lagpoly'][:8]}.h").read_text()
+    assert "by the lagpoly method" in header and f"the lagpoly model of tcbench run {ids['lagpoly']}" in header
+    done = _tcbench("export", f"runs=[{ids['memoriser']}]", "formats=[c]", "out=d", cwd=tmp_path)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+    assert "no model a device runs (memoriser: a replay of the training runs" in done.stderr, done.stderr

@@ -63,6 +63,14 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   level, all ``tcbench calibrate`` sees on a static record) writes a unit scale factor and its
   bias absorbs the level, so the model returns ``raw - offset``. A model with another term (an
   accelerometer's ``k a^2``, ``accel_nonlinearity``) is not exported, and the export says which.
+- ``model_mean``: a ``tcbench run``'s diagnosed model (``learner=model``, :func:`run_model_spec`):
+  one model per training run, each run as ``model`` on its own state, their offsets averaged (of
+  the ``inverse`` form, their scale factors too: ``(raw - mean offset) / mean scale``, in the
+  input's unit). A run of one training run keeps the plain ``model``.
+- ``lagpoly``: a run's lag-aware polynomial (:func:`lagpoly_spec`) as a ``model`` of one thermal
+  lag: the lag on the device's own intervals (the task's on the record's median interval: the
+  same where the intervals are uniform), its polynomial in the lagged temperature, of the
+  ``inverse`` form over its scale factor.
 """
 
 from __future__ import annotations
@@ -260,6 +268,38 @@ def model_spec(sensor_model: Any) -> dict[str, Any]:
     return spec
 
 
+def lagpoly_spec(fitted: Any, inverse: bool, quantity: str = "input", unit: str = "") -> dict[str, Any]:
+    """A fitted lag-aware polynomial (:class:`~tcbench.compensation.lagpoly.LagPoly`) as the
+    diagnosed model a device runs (``model`` kind, method ``lagpoly``): its bias polynomial in the
+    normalised lagged temperature, its lag the model's first-order filter on the device's own
+    intervals; ``inverse``: with its scale factor, the input (``quantity`` in ``unit``) solved
+    from the reading. ``ValueError`` for an inverse form without a scale factor."""
+    tau_s = float(fitted.tau_s)
+    spec: dict[str, Any] = {"method": "lagpoly", "centre_c": float(fitted.centre_c),
+                            "half_range_c": float(fitted.half_range_c), "bias": [float(b) for b in fitted.bias],
+                            "ref_c": float(fitted.centre_c),
+                            "effects": [{"id": "thermal_lag", "tau_s": tau_s}] if tau_s > 0 else []}
+    if not inverse:
+        return spec
+    if fitted.scale is None:
+        raise ValueError("lagpoly: a bias-only lag polynomial cannot solve for the input")
+    return spec | {"scale_factor": [float(k) for k in fitted.scale], "input_quantity": quantity, "input_unit": unit}
+
+
+def run_model_spec(models: Any, inverse: bool, quantity: str = "input", unit: str = "") -> dict[str, Any]:
+    """A run's diagnosed model (``learner=model``: one diagnosed model per training run, their
+    compensators' outputs averaged) as the device runs it: one model as calibrate's ``model``
+    (:func:`model_spec`), several as ``model_mean``, each on its own state, the offsets (and,
+    ``inverse``, the scale factors) averaged; ``inverse``: the input (``quantity`` in ``unit``)
+    ``(raw - b) / s`` of the mean ``b`` and ``s``; otherwise raw minus the mean offset (the scale
+    factors dropped, as the task's bias form drops them). ``ValueError`` naming a term not exported."""
+    members = [model_spec(m) for m in models]
+    if not inverse:
+        members = [{k: v for k, v in m.items() if k != "scale_factor"} for m in members]
+    spec = members[0] if len(members) == 1 else {"method": "model_mean", "models": members}
+    return spec | ({"input_quantity": quantity, "input_unit": unit} if inverse else {})
+
+
 def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray, raw: np.ndarray,
                        rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """What the exported code returns at each sample, in numpy: ``raw`` minus
@@ -270,14 +310,19 @@ def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.nda
         t = np.asarray(clock_s, dtype=np.float64)
         return _kind(spec).estimate(spec, t, np.asarray(raw, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
     corrected = np.asarray(raw, dtype=np.float64) - streamed_offset(spec, clock_s, temp_c, rate_c_per_s)
-    if spec["method"] != "model" or "scale_factor" not in spec:
+    if not _scaled(spec):
         return corrected
-    u = (_model_die(spec, np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
-         - spec["centre_c"]) / spec["half_range_c"]
-    scale = np.zeros_like(u)
-    for k in reversed(spec["scale_factor"]):
+    t, temp = np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64)
+    return corrected / np.mean([_model_scale(m, t, temp) for m in spec.get("models", [spec])], axis=0)
+
+
+def _model_scale(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """A diagnosed model's scale factor in its die temperature at each sample (1 without one)."""
+    u = (_model_die(spec, t, temp) - spec["centre_c"]) / spec["half_range_c"]
+    scale = np.zeros_like(u) if "scale_factor" in spec else np.ones_like(u)
+    for k in reversed(spec.get("scale_factor", [])):
         scale = scale * u + k
-    return corrected / scale
+    return scale
 
 
 def _model_die(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
@@ -554,7 +599,9 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
     else:
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
                    (" * the offset, over the scale factor s(T_die) (the input that explains the reading)."
-                    if "scale_factor" in spec else " * the offset.")]
+                    if _scaled(spec) else " * the offset.")]
+        if _scaled(spec) and "input_unit" in spec:
+            returns.append(f" * It is the {spec['input_quantity']}, in {spec['input_unit']}, not a corrected output.")
     lines = [f"/* {name}.h: temperature compensation by the {method} method, exported by tcbench export formats=[c].",
              *([f" * {about}"] if about else []),
              " *",
@@ -715,13 +762,21 @@ def _model_slots(spec: dict[str, Any]) -> list[str]:
 
 def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     """The update of the diagnosed model (see the module doc) and its operations per sample."""
+    flops, calls, lines = _model_lines(spec, 0)
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+
+
+def _model_lines(spec: dict[str, Any], base: int) -> tuple[int, int, list[str]]:
+    """The update's lines of one diagnosed model whose state starts at ``s->memory[base]``, its
+    operations and its ``exp`` calls per sample."""
     slots = _model_slots(spec)
-    lines = ["    int first = s->samples == 1;",
-             "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
+    stateful = any(e["id"] in ("thermal_lag", "temperature_rate", "hysteresis", "second_node") for e in spec["effects"])
+    lines = ["    int first = s->samples == 1;"] * stateful + [
+        "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
     flops, calls = 0, 0
     lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
     for k, e in lags:  # the die stage first, in order, as the simulator runs it
-        at = slots.index(f"die lag {k}")
+        at = base + slots.index(f"die lag {k}")
         lines += [f"    if (first) s->memory[{at}] = die;",
                   f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                   f"    die = s->memory[{at}];"]
@@ -732,13 +787,13 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     flops += 2 + 2 * len(spec["bias"])
     for k, e in enumerate(spec["effects"]):
         if e["id"] == "temperature_rate":
-            at = slots.index("last temperature")
+            at = base + slots.index("last temperature")
             lines += [f"    if (!first && dt_s > 0) offset += (R){_lit(e['coef_per_c_per_s'])} * "
                       f"((temperature_c - s->memory[{at}]) / dt_s);",
                       f"    s->memory[{at}] = temperature_c;"]
             flops += 4
         elif e["id"] == "hysteresis":
-            at, w = slots.index(f"play operator {k}"), e["width_c"]
+            at, w = base + slots.index(f"play operator {k}"), e["width_c"]
             start = float(np.clip(e["start_state"], -1.0, 1.0))
             lines += [f"    if (first) s->memory[{at}] = die - (R){_lit(start)} * (R){_lit(w)};",
                       f"    if (s->memory[{at}] < die - (R){_lit(w)}) s->memory[{at}] = die - (R){_lit(w)};",
@@ -753,7 +808,7 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
                       f"offset += (R){_lit(e['amplitude'])} * TC_EXP((R)-0.5 * (z * z)); }}"]
             flops, calls = flops + 6, calls + 1
         elif e["id"] == "second_node":
-            at = slots.index(f"second node {k}")
+            at = base + slots.index(f"second node {k}")
             lines += [f"    if (first) s->memory[{at}] = die;",
                       f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                       f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
@@ -764,7 +819,38 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
             lines.append(f"    scale = scale * u + (R){_lit(k)};")
         flops += 2 * len(spec["scale_factor"]) + 1
     flops += 1
-    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+    return flops, calls, lines
+
+
+def _model_mean_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    """The mean of several diagnosed models (a run's, one per training run): each model's update in
+    its own block on its own state, their offsets (and scale factors) averaged."""
+    scaled = _scaled(spec)
+    lines = ["    R total = 0" + (", total_scale = 0;" if scaled else ";")]
+    flops, calls, base = 0, 0, 0
+    for m in spec["models"]:
+        f, c, body = _model_lines(m, base)
+        base += len(_model_slots(m))
+        lines += ["    {", *("    " + line for line in body), "        total += offset;"]
+        if scaled:
+            lines.append("        total_scale += " + ("scale;" if "scale_factor" in m else "(R)1;"))
+        lines.append("    }")
+        flops, calls = flops + f + 1 + scaled, calls + c
+    n = len(spec["models"])
+    lines.append(f"    R offset = total / (R){n};")
+    if scaled:
+        lines.append(f"    R scale = total_scale / (R){n};")
+    flops += 1 + scaled
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), lines
+
+
+def _model_mean_slots(spec: dict[str, Any]) -> list[str]:
+    return [f"model {k} {slot}" for k, m in enumerate(spec["models"]) for slot in _model_slots(m)]
+
+
+def _scaled(spec: dict[str, Any]) -> bool:
+    """Whether the update returns ``(raw - offset) / scale`` (a model with a scale factor)."""
+    return "scale_factor" in spec or any("scale_factor" in m for m in spec.get("models", ()))
 
 
 def _source(spec: dict[str, Any], name: str, up: str, body: list[str], kind: _Kind) -> str:
@@ -867,7 +953,7 @@ static R network(R {names[0]}, R {names[1]}, const R *drive, R *hidden)
     else:
         update.append("    {")
     update += body
-    scaled = "scale_factor" in spec
+    scaled = _scaled(spec)
     back = (f"    return estimate;  /* the {kind.noun}'s estimate of the input */" if inverse else
             "    return (raw - offset) / scale;" if scaled else "    return raw - offset;")
     update += [back, "    }", "}\n"]
@@ -879,10 +965,13 @@ _KINDS = {
     "poly3": _Kind(False, _cubic_code, _cubic_offset),
     "poly3_rate": _Kind(True, _cubic_rate_code, _cubic_rate_offset),
     "model": _Kind(False, _model_code, lambda spec, t, temp, rate: _model_streamed(spec, t, temp), _model_slots),
+    "model_mean": _Kind(False, _model_mean_code, lambda spec, t, temp, rate: np.mean(
+        [_model_streamed(m, t, temp) for m in spec["models"]], axis=0), _model_mean_slots),
     "poly": _Kind(False, _poly_code, lambda spec, t, temp, rate: _poly_out(spec, temp, np.zeros_like(temp)),
                   estimate=lambda spec, t, raw, temp: _poly_out(spec, raw, temp), noun="polynomial"),
     "poly_rate": _Kind(True, _poly_code, lambda spec, t, temp, rate: _poly_out(spec, temp, rate), noun="polynomial"),
 }
+_KINDS["lagpoly"] = _KINDS["model"]  # the lag-aware polynomial: a diagnosed model of one thermal lag
 _NETWORK = _Kind(True, _network_code, lambda spec, t, temp, rate: _network_out(spec, t, temp, rate), network=True)
 _INVERSE = _Kind(False, _network_code, _no_offset, network=True,
                  estimate=lambda spec, t, raw, temp: _network_out(spec, t, raw, temp))
