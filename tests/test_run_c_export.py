@@ -16,6 +16,7 @@ import shutil
 import subprocess
 import sys
 from dataclasses import replace
+from types import SimpleNamespace
 from pathlib import Path
 
 import gymnasium as gym
@@ -25,7 +26,7 @@ import pytest
 import tcbench  # noqa: F401 - registers the envs
 from test_c_export import _stable
 from tcbench.compensation import methods
-from tcbench.compensation.c_export import c_sources, device_clock_s, streamed_corrected, write_c
+from tcbench.compensation.c_export import c_sources, device_clock_s, run_model_spec, streamed_corrected, write_c
 from tcbench.compensation.features import temperature_rate_c_per_s
 from tcbench.compensation.run_device import BASELINE_FITS, device_document
 from tcbench.runner.loop import compensate
@@ -370,3 +371,40 @@ def test_a_baselines_run_keeps_its_model_for_the_device(tmp_path: Path) -> None:
     done = _tcbench("export", f"runs=[{ids['memoriser']}]", "formats=[c]", "out=d", cwd=tmp_path)
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
     assert "no model a device runs (memoriser: a replay of the training runs" in done.stderr, done.stderr
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+def test_the_mean_of_diagnosed_models_solves_for_the_input_as_the_task_does(build: str, tmp_path: Path) -> None:
+    """learner=model of the full-temperature form: the task solves ``b + s a = U`` for the input
+    with the models' mean ``b`` and ``s`` (:func:`~tcbench.tasks.diagnosed.solve_input`, no
+    ``k a^2``); the device's ``model_mean`` returns ``(raw - mean b) / mean s`` in g, to the
+    tolerance on a 1-Hz record through a temperature cycle at four input levels. A model with an
+    ``accel_nonlinearity`` is left out with its reason."""
+    from tcbench.sensors.effects import EFFECTS
+    from tcbench.sensors.fitted import PolynomialModel as SensorModel
+    from tcbench.tasks.diagnosed import DiagnosedModels, solve_input
+
+    lag = EFFECTS["thermal_lag"]
+    models = (SensorModel(sensor="msra", centre_c=20.0, half_range_c=50.0, bias=(138.4, -9.1, 0.01),
+                          scale_factor=(199.3, 6.0, -0.001), effects=(lag(tau_s=300.0),)),
+              SensorModel(sensor="msra", centre_c=15.0, half_range_c=45.0, bias=(138.2, -9.0), scale_factor=(199.0, 6.1)))
+    fitted = DiagnosedModels(("a", "b"), models, ())
+    t_s = np.arange(0.0, 7200.0)
+    temp_c = 20.0 + 40.0 * np.sin(2 * np.pi * t_s / 7200.0)
+    applied = np.repeat([1.0, 0.0, -1.0, 0.0], t_s.size // 4)
+    b, s, k = fitted.response(t_s, temp_c)
+    raw = b + s * applied + 0.01 * np.sin(t_s / 7.0)  # the mean model's reading, and a wiggle
+    want = solve_input(raw, b, s, k)
+    spec = json.loads(json.dumps(run_model_spec(fitted.models, True, "acceleration", "g")))
+    assert spec["method"] == "model_mean" and spec["input_unit"] == "g"
+    assert "It is the acceleration, in g, not a corrected output." in c_sources(spec, "x").header
+    rec = SimpleNamespace(time_s=t_s, temperature_c=temp_c, output=raw)
+    got, _ = _streamed_by_c(spec, "tc_mean", rec, build, tmp_path)
+    bound = TOLERANCE[build] * np.max(np.abs(want))
+    assert np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want)) / bound
+    assert np.max(np.abs(want - applied)) < 1e-3  # the mean model explains the reading
+    k2 = (SensorModel(sensor="msra", bias=(138.0,), scale_factor=(199.0,),
+                      effects=(EFFECTS["accel_nonlinearity"](k2_per_g2=0.1),)),)
+    with pytest.raises(ValueError, match="its accel_nonlinearity term is not exported"):
+        run_model_spec(k2, True)
