@@ -229,8 +229,8 @@ class CompensationKind(JobKind):
         files += gyro_tables(result, where)
         from tcbench.compensation.run_device import BASELINE_FITS, FILE, device_document
 
-        name = job.learner.name
-        if name in BASELINE_FITS or (name not in BASELINES and getattr(job.env, "learner", None) is not None):
+        name, static = job.learner.name, hasattr(job.env, "clamp_inputs")  # a static-input task (not the gyro's)
+        if (name in BASELINE_FITS and static) or (name not in BASELINES and getattr(job.env, "learner", None) is not None):
             fitted = result.score.extra.get(BASELINE_FITS.get(name) or "")  # a baseline's fitted model
             (where / FILE).write_text(json.dumps(device_document(job.env, name, job.names.method, fitted), indent=1))
             files.append(where / FILE)
