@@ -4,7 +4,9 @@ compiled with the system C compiler and run sample by sample over the run's test
 the run's own compensation (the task's learner compensator) to 1e-9 (double build) and 1e-4 (float
 build), relative to the larger of the output and the record's largest raw reading. The
 full-temperature task's network (``msra_fulltemp``: ``[raw, T]`` to the input) runs too, and
-returns the task's own estimate of the input in g to the same tolerances, relative to its largest."""
+returns the task's own estimate of the input in g to the same tolerances, relative to its largest.
+So do a run's ``poly`` of every form and degree, its lag-aware polynomial (``learner=lagpoly``) and
+its diagnosed model (``learner=model``)."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import shutil
 import subprocess
 import sys
 from dataclasses import replace
+from types import SimpleNamespace
 from pathlib import Path
 
 import gymnasium as gym
@@ -23,9 +26,9 @@ import pytest
 import tcbench  # noqa: F401 - registers the envs
 from test_c_export import _stable
 from tcbench.compensation import methods
-from tcbench.compensation.c_export import device_clock_s, write_c
+from tcbench.compensation.c_export import c_sources, device_clock_s, run_model_spec, streamed_corrected, write_c
 from tcbench.compensation.features import temperature_rate_c_per_s
-from tcbench.compensation.run_device import device_document
+from tcbench.compensation.run_device import BASELINE_FITS, device_document
 from tcbench.runner.loop import compensate
 
 CC = shutil.which("cc")
@@ -191,17 +194,127 @@ def test_a_runs_cubic_runs_on_the_device_as_the_task_compensates(task: str, offs
     assert np.any(warmer.recording.temperature_c > box[1][0])  # the clamp is exercised
 
 
-@pytest.mark.parametrize(("task", "learner_params", "why"), [
-    (FULLTEMP, {}, "poly of form 'inverse': it solves for the input from [raw, T]"),
-    (ENV, {"form": "bias_rate"}, "poly of form 'bias_rate': its rate term is a polynomial in T"),
-    (ENV, {"degree": 4}, "poly of degree 4: the device's cubic takes degree 3 at most"),
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize(("task", "learner_params", "method"), [
+    (ENV, {"form": "bias_rate"}, "poly_rate"),
+    ("tcbench/MSRA-ZeroBias-v0", {"form": "bias_rate", "degree": 4, "offsets": "per_run"}, "poly_rate"),
+    (FULLTEMP, {}, "poly"),
+    (ENV, {"degree": 5}, "poly"),
 ])
-def test_a_runs_cubic_no_device_runs_says_why(task: str, learner_params: dict, why: str) -> None:
-    env = gym.make(task, learner="poly", learner_params=learner_params, n_train=2, n_test=1,
+def test_a_runs_poly_of_every_form_and_degree_runs_on_the_device(task: str, learner_params: dict, method: str,
+                                                                 build: str, tmp_path: Path) -> None:
+    """A run's poly learner other than the cubic PX4 runs (the rate term a polynomial in T on the
+    device's trailing rate window, the input solved from [raw, T], a degree above 3) is kept as its
+    Chebyshev series in the scaled inputs: compiled, it gives the task's own compensation (the
+    estimate in g for fulltemp) in both builds, its inputs held to the training box."""
+    n_train = 1 if task == FULLTEMP else 2  # fulltemp's test run then goes below the training range
+    env = gym.make(task, learner="poly", learner_params=learner_params, n_train=n_train, n_test=1,
                    recordings_seed=0).unwrapped
     compensate(env, "poly", "none", {}, 1, 0)
     doc = device_document(env, "poly", "poly")
-    assert doc["device"] == {} and doc["left_out"]["poly"].startswith(why)
+    assert "left_out" not in doc
+    spec = json.loads(json.dumps(doc["device"]["poly"]))
+    assert spec["method"] == method and spec["degree"] == learner_params.get("degree", 3)
+    box = env.data.input_range(env._x)
+    tr = env.data.test[0]
+    raw = tr.recording.output
+    got, stderr = _streamed_by_c(spec, "tc_poly", tr.recording, build, tmp_path)
+    want = methods.learner_compensator(env.data, env.learner, box)(tr, raw)
+    inverse = spec["form"] == "inverse"
+    bound = TOLERANCE[build] * (np.max(np.abs(want)) if inverse else np.maximum(np.abs(want), np.max(np.abs(raw))))
+    assert got.size == want.size and np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
+    header = c_sources(spec, "tc_poly").header
+    if inverse:  # the polynomial's estimate of the input in g, the temperature held to its range
+        assert "polynomial's estimate of the input (acceleration, in g)" in header
+        temp_c = tr.recording.temperature_c
+        free = env.learner.predict(np.column_stack([raw, temp_c]))
+        below = temp_c < box[0][1]
+        assert below.any() and np.max(np.abs(free - want)[below]) > 1e3 * TOLERANCE["double"] * np.max(np.abs(want))
+        assert np.sqrt(np.mean((want - tr.recording.input) ** 2)) < np.sqrt(np.mean(tr.recording.input ** 2))
+    else:
+        assert np.ptp(want - raw) > 10 * TOLERANCE["float"] * np.max(np.abs(raw))  # it corrects something
+    if method == "poly_rate":  # the rate term acts: without it the output differs
+        assert "dropped 0" in stderr and "RATE_CAPACITY" in header
+        flat = spec | {"rate": [0.0] * len(spec["rate"])}
+        clock = device_clock_s(np.r_[0.0, np.diff(tr.recording.time_s)])
+        without = streamed_corrected(flat, clock, tr.recording.temperature_c, raw)
+        assert np.max(np.abs(without - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(raw))
+
+
+def _baseline(task: str, learner: str, n_train: int) -> tuple[object, dict, object]:
+    """``task`` with the baseline ``learner`` scored as a run scores it, the ``device.json`` the
+    run keeps (:func:`~tcbench.runner.kinds.compensation.CompensationKind.record` passes the fit its
+    score keeps), and that fit."""
+    env = gym.make(task, learner=None, n_train=n_train, n_test=1, recordings_seed=0).unwrapped
+    result = compensate(env, learner, "none", {}, 1, 0)
+    key = BASELINE_FITS[learner]
+    fitted = result.score.extra.get(key) if key else None
+    return env, device_document(env, learner, learner, fitted), fitted
+
+
+def _compiled_agrees(spec: dict, env: object, want: np.ndarray, build: str, folder: Path, inverse: bool) -> None:
+    """``spec``'s C over the task's test record gives ``want`` to the build's tolerance."""
+    rec = env.data.test[0].recording
+    got, _ = _streamed_by_c(spec, "tc_run", rec, build, folder)
+    bound = TOLERANCE[build] * (np.max(np.abs(want)) if inverse else np.maximum(np.abs(want), np.max(np.abs(rec.output))))
+    assert got.size == want.size and np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want) / bound)
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+@pytest.mark.parametrize("task", [ENV, "tcbench/MSRA-ZeroBias-v0", FULLTEMP])
+def test_a_runs_lagpoly_runs_on_the_device_as_the_task_compensates(task: str, build: str, tmp_path: Path) -> None:
+    """learner=lagpoly: its lag the model's streaming first-order filter, its polynomial in the
+    lagged temperature; compiled, it gives the task's own compensation in both builds (fulltemp:
+    the input solved from the reading, in g, as the header says)."""
+    env, doc, fitted = _baseline(task, "lagpoly", 2)
+    spec = json.loads(json.dumps(doc["device"]["lagpoly"]))
+    assert spec["method"] == "lagpoly" and spec["effects"] == [{"id": "thermal_lag", "tau_s": fitted.tau_s}]
+    tr = env.data.test[0]
+    want = methods.lagpoly_compensator(env.data, fitted)(tr, tr.recording.output)
+    inverse = task == FULLTEMP
+    _compiled_agrees(spec, env, want, build, tmp_path, inverse)
+    assert ("the acceleration, in g, not a corrected output" in c_sources(spec, "x").header) == inverse
+    unlagged = spec | {"effects": []}  # the lag acts: without it the output differs
+    clock = device_clock_s(np.r_[0.0, np.diff(tr.recording.time_s)])
+    without = streamed_corrected(unlagged, clock, tr.recording.temperature_c, tr.recording.output)
+    assert np.max(np.abs(without - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(want))
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+def test_a_runs_diagnosed_model_runs_on_the_device_as_the_task_compensates(tmp_path: Path) -> None:
+    """learner=model on the room-temperature task: one model diagnosed per training run (here one
+    with a thermal lag, one without), the mean of their offsets removed; the device runs each on its
+    own state (``model_mean``) and, compiled, gives the task's own compensation in both builds (the
+    models hold only terms the device runs as the task's grid does: the lag and the polynomial)."""
+    env, doc, fitted = _baseline("tcbench/MSRA-ZeroBias-v0", "model", 2)
+    spec = json.loads(json.dumps(doc["device"]["model"]))
+    assert spec["method"] == "model_mean" and len(spec["models"]) == 2
+    assert any(m["effects"] for m in spec["models"])
+    tr = env.data.test[0]
+    rec = tr.recording
+    want = rec.output - fitted.bias(rec.time_s, rec.temperature_c)  # the task's compensator
+    for build in ("double", "float"):
+        _compiled_agrees(spec, env, want, build, tmp_path, False)
+    one = streamed_corrected(spec["models"][0], device_clock_s(np.r_[0.0, np.diff(rec.time_s)]), rec.temperature_c,
+                             rec.output)
+    assert np.max(np.abs(one - want)) > 1e4 * TOLERANCE["double"] * np.max(np.abs(rec.output))  # the mean acts
+
+
+GYRO = ("tcbench/Gyro-DriftNoise-v0", {"sample_rate_hz": 1.0, "hold_s": 600.0})  # a cheap gyro task
+
+
+def test_what_no_device_runs_says_why() -> None:
+    """The memoriser (a replay of the training runs, not a model) and the gyro task's pipeline
+    (it decomposes the whole record) keep why no device runs them."""
+    _, doc, _ = _baseline(ENV, "memoriser", 1)
+    assert doc["device"] == {} and doc["left_out"]["memoriser"].startswith("a replay of the training runs' mean")
+    env = gym.make(GYRO[0], learner="bp", learner_params={"training": "gd", "epochs": 2}, **GYRO[1]).unwrapped
+    compensate(env, "bp", "none", {}, 1, 0)
+    doc = device_document(env, "bp", "bp")
+    assert doc["device"] == {} and doc["left_out"]["bp"].startswith("the task's pipeline decomposes the whole record")
 
 
 def _tcbench(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -235,3 +348,63 @@ def test_export_takes_a_runs_id_and_refuses_in_one_line(tmp_path: Path) -> None:
     raw_id = [p.name for p in (tmp_path / "mlartifacts" / "tcbench").iterdir() if p.name != run_id][0]
     done = _tcbench("export", f"runs=[{raw_id}]", "formats=[c]", "out=e", cwd=tmp_path)
     assert done.returncode == 2 and "the run kept no device.json" in done.stderr, done.stderr
+
+
+@pytest.mark.slow
+def test_a_baselines_run_keeps_its_model_for_the_device(tmp_path: Path) -> None:
+    """``tcbench run learner=lagpoly`` keeps device.json from its score's fit, which ``tcbench
+    export runs=[ID] formats=[c]`` writes as C; a memoriser's run keeps why no device runs it, and
+    the export says so in one line, exit 2."""
+    ids = {}
+    for learner in ("lagpoly", "memoriser"):
+        before = set((tmp_path / "mlartifacts").rglob("device.json"))
+        done = _tcbench("run", "task=msra_zerobias", "task.n_train=2", "task.n_test=1", "task.recordings_seed=0",
+                        f"learner={learner}", "seed=0", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        found = set((tmp_path / "mlartifacts").rglob("device.json")) - before
+        assert len(found) == 1
+        ids[learner] = found.pop().parent.parent.name
+    done = _tcbench("export", f"runs=[{ids['lagpoly']}]", "formats=[c]", "out=c", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    header = (tmp_path / "c" / f"tc_msra_lagpoly_{ids['lagpoly'][:8]}.h").read_text()
+    assert "by the lagpoly method" in header and f"the lagpoly model of tcbench run {ids['lagpoly']}" in header
+    done = _tcbench("export", f"runs=[{ids['memoriser']}]", "formats=[c]", "out=d", cwd=tmp_path)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+    assert "no model a device runs (memoriser: a replay of the training runs" in done.stderr, done.stderr
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (cc) on this machine")
+@pytest.mark.parametrize("build", ["double", "float"])
+def test_the_mean_of_diagnosed_models_solves_for_the_input_as_the_task_does(build: str, tmp_path: Path) -> None:
+    """learner=model of the full-temperature form: the task solves ``b + s a = U`` for the input
+    with the models' mean ``b`` and ``s`` (:func:`~tcbench.tasks.diagnosed.solve_input`, no
+    ``k a^2``); the device's ``model_mean`` returns ``(raw - mean b) / mean s`` in g, to the
+    tolerance on a 1-Hz record through a temperature cycle at four input levels. A model with an
+    ``accel_nonlinearity`` is left out with its reason."""
+    from tcbench.sensors.effects import EFFECTS
+    from tcbench.sensors.fitted import PolynomialModel as SensorModel
+    from tcbench.tasks.diagnosed import DiagnosedModels, solve_input
+
+    lag = EFFECTS["thermal_lag"]
+    models = (SensorModel(sensor="msra", centre_c=20.0, half_range_c=50.0, bias=(138.4, -9.1, 0.01),
+                          scale_factor=(199.3, 6.0, -0.001), effects=(lag(tau_s=300.0),)),
+              SensorModel(sensor="msra", centre_c=15.0, half_range_c=45.0, bias=(138.2, -9.0), scale_factor=(199.0, 6.1)))
+    fitted = DiagnosedModels(("a", "b"), models, ())
+    t_s = np.arange(0.0, 7200.0)
+    temp_c = 20.0 + 40.0 * np.sin(2 * np.pi * t_s / 7200.0)
+    applied = np.repeat([1.0, 0.0, -1.0, 0.0], t_s.size // 4)
+    b, s, k = fitted.response(t_s, temp_c)
+    raw = b + s * applied + 0.01 * np.sin(t_s / 7.0)  # the mean model's reading, and a wiggle
+    want = solve_input(raw, b, s, k)
+    spec = json.loads(json.dumps(run_model_spec(fitted.models, True, "acceleration", "g")))
+    assert spec["method"] == "model_mean" and spec["input_unit"] == "g"
+    assert "It is the acceleration, in g, not a corrected output." in c_sources(spec, "x").header
+    rec = SimpleNamespace(time_s=t_s, temperature_c=temp_c, output=raw)
+    got, _ = _streamed_by_c(spec, "tc_mean", rec, build, tmp_path)
+    bound = TOLERANCE[build] * np.max(np.abs(want))
+    assert np.all(np.abs(got - want) <= bound), np.max(np.abs(got - want)) / bound
+    assert np.max(np.abs(want - applied)) < 1e-3  # the mean model explains the reading
+    k2 = (SensorModel(sensor="msra", bias=(138.0,), scale_factor=(199.0,),
+                      effects=(EFFECTS["accel_nonlinearity"](k2_per_g2=0.1),)),)
+    with pytest.raises(ValueError, match="its accel_nonlinearity term is not exported"):
+        run_model_spec(k2, True)

@@ -133,7 +133,7 @@ def read_run(given: str) -> list[RunNetwork]:
         folder = local_artifact_dir(run.info.artifact_uri)
         path = (folder / FILE) if folder is not None else Path(given) / FILE
         if not path.is_file():
-            raise CommandError(f"runs: {given}: the run kept no {FILE} (not a compensation run of a network, "
+            raise CommandError(f"runs: {given}: the run kept no {FILE} (not a compensation run of a fitted model, "
                                "or run before tcbench kept one)")
         run_id = given
     try:
@@ -144,9 +144,10 @@ def read_run(given: str) -> list[RunNetwork]:
         raise CommandError(f"runs: {path}: not a {FILE} tcbench export reads ({exc})") from None
     if not device:
         why = "; ".join(f"{k}: {v}" for k, v in left.items()) or "no network"
-        raise CommandError(f"runs: {given}: no network a device runs ({why})")
+        raise CommandError(f"runs: {given}: no model a device runs ({why})")
     return [RunNetwork(given, f"tc_{sensor}_{method}_{run_id[:8]}",
-                       f"{sensor}, output in {unit}: the {about.get('method', method)} network of tcbench run {run_id} "
+                       f"{sensor}, output in {unit}: the {about.get('method', method)} "
+                       f"{'network' if 'hidden' in spec else 'model'} of tcbench run {run_id} "
                        f"on {about.get('task', '?')}", spec) for method, spec in device.items()]
 
 

@@ -19,6 +19,11 @@ same arithmetic in numpy, the reference the compiled code is checked against):
 - ``poly3``: PX4's cubic about its reference, the temperature held to the fitted range (a
   ``tcbench run``'s cubic too, :func:`run_cubic_spec`: its Chebyshev series expanded about the
   middle of the training range).
+- ``poly`` and ``poly_rate``: a ``tcbench run``'s ``poly`` learner of another form or of degree
+  above 3 (:func:`run_poly_spec`), its Chebyshev series in its inputs scaled to [-1, 1] as it was
+  fitted, held to the training box: the offset ``b(T)``; with ``poly_rate`` ``b(T) + r(T) dT/dt``
+  on the trailing rate window below; of the ``inverse`` form (``msra_fulltemp``) the input
+  solved from ``[raw, T]``, ``(raw - b(T)) / K(T)``, returned in the input's unit.
 - ``poly3_rate``: that cubic plus the rate coefficient times the temperature rate, the
   least-squares slope over the trailing :data:`~tcbench.compensation.calibration.RATE_WINDOW_S`
   window ``t_i - w < t_j <= t_i``, each window's moments centred on its own means: the estimator
@@ -58,6 +63,14 @@ same arithmetic in numpy, the reference the compiled code is checked against):
   level, all ``tcbench calibrate`` sees on a static record) writes a unit scale factor and its
   bias absorbs the level, so the model returns ``raw - offset``. A model with another term (an
   accelerometer's ``k a^2``, ``accel_nonlinearity``) is not exported, and the export says which.
+- ``model_mean``: a ``tcbench run``'s diagnosed model (``learner=model``, :func:`run_model_spec`):
+  one model per training run, each run as ``model`` on its own state, their offsets averaged (of
+  the ``inverse`` form, their scale factors too: ``(raw - mean offset) / mean scale``, in the
+  input's unit). A run of one training run keeps the plain ``model``.
+- ``lagpoly``: a run's lag-aware polynomial (:func:`lagpoly_spec`) as a ``model`` of one thermal
+  lag: the lag on the device's own intervals (the task's on the record's median interval: the
+  same where the intervals are uniform), its polynomial in the lagged temperature, of the
+  ``inverse`` form over its scale factor.
 """
 
 from __future__ import annotations
@@ -201,6 +214,36 @@ def run_cubic_spec(learner: Any, temp_range_c: Any) -> dict[str, Any]:
             "tmin_c": low, "tmax_c": high}
 
 
+def run_poly_spec(learner: Any, box: tuple[Any, Any] | None, rate_window_s: float = RATE_WINDOW_S,
+                  capacity: int = 2, quantity: str = "input", unit: str = "") -> dict[str, Any]:
+    """A ``tcbench run``'s fitted ``poly`` learner of any form and degree as the ``poly`` (or, with
+    its rate term, ``poly_rate``) a device runs: its Chebyshev series in the inputs scaled to
+    [-1, 1] as it was fitted, its output scaled back. ``bias``: the offset ``b(T)``;
+    ``bias_rate``: ``b(T) + r(T) dT/dt`` on the trailing rate window (``rate_window_s``, a ring
+    of ``capacity`` samples); ``inverse``: the input (``quantity`` in ``unit``) solved from
+    ``[raw, T]``, ``(raw - b(T)) / K(T)`` in scaled units. ``box``: the lower and upper bounds of
+    the learner's two inputs (``None``: not held)."""
+    form = str(learner.describe().get("fitted_form"))
+    if form not in ("bias", "bias_rate", "inverse"):
+        raise ValueError(f"poly of form {form!r}: not fitted")
+    coef = np.asarray(learner.get_params(), dtype=np.float64)
+    d = int(learner.settings.degree)
+    xs, ys = learner.x_scaler, learner.y_scaler
+    low, high = (np.full(2, -np.inf), np.full(2, np.inf)) if box is None else box
+    spec: dict[str, Any] = {"method": "poly_rate" if form == "bias_rate" else "poly", "form": form, "degree": d,
+                            "bias": coef[:d + 1].tolist(), "x_low": xs.low.tolist(), "x_span": xs.span.tolist(),
+                            "y_low": float(ys.low[0]), "y_span": float(ys.span[0])}
+    if form == "inverse":
+        return spec | {"scale": coef[d + 1:].tolist(), "inputs": ["raw", "temperature_c"], "input_quantity": quantity,
+                       "input_unit": unit, "raw_range": _bounds((low[0], high[0])),
+                       "temp_range_c": _bounds((low[1], high[1]))}
+    spec |= {"inputs": ["temperature_c", "rate"], "temp_range_c": _bounds((low[0], high[0]))}
+    if form == "bias_rate":
+        spec |= {"rate": coef[d + 1:].tolist(), "rate_range": _bounds((low[1], high[1])),
+                 "rate_window_s": float(rate_window_s), "rate_capacity": int(capacity)}
+    return spec
+
+
 def is_inverse(spec: dict[str, Any]) -> bool:
     """Whether ``spec`` returns the input estimated from ``[raw, T]`` (else raw minus an offset)."""
     return spec.get("form") == "inverse"
@@ -225,6 +268,38 @@ def model_spec(sensor_model: Any) -> dict[str, Any]:
     return spec
 
 
+def lagpoly_spec(fitted: Any, inverse: bool, quantity: str = "input", unit: str = "") -> dict[str, Any]:
+    """A fitted lag-aware polynomial (:class:`~tcbench.compensation.lagpoly.LagPoly`) as the
+    diagnosed model a device runs (``model`` kind, method ``lagpoly``): its bias polynomial in the
+    normalised lagged temperature, its lag the model's first-order filter on the device's own
+    intervals; ``inverse``: with its scale factor, the input (``quantity`` in ``unit``) solved
+    from the reading. ``ValueError`` for an inverse form without a scale factor."""
+    tau_s = float(fitted.tau_s)
+    spec: dict[str, Any] = {"method": "lagpoly", "centre_c": float(fitted.centre_c),
+                            "half_range_c": float(fitted.half_range_c), "bias": [float(b) for b in fitted.bias],
+                            "ref_c": float(fitted.centre_c),
+                            "effects": [{"id": "thermal_lag", "tau_s": tau_s}] if tau_s > 0 else []}
+    if not inverse:
+        return spec
+    if fitted.scale is None:
+        raise ValueError("lagpoly: a bias-only lag polynomial cannot solve for the input")
+    return spec | {"scale_factor": [float(k) for k in fitted.scale], "input_quantity": quantity, "input_unit": unit}
+
+
+def run_model_spec(models: Any, inverse: bool, quantity: str = "input", unit: str = "") -> dict[str, Any]:
+    """A run's diagnosed model (``learner=model``: one diagnosed model per training run, their
+    compensators' outputs averaged) as the device runs it: one model as calibrate's ``model``
+    (:func:`model_spec`), several as ``model_mean``, each on its own state, the offsets (and,
+    ``inverse``, the scale factors) averaged; ``inverse``: the input (``quantity`` in ``unit``)
+    ``(raw - b) / s`` of the mean ``b`` and ``s``; otherwise raw minus the mean offset (the scale
+    factors dropped, as the task's bias form drops them). ``ValueError`` naming a term not exported."""
+    members = [model_spec(m) for m in models]
+    if not inverse:
+        members = [{k: v for k, v in m.items() if k != "scale_factor"} for m in members]
+    spec = members[0] if len(members) == 1 else {"method": "model_mean", "models": members}
+    return spec | ({"input_quantity": quantity, "input_unit": unit} if inverse else {})
+
+
 def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.ndarray, raw: np.ndarray,
                        rate_c_per_s: np.ndarray | None = None) -> np.ndarray:
     """What the exported code returns at each sample, in numpy: ``raw`` minus
@@ -233,16 +308,21 @@ def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.nda
     estimate of the input from ``[raw, T]``."""
     if is_inverse(spec):
         t = np.asarray(clock_s, dtype=np.float64)
-        return _network_out(spec, t, np.asarray(raw, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
+        return _kind(spec).estimate(spec, t, np.asarray(raw, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
     corrected = np.asarray(raw, dtype=np.float64) - streamed_offset(spec, clock_s, temp_c, rate_c_per_s)
-    if spec["method"] != "model" or "scale_factor" not in spec:
+    if not _scaled(spec):
         return corrected
-    u = (_model_die(spec, np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64))
-         - spec["centre_c"]) / spec["half_range_c"]
-    scale = np.zeros_like(u)
-    for k in reversed(spec["scale_factor"]):
+    t, temp = np.asarray(clock_s, dtype=np.float64), np.asarray(temp_c, dtype=np.float64)
+    return corrected / np.mean([_model_scale(m, t, temp) for m in spec.get("models", [spec])], axis=0)
+
+
+def _model_scale(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """A diagnosed model's scale factor in its die temperature at each sample (1 without one)."""
+    u = (_model_die(spec, t, temp) - spec["centre_c"]) / spec["half_range_c"]
+    scale = np.zeros_like(u) if "scale_factor" in spec else np.ones_like(u)
+    for k in reversed(spec.get("scale_factor", [])):
         scale = scale * u + k
-    return corrected / scale
+    return scale
 
 
 def _model_die(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
@@ -368,6 +448,31 @@ def _cubic_rate_offset(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, ra
     return _cubic_offset(spec, t, temp, rate) + spec["rate_coef"] * rate
 
 
+def _poly_out(spec: dict[str, Any], first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """A run's polynomial (:func:`run_poly_spec`) on its two inputs (``spec['inputs']``' order),
+    held to its box and scaled as it was fitted: the offset, or for ``inverse`` the input."""
+    from numpy.polynomial import chebyshev
+
+    (a_lo, a_hi), (b_lo, b_hi) = _poly_ranges(spec)
+    low, span = np.asarray(spec["x_low"]), np.asarray(spec["x_span"])
+    x = 2.0 * (np.column_stack([np.clip(first, a_lo, a_hi), np.clip(second, b_lo, b_hi)]) - low) / span - 1.0
+    inverse = is_inverse(spec)
+    basis = chebyshev.chebvander(x[:, 1 if inverse else 0], int(spec["degree"]))
+    y = basis @ np.asarray(spec["bias"])
+    if inverse:
+        y = (x[:, 0] - y) / (basis @ np.asarray(spec["scale"]))
+    elif "rate" in spec:
+        y = y + (basis[:, :-1] * x[:, 1:2]) @ np.asarray(spec["rate"])
+    return (y + 1.0) * 0.5 * spec["y_span"] + spec["y_low"]
+
+
+def _poly_ranges(spec: dict[str, Any]) -> tuple[list[float], list[float]]:
+    """The box each of a run's polynomial's two inputs is held to (the rate of a ``bias`` form: free)."""
+    if is_inverse(spec):
+        return spec["raw_range"], spec["temp_range_c"]
+    return spec["temp_range_c"], spec.get("rate_range", [-np.inf, np.inf])
+
+
 def _network_out(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """The network's output on its two inputs (:func:`_input_ranges`' order) at each sample."""
     if "wc" not in spec:
@@ -404,20 +509,23 @@ def _elman_streamed(spec: dict[str, Any], t: np.ndarray, first: np.ndarray, seco
 class _Kind:
     """How the export runs one kind of spec: whether it reads the trailing rate window, its
     operations per sample and the update's lines that compute ``offset`` (or, for an inverse
-    network, ``estimate``), its numpy reference (:func:`streamed_offset`), its state slots
-    besides the clock and the counters, and whether it is a network (whose weights the source
-    holds)."""
+    form, ``estimate``), its numpy reference (:func:`streamed_offset`; :func:`streamed_corrected`
+    its ``estimate`` of the input from the clock, raw and temperature for an inverse form), its
+    state slots besides the clock and the counters, whether it is a network (whose weights the
+    source holds), and what the header calls it."""
 
     rated: bool
     code: Callable[[dict[str, Any]], tuple[str, list[str]]]
     offset: Callable[[dict[str, Any], np.ndarray, np.ndarray, np.ndarray | None], np.ndarray]
     slots: Callable[[dict[str, Any]], list[str]] = lambda spec: []
     network: bool = False
+    estimate: Callable[[dict[str, Any], np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+    noun: str = "network"
 
 
 def _kind(spec: dict[str, Any]) -> _Kind:
     """The kind of ``spec``: by its method, a network (on ``[T, dT/dt]``, or ``inverse``) otherwise."""
-    return _INVERSE if is_inverse(spec) else _KINDS.get(spec["method"], _NETWORK)
+    return _KINDS.get(spec["method"]) or (_INVERSE if is_inverse(spec) else _NETWORK)
 
 
 def _no_offset(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray, rate: np.ndarray | None) -> np.ndarray:
@@ -485,13 +593,15 @@ def c_sources(spec: dict[str, Any], name: str, about: str = "") -> CSource:
         held = ("the temperature held to its training range, {:g} to {:g} degC".format(*spec["temp_range_c"])
                 if np.all(np.isfinite(spec["temp_range_c"])) else "the temperature not held")
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns the",
-                   f" * network's estimate of the input ({spec['input_quantity']}, in {spec['input_unit']}) "
+                   f" * {kind.noun}'s estimate of the input ({spec['input_quantity']}, in {spec['input_unit']}) "
                    "from the raw output and the temperature",
                    f" * ({held}), not a corrected output."]
     else:
         returns = [f" * Call {name}_init once, then {name}_update once per sample in time order: it returns raw minus",
                    (" * the offset, over the scale factor s(T_die) (the input that explains the reading)."
-                    if "scale_factor" in spec else " * the offset.")]
+                    if _scaled(spec) else " * the offset.")]
+        if _scaled(spec) and "input_unit" in spec:
+            returns.append(f" * It is the {spec['input_quantity']}, in {spec['input_unit']}, not a corrected output.")
     lines = [f"/* {name}.h: temperature compensation by the {method} method, exported by tcbench export formats=[c].",
              *([f" * {about}"] if about else []),
              " *",
@@ -591,6 +701,45 @@ def _network_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
         "s->drive, s->pending);"]
 
 
+def _poly_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    """A run's polynomial (:func:`run_poly_spec`): its operations per sample and the update's
+    lines, the Chebyshev polynomials of the scaled temperature by their recurrence (as numpy's
+    ``chebvander``), the series summed, the output scaled back."""
+    d, inverse, rated = int(spec["degree"]), is_inverse(spec), "rate" in spec
+    names, result = _NETWORK_IO[inverse]
+    (a_lo, a_hi), (b_lo, b_hi) = _poly_ranges(spec)
+    low, span = spec["x_low"], spec["x_span"]
+    lines = [f"    R x0 = (R)2 * ({_clamped(names[0], a_lo, a_hi)} - (R){_lit(low[0])}) / (R){_lit(span[0])} - (R)1;"]
+    if inverse or rated:
+        lines.append(f"    R x1 = (R)2 * ({_clamped(names[1], b_lo, b_hi)} - (R){_lit(low[1])}) / (R){_lit(span[1])}"
+                     " - (R)1;")
+    u = "x1" if inverse else "x0"
+    flops = 4 * len(lines)
+    lines.append(f"    R c0 = (R)1, c1 = {u};")
+    if d > 1:
+        lines.append(f"    R u2 = (R)2 * {u};")
+        lines += [f"    R c{k} = c{k - 1} * u2 - c{k - 2};" for k in range(2, d + 1)]
+        flops += 1 + 2 * (d - 1)
+
+    def series(coef: list[float], times: str = "") -> str:
+        return " + ".join(f"(c{k}{times}) * (R){_lit(c)}" for k, c in enumerate(coef))
+
+    lines.append(f"    R y = {series(spec['bias'])};")
+    flops += 2 * d + 1
+    if inverse:
+        lines += [f"    R k = {series(spec['scale'])};", "    y = (x0 - y) / k;"]
+        flops += 2 * d + 1 + 2
+    elif rated:
+        lines.append(f"    y = y + ({series(spec['rate'], ' * x1')});")
+        flops += 3 * d
+    lines.append(f"    R {result} = (y + (R)1) * (R)0.5 * (R){_lit(spec['y_span'])} + (R){_lit(spec['y_low'])};")
+    flops += 4 + (0 if inverse else 1)
+    if not rated:
+        return str(flops), lines
+    cap = int(spec["rate_capacity"])
+    return f"{flops} + 9 n, n the samples in the rate window (at most {cap}: {flops + 9 * cap})", lines
+
+
 # a network's two inputs and what its update computes, by whether it is an inverse one
 _NETWORK_IO = {False: (("temperature_c", "rate"), "offset"), True: (("raw", "temperature_c"), "estimate")}
 
@@ -613,13 +762,21 @@ def _model_slots(spec: dict[str, Any]) -> list[str]:
 
 def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     """The update of the diagnosed model (see the module doc) and its operations per sample."""
+    flops, calls, lines = _model_lines(spec, 0)
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+
+
+def _model_lines(spec: dict[str, Any], base: int) -> tuple[int, int, list[str]]:
+    """The update's lines of one diagnosed model whose state starts at ``s->memory[base]``, its
+    operations and its ``exp`` calls per sample."""
     slots = _model_slots(spec)
-    lines = ["    int first = s->samples == 1;",
-             "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
+    stateful = any(e["id"] in ("thermal_lag", "temperature_rate", "hysteresis", "second_node") for e in spec["effects"])
+    lines = ["    int first = s->samples == 1;"] * stateful + [
+        "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
     flops, calls = 0, 0
     lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
     for k, e in lags:  # the die stage first, in order, as the simulator runs it
-        at = slots.index(f"die lag {k}")
+        at = base + slots.index(f"die lag {k}")
         lines += [f"    if (first) s->memory[{at}] = die;",
                   f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                   f"    die = s->memory[{at}];"]
@@ -630,13 +787,13 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
     flops += 2 + 2 * len(spec["bias"])
     for k, e in enumerate(spec["effects"]):
         if e["id"] == "temperature_rate":
-            at = slots.index("last temperature")
+            at = base + slots.index("last temperature")
             lines += [f"    if (!first && dt_s > 0) offset += (R){_lit(e['coef_per_c_per_s'])} * "
                       f"((temperature_c - s->memory[{at}]) / dt_s);",
                       f"    s->memory[{at}] = temperature_c;"]
             flops += 4
         elif e["id"] == "hysteresis":
-            at, w = slots.index(f"play operator {k}"), e["width_c"]
+            at, w = base + slots.index(f"play operator {k}"), e["width_c"]
             start = float(np.clip(e["start_state"], -1.0, 1.0))
             lines += [f"    if (first) s->memory[{at}] = die - (R){_lit(start)} * (R){_lit(w)};",
                       f"    if (s->memory[{at}] < die - (R){_lit(w)}) s->memory[{at}] = die - (R){_lit(w)};",
@@ -651,7 +808,7 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
                       f"offset += (R){_lit(e['amplitude'])} * TC_EXP((R)-0.5 * (z * z)); }}"]
             flops, calls = flops + 6, calls + 1
         elif e["id"] == "second_node":
-            at = slots.index(f"second node {k}")
+            at = base + slots.index(f"second node {k}")
             lines += [f"    if (first) s->memory[{at}] = die;",
                       f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
                       f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
@@ -662,7 +819,38 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
             lines.append(f"    scale = scale * u + (R){_lit(k)};")
         flops += 2 * len(spec["scale_factor"]) + 1
     flops += 1
-    return f"{flops}" + (f" and {calls} exp" if calls else ""), "\n".join(lines) + "\n"
+    return flops, calls, lines
+
+
+def _model_mean_code(spec: dict[str, Any]) -> tuple[str, list[str]]:
+    """The mean of several diagnosed models (a run's, one per training run): each model's update in
+    its own block on its own state, their offsets (and scale factors) averaged."""
+    scaled = _scaled(spec)
+    lines = ["    R total = 0" + (", total_scale = 0;" if scaled else ";")]
+    flops, calls, base = 0, 0, 0
+    for m in spec["models"]:
+        f, c, body = _model_lines(m, base)
+        base += len(_model_slots(m))
+        lines += ["    {", *("    " + line for line in body), "        total += offset;"]
+        if scaled:
+            lines.append("        total_scale += " + ("scale;" if "scale_factor" in m else "(R)1;"))
+        lines.append("    }")
+        flops, calls = flops + f + 1 + scaled, calls + c
+    n = len(spec["models"])
+    lines.append(f"    R offset = total / (R){n};")
+    if scaled:
+        lines.append(f"    R scale = total_scale / (R){n};")
+    flops += 1 + scaled
+    return f"{flops}" + (f" and {calls} exp" if calls else ""), lines
+
+
+def _model_mean_slots(spec: dict[str, Any]) -> list[str]:
+    return [f"model {k} {slot}" for k, m in enumerate(spec["models"]) for slot in _model_slots(m)]
+
+
+def _scaled(spec: dict[str, Any]) -> bool:
+    """Whether the update returns ``(raw - offset) / scale`` (a model with a scale factor)."""
+    return "scale_factor" in spec or any("scale_factor" in m for m in spec.get("models", ()))
 
 
 def _source(spec: dict[str, Any], name: str, up: str, body: list[str], kind: _Kind) -> str:
@@ -765,8 +953,8 @@ static R network(R {names[0]}, R {names[1]}, const R *drive, R *hidden)
     else:
         update.append("    {")
     update += body
-    scaled = "scale_factor" in spec
-    back = ("    return estimate;  /* the network's estimate of the input */" if inverse else
+    scaled = _scaled(spec)
+    back = (f"    return estimate;  /* the {kind.noun}'s estimate of the input */" if inverse else
             "    return (raw - offset) / scale;" if scaled else "    return raw - offset;")
     update += [back, "    }", "}\n"]
     parts.append("\n".join(update))
@@ -777,9 +965,16 @@ _KINDS = {
     "poly3": _Kind(False, _cubic_code, _cubic_offset),
     "poly3_rate": _Kind(True, _cubic_rate_code, _cubic_rate_offset),
     "model": _Kind(False, _model_code, lambda spec, t, temp, rate: _model_streamed(spec, t, temp), _model_slots),
+    "model_mean": _Kind(False, _model_mean_code, lambda spec, t, temp, rate: np.mean(
+        [_model_streamed(m, t, temp) for m in spec["models"]], axis=0), _model_mean_slots),
+    "poly": _Kind(False, _poly_code, lambda spec, t, temp, rate: _poly_out(spec, temp, np.zeros_like(temp)),
+                  estimate=lambda spec, t, raw, temp: _poly_out(spec, raw, temp), noun="polynomial"),
+    "poly_rate": _Kind(True, _poly_code, lambda spec, t, temp, rate: _poly_out(spec, temp, rate), noun="polynomial"),
 }
+_KINDS["lagpoly"] = _KINDS["model"]  # the lag-aware polynomial: a diagnosed model of one thermal lag
 _NETWORK = _Kind(True, _network_code, lambda spec, t, temp, rate: _network_out(spec, t, temp, rate), network=True)
-_INVERSE = _Kind(False, _network_code, _no_offset, network=True)
+_INVERSE = _Kind(False, _network_code, _no_offset, network=True,
+                 estimate=lambda spec, t, raw, temp: _network_out(spec, t, raw, temp))
 
 
 def write_c(spec: dict[str, Any], name: str, folder: str | Path, about: str = "") -> list[Path]:

@@ -16,7 +16,7 @@ from collections.abc import Callable
 import numpy as np
 
 from tcbench.compensation.data import MSRAData, TaskDataError, TaskRecording
-from tcbench.compensation.lagpoly import fit_lag_poly
+from tcbench.compensation.lagpoly import LagPoly, fit_lag_poly
 from tcbench.compensation.oracle import oracle_bias, oracle_inverse
 from tcbench.learners.base import Learner
 
@@ -85,10 +85,11 @@ def memoriser_compensator(data: MSRAData) -> Compensator:
     return compensate
 
 
-def lagpoly_compensator(data: MSRAData) -> Compensator:
+def lagpoly_compensator(data: MSRAData, model: LagPoly | None = None) -> Compensator:
     """The lag-aware polynomial (:mod:`tcbench.compensation.lagpoly`) fitted on the training
-    recordings: the input solved from the output (``inverse``) or the modelled bias removed."""
-    model = fit_lag_poly([tr.recording for tr in data.train])
+    recordings (``model``: already fitted): the input solved from the output (``inverse``) or the
+    modelled bias removed."""
+    model = model if model is not None else fit_lag_poly([tr.recording for tr in data.train])
     if data.form == "inverse":
         return lambda tr, output: model.inverse(tr.recording, output)
     return lambda tr, output: np.asarray(output, dtype=np.float64) - model.bias_of(tr.recording)

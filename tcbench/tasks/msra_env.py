@@ -36,6 +36,7 @@ from tcbench.compensation.data import (
     file_data,
     simulated_data,
 )
+from tcbench.compensation.lagpoly import fit_lag_poly
 from tcbench.compensation.scoring import Score, score_outputs
 from tcbench.errors import unknown_name
 from tcbench.learners import registry as learners
@@ -69,7 +70,10 @@ def _memoriser(data: MSRAData, bias_form: str) -> Score:
 
 
 def _lagpoly(data: MSRAData, bias_form: str) -> Score:
-    return score_outputs(data, methods.lagpoly_compensator(data), bias_form)
+    fitted = fit_lag_poly([tr.recording for tr in data.train])
+    score = score_outputs(data, methods.lagpoly_compensator(data, fitted), bias_form)
+    score.extra["lagpoly"] = fitted  # a run keeps it for the device (tcbench.compensation.run_device)
+    return score
 
 
 def _model(data: MSRAData, bias_form: str) -> Score:

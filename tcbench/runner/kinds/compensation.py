@@ -227,10 +227,12 @@ class CompensationKind(JobKind):
                 nodes.to_csv(where / f"nodes_test{i}.csv", index=False)
                 files.append(where / f"nodes_test{i}.csv")
         files += gyro_tables(result, where)
-        if job.learner.name not in BASELINES and getattr(job.env, "learner", None) is not None:
-            from tcbench.compensation.run_device import FILE, device_document
+        from tcbench.compensation.run_device import BASELINE_FITS, FILE, device_document
 
-            (where / FILE).write_text(json.dumps(device_document(job.env, job.learner.name, job.names.method), indent=1))
+        name, static = job.learner.name, hasattr(job.env, "clamp_inputs")  # a static-input task (not the gyro's)
+        if (name in BASELINE_FITS and static) or (name not in BASELINES and getattr(job.env, "learner", None) is not None):
+            fitted = result.score.extra.get(BASELINE_FITS.get(name) or "")  # a baseline's fitted model
+            (where / FILE).write_text(json.dumps(device_document(job.env, name, job.names.method, fitted), indent=1))
             files.append(where / FILE)
         if job.plots is not False:  # null: plot (a sweep's launcher decides)
             n = job.names
