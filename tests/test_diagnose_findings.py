@@ -28,8 +28,8 @@ from tcbench.diagnose.report.explain import explain
 from tcbench.diagnose.report.markdown import format_where, render_markdown
 from tcbench.diagnose.report.plots import mark_bands, mark_levels, mark_times, residual_spectrum, write_plots
 from tcbench.diagnose.report.write import write_report
-from tcbench.diagnose.select.attribute import CONFUSABLE
-from tcbench.diagnose.select.library_findings import SHAPE, Extent, library_finding
+from tcbench.diagnose.select.library_findings import Extent, library_finding
+from tcbench.diagnose.terms import confusable_pairs, terms
 from tcbench.sensors.recording import Recording
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -73,7 +73,7 @@ def test_every_effect_in_report_json_satisfies_the_contract(written: tuple[dict[
     assert {"thermal_lag", "warmup", "outliers"} <= set(ids), report["verdict"]
     for entry in report["effects"]:
         check_finding(entry)
-        assert entry["library"] is (entry["id"] in SHAPE)
+        assert entry["library"] is (entry["id"] in {t.id for t in terms()})
         if entry["library"]:
             assert entry["shape"] == EXPECTED_SHAPE[entry["id"]]
     by_id = {e["id"]: e for e in report["effects"]}
@@ -103,7 +103,7 @@ def test_confusable_effect_names_the_test_that_separates_it() -> None:
     f = library_finding("thermal_lag", PARAMS["thermal_lag"], {}, EXTENT, ["temperature_rate", "hysteresis"]).to_json()
     assert f["confusable_with"] == ["temperature_rate", "hysteresis"]
     for other in ("temperature_rate", "hysteresis"):
-        assert CONFUSABLE[frozenset({"thermal_lag", other})] in f["confirm_with"]
+        assert confusable_pairs()[frozenset({"thermal_lag", other})] in f["confirm_with"]
     with pytest.raises(ValueError, match="not an effect of the library"):
         library_finding("bias_step", {}, {}, EXTENT)
 

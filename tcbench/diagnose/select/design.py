@@ -36,8 +36,12 @@ import numpy as np
 from tcbench.diagnose.signals import DiagnosisData, lagged
 from tcbench.diagnose.terms import is_open, open_term, term, terms
 
-DETERMINISTIC = tuple(t.id for t in terms() if t.deterministic)  # the forward selection's candidates, in order
-ALL_EFFECTS = tuple(t.id for t in terms())
+
+
+def deterministic() -> tuple[str, ...]:
+    """The forward selection's candidates, in order: the deterministic library terms registered
+    now (read at each call, so a term installed later in the process is among them)."""
+    return tuple(t.id for t in terms() if t.deterministic)
 
 
 @dataclass(frozen=True)
