@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tcbench.compensation.fitted_model import RIG_EFFECTS
+from tcbench.compensation.fitted_model import CLOCK_EFFECTS, RIG_EFFECTS
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
 from tcbench.diagnose.findings import WHERE_KEYS, check_finding
 from tcbench.diagnose.select.design import Designer, deterministic
@@ -74,6 +75,8 @@ def test_ids_unique_and_a_second_registration_refused() -> None:
 
 
 def test_order_is_the_forward_selection_and_report_order() -> None:
+    # the one literal list of the library's terms, a guard on the registry's order (the tests
+    # elsewhere read their term lists from the registry)
     assert deterministic() == ("thermal_lag", "temperature_rate", "hysteresis", "warmup", "aging_drift",
                              "temperature_cubic", "accel_nonlinearity")
     assert [t.id for t in terms() if not t.deterministic] == ["bias_instability"]
@@ -189,7 +192,32 @@ def test_noise_and_rig_tuples_come_from_the_effect_classes() -> None:
     assert set(STOCHASTIC_EFFECTS) == {"white_noise", "bias_instability", "random_walk", "quantisation",
                                        "noise_temperature", "noise_time"}
     assert set(RIG_EFFECTS) == {"periodic", "gated_periodic", "duty_cycle"}
+    assert set(CLOCK_EFFECTS) == {"bias_step", "transient", "warmup", "aging_drift"}
     assert all(issubclass(type(t), Term) for t in terms())
+
+
+def test_every_parameter_of_a_term_has_its_unit() -> None:
+    """Each fitted parameter of a library term (and the amplitudes of the open-world ones) is in
+    the report with a unit: its name says it (``_s``, ``_c``) or the term's ``units`` does."""
+    for t in terms():
+        for name in t.params(0.5, t.grid_values()[0], 20.0):
+            said = name.endswith(("_s", "_c")) and not name.endswith("_per_s")
+            assert said or t.unit_of(name, "g") is not None, (t.id, name)
+    assert term("temperature_rate").unit_of("coef_per_c_per_s", "deg/s") == "deg/s per degC/s"
+    assert term("periodic").unit_of("amplitude", "Hz") == "Hz" and term("periodic").unit_of("phase_rad", "Hz") is None
+    assert [t.id for t in (*terms(), *terms(open=True)) if t.gain_name] == ["bias_instability"]
+    assert all(not t.deterministic for t in terms() if t.gain_name) and term("bias_instability").gain_label
+
+
+def test_the_docs_effect_table_lists_the_registrys_terms_in_order() -> None:
+    """docs/concepts/physics.md, the effect library: its table lists every library term, in the
+    registry's order, before the effects the diagnosis does not model as a term."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "concepts" / "physics.md").read_text()
+    table = text.split("## The effect library", 1)[1].split("\n\n")[2]
+    rows = [line.split("|")[1].strip().strip("`") for line in table.splitlines()[2:]]
+    ids = [t.id for t in terms()]
+    assert rows[:len(ids)] == ids
+    assert not set(rows[len(ids):]) & {t.id for t in (*terms(), *terms(open=True))}
 
 
 # Each open-world term at a value, with the coefficients of a fit; ``exact``: its columns are the

@@ -80,7 +80,12 @@ class Term(ABC):
     - ``flicker_mimics``: a slow random excursion of the bias can look like it;
     - ``cached``: its column is costly; the designer keeps it per value and model temperature;
     - ``open_world``: structure outside the library (:class:`~.open_base.OpenTerm`), not a
-      candidate of the library's forward selection.
+      candidate of the library's forward selection;
+    - ``units``: ``{parameter name: its unit}`` for the report, ``{unit}`` standing for the
+      output unit, where the name does not say it (a name ending ``_s`` is in s, ``_c`` in degC);
+    - ``gain_name``, ``gain_label``: what its evidence's gain is, for a term not judged by the
+      held-out gain (``bias_instability``: an Allan ratio), in the report's table and on the
+      evidence plot's axis (None: the penalised held-out gain).
     """
 
     id: ClassVar[str] = ""
@@ -94,6 +99,9 @@ class Term(ABC):
     flicker_mimics: ClassVar[bool] = False
     cached: ClassVar[bool] = False
     open_world: ClassVar[bool] = False
+    units: ClassVar[Mapping[str, str]] = {}
+    gain_name: ClassVar[str | None] = None
+    gain_label: ClassVar[str | None] = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -104,6 +112,11 @@ class Term(ABC):
         if cls.id != cls.effect.id:
             raise ValueError(f"term {cls.id!r} models effect {cls.effect.id!r}: the ids must match")
         _REGISTRY[cls.id] = cls()
+
+    def unit_of(self, name: str, unit: str) -> str | None:
+        """The unit of its parameter ``name`` when the output is in ``unit`` (None: not in :attr:`units`)."""
+        u = self.units.get(name)
+        return None if u is None else u.format(unit=unit)
 
     def grid_values(self) -> list[float | None]:
         """Values of the nonlinear parameter searched (``[None]`` if it has none)."""

@@ -84,6 +84,7 @@ class TemperatureRateTerm(Term):
     id = "temperature_rate"
     effect = TemperatureRate
     shape = "temperature_dynamics"
+    units = {"coef_per_c_per_s": "{unit} per degC/s"}
     confirm_with = (
         "the same temperature swing at two ramp rates with soaks between: the term scales with the ramp rate, "
         "changes sign between heating and cooling and vanishes the moment a ramp stops")
@@ -124,6 +125,7 @@ class HysteresisTerm(Term):
     # bounded search, and past 8 degC up to half the temperature span, :meth:`past_grid`)
     grid = np.geomspace(0.2, 8.0, 12)
     cached = True
+    units = {"amplitude": "{unit}"}
     confirm_with = (
         "soaks at one temperature approached from above and from below, each long enough to settle: the "
         "difference between the two persists through the soak, where a lag or a rate term dies out")
