@@ -13,8 +13,8 @@ import pytest
 from tcbench.compensation.fitted_model import CLOCK_EFFECTS, RIG_EFFECTS
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
 from tcbench.diagnose.findings import WHERE_KEYS, check_finding
-from tcbench.diagnose.select.design import Designer, deterministic
-from tcbench.diagnose.signals import DiagnosisData
+from tcbench.diagnose.select.design import Designer, Model, deterministic
+from tcbench.diagnose.signals import DiagnosisData, lagged
 from tcbench.diagnose.terms import (
     OpenTerm,
     Term,
@@ -23,6 +23,7 @@ from tcbench.diagnose.terms import (
     is_term,
     open_finding,
     report_order,
+    temperature_transform,
     term,
     terms,
 )
@@ -30,7 +31,7 @@ from tcbench.diagnose.terms.base import signals
 from tcbench.sensors.effects import EFFECTS, Signals, make_effect, repeatable_effects
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 
-COLUMN_TERMS = [t.id for t in terms() if t.deterministic and t.id != "thermal_lag"]
+COLUMN_TERMS = [t.id for t in terms() if t.deterministic and not t.transforms_temperature]
 VALUES = {"hysteresis": 1.5, "warmup": 900.0}
 
 
@@ -110,6 +111,26 @@ def test_the_design_column_is_the_terms() -> None:
         np.testing.assert_array_equal(des.columns(effect, value, None)[:, 0], expected)
     with pytest.raises(ValueError, match="no regressor"):
         term("thermal_lag").column(d, 600.0, d.temp_c, des.centre_c, des.half_range_c)
+
+
+def test_the_designer_asks_the_term_that_transforms_the_temperature(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``thermal_lag`` is an input transform: a model holding it runs on the term's model
+    temperature (the die lag), with its one parameter; no other term transforms the temperature."""
+    assert [t.id for t in (*terms(), *terms(open=True)) if t.transforms_temperature] == ["thermal_lag"]
+    lag = temperature_transform()
+    assert lag is term("thermal_lag")
+    d = _data()
+    np.testing.assert_array_equal(Designer(d).temperature(600.0), lagged(d.t_s, d.temp_c, 600.0))
+    model = Model().with_effect("warmup", 900.0).with_effect("thermal_lag", 600.0)
+    assert model.lag_tau_s == 600.0 and model.ids == ("thermal_lag", "warmup") and model.n_params == 1 + 2
+    assert model.without("thermal_lag") == Model().with_effect("warmup", 900.0)
+    monkeypatch.setattr(type(lag), "model_temperature", lambda self, data, value: data.temp_c + value)
+    des = Designer(d)
+    np.testing.assert_array_equal(des.temperature(2.0), d.temp_c + 2.0)
+    u = (d.temp_c + 2.0 - des.centre_c) / des.half_range_c
+    np.testing.assert_array_equal(des.matrix(Model(lag_tau_s=2.0))[:, 1], u)
+    with pytest.raises(ValueError, match="does not transform"):
+        term("warmup").model_temperature(d, 1.0)
 
 
 def test_grids_and_parameter_names() -> None:

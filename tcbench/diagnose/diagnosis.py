@@ -66,7 +66,7 @@ from tcbench.diagnose.settings import (
     SelectionSettings,
 )
 from tcbench.diagnose.signals import DiagnosisData, prepare
-from tcbench.diagnose.terms import is_open, open_finding, report_order, term
+from tcbench.diagnose.terms import is_open, open_finding, report_order, temperature_transform, term
 from tcbench.sensors.recording import Recording
 
 __all__ = ["DiagnoseSettings", "Diagnosis", "Series", "base_model", "diagnose"]
@@ -97,7 +97,8 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
             "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
     effects: dict[str, dict[str, float]] = {}
     if att.final.lag_tau_s:
-        effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
+        lag = temperature_transform()
+        effects[lag.id] = lag.params(0.0, float(att.final.lag_tau_s), d.half_range_c)
     i = n_core
     for effect, value in att.final.terms:
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]

@@ -3,10 +3,11 @@
 Every finding of ``effects`` (the contract of :mod:`tcbench.diagnose.findings`, library effect or
 not) is rendered the same way, whatever its id: a row of the findings table (id, shape, library,
 where) and a section with its shape and what that shape looks like (docs/concepts/diagnosis-report.md, shapes), its scalar
-parameters with units (a term's from its :attr:`~tcbench.diagnose.terms.Term.units`), where (:func:`format_where`: instants in s and h from the start, periods
-in s and min, bands in degC, levels in the finding's ``params`` ``unit`` or the output unit), the
-evidence, what it cannot be told from, confirm-with, a table of its listed values (lists of one
-length in ``params`` and ``evidence``, such as outlier times and sizes) and its explanation.
+parameters with units (a term's from its :attr:`~tcbench.diagnose.terms.Term.units`), where
+(:func:`format_where`: instants in s and h from the start, periods in s and min, bands in degC,
+levels in the finding's ``params`` ``unit`` or the output unit), the evidence, what it cannot be
+told from, confirm-with, a table of its listed values (lists of one length in ``params`` and
+``evidence``, such as outlier times and sizes) and its explanation.
 """
 
 from __future__ import annotations

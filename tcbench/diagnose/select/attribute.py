@@ -252,7 +252,7 @@ def attribute(
 
 
 def _value(model: Model, effect: str) -> float | None:
-    if effect == "thermal_lag":
+    if term(effect).transforms_temperature:
         return model.lag_tau_s
     return dict(model.terms).get(effect)
 
