@@ -95,23 +95,30 @@ def tcbench(*args: str, cwd: Path, env: Mapping[str, str | None] | None = None) 
 
 
 def install_here(monkeypatch: pytest.MonkeyPatch, site: Path) -> None:
-    """The optimiser and learner plugins of the folder ``site`` (modules and their ``*.dist-info``
-    entry points), as a process started with ``PYTHONPATH=site`` has them: on ``sys.path`` here and
-    in the worker processes a sweep starts, and the registries of optimisers and learners read anew
-    (all undone after the test). Not effect or term plugins: the diagnosis reads its term lists
-    once, at import (``select.design.DETERMINISTIC``), so tests/test_term_plugins.py starts
-    processes of their own."""
+    """The plugins of the folder ``site`` (modules and their ``*.dist-info`` entry points), as a
+    process started with ``PYTHONPATH=site`` has them: on ``sys.path`` here and in the worker
+    processes a sweep starts, and the registries of optimisers, learners, effects and diagnosis
+    terms read anew (all undone after the test). The diagnosis reads its term lists from the
+    registry at each use, so a term installed here is a candidate of the next diagnosis."""
     import importlib
 
+    from tcbench.diagnose.terms import base as terms
     from tcbench.learners.registry import REGISTRY as LEARNERS
     from tcbench.optimisers.registry import REGISTRY as OPTIMISERS
+    from tcbench.sensors.effects import PLUGINS as EFFECTS
 
+    terms._registry()  # the built-in terms (and those installed before, left out below)
     monkeypatch.syspath_prepend(str(site))
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join(filter(None, [str(site), os.environ.get("PYTHONPATH")])))
-    for registry in (OPTIMISERS, LEARNERS):
+    monkeypatch.setattr(terms, "_REGISTRY", {k: v for k, v in terms._REGISTRY.items()
+                                             if type(v).__module__.startswith("tcbench.")})
+    monkeypatch.setattr(terms, "_loaded", False)
+    for registry in (OPTIMISERS, LEARNERS, EFFECTS, terms._PLUGINS):
+        fresh = registry in (EFFECTS, terms._PLUGINS)  # a term registers on import: its module is imported anew
         monkeypatch.setattr(registry, "_points", None)
-        monkeypatch.setattr(registry, "_entries", dict(registry._entries))
-        monkeypatch.setattr(registry, "_broken", dict(registry._broken))
-    for module in [p.stem for p in site.glob("*.py")] + [p.name for p in site.iterdir() if (p / "__init__.py").exists()]:
-        monkeypatch.delitem(sys.modules, module, raising=False)
+        monkeypatch.setattr(registry, "_entries", {} if fresh else dict(registry._entries))
+        monkeypatch.setattr(registry, "_broken", {} if fresh else dict(registry._broken))
+    tops = {p.stem for p in site.glob("*.py")} | {p.name for p in site.iterdir() if (p / "__init__.py").exists()}
+    for module in [m for m in sys.modules if m.partition(".")[0] in tops]:  # imported anew, so their terms register
+        monkeypatch.delitem(sys.modules, module)
     importlib.invalidate_caches()

@@ -25,15 +25,16 @@ from tcbench.datasets.concealed import concealed_recording
 from tcbench.diagnose.diagnosis import Diagnosis, Series, diagnose
 from tcbench.diagnose.findings import SHAPES, Finding, check_finding
 from tcbench.diagnose.report.explain import explain
-from tcbench.diagnose.report.markdown import format_where, render_markdown
+from tcbench.diagnose.report.markdown import finding_section, format_where, render_markdown
 from tcbench.diagnose.report.plots import mark_bands, mark_levels, mark_times, residual_spectrum, write_plots
 from tcbench.diagnose.report.write import write_report
-from tcbench.diagnose.select.attribute import CONFUSABLE
-from tcbench.diagnose.select.library_findings import SHAPE, Extent, library_finding
+from tcbench.diagnose.select.library_findings import Extent, library_finding
+from tcbench.diagnose.terms import confusable_pairs, terms
 from tcbench.sensors.recording import Recording
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-# docs/concepts/diagnosis-report.md, shapes: the shape each library effect takes in a residual
+# docs/concepts/diagnosis-report.md, shapes: the shape each library effect takes in a residual (a
+# literal guard on the terms' shapes; test_the_shapes_cover_the_registry checks it lists every term)
 EXPECTED_SHAPE = {
     "thermal_lag": "temperature_dynamics", "temperature_rate": "temperature_dynamics",
     "hysteresis": "temperature_dynamics", "temperature_cubic": "temperature_function", "warmup": "transient",
@@ -73,7 +74,7 @@ def test_every_effect_in_report_json_satisfies_the_contract(written: tuple[dict[
     assert {"thermal_lag", "warmup", "outliers"} <= set(ids), report["verdict"]
     for entry in report["effects"]:
         check_finding(entry)
-        assert entry["library"] is (entry["id"] in SHAPE)
+        assert entry["library"] is (entry["id"] in {t.id for t in terms()})
         if entry["library"]:
             assert entry["shape"] == EXPECTED_SHAPE[entry["id"]]
     by_id = {e["id"]: e for e in report["effects"]}
@@ -84,7 +85,11 @@ def test_every_effect_in_report_json_satisfies_the_contract(written: tuple[dict[
     assert by_id["thermal_lag"]["explanation"].startswith("The output follows a temperature that trails")
 
 
-@pytest.mark.parametrize("effect", sorted(EXPECTED_SHAPE))
+def test_the_shapes_cover_the_registry() -> None:
+    assert set(EXPECTED_SHAPE) == set(PARAMS) == {t.id for t in terms()}
+
+
+@pytest.mark.parametrize("effect", [t.id for t in terms()])
 def test_each_library_effect_maps_to_its_shape(effect: str) -> None:
     f = library_finding(effect, PARAMS[effect], {"gain_sigma2": 50.0}, EXTENT).to_json()
     check_finding(f)
@@ -99,11 +104,24 @@ def test_each_library_effect_maps_to_its_shape(effect: str) -> None:
         assert f["where"] == {}
 
 
+def test_report_md_gives_each_parameter_its_terms_unit() -> None:
+    """The parameters of a library finding carry the units its term declares; a screen's finding
+    (no term) those the report knows for it."""
+    lines = {e: finding_section(library_finding(e, PARAMS[e], {}, EXTENT), "deg/s", 0.0)[3] for e in PARAMS}
+    assert lines["temperature_rate"] == "- Parameters: coef_per_c_per_s = 0.5 deg/s per degC/s"
+    assert lines["hysteresis"] == "- Parameters: amplitude = 0.01 deg/s; width_c = 3 degC"
+    assert lines["aging_drift"] == "- Parameters: rate_per_h = 0.0001 deg/s/h"
+    assert lines["bias_instability"] == "- Parameters: b = 0.001 deg/s (flicker coefficient)"
+    assert lines["thermal_lag"] == "- Parameters: tau_s = 600 s (10 min)"
+    screen = Finding("variance", "variance", False, {"density": 0.2, "b": 3.0}, {}, {}, "x", "y")
+    assert finding_section(screen, "g", 0.0)[3] == "- Parameters: density = 0.2 g/sqrt(Hz); b = 3"
+
+
 def test_confusable_effect_names_the_test_that_separates_it() -> None:
     f = library_finding("thermal_lag", PARAMS["thermal_lag"], {}, EXTENT, ["temperature_rate", "hysteresis"]).to_json()
     assert f["confusable_with"] == ["temperature_rate", "hysteresis"]
     for other in ("temperature_rate", "hysteresis"):
-        assert CONFUSABLE[frozenset({"thermal_lag", other})] in f["confirm_with"]
+        assert confusable_pairs()[frozenset({"thermal_lag", other})] in f["confirm_with"]
     with pytest.raises(ValueError, match="not an effect of the library"):
         library_finding("bias_step", {}, {}, EXTENT)
 

@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tcbench.compensation.fitted_model import RIG_EFFECTS
+from tcbench.compensation.fitted_model import CLOCK_EFFECTS, RIG_EFFECTS
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR
 from tcbench.diagnose.findings import WHERE_KEYS, check_finding
-from tcbench.diagnose.select.attribute import CONFUSABLE
-from tcbench.diagnose.select.design import DETERMINISTIC, Designer
-from tcbench.diagnose.signals import DiagnosisData
+from tcbench.diagnose.select.design import Designer, Model, deterministic
+from tcbench.diagnose.signals import DiagnosisData, lagged
 from tcbench.diagnose.terms import (
     OpenTerm,
     Term,
@@ -23,6 +23,7 @@ from tcbench.diagnose.terms import (
     is_term,
     open_finding,
     report_order,
+    temperature_transform,
     term,
     terms,
 )
@@ -30,7 +31,7 @@ from tcbench.diagnose.terms.base import signals
 from tcbench.sensors.effects import EFFECTS, Signals, make_effect, repeatable_effects
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 
-COLUMN_TERMS = [t.id for t in terms() if t.deterministic and t.id != "thermal_lag"]
+COLUMN_TERMS = [t.id for t in terms() if t.deterministic and not t.transforms_temperature]
 VALUES = {"hysteresis": 1.5, "warmup": 900.0}
 
 
@@ -75,7 +76,9 @@ def test_ids_unique_and_a_second_registration_refused() -> None:
 
 
 def test_order_is_the_forward_selection_and_report_order() -> None:
-    assert DETERMINISTIC == ("thermal_lag", "temperature_rate", "hysteresis", "warmup", "aging_drift",
+    # the one literal list of the library's terms, a guard on the registry's order (the tests
+    # elsewhere read their term lists from the registry)
+    assert deterministic() == ("thermal_lag", "temperature_rate", "hysteresis", "warmup", "aging_drift",
                              "temperature_cubic", "accel_nonlinearity")
     assert [t.id for t in terms() if not t.deterministic] == ["bias_instability"]
 
@@ -110,6 +113,26 @@ def test_the_design_column_is_the_terms() -> None:
         term("thermal_lag").column(d, 600.0, d.temp_c, des.centre_c, des.half_range_c)
 
 
+def test_the_designer_asks_the_term_that_transforms_the_temperature(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``thermal_lag`` is an input transform: a model holding it runs on the term's model
+    temperature (the die lag), with its one parameter; no other term transforms the temperature."""
+    assert [t.id for t in (*terms(), *terms(open=True)) if t.transforms_temperature] == ["thermal_lag"]
+    lag = temperature_transform()
+    assert lag is term("thermal_lag")
+    d = _data()
+    np.testing.assert_array_equal(Designer(d).temperature(600.0), lagged(d.t_s, d.temp_c, 600.0))
+    model = Model().with_effect("warmup", 900.0).with_effect("thermal_lag", 600.0)
+    assert model.lag_tau_s == 600.0 and model.ids == ("thermal_lag", "warmup") and model.n_params == 1 + 2
+    assert model.without("thermal_lag") == Model().with_effect("warmup", 900.0)
+    monkeypatch.setattr(type(lag), "model_temperature", lambda self, data, value: data.temp_c + value)
+    des = Designer(d)
+    np.testing.assert_array_equal(des.temperature(2.0), d.temp_c + 2.0)
+    u = (d.temp_c + 2.0 - des.centre_c) / des.half_range_c
+    np.testing.assert_array_equal(des.matrix(Model(lag_tau_s=2.0))[:, 1], u)
+    with pytest.raises(ValueError, match="does not transform"):
+        term("warmup").model_temperature(d, 1.0)
+
+
 def test_grids_and_parameter_names() -> None:
     for t in terms():
         assert (t.grid is None) == (t.param is None)
@@ -122,7 +145,7 @@ def test_grids_and_parameter_names() -> None:
 
 def test_confusable_pairs_are_symmetric_and_name_registered_terms() -> None:
     pairs = confusable_pairs()
-    assert pairs == CONFUSABLE and pairs
+    assert pairs
     for t in terms():
         partners: Mapping[str, str] = t.partners()
         assert t.id not in partners
@@ -190,7 +213,32 @@ def test_noise_and_rig_tuples_come_from_the_effect_classes() -> None:
     assert set(STOCHASTIC_EFFECTS) == {"white_noise", "bias_instability", "random_walk", "quantisation",
                                        "noise_temperature", "noise_time"}
     assert set(RIG_EFFECTS) == {"periodic", "gated_periodic", "duty_cycle"}
+    assert set(CLOCK_EFFECTS) == {"bias_step", "transient", "warmup", "aging_drift"}
     assert all(issubclass(type(t), Term) for t in terms())
+
+
+def test_every_parameter_of_a_term_has_its_unit() -> None:
+    """Each fitted parameter of a library term (and the amplitudes of the open-world ones) is in
+    the report with a unit: its name says it (``_s``, ``_c``) or the term's ``units`` does."""
+    for t in terms():
+        for name in t.params(0.5, t.grid_values()[0], 20.0):
+            said = name.endswith(("_s", "_c")) and not name.endswith("_per_s")
+            assert said or t.unit_of(name, "g") is not None, (t.id, name)
+    assert term("temperature_rate").unit_of("coef_per_c_per_s", "deg/s") == "deg/s per degC/s"
+    assert term("periodic").unit_of("amplitude", "Hz") == "Hz" and term("periodic").unit_of("phase_rad", "Hz") is None
+    assert [t.id for t in (*terms(), *terms(open=True)) if t.gain_name] == ["bias_instability"]
+    assert all(not t.deterministic for t in terms() if t.gain_name) and term("bias_instability").gain_label
+
+
+def test_the_docs_effect_table_lists_the_registrys_terms_in_order() -> None:
+    """docs/concepts/physics.md, the effect library: its table lists every library term, in the
+    registry's order, before the effects the diagnosis does not model as a term."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "concepts" / "physics.md").read_text()
+    table = text.split("## The effect library", 1)[1].split("\n\n")[2]
+    rows = [line.split("|")[1].strip().strip("`") for line in table.splitlines()[2:]]
+    ids = [t.id for t in terms()]
+    assert rows[:len(ids)] == ids
+    assert not set(rows[len(ids):]) & {t.id for t in (*terms(), *terms(open=True))}
 
 
 # Each open-world term at a value, with the coefficients of a fit; ``exact``: its columns are the

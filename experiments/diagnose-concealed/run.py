@@ -29,7 +29,7 @@ from joblib import Parallel, delayed
 from tcbench.datasets.concealed import EFFECTS_BY_SENSOR, concealed_recording
 from tcbench.diagnose.diagnosis import diagnose
 from tcbench.diagnose.report.write import write_report
-from tcbench.diagnose.select.design import DETERMINISTIC
+from tcbench.diagnose.select.design import deterministic
 
 FIRST_SEED = 31_000_000
 RMSE_TARGET = 1.15  # held-out RMSE after refit / true noise sigma, for deterministic effects
@@ -104,7 +104,7 @@ def summary(df: pd.DataFrame, elapsed_s: float) -> str:
     controls = df[df.truth == "nothing"]
     named_rate = effects.correct.mean()
     false_alarm = (controls.named != "nothing").mean()
-    det = effects[effects.truth.isin(DETERMINISTIC) & effects.correct]
+    det = effects[effects.truth.isin(deterministic()) & effects.correct]
     worst = det.final_rmse_heldout_over_sigma.max()
     def ok(passed: bool) -> str:
         return "met" if passed else "NOT met"

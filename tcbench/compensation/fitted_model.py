@@ -41,7 +41,7 @@ from tcbench.sensors.segments import within_rate_hz
 from tcbench.sensors.truth import STOCHASTIC_EFFECTS
 
 RIG_EFFECTS = tuple(cls.id for cls in EFFECTS.values() if cls.rig)  # the rig's lines, not the sensor
-CLOCK_EFFECTS = ("bias_step", "transient", "warmup", "aging_drift")  # keyed to the calibration run's clock
+CLOCK_EFFECTS = tuple(cls.id for cls in EFFECTS.values() if cls.clock_keyed)  # keyed to the calibration run's clock
 
 
 def compensator(model: PolynomialModel) -> PolynomialModel:

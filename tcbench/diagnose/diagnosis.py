@@ -52,7 +52,7 @@ from tcbench.diagnose.screens.thermometer import Smoothing, ThermometerScreen, s
 from tcbench.diagnose.screens.thermometer_glitches import GlitchScreen, ThermometerGlitches, glitches
 from tcbench.diagnose.select.attribute import Attribution, Evidence, attribute
 from tcbench.diagnose.select.crossval import Fit
-from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model
+from tcbench.diagnose.select.design import Designer, Model, deterministic
 from tcbench.diagnose.select.discover import why_untestable
 from tcbench.diagnose.select.library_findings import Extent, library_finding
 from tcbench.diagnose.select.locate import Mismatch, locate
@@ -66,7 +66,7 @@ from tcbench.diagnose.settings import (
     SelectionSettings,
 )
 from tcbench.diagnose.signals import DiagnosisData, prepare
-from tcbench.diagnose.terms import is_open, open_finding, report_order, term
+from tcbench.diagnose.terms import is_open, open_finding, report_order, temperature_transform, term
 from tcbench.sensors.recording import Recording
 
 __all__ = ["DiagnoseSettings", "Diagnosis", "Series", "base_model", "diagnose"]
@@ -76,9 +76,9 @@ log = logging.getLogger(__name__)
 def base_model(effects: dict[str, dict[str, float]]) -> Model:
     """The starting :class:`Model` for effects already declared (``{id: params}``, as in
     ``model.yaml``); their nonlinear parameters stay fixed, their amplitudes are refitted."""
-    model = Model()
+    model, candidates = Model(), deterministic()
     for effect, params in effects.items():
-        if effect not in DETERMINISTIC:
+        if effect not in candidates:
             continue
         name = term(effect).param
         model = model.with_effect(effect, float(params[name]) if name else None)
@@ -97,7 +97,8 @@ def _physical(att: Attribution) -> tuple[dict[str, Any], dict[str, dict[str, flo
             "scale_factor": [float(b) for b in beta[3:6]] if n_core == 6 else [1.0]}
     effects: dict[str, dict[str, float]] = {}
     if att.final.lag_tau_s:
-        effects["thermal_lag"] = {"tau_s": float(att.final.lag_tau_s)}
+        lag = temperature_transform()
+        effects[lag.id] = lag.params(0.0, float(att.final.lag_tau_s), d.half_range_c)
     i = n_core
     for effect, value in att.final.terms:
         m = d.columns(effect, value, att.final.lag_tau_s).shape[1]
@@ -232,7 +233,7 @@ def report(name: str, declared: dict[str, dict[str, float]], before: Screened, a
         reference=ReferenceSummary.of(reference, final_rmse, data.white_sigma),
         statistics=Statistics(att.plan, data.smooth_s, _screen_statistics(results),
                               _not_tested(att, evidence, before, after, declared), settings=settings),
-        candidates=[evidence[e] for e in (*DETERMINISTIC, *_open_ids(evidence), FLICKER) if e in evidence],
+        candidates=[evidence[e] for e in (*deterministic(), *_open_ids(evidence), FLICKER) if e in evidence],
         confusable=confusable, model=_model_file(data, core, fitted, declared, results),
         series=_series(att, flicker, settings),
         outliers=spikes.found if isinstance(spikes, Spikes) else None,

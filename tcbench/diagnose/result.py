@@ -11,7 +11,7 @@ import numpy as np
 
 from tcbench.diagnose.findings import Finding
 from tcbench.diagnose.select.crossval import Fit
-from tcbench.diagnose.select.design import DETERMINISTIC
+from tcbench.diagnose.select.design import deterministic
 from tcbench.diagnose.select.evidence import Evidence
 from tcbench.diagnose.select.locate import AllanExcess, Mismatch
 from tcbench.diagnose.select.plan import StatsPlan
@@ -233,6 +233,6 @@ def evidence_json(e: Evidence, test: SignificanceTest) -> dict[str, Any]:
     if np.isfinite(e.gain):
         out |= {"gain_sigma2": round(float(e.gain), 2), "threshold_sigma2": float(e.threshold)}
     out |= significance_json(e, test)
-    if e.value is not None and e.effect in DETERMINISTIC and (name := term(e.effect).param):
+    if e.value is not None and e.effect in deterministic() and (name := term(e.effect).param):
         out[name] = float(e.value)
     return out

@@ -54,13 +54,17 @@ class Effect:
     ``stochastic``: part of the recorded noise (drawn, or the quantisation of what was drawn),
     left out of the deterministic truth; ``rig``: what the test rig does to the output (a
     compressor's, a fan's or a supply's line), not the sensor; ``repeatable``: a model may hold
-    further instances of it (``bias_step_2``: a second step, up to :data:`MAX_REPEATS`)."""
+    further instances of it (``bias_step_2``: a second step, up to :data:`MAX_REPEATS`);
+    ``clock_keyed``: it follows the recording's own clock (an instant of the run, the time since
+    its power-on), which a shipped compensator cannot know
+    (:func:`tcbench.compensation.fitted_model.compensator` leaves it out)."""
 
     id: ClassVar[str] = ""
     stage: ClassVar[str] = "output"
     stochastic: ClassVar[bool] = False
     rig: ClassVar[bool] = False
     repeatable: ClassVar[bool] = False
+    clock_keyed: ClassVar[bool] = False
 
     def die_temperature(self, s: Signals) -> np.ndarray:
         """Stage ``die``: the die temperature after this effect."""
@@ -148,6 +152,7 @@ class Warmup(Effect):
     """``amplitude * exp(-t / tau_s)`` after power-on (self-heating, stress settling)."""
 
     id: ClassVar[str] = "warmup"
+    clock_keyed: ClassVar[bool] = True
     amplitude: float = 0.0
     tau_s: float = 1200.0
 
@@ -161,6 +166,7 @@ class AgingDrift(Effect):
     temperature (linear ageing plus stress relaxation)."""
 
     id: ClassVar[str] = "aging_drift"
+    clock_keyed: ClassVar[bool] = True
     rate_per_h: float = 0.0
     relax_amplitude: float = 0.0
     relax_tau_s: float = 6000.0
@@ -250,6 +256,7 @@ class BiasStep(Effect):
 
     id: ClassVar[str] = "bias_step"
     repeatable: ClassVar[bool] = True
+    clock_keyed: ClassVar[bool] = True
     time_s: float = 0.0
     size: float = 0.0
 
@@ -333,6 +340,7 @@ class Transient(Effect):
 
     id: ClassVar[str] = "transient"
     repeatable: ClassVar[bool] = True
+    clock_keyed: ClassVar[bool] = True
     time_s: float = 0.0
     tau_s: float = 1800.0
     amplitude: float = 0.0

@@ -3,10 +3,11 @@
 Every finding of ``effects`` (the contract of :mod:`tcbench.diagnose.findings`, library effect or
 not) is rendered the same way, whatever its id: a row of the findings table (id, shape, library,
 where) and a section with its shape and what that shape looks like (docs/concepts/diagnosis-report.md, shapes), its scalar
-parameters with units, where (:func:`format_where`: instants in s and h from the start, periods
-in s and min, bands in degC, levels in the finding's ``params`` ``unit`` or the output unit), the
-evidence, what it cannot be told from, confirm-with, a table of its listed values (lists of one
-length in ``params`` and ``evidence``, such as outlier times and sizes) and its explanation.
+parameters with units (a term's from its :attr:`~tcbench.diagnose.terms.Term.units`), where
+(:func:`format_where`: instants in s and h from the start, periods in s and min, bands in degC,
+levels in the finding's ``params`` ``unit`` or the output unit), the evidence, what it cannot be
+told from, confirm-with, a table of its listed values (lists of one length in ``params`` and
+``evidence``, such as outlier times and sizes) and its explanation.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.select.attribute import Evidence
 from tcbench.diagnose.select.significance import SURROGATE
 from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings, differing
+from tcbench.diagnose.terms import Term, is_term, term, terms
 
 PLOT_CAPTIONS = {
     "residuals": "Held-out residual of the starting and the final model against time and temperature "
@@ -53,27 +55,44 @@ def _table(header: Sequence[str], rows: Iterable[Sequence[Any]]) -> list[str]:
     return lines
 
 
-def _param(name: str, value: float, unit: str) -> str:
-    """``name = value unit`` with the unit read off the parameter's name (``tau_s`` also in min)."""
+SCREEN_UNITS = {"amplitude": "{unit}", "density": "{unit}/sqrt(Hz)"}  # of a finding that is no term (a screen's)
+
+
+def _term(effect: str) -> Term | None:
+    """The term of ``effect``, or None for a finding that is no term (a screen's)."""
+    return term(effect) if is_term(effect) else None
+
+
+def _param(name: str, value: float, unit: str, t: Term | None = None) -> str:
+    """``name = value unit`` with the unit read off the parameter's name (``tau_s`` also in min)
+    or, where the name does not say it, off its term ``t`` (None: a screen's finding)."""
     v = _g(value)
     if name.endswith("_s") and not name.endswith("_per_s"):
         return f"{name} = {v} s ({_g(value / 60.0, 3)} min)"
-    units = {
-        "width_c": "degC", "amplitude": unit, "coef_per_c_per_s": f"{unit} per degC/s",
-        "rate_per_h": f"{unit}/h", "c3_per_c3": f"{unit}/degC^3", "k2_per_g2": f"{unit}/g^2",
-        "b": f"{unit} (flicker coefficient)", "density": f"{unit}/sqrt(Hz)",
-    }
-    if name in units:
-        return f"{name} = {v} {units[name]}"
+    if t is not None:
+        named = t.unit_of(name, unit)
+    else:
+        named = SCREEN_UNITS[name].format(unit=unit) if name in SCREEN_UNITS else None
+    if named is not None:
+        return f"{name} = {v} {named}"
     if name.endswith("_c"):
         return f"{name} = {v} degC"
     return f"{name} = {v}"
 
 
 def _gain_cell(e: Evidence) -> str:
-    if e.effect == "bias_instability":
-        return f"Allan ratio {_g(e.gain, 3)} (bound {_g(e.threshold, 3)})" if math.isfinite(e.gain) else "-"
-    return f"{_g(e.gain)} (threshold {_g(e.threshold)})" if math.isfinite(e.gain) else "-"
+    if not math.isfinite(e.gain):
+        return "-"
+    t = _term(e.effect)
+    if t is not None and t.gain_name:
+        return f"{t.gain_name} {_g(e.gain, 3)} (bound {_g(e.threshold, 3)})"
+    return f"{_g(e.gain)} (threshold {_g(e.threshold)})"
+
+
+def _gain_note() -> str:
+    """What the gain column holds for the terms not judged by the held-out gain."""
+    return " ".join(f"For {t.id} the number is the {t.gain_name} against its bound instead."
+                    for t in terms() if t.gain_name)
 
 
 def _test_cell(e: Evidence) -> str:
@@ -85,8 +104,9 @@ def _test_cell(e: Evidence) -> str:
 def _value_cell(e: Evidence) -> str:
     if e.value is None:
         return "-"
-    name = {"thermal_lag": "tau_s", "warmup": "tau_s", "hysteresis": "width_c"}.get(e.effect)
-    return _g(e.value) if name is None else _param(name, e.value, "")
+    t = _term(e.effect)
+    name = t.param if t is not None else None
+    return _g(e.value) if name is None else _param(name, e.value, "", t)
 
 
 SHAPE_SIGNATURE = {  # docs/concepts/diagnosis-report.md, shapes: what each shape looks like in the residual
@@ -173,12 +193,13 @@ def _evidence_text(ev: dict[str, Any], settings: DiagnoseSettings = DEFAULTS) ->
     return "; ".join(pairs) + "." if pairs else "-"
 
 
-def _scalar_params(params: dict[str, Any], unit: str) -> str:
+def _scalar_params(params: dict[str, Any], unit: str, t: Term | None = None) -> str:
+    """The scalar ``params`` of a finding (of term ``t``; None: a screen's) with their units."""
     out = []
     for k, v in params.items():
         if isinstance(v, bool) or isinstance(v, (list, tuple, dict)):
             continue
-        out.append(_param(k, v, unit) if isinstance(v, (int, float)) else f"{k} = {v}")
+        out.append(_param(k, v, unit, t) if isinstance(v, (int, float)) else f"{k} = {v}")
     return "; ".join(out) or "-"
 
 
@@ -216,7 +237,7 @@ def finding_section(f: Finding, unit: str, t0: float, settings: DiagnoseSettings
     unit_here = str(f.params.get("unit", unit))
     out = [f"### {f.id} ({f.shape}, {kind})", "",
            f"- Shape: {f.shape}" + (f" ({SHAPE_SIGNATURE[f.shape]})" if f.shape in SHAPE_SIGNATURE else ""),
-           f"- Parameters: {_scalar_params(f.params, unit_here)}",
+           f"- Parameters: {_scalar_params(f.params, unit_here, _term(f.id))}",
            f"- Where: {format_where(f.where, unit_here, t0)}",
            f"- Evidence: {_evidence_text(f.evidence, settings)}"]
     if f.extra.get("confusable_with"):
@@ -322,9 +343,11 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
 
     out += ["## Effects found", ""]
     if not d.effects:
-        flicker = next((e for e in d.candidates if e.effect == "bias_instability"), None)
+        noise = [t.id for t in terms() if not t.deterministic]  # judged from the residual, after the selection
+        flicker = next((e for e in d.candidates if e.effect in noise), None)
+        name = (flicker.effect if flicker else noise[0]).replace("_", " ")
         allan = ("the residual's Allan deviation follows the white-noise line" if flicker and flicker.status == "rejected"
-                 else f"bias instability: {flicker.reason}" if flicker else "bias instability was not tested")
+                 else f"{name}: {flicker.reason}" if flicker else f"{name} was not tested")
         out += [("Nothing missing: no candidate effect improves the held-out error by more than chance allows; "
                  f"{allan}."), ""]
     if d.effects:
@@ -347,8 +370,7 @@ def render_markdown(d: Diagnosis, plots: dict[str, str]) -> str:
              "parameter. An effect is kept when its gain exceeds the threshold and it is significant: its "
              f"cluster-robust Wald statistic exceeds {_g(settings.selection.wald_threshold)}, or, where that test "
              f"cannot be used, the surrogate test's p-value is at most {_g(settings.surrogate.level)} (the column "
-             "says which). For bias_instability "
-             "the number is the Allan ratio against its bound instead."), ""]
+             f"says which). {_gain_note()}"), ""]
     out += _table(["effect", "status", "gain (sigma^2)", "significance", "best parameter", "reason"],
                   ([e.effect, e.status, _gain_cell(e), _test_cell(e), _value_cell(e), e.reason]
                    for e in d.candidates))

@@ -33,6 +33,7 @@ from tcbench.diagnose.report.lomb import lombscargle_chunked
 from tcbench.diagnose.result import Diagnosis
 from tcbench.diagnose.select.attribute import Evidence
 from tcbench.diagnose.select.locate import AllanExcess
+from tcbench.diagnose.terms import Term, terms
 from tcbench.sensors.segments import segments, within_rate_hz
 
 BEFORE_COLOUR, AFTER_COLOUR = "tab:red", "tab:blue"
@@ -353,9 +354,11 @@ def _fmt(x: float) -> str:
 def plot_evidence(d: Diagnosis, path: Path) -> Path:
     """Penalised held-out gain (sigma^2 units, symlog) of every deterministic candidate against
     the detection threshold, coloured by status and annotated with the robust Wald statistic;
-    ``bias_instability`` (an Allan ratio against its bound) in its own panel below."""
-    det = [e for e in d.candidates if e.effect != "bias_instability"]
-    flicker = next((e for e in d.candidates if e.effect == "bias_instability"), None)
+    the term judged otherwise (its :attr:`~tcbench.diagnose.terms.Term.gain_name`:
+    ``bias_instability``'s Allan ratio against its bound) in its own panel below."""
+    other = next(t for t in terms() if t.gain_name)
+    det = [e for e in d.candidates if e.effect != other.id]
+    flicker = next((e for e in d.candidates if e.effect == other.id), None)
     fig, (ax, ax_b) = plt.subplots(2, 1, figsize=(9, 1.2 + 0.45 * len(det) + 1.6),
                                    gridspec_kw={"height_ratios": [max(len(det), 1), 1.6]})
     y = np.arange(len(det))[::-1]
@@ -392,14 +395,15 @@ def plot_evidence(d: Diagnosis, path: Path) -> Path:
                  f"(kept needs gain > {threshold:g} and robust Wald > {selection.wald_threshold:g})")
     ax.legend(fontsize=7, loc="lower right")
     ax.grid(True, axis="x", alpha=0.3)
-    _flicker_panel(ax_b, flicker)
+    _flicker_panel(ax_b, other, flicker)
     return _save(fig, path)
 
 
-def _flicker_panel(ax: plt.Axes, e: Evidence | None) -> None:
-    """``bias_instability``: Allan deviation / white line at the first tau over the bound."""
-    ax.set_yticks([0], ["bias_instability"])
-    ax.set_xlabel("Allan deviation / white line at the first τ over the bound (not a σ² gain)")
+def _flicker_panel(ax: plt.Axes, t: Term, e: Evidence | None) -> None:
+    """Term ``t``'s evidence ``e`` against its bound (``bias_instability``: Allan deviation /
+    white line at the first tau over the bound)."""
+    ax.set_yticks([0], [t.id])
+    ax.set_xlabel(t.gain_label)
     if e is None or not np.isfinite(e.gain):
         text = "not tested" if e is None else f"{e.status}: {e.reason}"
         ax.text(0.02, 0.5, text, transform=ax.transAxes, va="center", fontsize=8, style="italic",

@@ -35,9 +35,13 @@ from tcbench.diagnose.terms import terms
 
 ID = "bias_instability"
 FLICKER_FLOOR = 0.664  # Allan floor of flicker noise per unit b
-TIME_EFFECTS = tuple(t.id for t in terms() if t.flicker_mimics)  # what a slow random excursion of the bias can mimic
 FLICKER_TEST = ("a second power-on or a longer run: warm-up repeats after every power-on and ageing keeps "
                 "its sign, a flicker excursion does neither")
+
+
+def time_effects() -> tuple[str, ...]:
+    """The library terms a slow random excursion of the bias can mimic (registered now)."""
+    return tuple(t.id for t in terms() if t.flicker_mimics)
 
 
 @dataclass(frozen=True)
@@ -86,7 +90,7 @@ class Flicker(ScreenResult):
 
     def confusions(self, found: list[str]) -> list[Confusion]:
         """The effects found that a slow random excursion of the bias can mimic."""
-        return [Confusion((e, ID), FLICKER_TEST) for e in found if e in TIME_EFFECTS] if self.named else []
+        return [Confusion((e, ID), FLICKER_TEST) for e in found if e in time_effects()] if self.named else []
 
 
 def flicker_test(att: Attribution, fit: Fit, model: Model,

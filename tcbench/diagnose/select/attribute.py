@@ -39,7 +39,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from tcbench.diagnose.select.crossval import Fit, block_folds, fit_cv, robust_wald
-from tcbench.diagnose.select.design import DETERMINISTIC, Designer, Model, grid_values
+from tcbench.diagnose.select.design import Designer, Model, deterministic, grid_values
 from tcbench.diagnose.select.discover import best_open
 from tcbench.diagnose.select.evidence import Evidence, not_significant
 from tcbench.diagnose.select.plan import StatsPlan, plan_for
@@ -59,7 +59,6 @@ from tcbench.sensors.noise import flicker_score_variance
 # in ln(value) is the value to 2 %, finer than any term's parameter is determined by a record
 REFINE_XATOL = 0.02
 
-CONFUSABLE: dict[frozenset[str], str] = confusable_pairs()  # {pair: the test that would tell them apart}
 
 
 @dataclass
@@ -196,14 +195,15 @@ def attribute(
     cluster = np.floor((data.t_s - data.t_s[0]) / plan.cluster_s).astype(np.int64)
     scorer = _Scorer(designer, fold, k, cluster, selection, np.random.default_rng(settings.surrogate.seed))
     evidence: dict[str, Evidence] = {}
-    for effect in DETERMINISTIC:
+    candidates = deterministic()
+    for effect in candidates:
         if effect in base.ids:
             evidence[effect] = Evidence(effect, "in the model", reason="declared in the starting model")
         elif (why := designer.why_not_identifiable(effect)) is not None:
             evidence[effect] = Evidence(effect, "not identifiable", reason=why)
     model = base
     while len(model.ids) - len(base.ids) < max_effects:
-        open_effects = [e for e in DETERMINISTIC if e not in evidence or evidence[e].status == "rejected"]
+        open_effects = [e for e in candidates if e not in evidence or evidence[e].status == "rejected"]
         open_effects = [e for e in open_effects if e not in model.ids]
         if not open_effects and not open_world:
             break
@@ -252,7 +252,7 @@ def attribute(
 
 
 def _value(model: Model, effect: str) -> float | None:
-    if effect == "thermal_lag":
+    if term(effect).transforms_temperature:
         return model.lag_tau_s
     return dict(model.terms).get(effect)
 
@@ -262,7 +262,7 @@ def _confusions(
 ) -> list[tuple[str, str, str]]:
     out = []
     for kept in [e for e in model.ids if e not in base.ids]:
-        for pair, test in CONFUSABLE.items():
+        for pair, test in confusable_pairs().items():
             if kept not in pair:
                 continue
             (other,) = pair - {kept}

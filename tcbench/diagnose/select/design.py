@@ -2,8 +2,10 @@
 
 The minimal model (docs/concepts/diagnosis-report.md) is ``b(T) + input * k(T)``, with ``b`` and ``k``
 quadratic in ``u = (T - centre_c) / half_range_c``; the ``input * k(T)`` columns are dropped
-when the input never varies. ``T`` is the smoothed thermometer reading, or the die temperature
-``lag(T, tau_s)`` once ``thermal_lag`` is part of the model. Every other effect adds the
+when the input never varies. ``T`` is the smoothed thermometer reading, or what the term that
+transforms it gives once that term is part of the model
+(:func:`~tcbench.diagnose.terms.temperature_transform`: the die temperature ``lag(T, tau_s)`` of
+``thermal_lag``). Every other effect adds the
 column(s) of its term (:mod:`tcbench.diagnose.terms`, docs/concepts/physics.md, the effect library); its nonlinear parameter
 (a time constant, a width) is searched on the term's grid:
 
@@ -33,41 +35,47 @@ from typing import Any
 
 import numpy as np
 
-from tcbench.diagnose.signals import DiagnosisData, lagged
-from tcbench.diagnose.terms import is_open, open_term, term, terms
+from tcbench.diagnose.signals import DiagnosisData
+from tcbench.diagnose.terms import is_open, open_term, temperature_transform, term, terms
 
-DETERMINISTIC = tuple(t.id for t in terms() if t.deterministic)  # the forward selection's candidates, in order
-ALL_EFFECTS = tuple(t.id for t in terms())
+
+
+def deterministic() -> tuple[str, ...]:
+    """The forward selection's candidates, in order: the deterministic library terms registered
+    now (read at each call, so a term installed later in the process is among them)."""
+    return tuple(t.id for t in terms() if t.deterministic)
 
 
 @dataclass(frozen=True)
 class Model:
-    """A model of the output: the minimal model, an optional die lag, and added effect terms
-    ``(effect_id, nonlinear parameter or None)``; an open-world term
-    (:class:`~tcbench.diagnose.terms.OpenTerm`) has a tuple of nonlinear parameters."""
+    """A model of the output: the minimal model, an optional input transform of its temperature
+    (``lag_tau_s``: the value of :func:`~tcbench.diagnose.terms.temperature_transform`, the die
+    lag's time constant), and added effect terms ``(effect_id, nonlinear parameter or None)``; an
+    open-world term (:class:`~tcbench.diagnose.terms.OpenTerm`) has a tuple of nonlinear parameters."""
 
     lag_tau_s: float | None = None
     terms: tuple[tuple[str, Any], ...] = ()
 
     @property
     def ids(self) -> tuple[str, ...]:
-        return (("thermal_lag",) if self.lag_tau_s else ()) + tuple(e for e, _ in self.terms)
+        return ((temperature_transform().id,) if self.lag_tau_s else ()) + tuple(e for e, _ in self.terms)
 
     def with_effect(self, effect: str, value: float | None) -> Model:
         """This model with ``effect`` added (or its parameter replaced)."""
-        if effect == "thermal_lag":
+        if term(effect).transforms_temperature:
             return replace(self, lag_tau_s=value)
         return replace(self, terms=(*[t for t in self.terms if t[0] != effect], (effect, value)))
 
     def without(self, effect: str) -> Model:
-        if effect == "thermal_lag":
+        if term(effect).transforms_temperature:
             return replace(self, lag_tau_s=None)
         return replace(self, terms=tuple(t for t in self.terms if t[0] != effect))
 
     @property
     def n_params(self) -> int:
         """Extra parameters over the minimal model: each term's coefficients and searched values."""
-        return (1 if self.lag_tau_s else 0) + sum(term(e).n_params(v) for e, v in self.terms)
+        lag = temperature_transform().n_params(self.lag_tau_s) if self.lag_tau_s else 0
+        return lag + sum(term(e).n_params(v) for e, v in self.terms)
 
 
 @dataclass
@@ -92,11 +100,11 @@ class Designer:
         return self.data.input_levels >= 2
 
     def temperature(self, lag_tau_s: float | None) -> np.ndarray:
-        """Model temperature: the smoothed thermometer, or its lag of ``lag_tau_s``."""
+        """Model temperature: the smoothed thermometer, or its transform at ``lag_tau_s`` (its lag)."""
         if not lag_tau_s:
             return self.data.temp_c
         if lag_tau_s not in self._lag_cache:
-            self._lag_cache[lag_tau_s] = lagged(self.data.t_s, self.data.temp_c, lag_tau_s)
+            self._lag_cache[lag_tau_s] = temperature_transform().model_temperature(self.data, lag_tau_s)
         return self._lag_cache[lag_tau_s]
 
     def core_names(self) -> list[str]:

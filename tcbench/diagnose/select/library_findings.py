@@ -6,7 +6,7 @@ in a residual (docs/concepts/diagnosis-report.md, shapes), where it shows (the r
 temperature term, ``time_s`` 0 for the warm-up, nothing for the others) and its explanation;
 ``confirm_with`` names the measurement or test profile that would confirm the effect and, when
 the recording cannot tell it from another effect, the test of
-:data:`~tcbench.diagnose.select.attribute.CONFUSABLE` that would separate the two.
+:func:`~tcbench.diagnose.terms.confusable_pairs` that would separate the two.
 """
 
 from __future__ import annotations
@@ -15,10 +15,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from tcbench.diagnose.findings import Finding
-from tcbench.diagnose.select.attribute import CONFUSABLE
-from tcbench.diagnose.terms import Extent, is_term, term, terms
-
-SHAPE = {t.id: t.shape for t in terms()}  # the shape of each library effect, by id
+from tcbench.diagnose.terms import Extent, confusable_pairs, is_term, term, terms
 
 
 def where_of(effect: str, extent: Extent) -> dict[str, Any]:
@@ -29,9 +26,9 @@ def where_of(effect: str, extent: Extent) -> dict[str, Any]:
 def confirm_with(effect: str, confusable_with: Sequence[str] = ()) -> str:
     """The measurement that would confirm ``effect``; for each effect it ``confusable_with``,
     the test that would separate the two."""
-    text = term(effect).confirm_with
+    text, pairs = term(effect).confirm_with, confusable_pairs()
     for other in confusable_with:
-        test = CONFUSABLE.get(frozenset({effect, other}))
+        test = pairs.get(frozenset({effect, other}))
         if test:
             text += f"; to tell it from {other}: {test}"
     return text
@@ -48,7 +45,7 @@ def library_finding(
     ``evidence`` that kept it, on a recording of ``extent``; ``confusable_with`` (the effects
     this recording cannot tell it from) rides along as an extra key when not empty."""
     if not is_term(effect) or term(effect).open_world:
-        raise ValueError(f"{effect!r} is not an effect of the library; known: {', '.join(SHAPE)}")
+        raise ValueError(f"{effect!r} is not an effect of the library; known: {', '.join(t.id for t in terms())}")
     t = term(effect)
     return Finding(
         id=effect, shape=t.shape, library=True, params=dict(params), where=t.where(extent),

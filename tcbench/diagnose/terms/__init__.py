@@ -19,10 +19,11 @@ from tcbench.diagnose.terms.base import (
     confusable_pairs,
     is_term,
     term,
+    temperature_transform,
     term_source,
     terms,
 )
 from tcbench.diagnose.terms.open_base import OpenTerm, Search, is_open, open_finding, open_term, report_order
 
 __all__ = ["Extent", "OpenTerm", "Search", "Term", "broken_terms", "confusable_pairs", "is_open", "is_term",
-           "open_finding", "open_term", "report_order", "term", "term_source", "terms"]
+           "open_finding", "open_term", "report_order", "temperature_transform", "term", "term_source", "terms"]

@@ -2,9 +2,11 @@
 models, reports and explains it, and the registry that finds a term by its id.
 
 A subclass sets the class attributes (``id``, ``shape``, ``effect``, ``confirm_with``, ...) and
-implements :meth:`Term.explanation` and :meth:`Term.params`; a regressor (every term but
-``bias_instability``, which is judged from the residual's Allan deviation, and ``thermal_lag``,
-which moves the whole model to the die temperature) also implements :meth:`Term.column`.
+implements :meth:`Term.explanation` and :meth:`Term.params`; a regressor also implements
+:meth:`Term.column`. Two kinds of term are no regressor: noise (``deterministic = False``:
+``bias_instability``, judged from the residual's Allan deviation) and an input transform
+(``transforms_temperature``: ``thermal_lag``, which moves the whole model to the die temperature
+its :meth:`Term.model_temperature` gives; :func:`temperature_transform` finds it).
 Defining the subclass registers it: :func:`term` finds it by id, :func:`terms` lists them all
 in the order they were defined. Installed packages add terms under the entry-point group
 ``tcbench.terms`` (``my_effect = "pkg.module:MyEffectTerm"``, the name being the term's id); they
@@ -79,8 +81,15 @@ class Term(ABC):
       side of each pair (:meth:`partners` gives both);
     - ``flicker_mimics``: a slow random excursion of the bias can look like it;
     - ``cached``: its column is costly; the designer keeps it per value and model temperature;
+    - ``transforms_temperature``: an input transform, not a column: at its searched value the
+      whole model runs on :meth:`model_temperature` instead of the smoothed thermometer;
     - ``open_world``: structure outside the library (:class:`~.open_base.OpenTerm`), not a
-      candidate of the library's forward selection.
+      candidate of the library's forward selection;
+    - ``units``: ``{parameter name: its unit}`` for the report, ``{unit}`` standing for the
+      output unit, where the name does not say it (a name ending ``_s`` is in s, ``_c`` in degC);
+    - ``gain_name``, ``gain_label``: what its evidence's gain is, for a term not judged by the
+      held-out gain (``bias_instability``: an Allan ratio), in the report's table and on the
+      evidence plot's axis (None: the penalised held-out gain).
     """
 
     id: ClassVar[str] = ""
@@ -93,7 +102,11 @@ class Term(ABC):
     confusable: ClassVar[Mapping[str, str]] = {}
     flicker_mimics: ClassVar[bool] = False
     cached: ClassVar[bool] = False
+    transforms_temperature: ClassVar[bool] = False
     open_world: ClassVar[bool] = False
+    units: ClassVar[Mapping[str, str]] = {}
+    gain_name: ClassVar[str | None] = None
+    gain_label: ClassVar[str | None] = None
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -105,6 +118,11 @@ class Term(ABC):
             raise ValueError(f"term {cls.id!r} models effect {cls.effect.id!r}: the ids must match")
         _REGISTRY[cls.id] = cls()
 
+    def unit_of(self, name: str, unit: str) -> str | None:
+        """The unit of its parameter ``name`` when the output is in ``unit`` (None: not in :attr:`units`)."""
+        u = self.units.get(name)
+        return None if u is None else u.format(unit=unit)
+
     def grid_values(self) -> list[float | None]:
         """Values of the nonlinear parameter searched (``[None]`` if it has none)."""
         return [None] if self.grid is None else list(self.grid)
@@ -114,6 +132,11 @@ class Term(ABC):
         """The regressor at nonlinear parameter ``value`` on the model temperature ``temp_c``
         (``centre_c`` and ``half_range_c`` scale the temperature as the minimal model does)."""
         raise ValueError(f"effect {self.id!r} has no regressor")
+
+    def model_temperature(self, data: DiagnosisData, value: float) -> np.ndarray:
+        """The model temperature (degC) with this input transform at ``value``, for a term that
+        :attr:`transforms_temperature`."""
+        raise ValueError(f"term {self.id!r} does not transform the model temperature")
 
     def n_params(self, value: Any) -> int:
         """Parameters it adds to the minimal model at ``value``: its coefficient and its searched value."""
@@ -228,6 +251,12 @@ def terms(open: bool = False) -> tuple[Term, ...]:
     """The registered library terms (``open``: the open-world terms): the built-in ones in the
     order defined, then the installed ones."""
     return tuple(t for t in _registry().values() if t.open_world == open)
+
+
+def temperature_transform() -> Term:
+    """The term that transforms the model temperature (the first registered; the built-in
+    ``thermal_lag``): a model holds at most one."""
+    return next(t for t in _registry().values() if t.transforms_temperature)
 
 
 def is_term(term_id: str) -> bool:

@@ -24,6 +24,7 @@ class WarmupTerm(Term):
     # settles within the hour after power-on, so a slower decay is ageing's trend
     grid = np.geomspace(120.0, 7200.0, 14)
     flicker_mimics = True
+    units = {"amplitude": "{unit}"}
     confirm_with = (
         "a second power-on, ideally at constant temperature: a warm-up repeats after every power-on with the same "
         "time constant, and a longer run shows it settled")
@@ -59,6 +60,7 @@ class AgingDriftTerm(Term):
     effect = AgingDrift
     shape = "trend"
     flicker_mimics = True
+    units = {"rate_per_h": "{unit}/h"}
     confirm_with = (
         "a long soak at constant temperature, or a profile that revisits the same temperatures hours apart: "
         "ageing follows time and keeps its sign, a temperature term follows temperature")

@@ -4,11 +4,12 @@ the play of the die attach."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from tcbench.diagnose.settings import DEFAULTS
-from tcbench.diagnose.signals import DiagnosisData, hysteresis_state
+from tcbench.diagnose.signals import DiagnosisData, hysteresis_state, lagged
 from tcbench.diagnose.terms.base import Term, g3
 from tcbench.sensors.effects import Effect, Hysteresis, TemperatureRate, ThermalLag
 
@@ -48,6 +49,7 @@ class ThermalLagTerm(Term):
     effect = ThermalLag
     shape = "temperature_dynamics"
     param = "tau_s"
+    transforms_temperature = True
     # tau_s (s): 20 s (twenty steps of the 1 s filter clock, signals.GRID_S) to 1 h, 16 log-spaced (1.41x
     # apart; the selection's bounded search refines the best between its neighbours, not past 1 h): a slower
     # node behind the thermometer is the open-world second_node's (NODE_TAU_S, to 4 h)
@@ -62,6 +64,12 @@ class ThermalLagTerm(Term):
             "soaks of at least five die time constants after fast ramps: a lagging die keeps drifting "
             "into the soak, a thermal-gradient term stops with the ramp"),
     }
+
+    def model_temperature(self, data: DiagnosisData, value: float) -> np.ndarray:
+        return lagged(data.t_s, data.temp_c, value)
+
+    def n_params(self, value: Any) -> int:
+        return 1  # its time constant: no coefficient of its own
 
     def skip(self, data: DiagnosisData) -> str | None:
         return _still(data, "a thermal lag")
@@ -84,6 +92,7 @@ class TemperatureRateTerm(Term):
     id = "temperature_rate"
     effect = TemperatureRate
     shape = "temperature_dynamics"
+    units = {"coef_per_c_per_s": "{unit} per degC/s"}
     confirm_with = (
         "the same temperature swing at two ramp rates with soaks between: the term scales with the ramp rate, "
         "changes sign between heating and cooling and vanishes the moment a ramp stops")
@@ -124,6 +133,7 @@ class HysteresisTerm(Term):
     # bounded search, and past 8 degC up to half the temperature span, :meth:`past_grid`)
     grid = np.geomspace(0.2, 8.0, 12)
     cached = True
+    units = {"amplitude": "{unit}"}
     confirm_with = (
         "soaks at one temperature approached from above and from below, each long enough to settle: the "
         "difference between the two persists through the soak, where a lag or a rate term dies out")

@@ -16,6 +16,9 @@ class BiasInstabilityTerm(Term):
     effect = BiasInstability
     shape = "noise"
     deterministic = False
+    units = {"b": "{unit} (flicker coefficient)"}
+    gain_name = "Allan ratio"
+    gain_label = "Allan deviation / white line at the first τ over the bound (not a σ² gain)"
     confirm_with = (
         "a longer record at constant temperature after every deterministic term is modelled: flicker keeps the "
         "Allan deviation flat over decades of tau and does not repeat between runs, where a warm-up repeats "

@@ -113,6 +113,7 @@ class OpenTerm(Term):
     """
 
     open_world = True
+    units = {"amplitude": "{unit}"}
     value_names: ClassVar[tuple[str, ...]] = ()
     n_coef: ClassVar[int] = 1
     search_scale: ClassVar[float] = 1.0

@@ -19,6 +19,7 @@ class TemperatureCubicTerm(Term):
     id = "temperature_cubic"
     effect = TemperatureCubic
     shape = "temperature_function"
+    units = {"c3_per_c3": "{unit}/degC^3"}
     confirm_with = (
         "a finer grid of soaks over the same temperature range: the residual against temperature stays S-shaped "
         "and repeats at every visit of a temperature, in either direction and at any time")
@@ -47,6 +48,7 @@ class AccelNonlinearityTerm(Term):
     id = "accel_nonlinearity"
     effect = AccelNonlinearity
     shape = "input_function"
+    units = {"k2_per_g2": "{unit}/g^2"}
     confirm_with = (
         "more input levels on both sides of zero (a multi-position tumble or a rate table): a square term puts "
         "the responses at +a and -a on the same side of the straight line through them, by an amount growing as a^2")
