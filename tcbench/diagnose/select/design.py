@@ -39,7 +39,6 @@ from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import is_open, open_term, temperature_transform, term, terms
 
 
-
 def deterministic() -> tuple[str, ...]:
     """The forward selection's candidates, in order: the deterministic library terms registered
     now (read at each call, so a term installed later in the process is among them)."""
