@@ -83,12 +83,14 @@ from typing import Any
 
 import numpy as np
 
+from tcbench.compensation import c_model_terms as terms
+from tcbench.compensation.c_model_terms import c_literal as _lit
 from tcbench.compensation.calibration import RATE_WINDOW_S, OffsetModel
 from tcbench.compensation.features import temperature_rate_c_per_s
 
 EXPORTED = ("poly3", "poly3_rate", "bp", "bp_gd", "elman", "model")  # what a device can run of calibrate's methods
 NOT_EXPORTED = {"raw": "no correction", "memoriser": "a control that needs the parts' starts, not a compensator"}
-MODEL_TERMS = ("thermal_lag", "temperature_rate", "hysteresis", "temperature_cubic", "temperature_bump", "second_node")
+MODEL_TERMS = tuple(terms.TERMS)  # the diagnosed model's terms a device runs
 CAPACITY_MARGIN = 1.5  # the rate ring holds this many times the calibration record's fullest window
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,62}$")
 
@@ -318,70 +320,28 @@ def streamed_corrected(spec: dict[str, Any], clock_s: np.ndarray, temp_c: np.nda
 
 def _model_scale(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
     """A diagnosed model's scale factor in its die temperature at each sample (1 without one)."""
-    u = (_model_die(spec, t, temp) - spec["centre_c"]) / spec["half_range_c"]
+    u = (terms.die_temperature(spec["effects"], np.r_[0.0, np.diff(t)], temp) - spec["centre_c"]) / spec["half_range_c"]
     scale = np.zeros_like(u) if "scale_factor" in spec else np.ones_like(u)
     for k in reversed(spec.get("scale_factor", [])):
         scale = scale * u + k
     return scale
 
 
-def _model_die(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
-    """The die temperature the diagnosed model runs on: the thermometer through its thermal lags."""
-    dt = np.r_[0.0, np.diff(t)]
-    die = temp.copy()
-    for e in spec["effects"]:
-        if e["id"] == "thermal_lag":
-            die = _lag(die, dt, e["tau_s"])
-    return die
-
-
 def _model_streamed(spec: dict[str, Any], t: np.ndarray, temp: np.ndarray) -> np.ndarray:
-    """The causal diagnosed model (see the module doc), per sample in a loop for the sequential
-    parts (the lags and the play operator), vectorised for the rest."""
+    """The causal diagnosed model (see the module doc): the die stages first, as the simulator runs
+    them, then the bias polynomial in the die temperature and each term's addition, in order."""
     dt = np.r_[0.0, np.diff(t)]
-    die = temp.copy()
+    effects = spec["effects"]
+    die = terms.die_temperature(effects, dt, temp)
+    signals = terms.Signals(dt, temp, die, spec["ref_c"])
+    added = [terms.TERMS[e["id"]].reference(e, signals) for e in effects if not terms.TERMS[e["id"]].die_stage]
     offset = np.zeros(t.size)
-    terms: list[np.ndarray] = []
-    for e in spec["effects"]:  # the die stage first, as the simulator runs it
-        if e["id"] == "thermal_lag":
-            die = _lag(die, dt, e["tau_s"])
-    for e in spec["effects"]:
-        if e["id"] == "temperature_rate":
-            rate = np.r_[0.0, np.diff(temp) / np.where(dt[1:] > 0, dt[1:], 1.0)] if t.size else dt
-            terms.append(e["coef_per_c_per_s"] * rate)
-        elif e["id"] == "hysteresis":
-            w = e["width_c"]
-            state = np.empty(t.size)
-            p = float(die[0]) - float(np.clip(e["start_state"], -1.0, 1.0)) * w if t.size else 0.0
-            for i, x in enumerate(die.tolist()):
-                p = min(max(p, x - w), x + w)
-                state[i] = (x - p) / w
-            terms.append(e["amplitude"] * state)
-        elif e["id"] == "temperature_cubic":
-            terms.append(e["c3_per_c3"] * (die - spec["ref_c"]) ** 3)
-        elif e["id"] == "temperature_bump":
-            terms.append(e["amplitude"] * np.exp(-0.5 * ((die - e["centre_c"]) / e["width_c"]) ** 2))
-        elif e["id"] == "second_node":
-            terms.append(e["coef_per_c"] * (_lag(die, dt, e["tau_s"]) - die))
     u = (die - spec["centre_c"]) / spec["half_range_c"]
     for c in reversed(spec["bias"]):
         offset = offset * u + c
-    for term in terms:
+    for term in added:
         offset = offset + term
     return offset
-
-
-def _lag(x: np.ndarray, dt: np.ndarray, tau_s: float) -> np.ndarray:
-    """``y += (1 - exp(-dt / tau)) (x - y)``, ``y = x`` at the first sample (``tau_s <= 0``: x)."""
-    if tau_s <= 0 or x.size == 0:
-        return x.copy()
-    gain = 1.0 - np.exp(-dt / tau_s)
-    out = np.empty_like(x)
-    y = float(x[0])
-    for i, (xi, g) in enumerate(zip(x.tolist(), gain.tolist())):
-        y = y + g * (xi - y)
-        out[i] = y
-    return out
 
 
 def device_clock_s(dt_s: np.ndarray) -> np.ndarray:
@@ -543,14 +503,6 @@ class CSource:
     source: str
     state_bytes: dict[str, int]  # by build: double, float (x86-64 and ARM EABI alignment)
     flops: str  # floating-point operations per sample, in words
-
-
-def _lit(v: float) -> str:
-    """A C double literal that reads back exactly (hexadecimal)."""
-    v = float(v)
-    if np.isinf(v):
-        return "HUGE_VAL" if v > 0 else "-HUGE_VAL"
-    return v.hex()
 
 
 def _array(values: Any) -> str:
@@ -755,9 +707,7 @@ def _cubic_body(spec: dict[str, Any]) -> str:
 
 def _model_slots(spec: dict[str, Any]) -> list[str]:
     """The diagnosed model's state: each lag's and play operator's memory, the last temperature."""
-    names = {"thermal_lag": "die lag", "second_node": "second node", "hysteresis": "play operator"}
-    slots = [f"{names[e['id']]} {k}" for k, e in enumerate(spec["effects"]) if e["id"] in names]
-    return slots + ["last temperature"] * any(e["id"] == "temperature_rate" for e in spec["effects"])
+    return terms.slots(spec["effects"])
 
 
 def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
@@ -768,51 +718,29 @@ def _model_body(spec: dict[str, Any]) -> tuple[str, str]:
 
 def _model_lines(spec: dict[str, Any], base: int) -> tuple[int, int, list[str]]:
     """The update's lines of one diagnosed model whose state starts at ``s->memory[base]``, its
-    operations and its ``exp`` calls per sample."""
-    slots = _model_slots(spec)
-    stateful = any(e["id"] in ("thermal_lag", "temperature_rate", "hysteresis", "second_node") for e in spec["effects"])
-    lines = ["    int first = s->samples == 1;"] * stateful + [
+    operations and its ``exp`` calls per sample: its die stages in order, the bias polynomial in the
+    die temperature, each term's addition in order (:mod:`.c_model_terms`), the scale factor."""
+    effects, slots = spec["effects"], _model_slots(spec)
+    lines = ["    int first = s->samples == 1;"] * bool(slots) + [
         "    R die = temperature_c, offset = 0, u" + (", scale;" if "scale_factor" in spec else ";")]
     flops, calls = 0, 0
-    lags = [(k, e) for k, e in enumerate(spec["effects"]) if e["id"] == "thermal_lag"]
-    for k, e in lags:  # the die stage first, in order, as the simulator runs it
-        at = base + slots.index(f"die lag {k}")
-        lines += [f"    if (first) s->memory[{at}] = die;",
-                  f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
-                  f"    die = s->memory[{at}];"]
-        flops, calls = flops + 5, calls + 1
+
+    def add(staged: bool) -> None:
+        nonlocal flops, calls
+        for k, e in enumerate(effects):
+            term = terms.TERMS[e["id"]]
+            if term.die_stage == staged:
+                at = base + terms.slot_of(effects, k, slots) if term.slot is not None else -1
+                update = term.c_lines(e, spec["ref_c"], at)
+                lines.extend(update.lines)
+                flops, calls = flops + update.flops, calls + update.calls
+
+    add(staged=True)
     lines.append(f"    u = (die - (R){_lit(spec['centre_c'])}) / (R){_lit(spec['half_range_c'])};")
     for c in reversed(spec["bias"]):
         lines.append(f"    offset = offset * u + (R){_lit(c)};")
     flops += 2 + 2 * len(spec["bias"])
-    for k, e in enumerate(spec["effects"]):
-        if e["id"] == "temperature_rate":
-            at = base + slots.index("last temperature")
-            lines += [f"    if (!first && dt_s > 0) offset += (R){_lit(e['coef_per_c_per_s'])} * "
-                      f"((temperature_c - s->memory[{at}]) / dt_s);",
-                      f"    s->memory[{at}] = temperature_c;"]
-            flops += 4
-        elif e["id"] == "hysteresis":
-            at, w = base + slots.index(f"play operator {k}"), e["width_c"]
-            start = float(np.clip(e["start_state"], -1.0, 1.0))
-            lines += [f"    if (first) s->memory[{at}] = die - (R){_lit(start)} * (R){_lit(w)};",
-                      f"    if (s->memory[{at}] < die - (R){_lit(w)}) s->memory[{at}] = die - (R){_lit(w)};",
-                      f"    if (s->memory[{at}] > die + (R){_lit(w)}) s->memory[{at}] = die + (R){_lit(w)};",
-                      f"    offset += (R){_lit(e['amplitude'])} * ((die - s->memory[{at}]) / (R){_lit(w)});"]
-            flops += 6
-        elif e["id"] == "temperature_cubic":
-            lines += [f"    {{ R d = die - (R){_lit(spec['ref_c'])}; offset += (R){_lit(e['c3_per_c3'])} * (d * d * d); }}"]
-            flops += 5
-        elif e["id"] == "temperature_bump":
-            lines += [f"    {{ R z = (die - (R){_lit(e['centre_c'])}) / (R){_lit(e['width_c'])}; "
-                      f"offset += (R){_lit(e['amplitude'])} * TC_EXP((R)-0.5 * (z * z)); }}"]
-            flops, calls = flops + 6, calls + 1
-        elif e["id"] == "second_node":
-            at = base + slots.index(f"second node {k}")
-            lines += [f"    if (first) s->memory[{at}] = die;",
-                      f"    else s->memory[{at}] += ((R)1 - TC_EXP(-dt_s / (R){_lit(e['tau_s'])})) * (die - s->memory[{at}]);",
-                      f"    offset += (R){_lit(e['coef_per_c'])} * (s->memory[{at}] - die);"]
-            flops, calls = flops + 7, calls + 1
+    add(staged=False)
     if "scale_factor" in spec:  # the input that explains the reading: (raw - offset) / s(u)
         lines.append("    scale = 0;")
         for k in reversed(spec["scale_factor"]):
