@@ -14,6 +14,7 @@ with.
 from __future__ import annotations
 
 import logging
+import multiprocessing
 from dataclasses import replace
 from typing import Any
 
@@ -152,8 +153,9 @@ def diagnose(
     fitted = smoothing(rec, settings=settings)  # a coarse thermometer staircase widens the smoothing window
     if fitted.default_smooth_s >= default_s:
         return _diagnose(rec, fitted, glitch, sensor, declared or {}, name, settings, min_duration_s)
-    # the two diagnoses are independent: one per core (same results as in turn, in about half the time)
-    tried = Parallel(n_jobs=2)(delayed(_diagnose)(rec, s, glitch, sensor, declared or {}, name, settings,
+    # the two diagnoses are independent: one per core (same results as in turn, in about half the time);
+    # in turn in a sweep's worker (a daemon process, which joblib refuses to start workers from)
+    tried = Parallel(n_jobs=1 if multiprocessing.current_process().daemon else 2)(delayed(_diagnose)(rec, s, glitch, sensor, declared or {}, name, settings,
                                                   min_duration_s)
                                for s in (fitted, smoothing(rec, default_s, settings)))
     # the default window is a model choice like a term: it must pay the open-world gain threshold
