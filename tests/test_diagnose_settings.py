@@ -189,9 +189,9 @@ def test_the_wald_lags_reach_the_selections_robust_wald_test() -> None:
     """settings.selection.wald_lags is robust_wald's default and the scorer of the selection passes
     its own: on noise correlated over many clusters (a random walk) the lags add the clusters'
     covariances to the variance, so the statistic changes with them."""
-    from tcbench.diagnose.select.attribute import _Scorer
     from tcbench.diagnose.select.crossval import block_folds, robust_wald
     from tcbench.diagnose.select.design import Designer, Model
+    from tcbench.diagnose.select.score import Scorer
     from tcbench.diagnose.signals import DiagnosisData
 
     rng = np.random.default_rng(5)
@@ -203,7 +203,7 @@ def test_the_wald_lags_reach_the_selections_robust_wald_test() -> None:
                          np.zeros(n, dtype=int), 1.0, 1.0, 120.0)
     fold, cluster = block_folds(t, 160.0, 5), (t // 100.0).astype(np.int64)
     base, model = Model(), Model().with_effect("aging_drift", None)
-    scorers = {lags: _Scorer(Designer(data), fold, 5, cluster, replace(DEFAULTS.selection, wald_lags=lags))
+    scorers = {lags: Scorer(Designer(data), fold, 5, cluster, replace(DEFAULTS.selection, wald_lags=lags))
                for lags in (0, DEFAULTS.selection.wald_lags)}
     walds = {lags: robust_wald(s.fit(base), s.fit(model), cluster, lags) for lags, s in scorers.items()}
     default = scorers[DEFAULTS.selection.wald_lags]

@@ -2,7 +2,7 @@
 
 :mod:`~.attribute` adds, round by round, the effect (or open-world term, :mod:`~.discover`) whose
 columns (:mod:`~.design`) lower the held-out error of blocked cross-validation (:mod:`~.crossval`)
-most, if it passes the significance test (:mod:`~.significance`: the robust Wald test or the
+most, as :mod:`~.score` fits each model and scores each candidate, if it passes the significance test (:mod:`~.significance`: the robust Wald test or the
 spectral surrogates of :mod:`~.surrogate`, standard errors from :mod:`~.spectral_se`) that the
 statistics plan (:mod:`~.plan`) sizes to the record; :mod:`~.evidence` keeps how each candidate
 fared. Beside it: where a residual departs from white noise (:mod:`~.locate`), the

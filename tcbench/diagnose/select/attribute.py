@@ -1,6 +1,7 @@
 """Which effects the model misses: greedy forward selection on held-out error.
 
 Each round tries every effect not yet in the model at every value of its grid, scoring
+each (:class:`~tcbench.diagnose.select.score.Scorer`: fit a model, score a candidate) by
 
     gain = (SSE_heldout(model) - SSE_heldout(model + effect)) / v - 2 * extra parameters
 
@@ -33,32 +34,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
-from tcbench.diagnose.select.crossval import Fit, block_folds, fit_cv, robust_wald
-from tcbench.diagnose.select.design import Designer, Model, deterministic, grid_values
+from tcbench.diagnose.select.crossval import Fit, block_folds
+from tcbench.diagnose.select.design import Designer, Model, deterministic
 from tcbench.diagnose.select.discover import best_open
 from tcbench.diagnose.select.evidence import Evidence, not_significant
 from tcbench.diagnose.select.plan import StatsPlan, plan_for
-from tcbench.diagnose.select.significance import SURROGATE, SignificanceTest
-from tcbench.diagnose.select.surrogate import surrogate_test
-from tcbench.diagnose.select.thermometer_noise import thermometer_variance
-from tcbench.diagnose.settings import (
-    DEFAULTS,
-    DiagnoseSettings,
-    SelectionSettings,
-    SurrogateSettings,
-)
+from tcbench.diagnose.select.score import Scorer
+from tcbench.diagnose.select.significance import SURROGATE
+from tcbench.diagnose.settings import DEFAULTS, DiagnoseSettings
 from tcbench.diagnose.terms import confusable_pairs, is_open, open_term, term
-from tcbench.sensors.noise import flicker_score_variance
-
-# the refinement of a term's parameter between its best grid neighbours, on the log scale: 0.02
-# in ln(value) is the value to 2 %, finer than any term's parameter is determined by a record
-REFINE_XATOL = 0.02
-
 
 
 @dataclass
@@ -78,95 +65,6 @@ class Attribution:
     k: int
     plan: StatsPlan | None = None
     settings: DiagnoseSettings = DEFAULTS
-
-
-class _Scorer:
-    """Held-out fits of models on one recording, memoised; gains penalised and excess judged
-    as ``selection`` says, surrogates drawn from ``rng``."""
-
-    def __init__(self, designer: Designer, fold: np.ndarray, k: int, cluster: np.ndarray,
-                 selection: SelectionSettings = DEFAULTS.selection, rng: np.random.Generator | None = None) -> None:
-        self.designer, self.fold, self.k, self.cluster = designer, fold, k, cluster
-        self.selection = selection
-        self.rng = rng if rng is not None else np.random.default_rng(DEFAULTS.surrogate.seed)
-        self.sigma2 = designer.data.white_sigma**2
-        self._memo: dict[Model, Fit] = {}
-        self._noise_memo: dict[tuple[Model, Model], tuple[float, float]] = {}
-
-    def fit(self, model: Model) -> Fit:
-        if model not in self._memo:
-            x = self.designer.matrix(model)
-            self._memo[model] = fit_cv(x, self.designer.data.output, self.fold, self.k)
-        return self._memo[model]
-
-    def _noise(self, base: Model, model: Model) -> tuple[float, float]:
-        """Variance of the added signal's score under white output noise alone, and with the
-        thermometer noise the model inherits."""
-        key = (base, model)
-        if key not in self._noise_memo:
-            z = self.fit(base).residual - self.fit(model).residual
-            white = self.sigma2 * float(z @ z)
-            total = white + thermometer_variance(self.designer, model, self.fit(model).beta, z)
-            self._noise_memo[key] = (white, total)
-        return self._noise_memo[key]
-
-    def gain(self, base: Model, model: Model) -> float:
-        """Held-out SSE drop in units of the noise variance along the added signal (white plus
-        thermometer), minus the parameter penalty."""
-        white, total = self._noise(base, model)
-        drop = (self.fit(base).sse_heldout - self.fit(model).sse_heldout) / self.sigma2
-        share = white / total if total > 0 else 1.0
-        return drop * share - self.selection.penalty_sigma2_per_param * (model.n_params - base.n_params)
-
-    def wald(self, base: Model, model: Model) -> float:
-        """Robust Wald statistic (cluster covariance), never above the one with the known
-        white-plus-thermometer variance."""
-        robust = robust_wald(self.fit(base), self.fit(model), self.cluster, self.selection.wald_lags)
-        z = self.fit(base).residual - self.fit(model).residual
-        known = float(z @ self.fit(base).residual) ** 2 / max(self._noise(base, model)[1], 1e-300)
-        return min(robust, known)
-
-    def surrogate_p(self, base: Model, effect: str, value: Any, searched: list[Any] | None,
-                    settings: SurrogateSettings) -> float:
-        """p-value of adding ``effect`` to ``base`` by the surrogate test of ``settings``,
-        searched over its grid (or the values ``searched``) and ``value``; the noise model is the
-        residual of ``base`` plus ``effect`` at ``value``."""
-        grid = grid_values(effect) if searched is None else list(searched)
-        values = [*grid, *([value] if value is not None and value not in grid else [])]
-        xs = [self.designer.matrix(base.with_effect(effect, v)) for v in values]
-        noise = self.fit(base.with_effect(effect, value)).residual
-        p, _ = surrogate_test(self.designer.matrix(base), xs, self.designer.data.output, noise, self.rng, settings)
-        return p
-
-    def removes_most(self, base: Model, model: Model) -> bool:
-        """Whether ``model`` removes at least the selection's ``most_of_excess`` of the held-out
-        squared error that ``base`` leaves above the white noise."""
-        excess = self.fit(base).sse_heldout - self.designer.data.n * self.sigma2
-        drop = self.fit(base).sse_heldout - self.fit(model).sse_heldout
-        return excess > 0 and drop >= self.selection.most_of_excess * excess
-
-    def significant(self, base: Model, effect: str, value: Any, test: SignificanceTest,
-                    searched: list[Any] | None = None) -> tuple[bool, float, float, str]:
-        """Whether adding ``effect`` at ``value`` to ``base`` is significant against slow noise by
-        ``test``: ``(passed, robust Wald, surrogate p-value, name of the test that decided)``."""
-        wald = self.wald(base, base.with_effect(effect, value))
-        return test.judge(self, base, effect, value, wald, searched)
-
-    def best(self, base: Model, effect: str) -> tuple[float, float | None]:
-        """Best gain of adding ``effect`` to ``base`` over its grid, then refined."""
-        values = grid_values(effect)
-        gains = [self.gain(base, base.with_effect(effect, v)) for v in values]
-        i = int(np.argmax(gains))
-        if values[i] is None:
-            return gains[i], None
-        lo, hi = np.log(values[max(i - 1, 0)]), np.log(values[min(i + 1, len(values) - 1)])  # type: ignore[arg-type]
-        if i == len(values) - 1 and (top := term(effect).past_grid(self.designer.data)) is not None:
-            hi = max(hi, float(np.log(top)))  # best at the grid's edge: search on, as far as the term allows
-        res = minimize_scalar(lambda z: -self.gain(base, base.with_effect(effect, float(np.exp(z)))),
-                              bounds=(lo, hi), method="bounded", options={"xatol": REFINE_XATOL})
-        if -res.fun > gains[i]:
-            return float(-res.fun), float(np.exp(res.x))
-        return gains[i], values[i]
 
 
 def attribute(
@@ -193,13 +91,13 @@ def attribute(
     k = plan.k
     fold = block_folds(data.t_s, plan.block_s, k)
     cluster = np.floor((data.t_s - data.t_s[0]) / plan.cluster_s).astype(np.int64)
-    scorer = _Scorer(designer, fold, k, cluster, selection, np.random.default_rng(settings.surrogate.seed))
+    scorer = Scorer(designer, fold, k, cluster, selection, np.random.default_rng(settings.surrogate.seed))
     evidence: dict[str, Evidence] = {}
     candidates = deterministic()
     for effect in candidates:
         if effect in base.ids:
             evidence[effect] = Evidence(effect, "in the model", reason="declared in the starting model")
-        elif (why := designer.why_not_identifiable(effect)) is not None:
+        elif (why := term(effect).skip(data)) is not None:  # the recording cannot show it at all
             evidence[effect] = Evidence(effect, "not identifiable", reason=why)
     model = base
     while len(model.ids) - len(base.ids) < max_effects:
@@ -258,7 +156,7 @@ def _value(model: Model, effect: str) -> float | None:
 
 
 def _confusions(
-    scorer: _Scorer, model: Model, base: Model, evidence: dict[str, Evidence], threshold: float
+    scorer: Scorer, model: Model, base: Model, evidence: dict[str, Evidence], threshold: float
 ) -> list[tuple[str, str, str]]:
     out = []
     for kept in [e for e in model.ids if e not in base.ids]:
@@ -304,20 +202,12 @@ def recheck_with_flicker(att: Attribution, b: float,
     data = att.designer.data
     wald_threshold = att.settings.selection.wald_threshold
     cluster = np.zeros(data.n, dtype=np.int64)  # the robust test is not used here
-    scorer = _Scorer(att.designer, att.fold, att.k, cluster, att.settings.selection)
-    dt_s = float(np.median(np.diff(data.t_s)))
+    scorer = Scorer(att.designer, att.fold, att.k, cluster, att.settings.selection)
     model = att.final
-
-    def wald(effect: str, flicker_b: float) -> float:
-        reduced = model.without(effect)
-        z = scorer.fit(reduced).residual - scorer.fit(model).residual
-        var_flicker = flicker_score_variance(z, dt_s, flicker_b)
-        return float(z @ scorer.fit(reduced).residual) ** 2 / (scorer._noise(reduced, model)[1] + var_flicker)
-
     while True:
         judged = [e for e in model.ids if e not in att.base.ids and att.evidence[e].test != SURROGATE]
         # a surrogate test's null noise already had the residual's whole spectrum, flicker included
-        scores = sorted((wald(e, b), e) for e in judged)
+        scores = sorted((scorer.flicker_wald(model.without(e), model, b), e) for e in judged)
         weakest = next(((w, e) for w, e in scores if w <= wald_threshold and not (
             structure_remains is not None and structure_remains(
                 float(np.sqrt(scorer.fit(model.without(e)).sse_heldout / data.n))))), None)

@@ -38,6 +38,8 @@ import numpy as np
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import is_open, open_term, temperature_transform, term, terms
 
+DELTA_C = 0.01  # step of the numerical temperature slope (degC)
+
 
 def deterministic() -> tuple[str, ...]:
     """The forward selection's candidates, in order: the deterministic library terms registered
@@ -118,6 +120,14 @@ class Designer:
             cols += [a, a * u, a * u * u]
         return np.column_stack(cols)
 
+    def temperature_slope(self, model: Model, beta: np.ndarray) -> np.ndarray:
+        """d(output)/dT of the core fitted as ``beta`` (``model``'s coefficients) at its model
+        temperature, per sample (unit per degC): a central difference of ``DELTA_C``."""
+        temp = self.temperature(model.lag_tau_s)
+        core = beta[: len(self.core_names())]
+        up, down = self.core(temp + DELTA_C) @ core, self.core(temp - DELTA_C) @ core
+        return (up - down) / (2.0 * DELTA_C)
+
     def column(self, effect: str, value: float | None, temp_c: np.ndarray, lag_tau_s: float | None) -> np.ndarray:
         """The regressor of ``effect`` with nonlinear parameter ``value`` (its term's column)."""
         t = term(effect)
@@ -143,12 +153,3 @@ class Designer:
         cols = [self.core(self.temperature(model.lag_tau_s))]
         cols += [self.columns(e, v, model.lag_tau_s) for e, v in model.terms]
         return np.hstack(cols)
-
-    def why_not_identifiable(self, effect: str) -> str | None:
-        """Why this recording cannot show ``effect`` at all (its term's ``skip``), or None."""
-        return term(effect).skip(self.data)
-
-
-def grid_values(effect: str) -> list[float | None]:
-    """Values of the nonlinear parameter searched for ``effect`` (``[None]`` if it has none)."""
-    return term(effect).grid_values()

@@ -25,13 +25,14 @@ import numpy as np
 
 from tcbench.diagnose.select.design import Model
 from tcbench.diagnose.select.evidence import Evidence, not_significant
+from tcbench.diagnose.select.score import Scorer
 from tcbench.diagnose.select.significance import SignificanceTest
 from tcbench.diagnose.settings import DEFAULTS, DetectorSettings
 from tcbench.diagnose.signals import DiagnosisData
 from tcbench.diagnose.terms import Search, open_term, terms
 
 
-def proposals(scorer: Any, model: Model, detectors: DetectorSettings = DEFAULTS.detectors
+def proposals(scorer: Scorer, model: Model, detectors: DetectorSettings = DEFAULTS.detectors
               ) -> dict[str, list[tuple[float, ...]]]:
     """Values of each open-world term's nonlinear parameters worth scoring on ``model``'s residual
     (each term's :meth:`~tcbench.diagnose.terms.OpenTerm.propose`, its detectors run as
@@ -57,7 +58,7 @@ class _Screen:
     the residual's squared projection on the new columns made orthogonal to the model's; a
     term's refinement reads the ``detectors`` settings from it."""
 
-    def __init__(self, scorer: Any, model: Model, detectors: DetectorSettings = DEFAULTS.detectors) -> None:
+    def __init__(self, scorer: Scorer, model: Model, detectors: DetectorSettings = DEFAULTS.detectors) -> None:
         self.scorer, self.model, self.detectors = scorer, model, detectors
         self.data: DiagnosisData = scorer.designer.data
         x = scorer.designer.matrix(model)
@@ -78,7 +79,7 @@ class _Screen:
         return float(proj @ proj)
 
 
-def best_open(scorer: Any, model: Model, evidence: dict[str, Any], test: SignificanceTest,
+def best_open(scorer: Scorer, model: Model, evidence: dict[str, Any], test: SignificanceTest,
               threshold: float = DEFAULTS.selection.open_threshold_sigma2,
               detectors: DetectorSettings = DEFAULTS.detectors) -> tuple[str, float, tuple[float, ...]] | None:
     """One round: the open-world term that adds most to ``model`` above ``threshold`` and

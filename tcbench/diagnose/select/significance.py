@@ -30,7 +30,7 @@ Judgement = tuple[bool, float, float, str]  # (passed, robust Wald, surrogate p-
 
 
 class Scorer(Protocol):
-    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.select.attribute._Scorer`)."""
+    """What a test asks of the forward selection's scorer (:class:`tcbench.diagnose.select.score.Scorer`)."""
 
     def removes_most(self, base: Any, model: Any) -> bool: ...
 

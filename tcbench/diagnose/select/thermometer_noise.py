@@ -14,21 +14,11 @@ import numpy as np
 from tcbench.diagnose.select.design import Designer, Model
 from tcbench.diagnose.signals import lagged, smoothed_value
 
-DELTA_C = 0.01  # step of the numerical temperature slope
-
 
 def thermometer_sigma(designer: Designer) -> float:
     """Per-sample noise of the thermometer reading (degC): spread about its smoothed value."""
     d = designer.data
     return float(np.std(d.temp_raw_c - d.temp_c))
-
-
-def output_slope(designer: Designer, model: Model, beta: np.ndarray) -> np.ndarray:
-    """d(output)/dT of the fitted core at the model temperature, per sample (unit per degC)."""
-    temp = designer.temperature(model.lag_tau_s)
-    core = beta[: len(designer.core_names())]
-    up, down = designer.core(temp + DELTA_C) @ core, designer.core(temp - DELTA_C) @ core
-    return (up - down) / (2.0 * DELTA_C)
 
 
 def propagated_noise(designer: Designer, model: Model, beta: np.ndarray, seed: int = 0) -> np.ndarray:
@@ -38,7 +28,7 @@ def propagated_noise(designer: Designer, model: Model, beta: np.ndarray, seed: i
     eps = smoothed_value(d.t_s, rng.standard_normal(d.n) * thermometer_sigma(designer), d.smooth_s)
     if model.lag_tau_s:
         eps = lagged(d.t_s, eps, model.lag_tau_s)
-    return output_slope(designer, model, beta) * eps
+    return designer.temperature_slope(model, beta) * eps
 
 
 def thermometer_variance(designer: Designer, model: Model, beta: np.ndarray, z: np.ndarray) -> float:
@@ -50,7 +40,7 @@ def thermometer_variance(designer: Designer, model: Model, beta: np.ndarray, z: 
     sigma_t = thermometer_sigma(designer)
     if sigma_t == 0:
         return 0.0
-    w = output_slope(designer, model, beta) * z
+    w = designer.temperature_slope(model, beta) * z
     if model.lag_tau_s:
         w = lagged(d.t_s, w[::-1], model.lag_tau_s)[::-1]
     w = smoothed_value(d.t_s, w, d.smooth_s)
