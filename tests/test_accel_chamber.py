@@ -4,6 +4,7 @@ compensated by the baselines, the learners and the diagnosed model, on simulated
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import gymnasium as gym
@@ -99,12 +100,15 @@ def test_recordings_from_files_are_compensated_and_checked(tmp_path: Path) -> No
 
 
 def test_a_sweep_and_its_board_from_the_command_line(tmp_path: Path) -> None:
-    """Baselines and the two polynomials (named apart) in one sweep, then the board with both limits."""
+    """Baselines and the two polynomials (named apart) in one sweep, then the board with both limits.
+    The sweep's runs draw no figures (the board reads none); the single run draws the task's."""
     run = here("run", "-m", "task=accel_chamber", "learner=raw,oracle,oracle_thermometer,poly", "seed=0",
-                  cwd=tmp_path)
+               "tracking.plots=false", cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
     rate = here("run", "task=accel_chamber", "learner=poly", "learner.form=bias_rate", cwd=tmp_path)
     assert rate.returncode == 0 and "poly3_rate-accel_chamber-dev0-s0" in rate.stdout + rate.stderr
+    store = Path(os.environ["MLFLOW_TRACKING_URI"].removeprefix("sqlite:///")).parent
+    assert len(list(store.glob("mlartifacts/*/*/artifacts/fig7_test*.png"))) == 2  # the single run's figures only
     board = here("leaderboard", cwd=tmp_path)
     assert board.returncode == 0, board.stdout + board.stderr
     table = pd.read_csv(tmp_path / "leaderboards" / "accel_chamber-dev0.csv").set_index("method")

@@ -7,11 +7,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import mlflow
+import numpy as np
 import pytest
 
 from tcbench.cli import main
 from tcbench.datasets.concealed import concealed_recording
-from tcbench.sensors.recording import write_recording
+from tcbench.sensors.recording import make_recording, write_recording
 
 SHORT_GYRO = ["sensor=gyro", "protocol=static", "protocol_params.duration_s=600", "metrics=false"]
 
@@ -78,9 +79,15 @@ def test_diagnose_sweeps_a_fleet_and_tracks_each_diagnosis(workdir: Path,
 def test_a_failed_job_of_a_sweep_is_recorded_and_the_sweep_goes_on(workdir: Path,
                                                                   capsys: pytest.CaptureFixture[str]) -> None:
     """A recording the diagnosis cannot use (constant temperature, long enough for a full
-    diagnosis: a shorter one gets the short-record report) fails its job only."""
-    rec, _ = concealed_recording("gyro", None, 5)
-    good = write_recording(rec, workdir / "good.csv")
+    diagnosis: a shorter one gets the short-record report) fails its job only; the good one beside
+    it (40 min warming by 10 degC, read with 0.01 degC of thermometer noise: a full diagnosis at the
+    default smoothing window, of a record small enough to be quick) gets its report."""
+    rng = np.random.default_rng(0)
+    t_s = np.arange(2400.0)
+    temp_c = 20.0 + np.linspace(0.0, 10.0, t_s.size)
+    output = 0.01 * temp_c + rng.normal(0.0, 0.01, t_s.size)
+    good = write_recording(make_recording(t_s, temp_c + rng.normal(0.0, 0.01, t_s.size), np.zeros(t_s.size), output,
+                                          sensor="gyro", sample_rate_hz=1.0, device_id="good"), workdir / "good.csv")
     flat = [a for a in SHORT_GYRO if not a.startswith("protocol_params.duration_s")] + ["protocol_params.duration_s=1500"]
     assert main(["simulate", "name=flat", "out=.", *flat, "tracking.enabled=false"]) == 0
     code = main(["diagnose", "-m", f"recording={good},flat.csv", "out=fleet/${stem:recording}"])

@@ -35,8 +35,9 @@ def test_ifa_bp_job_is_tracked_with_figures(workdir: Path) -> None:
 
 
 def test_baselines_and_leaderboard(workdir: Path) -> None:
+    # no figures per run (the board reads none; test_ifa_bp_job_is_tracked_with_figures draws the task's)
     out = tcbench("run", "-m", "task=msra_fulltemp", "learner=raw,oracle,poly", "optimiser=none",
-                  "tracking.experiment=c", cwd=workdir)
+                  "tracking.experiment=c", "tracking.plots=false", cwd=workdir)
     assert out.returncode == 0, out.stderr
     assert "3 finished, 0 failed" in out.stdout
     lb = tcbench("leaderboard", "--experiment", "c", "--out", "lb", cwd=workdir)

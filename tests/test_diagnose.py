@@ -128,8 +128,7 @@ def test_cli_bad_recordings(tmp_path: Path, capsys: pytest.CaptureFixture[str], 
 
 
 def test_cli_unknown_effect_in_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    rec, _ = concealed_recording("gyro", None, 5)
-    path = write_recording(rec, tmp_path / "rec.csv")
+    path = _flat(tmp_path, 1.0, 10.0)  # a record the diagnosis takes (1 h warming by 10 degC): the model is refused
     model = tmp_path / "model.yaml"
     model.write_text("tcbench_model: 1\nsensor: gyro\ncore: {kind: polynomial, centre_c: 20, half_range_c: 10, "
                      "bias: [0.0], scale_factor: [1.0]}\neffects: {magnetic_creep: {k: 1}}\n")

@@ -42,6 +42,12 @@ def clean() -> tuple[Recording, float]:
     return rec, truth.white_sigma
 
 
+@pytest.fixture(scope="module")
+def clean_diagnosis(clean: tuple[Recording, float]) -> dg.Diagnosis:
+    """The clean record's diagnosis, one for the tests that compare a spiked record with it."""
+    return diagnose(clean[0])
+
+
 def test_bound_is_bonferroni_over_the_record() -> None:
     # 1.1 * Phi^-1(1 - 0.01 / (2 * 86400)) = 1.1 * 5.30; the bound grows with the record's length.
     assert z_bound(86_400) == pytest.approx(5.83, abs=0.01)
@@ -60,11 +66,11 @@ def test_clean_day_of_gaussian_noise_has_no_outlier() -> None:
 
 
 @pytest.mark.parametrize("k", [50.0, 300.0])
-def test_spike_at_the_last_sample(clean: tuple[Recording, float], k: float) -> None:
+def test_spike_at_the_last_sample(clean: tuple[Recording, float], clean_diagnosis: dg.Diagnosis, k: float) -> None:
     rec, sigma = clean
     n = rec.time_s.size
     spiked = _with_spikes(rec, [n - 1], [k * sigma])
-    d_clean, d_spiked = diagnose(rec), diagnose(spiked)
+    d_clean, d_spiked = clean_diagnosis, diagnose(spiked)
     # the clean record: nothing found, nothing excluded
     assert d_clean.effect_ids == []
     assert d_clean.outliers is not None and d_clean.outliers.count == 0
@@ -124,7 +130,8 @@ def test_a_long_run_is_not_a_spike() -> None:
     assert found.size[0] == pytest.approx(40.0, abs=4.0)
 
 
-def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], tmp_path: Path) -> None:
+def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], clean_diagnosis: dg.Diagnosis,
+                                         tmp_path: Path) -> None:
     # model.yaml records the spikes; the simulated model adds each at its sample and nowhere else
     rec, sigma = clean
     i = rec.time_s.size // 3
@@ -143,6 +150,6 @@ def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], tmp_pa
     assert np.flatnonzero(diff).tolist() == [i, rec.time_s.size - 1]
     assert diff[[i, -1]].tolist() == [v for _, v in spec.outliers]
     # and a model without outliers writes no outliers key (older files stay as they were)
-    clean_files = write_report(diagnose(rec), tmp_path / "clean")
+    clean_files = write_report(clean_diagnosis, tmp_path / "clean")
     assert "outliers" not in clean_files["model.yaml"].read_text()
     assert read_model(clean_files["model.yaml"]).outliers == ()

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tcbench.datasets.concealed import concealed_recording
@@ -12,6 +13,7 @@ from tcbench.diagnose.diagnosis import Diagnosis, diagnose
 from tcbench.diagnose.report.markdown import render_markdown
 from tcbench.diagnose.report.plots import plot_allan, plot_evidence, write_plots
 from tcbench.diagnose.result import Confusion
+from tcbench.sensors.recording import make_recording
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -25,8 +27,15 @@ def found() -> Diagnosis:
 
 @pytest.fixture(scope="module")
 def control() -> Diagnosis:
-    """A diagnosis of a recording with nothing missing."""
-    rec, _ = concealed_recording("gyro", None, 5)
+    """A diagnosis of a recording with nothing missing: 2 h at 1 Hz through one temperature cycle,
+    the output a line in temperature plus white noise (the minimal model), read by a thermometer
+    with 0.01 degC of white noise (so the default smoothing window: one diagnosis, not two)."""
+    rng = np.random.default_rng(0)
+    t_s = np.arange(7200.0)
+    temp_c = 20.0 + 10.0 * np.sin(2.0 * np.pi * t_s / t_s[-1])
+    output = 0.01 * temp_c + rng.normal(0.0, 0.01, t_s.size)
+    rec = make_recording(t_s, temp_c + rng.normal(0.0, 0.01, t_s.size), np.zeros(t_s.size), output, sensor="gyro",
+                         sample_rate_hz=1.0, device_id="control")
     return diagnose(rec, name="gyro-control")
 
 
