@@ -122,3 +122,17 @@ def install_here(monkeypatch: pytest.MonkeyPatch, site: Path) -> None:
     for module in [m for m in sys.modules if m.partition(".")[0] in tops]:  # imported anew, so their terms register
         monkeypatch.delitem(sys.modules, module)
     importlib.invalidate_caches()
+    end_reused_workers()  # and, after the test, the ones started with the plugins are not reused
+
+
+def end_reused_workers() -> None:
+    """joblib's reused worker processes (a diagnosis's two smoothing windows run there) end: those
+    started before a test installed plugins have neither the plugins' folder on their path nor
+    their terms (and those started with them have them after it); the next ones start from this
+    process's environment, as in a process started anew."""
+    from joblib.externals.loky import reusable_executor
+
+    with reusable_executor._executor_lock:
+        executor, reusable_executor._executor = reusable_executor._executor, None
+    if executor is not None:
+        executor.shutdown(wait=True)

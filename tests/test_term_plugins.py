@@ -6,13 +6,14 @@ the plugin is the command-line smoke test, and the example's own tests run in a 
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from cli_here import install_here
+from cli_here import end_reused_workers, install_here
 from cli_here import tcbench as here
 from plugin_site import fake_distribution, install_example, tcbench
 
@@ -32,10 +33,11 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.fixture
-def installed(site: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+def installed(site: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
     """The example plugin installed in this process too, for this test."""
     install_here(monkeypatch, site)
-    return site
+    yield site
+    end_reused_workers()
 
 
 def _simulate(coef: float, name: str, cwd: Path) -> Path:
