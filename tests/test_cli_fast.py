@@ -256,3 +256,15 @@ def test_an_unknown_protocol_is_one_line_listing_the_kind_s(sensor: str, known: 
                  "tracking.enabled=false"]) == 2
     assert capsys.readouterr().err.strip() == f"tcbench: error: unknown protocol 'warm' for {sensor}; known: {known}"
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_optimisation_job_and_a_board_load_no_simulator_and_no_signal_library() -> None:
+    """A worker of an optimisation sweep loads its job kind without the compensation stack, and a
+    board's modules load without scipy.signal (about a second of CPU in every such process);
+    scipy.signal comes when a filter runs."""
+    probe = ("import sys; import tcbench.runner.kinds.optimisation, tcbench.runner.config; "
+             "job = sorted(m for m in sys.modules if m.startswith(('tcbench.compensation', 'tcbench.sensors.simulate', "
+             "'scipy.signal'))); import tcbench.leaderboard.make; "
+             "board = sorted(m for m in sys.modules if m.startswith('scipy.signal')); print(job, board)")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[] []"

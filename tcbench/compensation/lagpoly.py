@@ -18,7 +18,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 from tcbench.sensors.recording import Recording
 
@@ -31,6 +30,8 @@ def lagged(t_s: np.ndarray, temp_c: np.ndarray, tau_s: float) -> np.ndarray:
     record's median sample interval."""
     if tau_s <= 0.0:
         return np.asarray(temp_c, dtype=np.float64)
+    from scipy.signal import lfilter  # here: scipy.signal takes about a second to import
+
     dt = float(np.median(np.diff(t_s))) if t_s.size > 1 else 1.0
     a = np.exp(-dt / tau_s)
     return lfilter([1.0 - a], [1.0, -a], temp_c, zi=[a * temp_c[0]])[0]

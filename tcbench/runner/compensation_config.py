@@ -15,6 +15,7 @@ from tcbench.errors import ConfigError
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.params import make_params
+from tcbench.runner.optimiser_config import OptimiserConfig, optimiser_of  # noqa: F401 - shared with optimisation jobs
 from tcbench.tasks import task_kwargs, task_spec
 
 
@@ -42,22 +43,6 @@ class LearnerConfig:
         return None if self.baseline else self.name
 
 
-@dataclass(frozen=True)
-class OptimiserConfig:
-    """A job's optimiser (a compensation job's searches the learner's initial weights, ``none``:
-    a random start; an optimisation job's minimises the task): its name, its parameters and its
-    leaderboard label."""
-
-    name: str
-    params: dict[str, Any]
-    label: Any = None
-
-    @property
-    def searches(self) -> bool:
-        """Whether it searches (``none``, :data:`~tcbench.optimisers.registry.NO_SEARCH`: a random start)."""
-        return self.name != optimisers.NO_SEARCH
-
-
 def learner_of(c: dict[str, Any]) -> LearnerConfig:
     """The job's learner: its config's ``learner``, which the task's defaults list fills when
     the command line gives none (``bp``); a ConfigError when the config has none."""
@@ -69,14 +54,6 @@ def learner_of(c: dict[str, Any]) -> LearnerConfig:
     name = str(params.pop("name", None))
     label = params.pop("label", None)
     return LearnerConfig(name, params, label)
-
-
-def optimiser_of(c: dict[str, Any]) -> OptimiserConfig:
-    """The job's optimiser (its config's ``optimiser``)."""
-    params = dict(c["optimiser"])
-    name = str(params.pop("name", None))
-    label = params.pop("label", None)
-    return OptimiserConfig(name, params, label)
 
 
 def build_env(task: dict[str, Any], learner: LearnerConfig, budget: int) -> Any:

@@ -16,7 +16,6 @@ import gymnasium as gym
 import numpy as np
 from omegaconf import DictConfig
 
-from tcbench.runner.compensation_config import validate_compensation
 from tcbench.errors import ConfigError
 from tcbench.optimisers import registry
 from tcbench.outputs import folder_problem
@@ -80,6 +79,9 @@ def validate(cfg: DictConfig | dict[str, Any]) -> None:
     c = as_dict(cfg)
     spec, task = checked_config(c)
     if spec.is_compensation:
+        # imported here: an optimisation job does not load the compensation stack
+        from tcbench.runner.compensation_config import validate_compensation
+
         validate_compensation(c, task)
         return
     validate_optimisation(c, spec, task)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from tcbench.runner import kept_env
-from tcbench.runner.compensation_config import optimiser_of
+from tcbench.runner.optimiser_config import optimiser_of
 from tcbench.runner.config import checked_config, validate_optimisation
 from tcbench.runner.kinds import JobNames
 from tcbench.runner.prepared_job import PreparedJob, run_settings

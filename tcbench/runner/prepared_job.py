@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tcbench.runner import kept_env
-from tcbench.runner.compensation_config import OptimiserConfig
+from tcbench.runner.optimiser_config import OptimiserConfig
 from tcbench.runner.kinds import JobNames
 from tcbench.tasks import TaskSpec
 

@@ -6,7 +6,6 @@ All amplitudes are in the sensor's output unit (Hz for the MSRA, deg/s for the g
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 from tcbench.sensors.thermal import gauss_markov
 
@@ -46,6 +45,8 @@ def flicker_score_variance(z: np.ndarray, dt_s: float, b: float, tau_max_s: floa
     form ``z' K z = 2 z' s - z' z`` takes one first-order recursion ``s_i = z_i + a s_(i-1)``,
     ``a = exp(-dt_s / tc)`` (O(n) per process). The draws' slow processes, drawn coarser and
     interpolated, have this covariance to within 1 %."""
+    from scipy.signal import lfilter  # here: scipy.signal takes about a second to import
+
     z = np.asarray(z, dtype=float)
     tcs, sigma = flicker_bank(z.size, dt_s, b, tau_max_s)
     zz = float(z @ z)

@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter
 
 
 @dataclass(frozen=True)
@@ -35,6 +34,8 @@ def first_order_lag(x: np.ndarray, dt_s: float, tau_s: float, y0: float | None =
     """Exact discretisation of ``dy/dt = (x - y)/tau`` for a sampled input (zero-order hold)."""
     if tau_s <= 0:
         return np.asarray(x, dtype=float).copy()
+    from scipy.signal import lfilter  # here: scipy.signal takes about a second to import
+
     a = np.exp(-dt_s / tau_s)
     start = float(x[0]) if y0 is None else float(y0)
     y, _ = lfilter([1.0 - a], [1.0, -a], x, zi=[a * start])
@@ -81,6 +82,8 @@ def gauss_markov(
     n: int, dt_s: float, tau_s: float, sigma: float, rng: np.random.Generator
 ) -> np.ndarray:
     """Stationary first-order Gauss-Markov process (std ``sigma``, correlation time ``tau_s``)."""
+    from scipy.signal import lfilter  # here: scipy.signal takes about a second to import
+
     a = np.exp(-dt_s / tau_s)
     drive = rng.standard_normal(n)
     drive *= sigma

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import median_filter
-from scipy.signal import find_peaks
 
 
 @dataclass(frozen=True)
@@ -64,6 +63,8 @@ def temperature_branches(t_s: np.ndarray, temp_c: np.ndarray, min_swing_c: float
         raise ValueError("time must increase strictly and both arrays be finite")
     if not min_swing_c > 0 or not smooth_s >= 0:
         raise ValueError("min_swing_c must be > 0 and smooth_s >= 0")
+    from scipy.signal import find_peaks  # here: scipy.signal takes about a second to import
+
     width = max(1, int(round(smooth_s / float(np.median(np.diff(t))))) | 1)
     smooth = median_filter(temp, size=min(width, temp.size - (temp.size % 2 == 0)), mode="nearest")
     maxima, _ = find_peaks(smooth, prominence=min_swing_c)
