@@ -28,7 +28,8 @@ def test_registered_through_the_entry_point_and_contract() -> None:
     entry = available()["tpe"]
     assert entry.package == "tcbench-peers"
     assert entry.cls.single_objective and not entry.cls.multi_objective
-    assert check_optimizer(entry.cls) >= 2
+    # a prime budget (a last generation cut short) below the default 257: TPE's ask grows with the points told
+    assert check_optimizer(entry.cls, budgets=(60, 97)) >= 2
     assert check_optimizer(entry.cls, dims=(2,), budgets=(60,), params={"population": 7, "constant_liar": True}) == 2
 
 

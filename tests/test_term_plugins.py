@@ -42,7 +42,7 @@ def installed(site: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
 
 def _simulate(coef: float, name: str, cwd: Path) -> Path:
     run = here("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "seed=2",
-                  f"effects.{TERM}.coef_per_c2_per_min2={coef}", OTHERS, "protocol_params.sample_rate_hz=1",
+                  f"effects.{TERM}.coef_per_c2_per_min2={coef}", OTHERS, "protocol_params.sample_rate_hz=0.2",
                   "out=rec", f"name={name}", "metrics=false", "tracking.enabled=false", cwd=cwd)
     assert run.returncode == 0, run.stderr
     return cwd / "rec" / f"{name}.csv"
