@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -13,6 +14,7 @@ import tcbench  # noqa: F401  (registers the envs)
 from tcbench.compensation.data import TaskDataError
 from tcbench.compensation.gyro.tuning import compromise, decode, tuning_window, vmd_objectives
 from tcbench.learners.polynomial import PolynomialModel
+from tcbench.runner import loop, remembered
 from tcbench.runner.loop import _tune, run_compensation, tune_vmd
 from tcbench.sensors.recording import make_recording, write_recording
 from tcbench.sensors.simulate import simulate_recording
@@ -78,7 +80,9 @@ def test_tuning_env_passes_check_env_and_keeps_a_front() -> None:
         env.step(np.array([3.0, 5000.0]))
 
 
-def test_tuning_by_mopso_is_deterministic_and_in_range() -> None:
+def test_tuning_by_mopso_is_deterministic_and_in_range(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "cache").write_text("a file: nothing kept, both tunings computed")
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(tmp_path / "cache"))
     kwargs = {"device_seed": 0, "recordings_seed": 0, "train_files": None} | SMALL
     a = tune_vmd(kwargs, "mopso", 80, 256)
     assert 4 <= a.k <= 12 and 1000 <= a.alpha <= 10000 and a.evaluations == 80
@@ -87,6 +91,47 @@ def test_tuning_by_mopso_is_deterministic_and_in_range() -> None:
     b = tune_vmd(kwargs, "mopso", 80, 256)
     assert (a.k, a.alpha) == (b.k, b.alpha)
     np.testing.assert_array_equal(a.front_f, b.front_f)
+
+
+def test_a_tuning_is_kept_between_processes_and_keyed_by_record_settings_and_code(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(tmp_path / "cache"))
+    kwargs = {"device_seed": 0, "recordings_seed": 1, "train_files": None} | SMALL
+    a = tune_vmd(kwargs, "mopso", 40, 256)
+    _tune.cache_clear()  # as a new process: only the user cache has it
+
+    def untuned(*args: object) -> None:
+        raise AssertionError("tuned again")
+
+    monkeypatch.setattr(loop, "_tune", untuned)
+    b = tune_vmd(kwargs, "mopso", 40, 256)
+    assert (a.k, a.alpha, a.seconds) == (b.k, b.alpha, b.seconds)
+    np.testing.assert_array_equal(a.evaluated_f, b.evaluated_f)
+    with pytest.raises(AssertionError, match="tuned again"):  # another draw
+        tune_vmd({**kwargs, "recordings_seed": 2}, "mopso", 40, 256)
+    with pytest.raises(AssertionError, match="tuned again"):  # another budget
+        tune_vmd(kwargs, "mopso", 41, 256)
+    monkeypatch.setattr(remembered, "source_digest", lambda: "other code")
+    with pytest.raises(AssertionError, match="tuned again"):  # the same with other code
+        tune_vmd(kwargs, "mopso", 40, 256)
+
+
+def test_a_recording_file_s_bytes_are_in_the_key(tmp_path: Path) -> None:
+    f = tmp_path / "train.csv"
+    f.write_text("t,y\n0,1\n")
+    first = remembered.key_of({"budget": 1}, [str(f)])
+    assert remembered.key_of({"budget": 1}, [str(f)]) == first != remembered.key_of({"budget": 2}, [str(f)])
+    f.write_text("t,y\n0,2\n")
+    assert remembered.key_of({"budget": 1}, [str(f)]) != first
+
+
+def test_an_unusable_cache_computes_and_keeps_nothing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "cache").write_text("not a folder")
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(tmp_path / "cache"))
+    calls = []
+    assert remembered.remembered("kind", "k", lambda: calls.append(1) or 7) == 7
+    assert remembered.remembered("kind", "k", lambda: calls.append(1) or 7) == 7
+    assert calls == [1, 1] and (tmp_path / "cache").read_text() == "not a folder"
 
 
 # -- the compensation env ------------------------------------------------------------------------

@@ -19,6 +19,7 @@ import tcbench.tasks as tasks
 from tcbench.metrics.multiobjective import igd
 from tcbench.optimisers import registry
 from tcbench.optimisers.protocol import Optimiser, ProtocolError
+from tcbench.runner.remembered import key_of, remembered
 
 if TYPE_CHECKING:  # the compensation side (simulators, scipy) loads only when a compensation run needs it
     from tcbench.compensation.scoring import Score
@@ -248,9 +249,13 @@ def tune_vmd(env_kwargs: dict[str, Any], tuner: str = "mopso", budget: int = 440
     the multi-objective optimiser ``tuner`` (``tuner_params``, or its defaults) within ``budget``
     evaluations. The tuning's random stream is fixed (seed 0): the tuned
     decomposition is a property of the training record, shared by every restart of the learner
-    (and remembered for the process)."""
-    return _tune(json.dumps(env_kwargs, sort_keys=True), str(tuner), json.dumps(tuner_params or {}, sort_keys=True),
-                 int(budget), int(samples), bool(progress))
+    (remembered for the process, and between processes in the user cache:
+    :mod:`tcbench.runner.remembered`, keyed by the record, these settings and the code)."""
+    args = (json.dumps(env_kwargs, sort_keys=True), str(tuner), json.dumps(tuner_params or {}, sort_keys=True),
+            int(budget), int(samples))
+    key = key_of({"env": args[0], "tuner": args[1], "params": args[2], "budget": args[3], "samples": args[4]},
+                 list(env_kwargs.get("train_files") or ()))
+    return remembered("vmd-tuning", key, lambda: _tune(*args, bool(progress)))
 
 
 @dataclass
