@@ -114,6 +114,12 @@ def test_a_tuning_is_kept_between_processes_and_keyed_by_record_settings_and_cod
     monkeypatch.setattr(remembered, "source_digest", lambda: "other code")
     with pytest.raises(AssertionError, match="tuned again"):  # the same with other code
         tune_vmd(kwargs, "mopso", 40, 256)
+    monkeypatch.setattr(loop, "_tune", _tune)
+    kept = tmp_path / "cache" / "vmd-tuning"
+    assert len(list(kept.glob("*.pkl"))) == 1
+    # a plugin's tuner (nsga2 from tcbench-peers): its code is not in the key, so nothing is kept
+    tune_vmd(kwargs, "nsga2", 40, 256, tuner_params={"population": 20})
+    assert len(list(kept.glob("*.pkl"))) == 1
 
 
 def test_a_recording_file_s_bytes_are_in_the_key(tmp_path: Path) -> None:
