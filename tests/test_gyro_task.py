@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -138,6 +139,18 @@ def test_an_unusable_cache_computes_and_keeps_nothing(tmp_path: Path, monkeypatc
     assert remembered.remembered("kind", "k", lambda: calls.append(1) or 7) == 7
     assert remembered.remembered("kind", "k", lambda: calls.append(1) or 7) == 7
     assert calls == [1, 1] and (tmp_path / "cache").read_text() == "not a folder"
+
+
+def test_a_full_disk_keeps_no_half_written_result(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("TCBENCH_CACHE_DIR", str(tmp_path / "cache"))
+
+    def full(value: object, f: Any, protocol: int) -> None:
+        f.write(b"half")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(remembered.pickle, "dump", full)
+    assert remembered.remembered("kind", "k", lambda: 7) == 7
+    assert list((tmp_path / "cache" / "kind").iterdir()) == []
 
 
 # -- the compensation env ------------------------------------------------------------------------

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcbench.sensors.recording import Recording
+from tcbench.sensors.thermal import first_order_lag
 
 TAUS_S = np.concatenate(([0.0], np.geomspace(30.0, 3000.0, 21)))  # 0: no lag
 DEGREES = (1, 2, 3)
@@ -30,11 +31,8 @@ def lagged(t_s: np.ndarray, temp_c: np.ndarray, tau_s: float) -> np.ndarray:
     record's median sample interval."""
     if tau_s <= 0.0:
         return np.asarray(temp_c, dtype=np.float64)
-    from scipy.signal import lfilter  # here: scipy.signal takes about a second to import
-
     dt = float(np.median(np.diff(t_s))) if t_s.size > 1 else 1.0
-    a = np.exp(-dt / tau_s)
-    return lfilter([1.0 - a], [1.0, -a], temp_c, zi=[a * temp_c[0]])[0]
+    return first_order_lag(temp_c, dt, tau_s)
 
 
 @dataclass(frozen=True)

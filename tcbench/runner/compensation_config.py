@@ -15,7 +15,7 @@ from tcbench.errors import ConfigError
 from tcbench.learners import registry as learners
 from tcbench.optimisers import registry as optimisers
 from tcbench.params import make_params
-from tcbench.runner.optimiser_config import OptimiserConfig, optimiser_of  # noqa: F401 - shared with optimisation jobs
+from tcbench.runner.optimiser_config import OptimiserConfig, optimiser_of
 from tcbench.tasks import task_kwargs, task_spec
 
 

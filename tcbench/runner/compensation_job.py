@@ -18,7 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from tcbench.runner import kept_env
-from tcbench.runner.compensation_config import LearnerConfig, learner_of, optimiser_of, validate_compensation
+from tcbench.runner.compensation_config import LearnerConfig, learner_of, validate_compensation
+from tcbench.runner.optimiser_config import optimiser_of
 from tcbench.runner.config import checked_config
 from tcbench.runner.kinds import JobNames
 from tcbench.runner.prepared_job import PreparedJob, run_settings

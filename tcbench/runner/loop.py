@@ -252,13 +252,15 @@ def tune_vmd(env_kwargs: dict[str, Any], tuner: str = "mopso", budget: int = 440
     (remembered for the process, and between processes in the user cache when the tuner is one of
     tcbench's own: :mod:`tcbench.runner.remembered`, keyed by the record, these settings and the code;
     a plugin's code is not in the key, so a plugin tuner tunes in every process)."""
-    args = (json.dumps(env_kwargs, sort_keys=True), str(tuner), json.dumps(tuner_params or {}, sort_keys=True),
-            int(budget), int(samples))
+    inputs = {"env": json.dumps(env_kwargs, sort_keys=True), "tuner": str(tuner),
+              "params": json.dumps(tuner_params or {}, sort_keys=True), "budget": int(budget), "samples": int(samples)}
+
+    def tune() -> VMDTuning:
+        return _tune(*inputs.values(), bool(progress))
+
     if registry.available()[str(tuner)].package != "tcbench":
-        return _tune(*args, bool(progress))
-    key = key_of({"env": args[0], "tuner": args[1], "params": args[2], "budget": args[3], "samples": args[4]},
-                 list(env_kwargs.get("train_files") or ()))
-    return remembered("vmd-tuning", key, lambda: _tune(*args, bool(progress)))
+        return tune()
+    return remembered("vmd-tuning", key_of(inputs, list(env_kwargs.get("train_files") or ())), tune)
 
 
 @dataclass

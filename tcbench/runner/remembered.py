@@ -13,6 +13,7 @@ compute it; neither sees half a file); a cache that cannot be used computes with
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -66,12 +67,14 @@ def remembered(kind: str, key: str, compute: Callable[[], T]) -> T:
     except (OSError, pickle.UnpicklingError, EOFError, AttributeError) as exc:  # unreadable: computed anew
         log.info("%s: %s not read (%s); computing", kind, path, exc)
     value = compute()
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}")
         with tmp.open("wb") as f:
             pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL)
         os.replace(tmp, path)
     except OSError as exc:
         log.info("%s: not kept (%s)", kind, exc)
+        with contextlib.suppress(OSError):  # a full disk leaves no half-written file behind
+            tmp.unlink(missing_ok=True)
     return value
