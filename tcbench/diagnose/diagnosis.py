@@ -155,9 +155,10 @@ def diagnose(
         return _diagnose(rec, fitted, glitch, sensor, declared or {}, name, settings, min_duration_s)
     # the two diagnoses are independent: one per core (same results as in turn, in about half the time);
     # in turn in a sweep's worker (a daemon process, which joblib refuses to start workers from)
-    tried = Parallel(n_jobs=1 if multiprocessing.current_process().daemon else 2)(delayed(_diagnose)(rec, s, glitch, sensor, declared or {}, name, settings,
-                                                  min_duration_s)
-                               for s in (fitted, smoothing(rec, default_s, settings)))
+    workers = 1 if multiprocessing.current_process().daemon else 2
+    tried = Parallel(n_jobs=workers)(delayed(_diagnose)(rec, s, glitch, sensor, declared or {}, name, settings,
+                                                        min_duration_s)
+                                     for s in (fitted, smoothing(rec, default_s, settings)))
     # the default window is a model choice like a term: it must pay the open-world gain threshold
     sse = [d.final.rmse_heldout ** 2 * d.noise.samples for d in tried]
     gain = (sse[0] - sse[1]) / tried[0].noise.white_sigma ** 2
