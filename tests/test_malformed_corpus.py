@@ -72,13 +72,18 @@ def test_metrics_and_diagnose_do_not_overwrite_their_inputs(workdir: Path,
 
 # -- point 2: names stay inside out= --------------------------------------------------------------
 @pytest.mark.parametrize("name", ["{tmp}/x/ESCAPE", "../escape", "", "''", ".", "..", "a\\b", "a/b", "nul\0x"])
-def test_names_stay_inside_out(workdir: Path, capsys: pytest.CaptureFixture[str], name: str) -> None:
-    name = name.format(tmp=workdir.parent)
-    log_csv(workdir / "log.csv")
-    outside = snapshot(workdir.parent)
-    refused(capsys, workdir, [*SIM, f"name={name}", "out=o"], "name=")
-    refused(capsys, workdir, [*IMPORT, "csv=log.csv", f"name={name}", "out=o"], "name=")
-    assert snapshot(workdir.parent) == outside
+def test_names_stay_inside_out(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                               capsys: pytest.CaptureFixture[str], name: str) -> None:
+    work = tmp_path / "work"  # its parent holds this test's files alone (the escapes land there)
+    work.mkdir()
+    monkeypatch.chdir(work)
+    monkeypatch.delenv("MLFLOW_TRACKING_URI", raising=False)
+    name = name.format(tmp=tmp_path)
+    log_csv(work / "log.csv")
+    outside = snapshot(tmp_path)
+    refused(capsys, work, [*SIM, f"name={name}", "out=o"], "name=")
+    refused(capsys, work, [*IMPORT, "csv=log.csv", f"name={name}", "out=o"], "name=")
+    assert snapshot(tmp_path) == outside
 
 
 # -- point 8: a full disk --------------------------------------------------------------------------

@@ -19,6 +19,8 @@ import mlflow
 import pytest
 from cli_here import tcbench as here
 
+from tcbench.tracking.template import create_store
+
 
 def tcbench(*args: str, cwd: Path, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
     full = {**os.environ, **(env or {})}
@@ -73,12 +75,16 @@ def tracking_server(tmp_path: Path):
     port = _free_port()
     log = (tmp_path / "server.log").open("w")
     # one server worker: the parallel jobs are its clients, served concurrently; it starts in about half the
-    # time two take (12.6 s against 22.2 s to answer /health on two busy cores)
+    # time two take (12.6 s against 22.2 s to answer /health on two busy cores). Its store is a copy of the
+    # migrated empty one (no migrations at start), and it starts no job runner (MLflow's seven huey consumers,
+    # which tcbench does not use)
+    assert create_store(tmp_path / "server.db")
     proc = subprocess.Popen(
         [sys.executable, "-m", "mlflow", "server", "--host", "127.0.0.1", "--port", str(port),
          "--backend-store-uri", f"sqlite:///{tmp_path / 'server.db'}",
          "--artifacts-destination", str(tmp_path / "artifacts"), "--workers", "1"],
         stdout=log, stderr=subprocess.STDOUT, cwd=tmp_path,
+        env={**os.environ, "MLFLOW_SERVER_ENABLE_JOB_EXECUTION": "false"},
     )
     url = f"http://127.0.0.1:{port}"
     try:
