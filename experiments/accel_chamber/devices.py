@@ -1,7 +1,8 @@
 """The accelerometer chamber task across devices: from the per-device boards ``tcbench leaderboard``
 wrote (``<board dir>/accel_chamber-dev<N>.csv``), one table of every method's median drift per
-device, its ratio to the thermometer-limited oracle, the best method that is not a limit, and the
-device's drawn lag and hysteresis (what decides which method wins).
+device, its ratio to the thermometer-limited oracle, the best method that is not a limit (and the rows
+the board's paired test ties with it), and the device's drawn lag and hysteresis (what decides which
+method wins).
 
 Usage: python experiments/accel_chamber/devices.py --boards DIR (run.sh calls it); writes
 ``DIR/devices.md``, ``DIR/devices.csv`` and ``DIR/devices.png``.
@@ -44,12 +45,28 @@ def device_table(boards: Path) -> pd.DataFrame:
         best = drift[methods].idxmin()
         row["best"] = best
         row["best_x_thermo"] = board.loc[best, "x_thermo"]
+        row["tied_with_best"] = ", ".join(tied(board, best))
         rows.append(row)
     return pd.DataFrame(rows)
 
 
+def tied(board: pd.DataFrame, best: str, alpha: float = 0.05) -> list[str]:
+    """The methods ranked right after ``best`` that the board's paired test does not tell from the
+    row above them (``p_vs_next`` >= ``alpha``: Wilcoxon signed-rank over the draws), down to the
+    first that it does or to a limit."""
+    ranked = board.sort_values("rank")
+    names = list(ranked.index)
+    out = []
+    for above, below in zip(names[names.index(best):], names[names.index(best) + 1:]):
+        p = ranked.loc[above, "p_vs_next"]
+        if below in LIMITS or pd.isna(p) or p < alpha:
+            break
+        out.append(below)
+    return out
+
+
 def plot(table: pd.DataFrame, path: Path) -> None:
-    ratios = [c for c in table.columns if c.startswith("x_")]
+    ratios = [c for c in table.columns if c.startswith("x_") and table[c].notna().all()]  # on every device
     fig, ax = plt.subplots(figsize=(8, 4))
     for c in ratios:
         ax.plot(table["device"], table[c], marker="o", label=c[2:])
@@ -76,7 +93,9 @@ def main() -> None:
     plot(table, args.boards / "devices.png")
     text = ["# accel_chamber across devices", "",
             "Median drift of each method over the thermometer-limited oracle's (x_*, 1 = the limit), per simulated "
-            "device; lag_s and hysteresis_mg are the device's drawn thermal lag and half loop. Source: the boards "
+            "device; lag_s and hysteresis_mg are the device's drawn thermal lag and half loop; best = the lowest "
+            "median drift that is not a limit, tied_with_best = the rows below it the board's paired test (p_vs_next "
+            ">= 0.05, Wilcoxon signed-rank over the draws) does not tell from the row above. Source: the boards "
             "beside this file (`bash experiments/accel_chamber/run.sh`).", "",
             markdown_table(table.round(3)), "", "![ratios per device](devices.png)", ""]
     (args.boards / "devices.md").write_text("\n".join(text))

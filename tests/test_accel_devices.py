@@ -1,0 +1,34 @@
+"""experiments/accel_chamber/devices.py: the best method per device and the rows the board's paired
+test ties with it."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+spec = importlib.util.spec_from_file_location("accel_devices", ROOT / "experiments/accel_chamber/devices.py")
+devices = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(devices)
+
+
+def board(rows: list[tuple[str, float]]) -> pd.DataFrame:
+    """A board of (method, p_vs_next) rows in rank order."""
+    return pd.DataFrame({"rank": range(1, len(rows) + 1), "method": [m for m, _ in rows],
+                         "p_vs_next": [p for _, p in rows]}).set_index("method")
+
+
+def test_ties_follow_the_paired_test_down_to_the_first_difference() -> None:
+    b = board([("oracle", 1e-9), ("oracle_thermometer", 1e-9), ("diagnosed", 0.98), ("poly3_rate", 0.3),
+               ("lagpoly", 0.01), ("poly3", np.nan)])
+    assert devices.tied(b, "diagnosed") == ["poly3_rate", "lagpoly"]
+    assert devices.tied(b, "lagpoly") == []
+
+
+def test_no_tie_across_a_limit_or_a_missing_test() -> None:
+    b = board([("poly3_rate", 0.5), ("oracle_thermometer", 0.5), ("poly3", 0.9)])
+    assert devices.tied(b, "poly3_rate") == []
+    assert devices.tied(board([("lagpoly", np.nan), ("poly3", 0.9)]), "lagpoly") == []
