@@ -42,4 +42,4 @@ tcbench run -m task=accel_chamber task.split=new_device,new_profile,replay learn
 rm -rf "$out" && mkdir -p "$out"
 tcbench leaderboard --experiment accel-chamber --sweep "$sweep" --out "$out" overwrite=true
 python "$here/devices.py" --boards "$out"
-python "$here/pairs.py"  # the paired tests README.md quotes
+python "$here/pairs.py" --sweep "$sweep"  # the paired tests README.md quotes
