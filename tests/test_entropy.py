@@ -7,8 +7,19 @@ import pytest
 
 from tcbench.signal.entropy import fuzzy_entropy, permutation_entropy, sample_entropy
 
-antropy = pytest.importorskip("antropy")
-EntropyHub = pytest.importorskip("EntropyHub")
+# The peer libraries are imported by the tests that compare with them, on one worker: antropy compiles
+# its numba functions on import (about 12 CPU-s), which every worker would pay at collection.
+pytestmark = pytest.mark.xdist_group("entropy-peers")
+
+
+@pytest.fixture(scope="module")
+def antropy():  # type: ignore[no-untyped-def]
+    return pytest.importorskip("antropy")
+
+
+@pytest.fixture(scope="module")
+def EntropyHub():  # type: ignore[no-untyped-def]  # noqa: N802 - the library's own name
+    return pytest.importorskip("EntropyHub")
 
 TOL = 1e-9
 
@@ -30,13 +41,13 @@ SIGNALS = _signals()
 
 @pytest.mark.parametrize("name", sorted(SIGNALS))
 @pytest.mark.parametrize("m", [1, 2, 3])
-def test_sample_entropy_matches_antropy(name, m):
+def test_sample_entropy_matches_antropy(name, m, antropy):
     x = SIGNALS[name]
     expected = antropy.sample_entropy(x, order=m, metric="chebyshev")
     assert abs(sample_entropy(x, m=m) - expected) <= TOL
 
 
-def test_sample_entropy_matches_antropy_kdtree_path():
+def test_sample_entropy_matches_antropy_kdtree_path(antropy):
     # antropy switches from its numba loop to a KD-tree at 5000 samples.
     x = np.random.default_rng(5).standard_normal(5200)
     assert abs(sample_entropy(x) - antropy.sample_entropy(x, order=2)) <= TOL
@@ -44,20 +55,20 @@ def test_sample_entropy_matches_antropy_kdtree_path():
 
 @pytest.mark.parametrize("name", sorted(SIGNALS))
 @pytest.mark.parametrize(("m", "delay"), [(3, 1), (4, 1), (5, 2), (6, 3), (3, 4)])
-def test_permutation_entropy_matches_antropy(name, m, delay):
+def test_permutation_entropy_matches_antropy(name, m, delay, antropy):
     x = SIGNALS[name]
     expected = antropy.perm_entropy(x, order=m, delay=delay, normalize=True)
     assert abs(permutation_entropy(x, m=m, delay=delay) - expected) <= TOL
 
 
-def test_permutation_entropy_ties_match_stable_argsort():
+def test_permutation_entropy_ties_match_stable_argsort(antropy):
     x = np.random.default_rng(3).integers(0, 3, 800).astype(float)  # many ties
     for m in (3, 4, 5):
         expected = antropy.perm_entropy(x, order=m, normalize=True)
         assert abs(permutation_entropy(x, m=m) - expected) <= TOL
 
 
-def test_permutation_entropy_unnormalised_is_in_nats():
+def test_permutation_entropy_unnormalised_is_in_nats(antropy):
     x = SIGNALS["white"]
     bits = antropy.perm_entropy(x, order=4, normalize=False)
     assert abs(permutation_entropy(x, m=4, normalize=False) - bits * np.log(2)) <= TOL
@@ -65,13 +76,13 @@ def test_permutation_entropy_unnormalised_is_in_nats():
 
 @pytest.mark.parametrize("name", sorted(SIGNALS))
 @pytest.mark.parametrize("m", [1, 2, 3])
-def test_fuzzy_entropy_matches_entropyhub(name, m):
+def test_fuzzy_entropy_matches_entropyhub(name, m, EntropyHub):
     x = SIGNALS[name][:700]  # EntropyHub holds an N x N matrix
     fuzz, _, _ = EntropyHub.FuzzEn(x, m=m, tau=1, r=(0.2 * np.std(x), 2), Fx="default")
     assert abs(fuzzy_entropy(x, m=m) - fuzz[m - 1]) <= TOL
 
 
-def test_fuzzy_entropy_r_and_exponent_match_entropyhub():
+def test_fuzzy_entropy_r_and_exponent_match_entropyhub(EntropyHub):
     x = SIGNALS["walk"][:600]
     fuzz, _, _ = EntropyHub.FuzzEn(x, m=2, tau=1, r=(0.15 * np.std(x), 3), Fx="default")
     assert abs(fuzzy_entropy(x, m=2, r=0.15, n=3) - fuzz[1]) <= TOL
