@@ -70,3 +70,17 @@ def test_the_user_s_own_sweep_dir_and_logging_win(workdir: Path, capsys: pytest.
     captured = capsys.readouterr()
     assert (workdir / "mine" / "multirun.yaml").is_file() and not (workdir / "cal" / "multirun").exists()
     assert "[HYDRA] Launching 1 jobs" in captured.out
+
+
+def test_a_failed_job_is_not_counted_against_the_next_command(workdir: Path,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """main() run twice in one process: the first command's failed job is not the sweep's after it."""
+    from tcbench.tracking import store as tracking
+
+    uri = f"sqlite:///{workdir / 'mlflow.db'}"
+    tracking.prepare_store(uri, "calibrations")
+    assert main(["leaderboard", "experiments=[calibrations,diagnosis]", f"tracking.uri={uri}", "out=lb"]) != 0
+    _gyro(workdir / "a.csv", 1)
+    assert main(["calibrate", "-m", "recording=a.csv", "out=cal/${stem:recording}", "methods=[raw]",
+                 "tracking.enabled=false"]) == 0
+    assert "failed" not in capsys.readouterr().out.split("calibrate a.csv")[-1]

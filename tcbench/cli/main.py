@@ -78,6 +78,9 @@ def _app_command(command: str, argv: list[str]) -> int:
     if words.sweeps and spec.runs_here:
         return _in_turn(command, list(words.overrides))
     if words.sweeps:
+        from tcbench.runner.job import FAILURES
+
+        FAILURES.clear()  # this command's jobs only (main() may run again in one process)
         checked = _run_sweep(["-m", *words.overrides], spec.config)
         assert checked is not None
         if not checked.tracking_enabled:
