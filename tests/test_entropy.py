@@ -7,19 +7,10 @@ import pytest
 
 from tcbench.signal.entropy import fuzzy_entropy, permutation_entropy, sample_entropy
 
-# The peer libraries are imported by the tests that compare with them, on one worker: antropy compiles
-# its numba functions on import (about 12 CPU-s), which every worker would pay at collection.
-pytestmark = pytest.mark.xdist_group("entropy-peers")
+# The peer libraries are imported inside the tests that compare with them, each in one test (on one
+# worker): antropy compiles its numba functions on import (about 12 CPU-s), which every worker would
+# pay at collection, and EntropyHub takes about 3 s.
 
-
-@pytest.fixture(scope="module")
-def antropy():  # type: ignore[no-untyped-def]
-    return pytest.importorskip("antropy")
-
-
-@pytest.fixture(scope="module")
-def EntropyHub():  # type: ignore[no-untyped-def]  # noqa: N802 - the library's own name
-    return pytest.importorskip("EntropyHub")
 
 TOL = 1e-9
 
@@ -39,55 +30,47 @@ def _signals() -> dict[str, np.ndarray]:
 SIGNALS = _signals()
 
 
-@pytest.mark.parametrize("name", sorted(SIGNALS))
-@pytest.mark.parametrize("m", [1, 2, 3])
-def test_sample_entropy_matches_antropy(name, m, antropy):
-    x = SIGNALS[name]
-    expected = antropy.sample_entropy(x, order=m, metric="chebyshev")
-    assert abs(sample_entropy(x, m=m) - expected) <= TOL
+def test_sample_and_permutation_entropy_match_antropy() -> None:
+    """Every signal at orders 1-3 (sample) and five (order, delay) pairs (permutation), the KD-tree
+    path antropy takes from 5000 samples, ties broken as a stable argsort, and nats unnormalised."""
+    antropy = pytest.importorskip("antropy")
+    wrong = []
+    for name, x in sorted(SIGNALS.items()):
+        for m in (1, 2, 3):
+            if abs(sample_entropy(x, m=m) - antropy.sample_entropy(x, order=m, metric="chebyshev")) > TOL:
+                wrong.append(f"sample {name} m={m}")
+        for m, delay in ((3, 1), (4, 1), (5, 2), (6, 3), (3, 4)):
+            expected = antropy.perm_entropy(x, order=m, delay=delay, normalize=True)
+            if abs(permutation_entropy(x, m=m, delay=delay) - expected) > TOL:
+                wrong.append(f"permutation {name} m={m} delay={delay}")
+    x = np.random.default_rng(5).standard_normal(5200)  # antropy's KD-tree path
+    if abs(sample_entropy(x) - antropy.sample_entropy(x, order=2)) > TOL:
+        wrong.append("sample, KD-tree path")
+    ties = np.random.default_rng(3).integers(0, 3, 800).astype(float)
+    wrong += [f"permutation ties m={m}" for m in (3, 4, 5)
+              if abs(permutation_entropy(ties, m=m) - antropy.perm_entropy(ties, order=m, normalize=True)) > TOL]
+    bits = antropy.perm_entropy(SIGNALS["white"], order=4, normalize=False)
+    if abs(permutation_entropy(SIGNALS["white"], m=4, normalize=False) - bits * np.log(2)) > TOL:
+        wrong.append("permutation unnormalised (nats)")
+    assert wrong == []
 
 
-def test_sample_entropy_matches_antropy_kdtree_path(antropy):
-    # antropy switches from its numba loop to a KD-tree at 5000 samples.
-    x = np.random.default_rng(5).standard_normal(5200)
-    assert abs(sample_entropy(x) - antropy.sample_entropy(x, order=2)) <= TOL
-
-
-@pytest.mark.parametrize("name", sorted(SIGNALS))
-@pytest.mark.parametrize(("m", "delay"), [(3, 1), (4, 1), (5, 2), (6, 3), (3, 4)])
-def test_permutation_entropy_matches_antropy(name, m, delay, antropy):
-    x = SIGNALS[name]
-    expected = antropy.perm_entropy(x, order=m, delay=delay, normalize=True)
-    assert abs(permutation_entropy(x, m=m, delay=delay) - expected) <= TOL
-
-
-def test_permutation_entropy_ties_match_stable_argsort(antropy):
-    x = np.random.default_rng(3).integers(0, 3, 800).astype(float)  # many ties
-    for m in (3, 4, 5):
-        expected = antropy.perm_entropy(x, order=m, normalize=True)
-        assert abs(permutation_entropy(x, m=m) - expected) <= TOL
-
-
-def test_permutation_entropy_unnormalised_is_in_nats(antropy):
-    x = SIGNALS["white"]
-    bits = antropy.perm_entropy(x, order=4, normalize=False)
-    assert abs(permutation_entropy(x, m=4, normalize=False) - bits * np.log(2)) <= TOL
-
-
-@pytest.mark.parametrize("name", sorted(SIGNALS))
-@pytest.mark.parametrize("m", [1, 2, 3])
-def test_fuzzy_entropy_matches_entropyhub(name, m, EntropyHub):
-    x = SIGNALS[name][:700]  # EntropyHub holds an N x N matrix
-    fuzz, _, _ = EntropyHub.FuzzEn(x, m=m, tau=1, r=(0.2 * np.std(x), 2), Fx="default")
-    assert abs(fuzzy_entropy(x, m=m) - fuzz[m - 1]) <= TOL
-
-
-def test_fuzzy_entropy_r_and_exponent_match_entropyhub(EntropyHub):
+def test_fuzzy_entropy_matches_entropyhub() -> None:
+    """Every signal at orders 1-3 with r = 0.2 sigma, n = 2; then other r and exponents."""
+    EntropyHub = pytest.importorskip("EntropyHub")  # noqa: N806 - the library's own name
+    wrong = []
+    for name, signal in sorted(SIGNALS.items()):
+        x = signal[:700]  # EntropyHub holds an N x N matrix
+        for m in (1, 2, 3):
+            fuzz, _, _ = EntropyHub.FuzzEn(x, m=m, tau=1, r=(0.2 * np.std(x), 2), Fx="default")
+            if abs(fuzzy_entropy(x, m=m) - fuzz[m - 1]) > TOL:
+                wrong.append(f"{name} m={m}")
     x = SIGNALS["walk"][:600]
-    fuzz, _, _ = EntropyHub.FuzzEn(x, m=2, tau=1, r=(0.15 * np.std(x), 3), Fx="default")
-    assert abs(fuzzy_entropy(x, m=2, r=0.15, n=3) - fuzz[1]) <= TOL
-    fuzz, _, _ = EntropyHub.FuzzEn(x, m=2, tau=1, r=(0.3 * np.std(x), 1), Fx="default")
-    assert abs(fuzzy_entropy(x, m=2, r=0.3, n=1) - fuzz[1]) <= TOL
+    for r, n in ((0.15, 3), (0.3, 1)):
+        fuzz, _, _ = EntropyHub.FuzzEn(x, m=2, tau=1, r=(r * np.std(x), n), Fx="default")
+        if abs(fuzzy_entropy(x, m=2, r=r, n=n) - fuzz[1]) > TOL:
+            wrong.append(f"walk r={r} n={n}")
+    assert wrong == []
 
 
 def test_sine_is_more_regular_than_white_noise():
