@@ -45,14 +45,16 @@ def test_single_objective_optimiser_refused_on_mo_task() -> None:
         validate(job("ifa", 0) | {"optimiser": {"name": "ifa", "population": 10}})
 
 
-def test_mo_leaderboard_columns_and_front(workdir: Path) -> None:
+def test_mo_leaderboard_columns_and_front(workdir: Path, capfd: pytest.CaptureFixture[str]) -> None:
     for seed in range(2):
         assert run_job(job("mopso", seed)) is not None
     runs = leaderboard.load_runs(tracking.client(), ["mo"])
     (board,) = leaderboard.boards(runs)
     assert list(board.table.columns) == leaderboard.MO_COLUMNS
     assert board.table.loc[0, "median_hv"] > 0 and board.table.loc[0, "median_igd"] > 0
+    capfd.readouterr()
     paths = leaderboard.write(board, workdir / "lb", tracking.client(), "test")
+    assert "Downloading artifacts" not in capfd.readouterr().err  # the front is read without a progress bar
     assert paths["front"].stat().st_size > 5000
     assert "![front]" in paths["md"].read_text()
     assert pd.read_csv(paths["csv"])["seeds"].tolist() == [2]
