@@ -26,6 +26,17 @@ def test_every_quoted_number_of_every_page_is_its_board_s() -> None:
     assert not stale, "\n".join(stale)
 
 
+def test_no_quoted_number_follows_a_digit_group() -> None:
+    """A number written with a space between its thousands ("1 780") and quoted bare keeps its first
+    group when rewritten: "1 1.78e+03" read as its board's 1.78e+03 and showed a stray 1."""
+    import re
+
+    split = re.compile(r"\d [^\s<>\[\](]+<!-- [^>]*\.csv ")
+    found = [f"{page.relative_to(ROOT)}: {m.group(0)}" for page in PAGES
+             for m in split.finditer(page.read_text(encoding="utf-8"))]
+    assert not found, "\n".join(found)
+
+
 def test_every_table_of_every_page_is_its_board_s() -> None:
     found = [t for page in PAGES for t in tables(page)]
     assert sum(t.page == REAL_IMU for t in found) == 3
