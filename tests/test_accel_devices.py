@@ -32,3 +32,21 @@ def test_no_tie_across_a_limit_or_a_missing_test() -> None:
     b = board([("poly3_rate", 0.5), ("oracle_thermometer", 0.5), ("poly3", 0.9)])
     assert devices.tied(b, "poly3_rate") == []
     assert devices.tied(board([("lagpoly", np.nan), ("poly3", 0.9)]), "lagpoly") == []
+
+
+pairs_spec = importlib.util.spec_from_file_location("accel_pairs", ROOT / "experiments/accel_chamber/pairs.py")
+pairs = importlib.util.module_from_spec(pairs_spec)
+pairs_spec.loader.exec_module(pairs)
+
+
+def test_pairs_compare_draw_by_draw_as_the_board() -> None:
+    """Two rows paired on their draws: the count below, and the board's p-value (none under 6 pairs)."""
+    rng = np.random.default_rng(0)
+    base = rng.uniform(100, 200, 10)
+    runs = pd.DataFrame({"task": "accel_chamber-dev3", "method": ["a"] * 10 + ["b"] * 10,
+                         "draw": list(range(10)) * 2, "seed": list(range(10)) * 2,
+                         "drift_ug": np.concatenate([base, base * 1.1])})
+    line = pairs.compare(runs, 3, "a", "b")
+    assert line.startswith("device 3: a below b on 10 of 10 draws, Wilcoxon p = 0.002"), line
+    assert pairs.compare(runs[runs["draw"] < 5], 3, "a", "b").endswith("p = nan")
+    assert pairs.compare(runs, 3, "a", "c") == "device 3: no runs of c"

@@ -12,10 +12,14 @@ import argparse
 import os
 from pathlib import Path
 
-import mlflow
 import numpy as np
 import pandas as pd
-from scipy.stats import wilcoxon
+
+from tcbench.leaderboard.compensation import load_runs
+from tcbench.leaderboard.files import one_run_per_job
+from tcbench.leaderboard.paired import draw_column, pairing_index
+from tcbench.stats import paired_p_value
+from tcbench.tracking import store as tracking
 
 HERE = Path(__file__).resolve().parent
 QUOTED = ["0:poly3_rate:IFA-BP-gd", "0:IFA-BP-gd:random-BP-gd", "0:memoriser:poly3",
@@ -24,28 +28,27 @@ QUOTED = ["0:poly3_rate:IFA-BP-gd", "0:IFA-BP-gd:random-BP-gd", "0:memoriser:pol
 
 
 def drifts(sweep: str, uri: str) -> pd.DataFrame:
-    """drift_ug of every finished next_run run of the sweep: device task, method, draw."""
-    client = mlflow.MlflowClient(uri)
-    exp = client.get_experiment_by_name("accel-chamber")
-    if exp is None:
-        raise SystemExit(f"no experiment accel-chamber in {uri}: run experiments/accel_chamber/run.sh first")
-    runs = client.search_runs([exp.experiment_id], f"tags.`tcbench.sweep_id` = '{sweep}' and "
-                              "attributes.status = 'FINISHED'", max_results=50_000)
-    rows = [{"task": r.data.tags["tcbench.task"], "method": r.data.tags["tcbench.method"],
-             "draw": r.data.tags.get("tcbench.draw"), "drift_ug": r.data.metrics.get("drift_ug")}
-            for r in runs if r.data.tags.get("tcbench.split", "next_run") == "next_run"]
-    return pd.DataFrame(rows).dropna()
+    """The finished next_run runs of the sweep (:func:`tcbench.leaderboard.compensation.load_runs`),
+    one per job as the boards keep them (a repeated job's latest), each with its draw."""
+    runs = load_runs(tracking.client(uri), ["accel-chamber"], sweep)
+    if runs.empty:
+        raise SystemExit(f"no runs of sweep {sweep} in {uri}: run experiments/accel_chamber/run.sh first")
+    runs = one_run_per_job(runs[(runs["status"] == "FINISHED") & (runs["split"] == "next_run")]).copy()
+    runs["draw"] = draw_column(runs)
+    return runs
 
 
-def compare(table: pd.DataFrame, device: int, a: str, b: str) -> str:
-    runs = table[table["task"] == f"accel_chamber-dev{device}"].pivot_table(
-        index="draw", columns="method", values="drift_ug", aggfunc="last")
-    if a not in runs or b not in runs:
-        return f"device {device}: no runs of {a if a not in runs else b}"
-    both = runs[[a, b]].dropna()
-    x, y = both[a].to_numpy(), both[b].to_numpy()
-    p = wilcoxon(x, y).pvalue if len(both) >= 6 else float("nan")
-    return f"device {device}: {a} below {b} on {int(np.sum(x < y))} of {len(both)} draws, Wilcoxon p = {p:.2g}"
+def compare(runs: pd.DataFrame, device: int, a: str, b: str) -> str:
+    """Row ``a`` against row ``b`` on one device, paired as the board pairs ``p_vs_next``."""
+    on = runs[runs["task"] == f"accel_chamber-dev{device}"]
+    x, y = (on[on["method"] == m] for m in (a, b))
+    if x.empty or y.empty:
+        return f"device {device}: no runs of {a if x.empty else b}"
+    xs, ys = (pd.Series(r["drift_ug"].to_numpy(float), index=pairing_index(r)) for r in (x, y))
+    both = pd.concat([xs, ys], axis=1, join="inner").dropna()
+    below = int(np.sum(both.iloc[:, 0] < both.iloc[:, 1]))
+    return (f"device {device}: {a} below {b} on {below} of {len(both)} draws, "
+            f"Wilcoxon p = {paired_p_value(xs, ys):.2g}")
 
 
 def main() -> None:
@@ -54,10 +57,10 @@ def main() -> None:
     parser.add_argument("pairs", nargs="*", default=QUOTED, help="DEVICE:A:B")
     args = parser.parse_args()
     uri = os.environ.get("MLFLOW_TRACKING_URI", f"sqlite:///{HERE / 'mlflow.db'}")
-    table = drifts(args.sweep, uri)
+    runs = drifts(args.sweep, uri)
     for pair in args.pairs:
         device, a, b = pair.split(":")
-        print(compare(table, int(device), a, b))
+        print(compare(runs, int(device), a, b))
 
 
 if __name__ == "__main__":
