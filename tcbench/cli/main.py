@@ -78,9 +78,6 @@ def _app_command(command: str, argv: list[str]) -> int:
     if words.sweeps and spec.runs_here:
         return _in_turn(command, list(words.overrides))
     if words.sweeps:
-        from tcbench.runner.job import FAILURES
-
-        FAILURES.clear()  # this command's jobs only (main() may run again in one process)
         checked = _run_sweep(["-m", *words.overrides], spec.config)
         assert checked is not None
         if not checked.tracking_enabled:
@@ -164,6 +161,9 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
 
     from tcbench.cli.app import hydra_app, plan, sweep_dir, with_overrides
     from tcbench.errors import ConfigError
+    from tcbench.runner.job import FAILURES
+
+    FAILURES.clear()  # this sweep's failed jobs only (main() may run again in one process)
 
     info = asks_info(args)
     if not info and not any(a.startswith("tracking.sweep_id=") for a in args):
@@ -312,7 +312,6 @@ def cmd_run(args: list[str]) -> int:
         return 0
     from tcbench.runner.job import FAILURES
 
-    FAILURES.clear()  # this command's jobs only
     checked = _run_sweep(args)
     if checked is None:
         return 1 if FAILURES else 0
