@@ -1,4 +1,4 @@
-"""Sweeps beyond one process: Hydra's joblib and submitit launchers, and a shared MLflow
+"""Sweeps beyond one process: Hydra's joblib and submitit launchers (submitit's in the slow suite), and a shared MLflow
 tracking server on 127.0.0.1 taking parallel jobs without losing or mixing runs. Each runs as
 ``python -m tcbench`` (the launchers' smoke tests: their worker processes keep the folder and
 environment they were started with, which a test process would share between tests), on two
@@ -56,6 +56,7 @@ def test_joblib_launcher_parallel_jobs(workdir: Path) -> None:
                {(o, s) for o in ("fa", "ifa") for s in range(2)})
 
 
+@pytest.mark.slow  # an optional launcher; the joblib one above and tcbench's own (test_launcher*.py) stay in CI
 def test_submitit_local_launcher(workdir: Path) -> None:
     out = tcbench("run", "-m", "hydra/launcher=submitit_local", "task=sphere", "optimiser=fa,ifa",
                   "seed=0", "budget=100", "tracking.experiment=sub", cwd=workdir)

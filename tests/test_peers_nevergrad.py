@@ -48,13 +48,10 @@ def test_contract_leaves_no_helper_thread(name: str) -> None:
 # 0.023, 0.091, 9.3e-4, 0.11, 2.9e-4), nevergrad's DE driven directly does the same (median
 # 0.01 with num_workers 30); random search's median is ~2.
 def test_ngopt_solves_the_shifted_5d_sphere() -> None:
-    """Two seeds, each to 1e-6 (measured below 1e-16 on every seed of 0-9)."""
-    gaps = []
-    for seed in (0, 1):
-        r = run_optimisation({"name": "sphere", "dim": 5, "shift": True}, {"name": "ngopt"}, 2000, seed)
-        assert r.evaluations == 2000
-        gaps.append(r.best_f - r.f_opt)
-    assert all(g < 1e-6 for g in gaps), gaps
+    """To 1e-6 (measured below 1e-16 on every seed of 0-9; one of them here)."""
+    r = run_optimisation({"name": "sphere", "dim": 5, "shift": True}, {"name": "ngopt"}, 2000, 0)
+    assert r.evaluations == 2000
+    assert r.best_f - r.f_opt < 1e-6, r.best_f - r.f_opt
 
 
 def test_ng_de_makes_robust_progress_on_the_shifted_5d_sphere() -> None:
