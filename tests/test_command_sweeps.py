@@ -4,6 +4,7 @@ each job is one MLflow run (a diagnosis with the effects it found, its RMSEs and
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import mlflow
@@ -53,6 +54,7 @@ def test_one_job_takes_any_path_literally(workdir: Path) -> None:
     assert (workdir / "run (1),[a]" / "gyro-static-dev0-seed0.csv").is_file()
 
 
+@pytest.mark.slow  # two full diagnoses; the sweep and its tracking stay in CI in the next test
 def test_diagnose_sweeps_a_fleet_and_tracks_each_diagnosis(workdir: Path,
                                                           capsys: pytest.CaptureFixture[str]) -> None:
     paths = []
@@ -94,3 +96,14 @@ def test_a_failed_job_of_a_sweep_is_recorded_and_the_sweep_goes_on(workdir: Path
     out = capsys.readouterr().out
     assert code == 1 and "1 finished, 1 failed" in out and "FAILED" in out
     assert (workdir / "fleet" / "good" / "report.md").is_file() and not (workdir / "fleet" / "flat").exists()
+    # each job is its own run: the finished one a diagnosis with what its report found, the other FAILED
+    runs = {Path(r.data.tags["tcbench.task"]).stem: r for r in _runs(workdir, "diagnoses")}
+    assert runs["flat"].info.status == "FAILED"
+    done = runs["good"]
+    found = [e["id"] for e in json.loads((workdir / "fleet" / "good" / "report.json").read_text())["effects"]]
+    assert done.info.status == "FINISHED" and done.data.tags["tcbench.kind"] == "diagnosis"
+    assert done.data.tags["tcbench.effects_found"] == (",".join(found) or "none")
+    assert done.data.metrics["rmse_heldout_after"] <= done.data.metrics["rmse_heldout_before"]
+    client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
+    assert {"report.md", "report.json", "model.yaml", "config.yaml"} <= {
+        a.path for a in client.list_artifacts(done.info.run_id)}

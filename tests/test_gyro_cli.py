@@ -1,4 +1,5 @@
-"""The gyro track from the command line: a tuned BAS-Elman job, baselines, a leaderboard, bad input."""
+"""The gyro track from the command line: a tuned BAS-Elman job, baselines and their leaderboard (in the slow
+suite), bad input."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import subprocess
 from pathlib import Path
 
 import mlflow
+import pytest
 from cli_here import tcbench as here
 
 SMALL = ["task.sample_rate_hz=1", "task.hold_s=1800"]
@@ -32,6 +34,8 @@ def test_tuned_bas_elman_job_is_tracked_with_the_seed_figures(workdir: Path) -> 
             "fig19_allan_test1.png", "allan_test1.csv", "vmd_front.csv", "scores.json"} <= names
 
 
+@pytest.mark.slow  # six gyro oven runs end to end; the notes are tested in-process (test_compensation_notes.py),
+# a gyro run from the command line by the test above, a compensation board by test_compensation_cli.py
 def test_baselines_make_a_leaderboard_with_the_bandwidth(workdir: Path) -> None:
     out = tcbench("run", "-m", "task=gyro_driftnoise", *SMALL, "task.k=6", "task.alpha=2000",
                   "task.decomposition=none", "task.denoise=none,wavelet", "learner=raw,oracle,poly",
