@@ -82,3 +82,15 @@ def test_the_budget_verdict_divides_each_restart_by_raw_on_its_own_draw() -> Non
     budget = tables.budget_table(pd.DataFrame(rows), "IFA-BP-gd-3000ep").set_index("epochs")
     assert budget.loc[3000, "median_gain_sf"] == "80× (yes)" and budget.loc[3000, "best_gain_bias"] == "200× (no)"
     assert budget.loc[1000, "median_gain_sf"] == "40× (no)"
+
+
+def test_a_tier_sweep_replaces_its_own_claims_and_keeps_the_other_tiers(tmp_path) -> None:
+    path = tmp_path / "claims.csv"
+    pd.DataFrame({"tier": ["next_run", "next_run", "replay"], "claim": ["a", "b", "c"],
+                  "reproduced": ["no", "yes", "yes"]}).to_csv(path, index=False)
+    new = pd.DataFrame({"claim": ["a", "d"], "reproduced": ["yes", "no"], "tier": ["new_device", "replay"]})
+    merged = tables.merged_claims(path, new)
+    assert list(merged.columns[:1]) == ["tier"]
+    assert merged[["tier", "claim", "reproduced"]].values.tolist() == [
+        ["next_run", "a", "no"], ["next_run", "b", "yes"], ["new_device", "a", "yes"], ["replay", "d", "no"]]
+    assert tables.tier_file("next_run") == "tables.md" and tables.tier_file("new_device") == "tables.new_device.md"

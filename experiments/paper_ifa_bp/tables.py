@@ -1,8 +1,12 @@
 """Seed 000 Tables 1-2 side by side with tcbench's reproduction, and the verdict on each claim.
 
-Reads the finished compensation runs of one sweep from MLflow and writes ``tables.md`` (and
-``claims.csv``) into ``--out``. "best of N" is the run with the smallest training RMSE, the
-paper's selection; medians and bootstrap intervals are over the N restarts (seeds).
+Reads the finished compensation runs of the sweeps given from MLflow and writes, into ``--out``, one
+table file per tier its runs hold (``tables.md`` for the default tier, ``next_run``, with the budget
+study and the figures; ``tables.<tier>.md`` for the others) and ``claims.csv``, where the claims of
+the tiers the runs hold replace those rows and the rows of every other tier are kept: the tiers can
+be run, and their tables regenerated, one sweep at a time. "best of N" is the run with the smallest
+training RMSE, the paper's selection; medians and bootstrap intervals are over the N restarts
+(seeds), restart i on draw i.
 
     python experiments/paper_ifa_bp/tables.py --experiment paper-ifa-bp --sweep ID --out DIR
 """
@@ -47,6 +51,8 @@ TIER_NOTE = {
     "new_device": "Tier `new_device`: the training runs are of some units of the population, the test runs of "
                   "others: whether a calibration of one unit carries to the lot.",
 }
+TIERS = (DEFAULT_TIER, "new_device", "new_profile", "replay")  # the order of the claims and the tables
+assert set(TIERS) == set(SPLITS), "TIERS must list every split tier"
 TITLE = {"msra_zerobias": "Table 1: zero-bias stability at room temperature (µg)",
          "msra_fulltemp": "Table 2: variation of scale factor (ppm) and bias (µg) over -40…60 °C"}
 
@@ -250,7 +256,7 @@ def main() -> None:
     runs = one_run_per_job(runs)
     runs = runs[runs["status"] == "FINISHED"]
     ns.out.mkdir(parents=True, exist_ok=True)
-    lines = ["# Seed 000 Tables 1–2: the paper against tcbench", "",
+    intro = ["# Seed 000 Tables 1–2: the paper against tcbench", "",
              f"Source: MLflow experiment {ns.experiment}. Restart i of every row, the limits included, trains and "
              "tests on draw i of the runs. The best-of-N tables show each learner and baseline as the paper selects "
              "it, the restart with the smallest training RMSE, with its gain against raw on that restart's own draw "
@@ -258,32 +264,72 @@ def main() -> None:
              "of their per-draw gains; raw as its median over the draws. poly3_runs = the cubic fitted within runs (a "
              "constant per power-on). halfg_error_ug (not in the paper) = RMS error of the compensated output when "
              "the 0 g samples are moved to ±0.5 g, accelerations no training sample had (µg).", ""]
+    tiers = [t for t in TIERS if t in set(runs["split"])]
+    if not tiers:
+        raise SystemExit(f"tables.py: no finished run in experiment {ns.experiment!r} (sweeps {ns.sweep or 'all'})")
+    pages: dict[str, list[str]] = {}
     frames = []
-    tiers = [t for t in (DEFAULT_TIER, *SPLITS) if t in set(runs["split"])]
-    tiers = list(dict.fromkeys(tiers))  # the default tier first
     for tier in tiers:
         at = runs[runs["split"] == tier]
-        learners = sorted(m for m in at["method"].unique() if m not in BASELINES)
-        lines += [f"# Tier: {tier}", "", TIER_NOTE.get(tier, ""), ""]
-        for task in ("msra_zerobias", "msra_fulltemp"):
-            g = at[at["task_name"] == task]
-            if g.empty:
-                continue
-            best_cols = [m for m in (*learners, *BASELINES[1:]) if m.startswith(("FA-", "IFA-")) or m in BASELINES]
-            lines += [f"## {TITLE[task]} ({tier})", "", "Best of N by training RMSE (the paper's selection):", "",
-                      markdown_table(best_table(g, task, best_cols)), "",
-                      "Over all restarts: median [95 % bootstrap CI] of the mean over the two test datasets:", "",
-                      markdown_table(median_table(g, task, [*learners, *BASELINES[1:], "raw"])), ""]
-        for training in ns.training:
-            for reading in ("", "_YANG"):  # as printed, and the readings that reproduce seed 000's Fig. 3
-                fa, ifa = f"FA{reading}-BP-{training}", f"IFA{reading}-BP-{training}"
-                if (at["method"] == ifa).any():
-                    frames.append(claims(at, fa, ifa).assign(tier=tier))
-    verdict = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["tier"])
-    verdict = verdict[["tier", *[c for c in verdict.columns if c != "tier"]]]
-    lines += ["# The paper's claims per tier (gains against raw, worst of the two test datasets)", "",
-              markdown_table(verdict), ""]
-    runs = runs[runs["split"] == DEFAULT_TIER]  # the budget study and the figures: the default tier
+        verdict = tier_claims(at, ns.training).assign(tier=tier)
+        frames.append(verdict)
+        pages[tier] = [*intro, *tier_tables(at, tier), "# The paper's claims (gains against raw, worst of the two "
+                       "test datasets)", "", markdown_table(verdict.drop(columns="tier")), ""]
+    verdict = merged_claims(ns.out / "claims.csv", pd.concat(frames, ignore_index=True))
+    if DEFAULT_TIER in pages:
+        pages[DEFAULT_TIER] += budget_and_figures(client, runs[runs["split"] == DEFAULT_TIER], ns.out)
+    for tier, lines in pages.items():
+        (ns.out / tier_file(tier)).write_text("\n".join(lines))
+        print("\n".join(lines))
+    verdict.to_csv(ns.out / "claims.csv", index=False)
+
+
+def tier_file(tier: str) -> str:
+    """The tables' file of ``tier``: ``tables.md`` for the default tier, ``tables.<tier>.md`` else."""
+    return "tables.md" if tier == DEFAULT_TIER else f"tables.{tier}.md"
+
+
+def tier_tables(at: pd.DataFrame, tier: str) -> list[str]:
+    """The best-of-N and median tables of both tasks on one tier (markdown lines)."""
+    learners = sorted(m for m in at["method"].unique() if m not in BASELINES)
+    lines = [f"# Tier: {tier}", "", TIER_NOTE.get(tier, ""), ""]
+    for task in ("msra_zerobias", "msra_fulltemp"):
+        g = at[at["task_name"] == task]
+        if g.empty:
+            continue
+        best_cols = [m for m in (*learners, *BASELINES[1:]) if m.startswith(("FA-", "IFA-")) or m in BASELINES]
+        lines += [f"## {TITLE[task]} ({tier})", "", "Best of N by training RMSE (the paper's selection):", "",
+                  markdown_table(best_table(g, task, best_cols)), "",
+                  "Over all restarts: median [95 % bootstrap CI] of the mean over the two test datasets:", "",
+                  markdown_table(median_table(g, task, [*learners, *BASELINES[1:], "raw"])), ""]
+    return lines
+
+
+def tier_claims(at: pd.DataFrame, trainings: list[str]) -> pd.DataFrame:
+    """The paper's claims judged on one tier's runs, for each BP training and both readings of FA/IFA."""
+    frames = []
+    for training in trainings:
+        for reading in ("", "_YANG"):  # as printed, and the readings that reproduce seed 000's Fig. 3
+            fa, ifa = f"FA{reading}-BP-{training}", f"IFA{reading}-BP-{training}"
+            if (at["method"] == ifa).any():
+                frames.append(claims(at, fa, ifa))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["claim"])
+
+
+def merged_claims(path: Path, new: pd.DataFrame) -> pd.DataFrame:
+    """``new`` (with its ``tier`` column first) in place of the rows of its tiers in the claims file at
+    ``path``, whose rows of other tiers are kept; tiers in the order of :data:`TIERS`."""
+    new = new[["tier", *[c for c in new.columns if c != "tier"]]]
+    if path.exists():
+        old = pd.read_csv(path, dtype=str, keep_default_na=False)
+        new = pd.concat([old[~old["tier"].isin(set(new["tier"]))], new.astype(str)], ignore_index=True)
+    order = {t: i for i, t in enumerate(TIERS)}
+    return new.sort_values("tier", key=lambda t: t.map(order), kind="stable").reset_index(drop=True)
+
+
+def budget_and_figures(client, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
+    """The gradient-descent budget tables (``gd_budget.csv``) and the figures of the default tier."""
+    lines: list[str] = []
     for method in sorted(m for m in runs["method"].unique() if re.fullmatch(r"IFA-BP-gd-\d+ep", str(m))):
         budget = budget_table(runs, method)
         if budget.empty:
@@ -295,15 +341,12 @@ def main() -> None:
                   "median restart; (yes) where the paper's >70× (scale factor) or ~1000× (bias, counted from 300×) "
                   "is reached. halfg = the ±0.5 g probe error (µg; the oracle's is about 2).", "",
                   markdown_table(budget), ""]
-        budget.to_csv(ns.out / "gd_budget.csv", index=False)
-    (ns.out / "tables.md").write_text("\n".join(lines))
-    verdict.to_csv(ns.out / "claims.csv", index=False)
-    figures = copy_figures(client, runs, ns.out)
+        budget.to_csv(out / "gd_budget.csv", index=False)
+    figures = copy_figures(client, runs, out)
     if figures:
         lines += ["## Figures (seed 000 Figs. 7-10, test dataset 1 of the runs above)", ""]
         lines += [f"![{f}]({f})" for f in figures] + [""]
-        (ns.out / "tables.md").write_text("\n".join(lines))
-    print("\n".join(lines))
+    return lines
 
 
 if __name__ == "__main__":
