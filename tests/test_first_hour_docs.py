@@ -82,3 +82,23 @@ def test_a_board_says_why_p_vs_next_is_a_dash_and_labels_its_plot(tmp_path: Path
     assert "| – |" in text and "p_vs_next is – where the row and the next share fewer than 6 pairs" in text
     assert "6" in column_label("p_vs_next") and "–" in column_label("p_vs_next")
     assert said == ["zero-bias stability from power-on (µg)"]
+
+
+@pytest.mark.parametrize(("split", "title"), [("new_profile", "msra_zerobias-dev0 (new_profile): "),
+                                              ("next_run", "msra_zerobias-dev0: ")])
+def test_a_tier_boards_plot_names_its_tier(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, split: str,
+                                          title: str) -> None:
+    """A tier's plot sits beside the default tier's in the same folder: its title says which it is."""
+    from matplotlib.axes import Axes
+
+    from tcbench.leaderboard import compensation as comp
+
+    matplotlib.use("Agg")
+    runs = pd.concat([_runs("IFA-BP-gd", np.linspace(90.0, 110.0, 6)), _runs("raw", np.full(6, 232.0))],
+                     ignore_index=True)
+    board = comp.CompensationBoard("msra_zerobias-dev0", "roomtemp", comp.summarise(runs, "roomtemp"), runs,
+                                   split=split)
+    said: list[str] = []
+    monkeypatch.setattr(Axes, "set_title", lambda self, label, *a, **k: said.append(label))
+    comp.write(board, tmp_path, "a test")
+    assert len(said) == 1 and said[0].startswith(title)

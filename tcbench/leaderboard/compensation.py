@@ -446,7 +446,8 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
         ax.set_yscale("log")
     what, _, unit = METRIC_LABELS.get(primary, primary).rpartition(", ")
     ax.set_ylabel(f"{what} ({unit})" if what else unit)
-    ax.set_title(f"{board.task}: {what or unit} per restart (line: median)")
+    tier = "" if board.split in ("", DEFAULT_TIER) else f" ({board.split})"
+    ax.set_title(f"{board.task}{tier}: {what or unit} per restart (line: median)")
     ax.grid(True, which="both", axis="y", alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
