@@ -88,9 +88,18 @@ def test_a_tier_sweep_replaces_its_own_claims_and_keeps_the_other_tiers(tmp_path
     path = tmp_path / "claims.csv"
     pd.DataFrame({"tier": ["next_run", "next_run", "replay"], "claim": ["a", "b", "c"],
                   "reproduced": ["no", "yes", "yes"]}).to_csv(path, index=False)
-    new = pd.DataFrame({"claim": ["a", "d"], "reproduced": ["yes", "no"], "tier": ["new_device", "replay"]})
+    new = pd.DataFrame({"claim": ["a", "d"], "reproduced": ["yes", "no"], "tier": ["new_device", "replay"],
+                        "selection": ["x median over 30 restarts", "x best of N by training RMSE"]})
     merged = tables.merged_claims(path, new)
     assert list(merged.columns[:1]) == ["tier"]
     assert merged[["tier", "claim", "reproduced"]].values.tolist() == [
         ["next_run", "a", "no"], ["next_run", "b", "yes"], ["new_device", "a", "yes"], ["replay", "d", "no"]]
     assert tables.tier_file("next_run") == "tables.md" and tables.tier_file("new_device") == "tables.new_device.md"
+
+
+def test_a_claim_row_says_whether_a_test_or_the_papers_pick_judged_it() -> None:
+    verdict = tables.claims(_runs(12.0, 14.0, 0), "FA-BP-gd", "IFA-BP-gd").assign(tier="next_run")
+    rows = tables.merged_claims(Path("/nonexistent/claims.csv"), verdict)
+    picks = rows["reproduced"].str.startswith("a pick")
+    assert picks.any() and (~picks).any()
+    assert (rows.loc[picks, "judged_by"] == "pick").all() and (rows.loc[~picks, "judged_by"] == "test").all()

@@ -324,7 +324,9 @@ def merged_claims(path: Path, new: pd.DataFrame) -> pd.DataFrame:
         old = pd.read_csv(path, dtype=str, keep_default_na=False)
         new = pd.concat([old[~old["tier"].isin(set(new["tier"]))], new.astype(str)], ignore_index=True)
     order = {t: i for i, t in enumerate(TIERS)}
-    return new.sort_values("tier", key=lambda t: t.map(order), kind="stable").reset_index(drop=True)
+    new = new.sort_values("tier", key=lambda t: t.map(order), kind="stable").reset_index(drop=True)
+    # a verdict by a test (the median's interval, a paired Wilcoxon) or the paper's pick (one run, not a test)
+    return new.assign(judged_by=np.where(new["selection"].astype(str).str.contains("best of N"), "pick", "test"))
 
 
 def budget_and_figures(client, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
