@@ -103,3 +103,10 @@ def test_a_claim_row_says_whether_a_test_or_the_papers_pick_judged_it() -> None:
     picks = rows["reproduced"].str.startswith("a pick")
     assert picks.any() and (~picks).any()
     assert (rows.loc[picks, "judged_by"] == "pick").all() and (rows.loc[~picks, "judged_by"] == "test").all()
+
+
+def test_a_sweep_of_baselines_alone_leaves_no_claim_of_its_tier(tmp_path) -> None:
+    runs = _runs(12.0, 14.0, 0).assign(method="poly3")
+    verdict = tables.tier_claims(runs, ["gd", "lm"]).assign(tier="new_profile")
+    assert verdict.empty
+    assert tables.merged_claims(tmp_path / "claims.csv", verdict).empty

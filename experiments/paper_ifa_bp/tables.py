@@ -326,7 +326,8 @@ def merged_claims(path: Path, new: pd.DataFrame) -> pd.DataFrame:
     order = {t: i for i, t in enumerate(TIERS)}
     new = new.sort_values("tier", key=lambda t: t.map(order), kind="stable").reset_index(drop=True)
     # a verdict by a test (the median's interval, a paired Wilcoxon) or the paper's pick (one run, not a test)
-    return new.assign(judged_by=np.where(new["selection"].astype(str).str.contains("best of N"), "pick", "test"))
+    selection = new["selection"] if "selection" in new else pd.Series("", index=new.index)
+    return new.assign(judged_by=np.where(selection.astype(str).str.contains("best of N"), "pick", "test"))
 
 
 def budget_and_figures(client, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
