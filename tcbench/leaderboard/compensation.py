@@ -68,9 +68,14 @@ class CompensationBoard:
     split: str = ""  # the tier the simulated test runs were drawn on (tcbench.compensation.data.SPLITS)
 
     @property
+    def named_tier(self) -> str:
+        """The tier a board names (in its file stem and plot title): empty for the default ``next_run``."""
+        return "" if self.split in ("", DEFAULT_TIER) else self.split
+
+    @property
     def stem(self) -> str:
         """File stem: the task, with the tier after it unless it is the default ``next_run``."""
-        return self.task if self.split in ("", DEFAULT_TIER) else f"{self.task}.{self.split}"
+        return f"{self.task}.{self.named_tier}" if self.named_tier else self.task
 
 
 def load_runs(client, experiments: list[str], sweep: str | None = None) -> pd.DataFrame:  # type: ignore[no-untyped-def]
@@ -446,7 +451,7 @@ def _plot(board: CompensationBoard, path: Path) -> Path:
         ax.set_yscale("log")
     what, _, unit = METRIC_LABELS.get(primary, primary).rpartition(", ")
     ax.set_ylabel(f"{what} ({unit})" if what else unit)
-    tier = "" if board.split in ("", DEFAULT_TIER) else f" ({board.split})"
+    tier = f" ({board.named_tier})" if board.named_tier else ""
     ax.set_title(f"{board.task}{tier}: {what or unit} per restart (line: median)")
     ax.grid(True, which="both", axis="y", alpha=0.3)
     fig.tight_layout()
