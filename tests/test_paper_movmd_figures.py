@@ -1,0 +1,68 @@
+"""Seed 001's Fig. 19 claim judged over draws (experiments/paper_movmd_tfpf/figures.py): each
+restart's gain on its own draw, the interval of the median deciding, and one device's section
+rerun without losing the other's."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+spec = importlib.util.spec_from_file_location("fig19", ROOT / "experiments/paper_movmd_tfpf/figures.py")
+assert spec is not None and spec.loader is not None
+fig19 = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(fig19)
+
+METRICS = ("arw_1s_deg_per_sqrt_h", "bias_instability_dph", "drift_dph")
+
+
+def _runs(gain: tuple[float, float], seed: int = 0) -> pd.DataFrame:
+    """raw, the oracle and the paper's method on 30 draws whose raw differs draw to draw; the
+    method's ARW and bias-instability gains on its own draw uniform in ``gain``."""
+    rng = np.random.default_rng(seed)
+    raw = {m: rng.uniform(0.3, 3.0, 30) * scale for m, scale in zip(METRICS, (0.5, 30.0, 45.0), strict=True)}
+    rows = []
+    for d in range(30):
+        g = rng.uniform(*gain)
+        values = {"raw": {m: raw[m][d] for m in METRICS},
+                  "oracle": {m: raw[m][d] * 0.9 for m in METRICS},
+                  fig19.PAPER_METHOD: {"arw_1s_deg_per_sqrt_h": raw["arw_1s_deg_per_sqrt_h"][d] / g,
+                                       "bias_instability_dph": raw["bias_instability_dph"][d] / g,
+                                       "drift_dph": raw["drift_dph"][d] * 0.95}}
+        for method, v in values.items():
+            rows.append({"method": method, "seed": d, "draw_tag": str(d), "params": {}, "status": "FINISHED", "bandwidth_hz": 0.07,
+                         "rms_error_dph": 1.0, **v, **{f"raw_{m}": raw[m][d] for m in METRICS}})
+    return pd.DataFrame(rows)
+
+
+def test_the_gain_is_taken_on_each_draw_not_between_medians() -> None:
+    runs = _runs((4.0, 6.0))
+    table = fig19._table(runs).set_index("method")
+    mine = runs[runs["method"] == fig19.PAPER_METHOD]
+    paired = float(np.median(mine["raw_arw_1s_deg_per_sqrt_h"] / mine["arw_1s_deg_per_sqrt_h"]))
+    between_medians = float(runs.loc[runs["method"] == "raw", "arw_1s_deg_per_sqrt_h"].median()
+                            / mine["arw_1s_deg_per_sqrt_h"].median())
+    assert table.loc[fig19.PAPER_METHOD, "arw_gain"] == paired and 4.0 <= paired <= 6.0
+    assert abs(between_medians - paired) > 0.01  # raw differs draw to draw: the two definitions part
+    assert table.loc[fig19.PAPER_METHOD, "draws"] == 30 and table.loc["raw", "arw_gain"] == 1.0
+    paper = table.loc[f"{fig19.PAPER_METHOD} (seed 001, Fig. 19)"]
+    assert round(paper["arw_gain"]) == 102 and round(paper["bi_gain"]) == 233
+
+
+def test_the_paper_factor_is_judged_by_the_interval() -> None:
+    assert "**not reproduced**" in fig19._verdict(_runs((4.0, 6.0)))[0]
+    assert "**reproduced**" in fig19._verdict(_runs((300.0, 400.0)))[0]
+    spans = fig19._verdict(_runs((60.0, 400.0)))[0]  # the ARW interval straddles ×102
+    assert "not shown either way" in spans and "**not decided**" in spans
+    made_of = fig19._verdict(_runs((4.0, 6.0)))[1]
+    assert "30 draws" not in made_of and "the oracle's on the same draws" in made_of
+
+
+def test_one_device_is_rerun_without_losing_the_other() -> None:
+    old = "# Seed 001\n\nintro\n\n## dev0\n\nold dev0\n\n## dev0-low\n\nlow table\n\n## Tiers: next run\n\nold tiers\n"
+    kept = fig19.kept_sections(old, {"dev0"})
+    assert list(kept) == ["dev0-low"] and "low table" in kept["dev0-low"]
+    assert fig19.kept_sections("", {"dev0"}) == {}
