@@ -116,6 +116,16 @@ def test_a_stale_number_is_found_named_and_rewritten(tmp_path: Path, capsys: pyt
     assert main(["--check", str(page)]) == 0
 
 
+def test_one_cell_of_two_boards_on_one_line_gets_each_board_s_value(tmp_path: Path) -> None:
+    """A replay board and a next_run board quote the same row and column on one table line: each
+    quote is rewritten from its own CSV, not both from whichever was read first."""
+    page = _page(tmp_path, '| 1<!-- replay.csv "oracle | median_ug" --> | 1<!-- board.csv "oracle | median_ug" --> |\n')
+    (tmp_path / "replay.csv").write_text("rank,method,median_ug\n1,oracle,44.1\n")
+    assert rewrite(page) == 2
+    assert page.read_text() == ('| 44.1<!-- replay.csv "oracle | median_ug" --> | '
+                                '5.82<!-- board.csv "oracle | median_ug" --> |\n')
+
+
 @pytest.mark.parametrize(("quote", "says"), [
     ('[1](nowhere.csv "oracle | median_ug")', "no such CSV"),
     ('[1](board.csv "oracle | mean_ug")', "no column 'mean_ug'"),

@@ -209,12 +209,12 @@ def tables(page: Path) -> list[Table]:
 
 def rewrite(page: Path) -> int:
     """Set every quoted number and table of ``page`` to its CSV's; how many changed."""
-    stale = {(q.line, q.row, q.column): q.value for q in quotes(page) if q.stale}
+    stale = {(q.line, q.csv, q.row, q.column): q.value for q in quotes(page) if q.stale}
     lines = page.read_text(encoding="utf-8").splitlines(keepends=True)
 
     def fix(n: int, m: re.Match[str]) -> str:
-        text, _, row, column = _parts(m)
-        value = stale.get((n, row, column))
+        text, path, row, column = _parts(m)
+        value = stale.get((n, (page.parent / path).resolve(), row, column))
         if value is None:
             return m[0]
         return f"[{value}]" + m[0][len(text) + 2:] if m["text"] is not None else value + m[0][len(text):]
