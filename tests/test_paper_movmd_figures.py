@@ -66,3 +66,19 @@ def test_one_device_is_rerun_without_losing_the_other() -> None:
     kept = fig19.kept_sections(old, {"dev0"})
     assert list(kept) == ["dev0-low"] and "low table" in kept["dev0-low"]
     assert fig19.kept_sections("", {"dev0"}) == {}
+
+
+def test_the_gain_interval_is_in_the_table() -> None:
+    table = fig19._table(_runs((4.0, 6.0))).set_index("method")
+    low, high = (float(v) for v in table.loc[fig19.PAPER_METHOD, "ci95_arw_gain"].split("–"))
+    assert 4.0 <= low <= table.loc[fig19.PAPER_METHOD, "arw_gain"] <= high <= 6.0
+    assert table.loc["raw", "ci95_bi_gain"] == "1–1"
+
+
+def test_every_row_is_paired_with_the_paper_s_method_on_drift() -> None:
+    runs = _runs((4.0, 6.0))
+    table = fig19._table(runs).set_index("method")
+    # the paper's drift is 0.95 of raw on every draw, the oracle's 0.9: lower on all 30, and significant
+    assert table.loc["oracle", "draws_lower_than_paper"] == 30 == table.loc["oracle", "draws_paired_with_paper"]
+    assert table.loc["raw", "draws_lower_than_paper"] == 0 and table.loc["raw", "p_drift_vs_paper"] < 1e-5
+    assert table.loc[fig19.PAPER_METHOD, ["p_drift_vs_paper", "draws_paired_with_paper"]].isna().all()

@@ -24,8 +24,8 @@ from tcbench.leaderboard import compensation as board
 from tcbench.compensation.gyro.plots import allan_methods_figure
 from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.compensation.data import DEFAULT_TIER
-from tcbench.leaderboard.paired import draw_column, limit_by_draw, n_draws, paired_ratios
-from tcbench.stats import bootstrap_median_ci
+from tcbench.leaderboard.paired import draw_column, limit_by_draw, n_draws, paired_ratios, pairing_index
+from tcbench.stats import bootstrap_median_ci, paired_p_value
 from tcbench.signal.allan import AllanDeviation
 
 PAPER = {"raw": (0.531076, 32.7364), "MOVMD-TFPF+BAS-elman-adam": (5.22502e-3, 0.140403)}  # Fig. 19
@@ -46,19 +46,35 @@ def _table(runs: pd.DataFrame) -> pd.DataFrame:
         row: dict[str, object] = {"method": method, "runs": len(g), "draws": _draws(g)}
         for c in COLUMNS:
             row[c] = float(g[c].median())
-        row["arw_gain"] = float(_gains(g, "arw_1s_deg_per_sqrt_h").median())
-        row["bi_gain"] = float(_gains(g, "bias_instability_dph").median())
+        for gain, metric in (("arw_gain", "arw_1s_deg_per_sqrt_h"), ("bi_gain", "bias_instability_dph")):
+            per_run = _gains(g, metric).to_numpy(float)
+            row[gain] = float(np.median(per_run))
+            low, high = bootstrap_median_ci(per_run)
+            row[f"ci95_{gain}"] = f"{low:.3g}–{high:.3g}" if not np.isnan(low) else "–"
         rows.append(row)
     raw = next(r for r in rows if r["method"] == "raw")
     for r in rows:  # no per-run raw: the medians' ratio
         if np.isnan(r["arw_gain"]):  # type: ignore[call-overload]
             r["arw_gain"] = raw["arw_1s_deg_per_sqrt_h"] / r["arw_1s_deg_per_sqrt_h"]  # type: ignore[operator]
             r["bi_gain"] = raw["bias_instability_dph"] / r["bias_instability_dph"]  # type: ignore[operator]
+    paper = _drift_by_draw(runs[runs["method"] == PAPER_METHOD])
+    for r in (r for r in rows if r["method"] != PAPER_METHOD):  # the drift against the paper's on the same draws
+        mine = _drift_by_draw(runs[runs["method"] == r["method"]])
+        both = pd.concat([mine, paper], axis=1, join="inner").dropna()
+        r["p_drift_vs_paper"] = paired_p_value(mine, paper)
+        r["draws_lower_than_paper"] = int((both.iloc[:, 0] < both.iloc[:, 1]).sum()) if len(both) else np.nan
+        r["draws_paired_with_paper"] = len(both)
     for method, (arw, bi) in PAPER.items():
         rows.append({"method": f"{method} (seed 001, Fig. 19)", "runs": np.nan, "draws": np.nan,
                      "arw_1s_deg_per_sqrt_h": arw, "bias_instability_dph": bi,
                      "arw_gain": PAPER["raw"][0] / arw, "bi_gain": PAPER["raw"][1] / bi})
     return pd.DataFrame(rows).sort_values("drift_dph", na_position="last")
+
+
+def _drift_by_draw(g: pd.DataFrame) -> pd.Series:
+    """A method's drift per run, indexed by (draw, seed) as the boards pair runs."""
+    g = g.assign(draw=draw_column(g))
+    return pd.Series(g["drift_dph"].to_numpy(float), index=pairing_index(g))
 
 
 def _draws(g: pd.DataFrame) -> int:
@@ -216,21 +232,24 @@ def main() -> None:
     tiers = runs
     runs = runs[runs["split"] == DEFAULT_TIER]  # Fig. 19 on the default tier; the others in the tier table
     args.out.mkdir(parents=True, exist_ok=True)
+    sections = {str(task): _section(client, str(task), g, args.out) for task, g in runs.groupby("task")}
+    path = args.out / "fig19.md"
+    kept = kept_sections(path.read_text() if path.is_file() else "", set(sections))
     lines = [
         "# Seed 001 Fig. 19 beside tcbench", "",
         "Simulated 14 h oven runs of gyro 0 at 10 Hz (one to train, one to test; `bash "
         "experiments/paper_movmd_tfpf/run.sh`): the device as simulated by default (flicker B ≈ 33 °/h, "
-        "experiments/raw-sensors/README.md)" + (", and the same device with 3 °/h of flicker" if runs["task"].nunique() > 1 else "")
-        + ". Medians over restarts (restart i on draw i of the runs); gains are the median over restarts of raw ÷ method on the restart's own test run; ARW = σ(1 s)/60 "
+        "experiments/raw-sensors/README.md)" + (", and the same device with 3 °/h of flicker" if len(sections | kept) > 1 else "")
+        + ". Medians over restarts (restart i on draw i of the runs, unless a section says they shared one draw); "
+        "gains are the median over restarts of raw ÷ method on the restart's own test run; ARW = σ(1 s)/60 "
         "in °/√h (seed 001 prints °/h/√Hz for a value that only fits its bias stability as °/√h, "
         "docs/concepts/physics.md, metrics); bias instability = Allan minimum / 0.664 (°/h); drift = std of the 5-min soak "
         "means (°/h); rms = RMS error against the true rate (°/h); bandwidth = −3 dB frequency of the "
         "whole method, measured by injecting a multi-sine rate into the test run (5 Hz = Nyquist: "
-        "nothing lost). The paper's rows: its raw ÷ its result.", "",
+        "nothing lost); p_drift_vs_paper = Wilcoxon signed-rank p of the drift against the paper's method, paired "
+        "by draw, and draws_lower_than_paper = on how many of the draws_paired_with_paper the row's drift is the "
+        "lower. The paper's rows: its raw ÷ its result.", "",
     ]
-    sections = {str(task): _section(client, str(task), g, args.out) for task, g in runs.groupby("task")}
-    path = args.out / "fig19.md"
-    kept = kept_sections(path.read_text() if path.is_file() else "", set(sections))
     lines += [line for _, body in sorted((sections | kept).items()) for line in body]
     lines += _tier_table(tiers)
     path.write_text("\n".join(lines))
