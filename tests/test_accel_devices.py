@@ -3,16 +3,11 @@ test ties with it."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from script_module import load
 
-ROOT = Path(__file__).resolve().parents[1]
-spec = importlib.util.spec_from_file_location("accel_devices", ROOT / "experiments/accel_chamber/devices.py")
-devices = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(devices)
+devices = load("experiments/accel_chamber/devices.py", "accel_devices")
 
 
 def board(rows: list[tuple[str, float]]) -> pd.DataFrame:
@@ -34,9 +29,7 @@ def test_no_tie_across_a_limit_or_a_missing_test() -> None:
     assert devices.tied(board([("lagpoly", np.nan), ("poly3", 0.9)]), "lagpoly") == []
 
 
-pairs_spec = importlib.util.spec_from_file_location("accel_pairs", ROOT / "experiments/accel_chamber/pairs.py")
-pairs = importlib.util.module_from_spec(pairs_spec)
-pairs_spec.loader.exec_module(pairs)
+pairs = load("experiments/accel_chamber/pairs.py", "accel_pairs")
 
 
 def test_pairs_compare_draw_by_draw_as_the_board() -> None:

@@ -4,17 +4,13 @@ reported but never a verdict."""
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from script_module import load
 
-ROOT = Path(__file__).resolve().parents[1]
-spec = importlib.util.spec_from_file_location("paper_tables", ROOT / "experiments/paper_ifa_bp/tables.py")
-assert spec is not None and spec.loader is not None
-tables = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(tables)
+tables = load("experiments/paper_ifa_bp/tables.py", "paper_tables")
 
 METRICS = ("zb_after_30min_ug", "zb_after_20min_ug", "zb_zero_start_ug")
 

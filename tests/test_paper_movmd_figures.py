@@ -4,17 +4,11 @@ rerun without losing the other's."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
+from script_module import load
 
-ROOT = Path(__file__).resolve().parents[1]
-spec = importlib.util.spec_from_file_location("fig19", ROOT / "experiments/paper_movmd_tfpf/figures.py")
-assert spec is not None and spec.loader is not None
-fig19 = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(fig19)
+fig19 = load("experiments/paper_movmd_tfpf/figures.py", "fig19")
 
 METRICS = ("arw_1s_deg_per_sqrt_h", "bias_instability_dph", "drift_dph")
 
