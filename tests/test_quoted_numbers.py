@@ -143,11 +143,12 @@ def test_a_quote_of_nothing_is_one_line_naming_the_page_and_line(tmp_path: Path,
 
 
 def test_a_site_page_quotes_with_a_comment_and_is_rewritten_alike(tmp_path: Path) -> None:
-    page = _page(tmp_path, 'limit 5.9<!-- board.csv "oracle | median_ug" --> and (8<!-- board.csv "poly3 | runs" -->)\n')
-    assert [(q.text, q.value) for q in quotes(page)] == [("5.9", "5.82"), ("8", "30")]
-    assert rewrite(page) == 2
+    page = _page(tmp_path, 'limit 5.9<!-- board.csv "oracle | median_ug" --> and (8<!-- board.csv "poly3 | runs" -->),'
+                           ' gain ×1<!-- board.csv "poly3 | median_ug" -->\n')
+    assert [(q.text, q.value) for q in quotes(page)] == [("5.9", "5.82"), ("8", "30"), ("1", "39.2")]
+    assert rewrite(page) == 3
     assert page.read_text() == ('limit 5.82<!-- board.csv "oracle | median_ug" --> and '
-                                '(30<!-- board.csv "poly3 | runs" -->)\n')
+                                '(30<!-- board.csv "poly3 | runs" -->), gain ×39.2<!-- board.csv "poly3 | median_ug" -->\n')
 
 
 def test_a_table_is_written_checked_and_rewritten(tmp_path: Path) -> None:
