@@ -8,8 +8,8 @@ The title is ``ROW | COLUMN``: ROW is the value of the CSV's ``method`` column (
 ``key=value & key=value`` for CSVs keyed by several columns; COLUMN is the column. The link's text is
 the cell as a board shows it (three significant digits; an interval column as written). A page of
 the documentation site, whose links must stay inside the site, writes the number followed by the
-same locator in a comment: ``30.1<!-- ../../leaderboards/x.csv "oracle_thermometer | median_bias_ug" -->`` (a ``×`` written before it
-stays outside the quote).
+same locator in a comment: ``30.1<!-- ../../leaderboards/x.csv "oracle_thermometer | median_bias_ug" -->``
+(a ``×`` written before it stays outside the quote).
 
 A page holds a table of a CSV between two markers, each alone on its line,
 ``<!-- table: CSV "ROWS | COLUMNS" -->`` and ``<!-- /table -->``::
