@@ -115,8 +115,9 @@ def _verdict(runs: pd.DataFrame) -> list[str]:
     verdict = "**reproduced**." if arw == bi == "reached" else (
         "**not reproduced** at the paper's size." if "not reached" in (arw, bi) else "**not decided** by these runs.")
     oracle = runs[runs["method"] == "oracle"]
-    limit = {m: limit_by_draw(runs.assign(draw=draw_column(runs)), "oracle", m) for m in (*COLUMNS[:3],)}
-    at = mine.assign(draw=draw_column(mine))
+    drawn = runs.assign(draw=draw_column(runs))
+    limit = {m: limit_by_draw(drawn, "oracle", m) for m in COLUMNS[:3]}
+    at = drawn[drawn["method"] == PAPER_METHOD]
     below = {m: np.median(paired_ratios(at, limit[m], m)) if len(limit[m]) else np.nan for m in limit}
     return [
         f"**Claim (Fig. 19): ARW 0.531 → 5.2e-3 (×{paper_arw:.0f}) and bias stability 32.7 → 0.14 °/h "
