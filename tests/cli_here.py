@@ -6,7 +6,10 @@ what the commands do call :func:`tcbench` here; a few keep a real ``python -m tc
 command-line smoke tests: ``run``, ``run -m`` and ``leaderboard`` in tests/test_cli.py with
 ``diagnose``, ``simulate`` and ``metrics`` in tests/test_simulate.py, ``list`` with plugins in
 tests/test_plugins.py, ``export`` in tests/test_run_c_export.py), and so do the tests of what
-only a process of its own shows (signals, kill -9, memory caps, sweeps racing on one store).
+only a process of its own shows (signals, kill -9, memory caps, sweeps racing on one store): all
+but a worker killed mid-sweep (tests/test_sweep_failures.py) in the slow suite, with in-process
+tests of what they reach in CI (a resume marking a gone process's runs, the memory refusals, the
+checks of a server store).
 """
 
 from __future__ import annotations

@@ -40,13 +40,17 @@ def test_the_registry_names_every_kind() -> None:
         kinds.register(accel)
 
 
-def test_chamber_metrics_recover_the_simulated_device() -> None:
+def test_chamber_metrics_recover_the_simulated_device(tmp_path: Path) -> None:
     """Through a chamber cycle the bias slope, noise density and flicker floor read from the
-    recording are the device's own; heating and cooling open a loop (hysteresis and lag)."""
+    recording are the device's own; heating and cooling open a loop (hysteresis and lag), which
+    the bias-against-temperature plot names."""
     device = unit("accel", 0).model
     rec = simulate_recording("accel", "chamber", 0, 0)
     assert rec.meta.units["output"] == "g" and rec.input.max() == 0.0
-    m = analyse(rec).metrics
+    report = analyse(rec, tmp_path)
+    m = report.metrics
+    assert {p.name for p in report.files.values()} >= {"allan.png", "bias_vs_temperature.png"}
+    assert all(p.stat().st_size > 5000 for p in report.files.values() if p.suffix == ".png")
     white_ug = device.effect("white_noise").params()["density"] * 1e6
     flicker_ug = device.effect("bias_instability").params()["b"] * 1e6
     assert m["bias_temp_slope_ug_per_c"] == pytest.approx(device.b1_mg_per_k * 1e3, rel=0.1)
@@ -209,16 +213,26 @@ def test_a_fourth_kind_is_one_module(tmp_path: Path) -> None:
         kinds.get("beam")
 
 
-def test_the_accelerometer_is_diagnosed_and_calibrated(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """A simulated chamber cycle: ``tcbench diagnose`` writes its model, ``tcbench calibrate`` fitted on the full cooling branch beats the raw output on the other branches, and
-    ``tcbench export`` writes PX4's accelerometer parameters (TC_A*, in m/s^2)."""
+def _chamber_cycle(capsys: pytest.CaptureFixture[str]) -> str:
+    """A simulated chamber cycle of accelerometer 0 written to rec/; its path."""
     code, _, err = run(capsys, "simulate", "sensor=accel", "protocol=chamber", "device_seed=0", "out=rec",
                        "tracking.enabled=false")
     assert code == 0, err
-    path = "rec/accel-chamber-dev0-seed0.csv"
-    code, out, err = run(capsys, "diagnose", f"recording={path}", "out=diag", "tracking.enabled=false")
+    return "rec/accel-chamber-dev0-seed0.csv"
+
+
+@pytest.mark.slow  # a whole diagnosis; the accel chamber board's diagnosed row (tests/test_accel_chamber.py) stays in CI
+def test_the_accelerometer_is_diagnosed(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A simulated chamber cycle: ``tcbench diagnose`` writes its model."""
+    code, out, err = run(capsys, "diagnose", f"recording={_chamber_cycle(capsys)}", "out=diag", "tracking.enabled=false")
     assert code == 0, err
     assert "baseline RMSE held-out" in out and (workdir / "diag" / "model.yaml").is_file()
+
+
+def test_the_accelerometer_is_calibrated_and_exported(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A simulated chamber cycle: ``tcbench calibrate`` fitted on the full cooling branch beats the raw output on
+    the other branches, and ``tcbench export`` writes PX4's accelerometer parameters (TC_A*, in m/s^2)."""
+    path = _chamber_cycle(capsys)
     code, out, err = run(capsys, "calibrate", f"recording={path}", "out=cal", "train_branches=[1]",
                          "methods=[raw,poly3]", "axis=z", "tracking.enabled=false")
     assert code == 0, err

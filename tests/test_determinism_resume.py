@@ -60,6 +60,7 @@ def _finished(db: Path) -> list[int]:
     return [int(v) for (v,) in rows]
 
 
+@pytest.mark.slow  # kill -9 of a sweep's process group; a resume marking a gone process's runs (tests/test_sweep_failures.py) stays in CI
 def test_sweep_killed_and_resumed_runs_every_job_once(workdir: Path) -> None:
     args = [sys.executable, "-m", "tcbench", "run", "-m", "task=sphere", "optimiser=pso", "budget=2000",
             "seed=range(16)", "tracking.sweep_id=killed", "hydra.sweep.dir=multirun/killed"]

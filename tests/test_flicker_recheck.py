@@ -92,3 +92,21 @@ def test_a_20_minute_logging_gap_changes_no_finding(tmp_path: Path) -> None:
     assert "bias_instability" in named[0]
     assert not [e for e in named[0] if e == "aging_drift" or e.startswith("bias_step")]  # no stand-in
     assert both[1].final.rmse_heldout == pytest.approx(both[0].final.rmse_heldout, rel=0.01)
+
+
+def test_flicker_is_not_judged_while_temperature_structure_remains() -> None:
+    """``bias_instability``'s evidence: declared, not tested while the final model's held-out RMSE
+    is above the reference's ratio (an Allan excess it leaves is not flicker), else not identifiable
+    where the screen did not run."""
+    from tcbench.diagnose.screens.flicker import flicker_evidence
+    from tcbench.diagnose.select.reference import Reference
+
+    reference = Reference(rmse_heldout=2.0, rmse_fit=1.9, terms=["T"], alpha=0.0, heldout_residual=np.zeros(3))
+    above = reference.structure_ratio * 2.0 * 1.5
+    declared = flicker_evidence(None, None, True, reference, above, "ug")
+    assert (declared.status, declared.reason) == ("in the model", "declared in the starting model")
+    remains = flicker_evidence(None, None, False, reference, above, "ug")
+    assert remains.status == "not tested" and remains.reason.startswith(
+        f"deterministic temperature structure remains (the reference reaches 2, the final model {above:.4g} ug held out)")
+    gone = flicker_evidence(None, "record too short for an Allan deviation", False, reference, 2.0, "ug")
+    assert (gone.status, gone.reason) == ("not identifiable", "record too short for an Allan deviation")

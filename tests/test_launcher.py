@@ -73,6 +73,7 @@ def test_one_compose_per_group_and_every_job_once(workdir: Path, monkeypatch, la
     assert len(seen) == 6
 
 
+@pytest.mark.slow  # the workers' crash and kill cases on two workers (tests/test_sweep_failures.py) stay in CI
 def test_two_worker_processes_record_every_run_once(workdir: Path) -> None:
     """The launcher's fresh worker processes, started from this process (4 jobs on 2 workers)."""
     out = tcbench("run", "-m", "task=sphere", "task.dim=2", "budget=60", "optimiser=fa", "seed=range(4)",

@@ -1,4 +1,4 @@
-"""Sweeps beyond one process: Hydra's joblib and submitit launchers (submitit's in the slow suite), and a shared MLflow
+"""Sweeps beyond one process: Hydra's joblib and submitit launchers (both in the slow suite), and a shared MLflow
 tracking server on 127.0.0.1 taking parallel jobs without losing or mixing runs. Each runs as
 ``python -m tcbench`` (the launchers' smoke tests: their worker processes keep the folder and
 environment they were started with, which a test process would share between tests), on two
@@ -47,6 +47,7 @@ def check_runs(client: mlflow.MlflowClient, experiment: str, expected: set[tuple
     assert sorted(seen) == sorted(expected)
 
 
+@pytest.mark.slow  # a sweep in a process of its own on Hydra's joblib launcher; tcbench's own launcher (test_launcher*.py) stays in CI
 def test_joblib_launcher_parallel_jobs(workdir: Path) -> None:
     out = tcbench("run", "-m", "hydra/launcher=joblib", "hydra.launcher.n_jobs=2", "task=sphere",
                   "optimiser=fa,ifa", "seed=range(2)", "budget=100", "tracking.experiment=par", cwd=workdir)
@@ -106,6 +107,7 @@ def tracking_server(tmp_path: Path):
         log.close()
 
 
+@pytest.mark.slow  # an MLflow server of its own; the server-store checks (tests/test_tracking_checks.py) stay in CI
 def test_parallel_jobs_against_a_tracking_server(tracking_server: str, tmp_path: Path) -> None:
     work = tmp_path / "work"
     work.mkdir()

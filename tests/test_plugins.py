@@ -29,11 +29,11 @@ def in_here(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
 
 
 def test_example_plugin_on_a_leaderboard(site: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """``tcbench list`` with the plugin on PYTHONPATH in a process of its own; the sweep and the
-    board in this one with the plugin installed here."""
-    listed = tcbench("list", cwd=tmp_path, path=site)
-    assert "de         tcbench_de.de.DifferentialEvolution  (from tcbench-de; single-objective)" in listed.stdout
+    """Listed, swept and on a board, in this process with the plugin installed here (``tcbench
+    list`` with plugins in a process of its own: the broken plugin's test below)."""
     install_here(monkeypatch, site)
+    listed = in_here("list", cwd=tmp_path)
+    assert "de         tcbench_de.de.DifferentialEvolution  (from tcbench-de; single-objective)" in listed.stdout
     run = in_here("run", "-m", "optimiser=de,ifa", "task=sphere", "seed=range(2)", "budget=200",
                   "tracking.experiment=plugins", cwd=tmp_path)
     assert run.returncode == 0, run.stderr

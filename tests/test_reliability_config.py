@@ -153,6 +153,7 @@ def _ctrl_c_default() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
+@pytest.mark.slow  # a sweep in a process of its own, interrupted from outside
 @pytest.mark.skipif(sys.platform != "linux", reason="signals as on Linux")
 def test_ctrl_c_of_a_parallel_sweep_marks_the_workers_runs_killed(tmp_path: Path) -> None:
     """Ctrl-C of a sweep on two workers left the runs the workers held RUNNING for ever."""

@@ -111,15 +111,46 @@ def test_untracked_failures_are_listed_and_the_sweep_goes_on(site: Path, tmp_pat
     assert not (tmp_path / "mlflow.db").exists()
 
 
-def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, tmp_path: Path,
-                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_job_too_big_by_its_estimate_is_refused_before_it_starts(site: Path, tmp_path: Path,
+                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
     """``task.dim=100000000`` grew to 24 GB and was killed by the kernel without a word: a job too
-    big by its optimiser's estimate is refused before it starts, and one that allocates past the
-    budget anyway fails with a MemoryError while the sweep goes on."""
-    env_args = ("run", "task=sphere", "task.dim=100000000", "budget=200")
-    before = tcbench(*env_args, cwd=tmp_path, site=site)
+    big by its optimiser's estimate is refused before it starts, against the free memory or
+    ``$TCBENCH_JOB_MEMORY_MB``, which must be a positive number of megabytes."""
+    args = ("run", "task=sphere", "task.dim=100000000", "budget=200")
+    before = tcbench(*args, cwd=tmp_path, site=site)
     assert before.returncode == 2 and "Traceback" not in before.stderr
     assert "task.dim=100000000: a run of optimiser ifa would need about" in before.stderr
+    assert "one job may use here (free memory, or $TCBENCH_JOB_MEMORY_MB)" in before.stderr
+    monkeypatch.setenv("TCBENCH_JOB_MEMORY_MB", "1.5")
+    small = tcbench("run", "task=sphere", "task.dim=20000", "budget=200", cwd=tmp_path, site=site)
+    assert small.returncode == 2 and "more than the 1.5 MB one job may use here" in small.stderr
+    for bad, words in (("lots", "must be a number of megabytes, got 'lots'"), ("-3", "must be positive, got '-3'")):
+        monkeypatch.setenv("TCBENCH_JOB_MEMORY_MB", bad)
+        out = tcbench(*args, cwd=tmp_path, site=site)
+        assert out.returncode == 2 and f"$TCBENCH_JOB_MEMORY_MB {words}" in out.stderr and "Traceback" not in out.stderr
+    assert not (tmp_path / "mlflow.db").exists()
+
+
+def test_a_memory_error_names_the_budget() -> None:
+    from tcbench.runner.job import FAILURES, failed
+
+    try:
+        failure = failed("big-job", MemoryError())
+    finally:
+        FAILURES.clear()
+    assert failure.error == "MemoryError (more than one job may use here: the memory free when it started, " \
+        "or $TCBENCH_JOB_MEMORY_MB)" and not failure.user
+    try:
+        failure = failed("big-job", MemoryError("Unable to allocate 3 GiB"))
+    finally:
+        FAILURES.clear()
+    assert failure.error.startswith("MemoryError: Unable to allocate 3 GiB (more than one job may use here")
+
+
+@pytest.mark.slow  # a process of its own, capped: tests/test_sweep_failures.py's refusals above stay in CI
+def test_a_job_past_its_memory_is_a_failed_job_not_a_killed_machine(site: Path, tmp_path: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """A job that allocates past the budget fails with a MemoryError while the sweep goes on."""
     monkeypatch.setenv("TCBENCH_JOB_MEMORY_MB", "200")  # a cap on the process of its one job: not this one
     run = in_a_process("run", "-m", "task=sphere", "task.dim=7,2", "optimiser=fa", "optimiser.name=crashy",
                   "seed=0", "budget=60", cwd=tmp_path, site=site)
@@ -161,6 +192,38 @@ def _children(pid: int) -> set[int]:
     return {int(p) for p in out.stdout.split()}
 
 
+def test_a_resume_marks_the_runs_of_a_gone_process_killed(tmp_path: Path) -> None:
+    """A sweep's runs left RUNNING by a process of this host that no longer exists are marked KILLED
+    by a resume of the sweep (which then runs their jobs again); runs of a live process or of
+    another host are left alone (the kill -9 of a whole sweep, workers and all, is the slow test below)."""
+    import socket
+
+    args = ("run", "-m", "task=sphere", "optimiser=fa", "seed=range(2)", "budget=60", "tracking.sweep_id=gone")
+    first = here(*args, cwd=tmp_path, env={"MLFLOW_TRACKING_URI": None})
+    assert first.returncode == 0, first.stderr
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    alive = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(300)"])
+    c = MlflowClient(tracking_uri=f"sqlite:///{tmp_path / 'mlflow.db'}")
+    exp = c.get_experiment_by_name("tcbench").experiment_id
+    left = {name: c.create_run(exp, run_name=name, tags={"tcbench.sweep_id": "gone", "tcbench.host": host,
+                                                          "tcbench.pid": str(pid), "tcbench.task": "sphere-2d"}).info.run_id
+            for name, host, pid in (("dead", socket.gethostname(), gone.pid), ("alive", socket.gethostname(), alive.pid),
+                                    ("elsewhere", "another-host", gone.pid))}
+    try:
+        resume = here(*args, "tracking.resume=true", cwd=tmp_path, env={"MLFLOW_TRACKING_URI": None})
+    finally:
+        alive.kill()
+        alive.wait()
+    assert resume.returncode == 0, resume.stdout + resume.stderr
+    assert "1 run of sweep gone left RUNNING by a process that is gone marked KILLED" in resume.stderr
+    dead = c.get_run(left["dead"])
+    assert dead.info.status == "KILLED"
+    assert dead.data.tags["tcbench.error"] == f"process {gone.pid} on {socket.gethostname()} killed (found RUNNING)"
+    assert [c.get_run(left[k]).info.status for k in ("alive", "elsewhere")] == ["RUNNING", "RUNNING"]
+
+
+@pytest.mark.slow  # processes killed from outside; the resume's marking above stays in CI
 @pytest.mark.skipif(sys.platform != "linux", reason="process groups and pgrep as on Linux")
 def test_killed_sweep_workers_exit_and_resume_marks_dead_runs(site: Path, tmp_path: Path) -> None:
     """kill -9 of the sweep's main process left its workers (and the resource tracker) alive for

@@ -3,9 +3,6 @@ weights, one batched evaluation per generation; learners come from plugins like 
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -106,24 +103,17 @@ class Linear(Learner):
 
 
 def test_learner_plugin_from_another_package(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """``tcbench list`` with the plugin on PYTHONPATH in a process of its own; the run in this
-    one with the plugin installed here (:func:`cli_here.install_here`)."""
+    """The plugin installed here (:func:`cli_here.install_here`, as ``PYTHONPATH`` would): listed,
+    and a run of it (``tcbench list`` with plugins in a process of its own: tests/test_plugins.py)."""
     site = tmp_path / "site"
     info = site / "linear_plugin-0.1.dist-info"
     info.mkdir(parents=True)
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: linear-plugin\nVersion: 0.1\n")
     (info / "entry_points.txt").write_text("[tcbench.learners]\nlinear = linear_mod:Linear\n")
     (site / "linear_mod.py").write_text(LINEAR_PLUGIN)
-    env = {**os.environ, "PYTHONPATH": str(site)}
-    env.pop("MLFLOW_TRACKING_URI", None)
-
-    def tcbench(*args: str) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([sys.executable, "-m", "tcbench", *args], cwd=tmp_path, env=env,
-                              capture_output=True, text=True, timeout=300)
-
-    listed = tcbench("list")
-    assert "linear     linear_mod.Linear  (from linear-plugin; closed form)" in listed.stdout
     install_here(monkeypatch, site)
+    listed = here("list", cwd=tmp_path)
+    assert "linear     linear_mod.Linear  (from linear-plugin; closed form)" in listed.stdout
     run = here("run", "task=msra_fulltemp", "learner=raw", "learner.name=linear", "optimiser=none", cwd=tmp_path,
                env={"MLFLOW_TRACKING_URI": None})
     assert run.returncode == 0, run.stderr

@@ -50,7 +50,7 @@ def failed(name: str, exc: BaseException) -> JobFailure:
     if isinstance(exc, MemoryError):
         from tcbench.runner.memory import ENV
 
-        error += f" (more than one job may use here: the memory free when it started, or ${ENV})"
+        error = f"{error.rstrip(': ')} (more than one job may use here: the memory free when it started, or ${ENV})"
     failure = JobFailure(name, error_line(error), user)
     log.error("job %s failed: %s", name, failure.error)
     log.debug("%s", traceback.format_exc())
