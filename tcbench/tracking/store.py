@@ -164,6 +164,9 @@ def sweep_id_from_hydra() -> str:
 def finished_run(cfg: Mapping[str, Any]) -> str | None:
     """Id of a FINISHED run of the same config (hash) and seed in the job's experiment, if any."""
     track = cfg["tracking"]
+    db = sqlite_path(track.get("uri"))
+    if db is not None and not db.exists():  # no store yet: no run (and no store made to say so)
+        return None
     c = client(track.get("uri"))
     exp = c.get_experiment_by_name(track["experiment"])
     if exp is None:
@@ -244,6 +247,11 @@ def local_artifact_dir(artifact_uri: str | None) -> Path | None:
 
 @functools.cache
 def _experiment_id(uri: str, name: str) -> str:
+    """The experiment's id; a local store not made yet is made first by :func:`prepare_store` (a
+    copy of the migrated empty store, not MLflow's migrations: seconds saved on each new store)."""
+    db = sqlite_path(uri)
+    if db is not None and (not db.exists() or db.stat().st_size == 0):
+        return prepare_store(uri, name)
     return experiment_id(client(uri), name)
 
 
@@ -319,8 +327,8 @@ def job_run(
     running (:func:`mark_dead_runs`)."""
     track = cfg["tracking"]
     uri = tracking_uri(track.get("uri"))
+    exp = _experiment_id(uri, track["experiment"])  # first: a new store is made before a client opens it
     c = client(uri)
-    exp = _experiment_id(uri, track["experiment"])
     all_tags = {
         f"{TAG_PREFIX}version": __version__,
         f"{TAG_PREFIX}git_commit": git_commit(),
