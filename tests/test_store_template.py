@@ -68,6 +68,25 @@ def test_prepare_store_uses_the_template_and_leaves_no_temporary_file(workdir: P
     assert sorted(p.name for p in (workdir / "sub").iterdir()) == ["mlflow.db", "mlflow.db.lock"]
 
 
+def test_a_job_on_a_new_store_makes_it_from_the_template(workdir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A job's run (the library's :func:`~tcbench.runner.job.run_job`, no command before it) on a
+    store not made yet copies the migrated empty store, as a command does, instead of letting MLflow
+    migrate one; a resume's lookup on no store makes none."""
+    from test_tracking import BASE
+
+    from tcbench.runner.job import run_job
+
+    made: list[Path] = []
+    create = store_template.create_store
+    monkeypatch.setattr(store_template, "create_store", lambda db: made.append(Path(db)) or create(db))
+    uri = f"sqlite:///{workdir / 'new.db'}"
+    cfg = {**BASE, "tracking": {**BASE["tracking"], "uri": uri, "resume": True}}
+    assert tracking.finished_run(cfg) is None and not (workdir / "new.db").exists()
+    assert run_job(cfg) is not None
+    assert made == [workdir / "new.db"]
+    assert tracking.finished_run(cfg) is not None
+
+
 @pytest.mark.parametrize("damage", ["garbage", "no note"])
 def test_a_broken_template_is_rebuilt(workdir: Path, cache: Path, damage: str) -> None:
     template = store_template.ensure_template()
