@@ -42,8 +42,8 @@ def test_the_registry_names_every_kind() -> None:
 
 def test_chamber_metrics_recover_the_simulated_device(tmp_path: Path) -> None:
     """Through a chamber cycle the bias slope, noise density and flicker floor read from the
-    recording are the device's own; heating and cooling open a loop (hysteresis and lag), which
-    the bias-against-temperature plot names."""
+    recording are the device's own; heating and cooling open a loop (hysteresis and lag); the
+    report draws the Allan and bias-against-temperature plots."""
     device = unit("accel", 0).model
     rec = simulate_recording("accel", "chamber", 0, 0)
     assert rec.meta.units["output"] == "g" and rec.input.max() == 0.0

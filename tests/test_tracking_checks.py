@@ -76,8 +76,9 @@ def test_a_server_store_is_asked_once_whether_it_is_mlflow(http_answering: str, 
 def test_the_store_helpers_on_runs_and_processes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A server store takes no file lock and keeps no local artifacts; a finished process is not
     alive; a run is marked ended with its error; every job run is announced to ``on_run_created``."""
+    monkeypatch.chdir(tmp_path)
     with store.store_lock("http://127.0.0.1:5000"):
-        assert not (tmp_path / ".lock").exists()
+        assert list(tmp_path.iterdir()) == []  # no lock file: the server keeps its own store
     assert store.local_artifact_dir("http://127.0.0.1:5000/artifacts/1") is None
     assert store.local_artifact_dir(f"file://{tmp_path}") == tmp_path
     gone = subprocess.Popen([sys.executable, "-c", "pass"])
