@@ -46,6 +46,21 @@ def _tracking_store(tmp_path_factory, monkeypatch):  # type: ignore[no-untyped-d
     monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path_factory.mktemp('mlflow') / 'mlflow.db'}")
 
 
+@pytest.fixture(autouse=True)
+def _joblib_in_turn(request):  # type: ignore[no-untyped-def]
+    """The code's own joblib work (a diagnosis's two smoothing windows) in turn in the test's process:
+    the two test workers already hold both cores, so the pool's workers only add their imports (about 50
+    CPU-s over the run) and their memory. Tests marked ``worker_processes`` start the workers as a
+    user's process does (the same results: tests/test_diagnose_in_worker.py)."""
+    if request.node.get_closest_marker("worker_processes"):
+        yield
+        return
+    from joblib import parallel_config
+
+    with parallel_config(backend="sequential"):
+        yield
+
+
 @pytest.fixture
 def workdir(tmp_path, monkeypatch):
     """Run in an empty directory with no tracking server configured."""

@@ -87,6 +87,24 @@ def test_the_value_alone_is_the_smoothed_value() -> None:
         np.testing.assert_array_equal(smoothed_value(t, x, 120.0), smooth_temperature(t, x, 120.0)[0])
 
 
+
+def test_bursts_smoothed_together_are_each_burst_smoothed_alone() -> None:
+    """The bursts of one length are smoothed as the rows of one array: each row's value and rate are
+    its own burst's alone (to rounding), beside a longer burst and a sparse tail (the local line)."""
+    rng = np.random.default_rng(5)
+    parts = [k * 300 + np.arange(0, 5, 0.02) for k in range(12)] + [4000 + np.arange(0, 9, 0.02)]
+    t = np.concatenate([*parts, 5000 + 60.0 * np.arange(5)])
+    x = 20.0 + np.sin(t / 700.0) + rng.normal(0.0, 0.01, t.size)
+    value, rate = smooth_temperature(t, x, 120.0)
+    at = 0
+    for part in parts:
+        alone = slice(at, at + part.size)
+        v, r = smooth_temperature(t[alone], x[alone], 120.0)
+        np.testing.assert_allclose(value[alone], v, rtol=1e-12)
+        np.testing.assert_allclose(rate[alone], r, rtol=1e-9, atol=1e-12)
+        at += part.size
+    assert np.all(np.abs(value[at:] - x[at:]) < 0.1) and np.all(np.isfinite(rate[at:]))  # the sparse tail's line
+
 def _cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
     code = main(["diagnose", *args])
     return code, capsys.readouterr().err

@@ -1,10 +1,15 @@
-"""A diagnosis in a sweep's worker (a daemon process) tries its two smoothing windows in turn,
-where joblib would refuse to start workers of its own and warn in every job's log."""
+"""A diagnosis tries its two smoothing windows on two joblib workers in a user's process, and in turn
+in a sweep's worker (a daemon process, where joblib would refuse to start workers of its own and warn
+in every job's log); both ways give the same diagnosis."""
 
 from __future__ import annotations
 
+import json
 import warnings
 from typing import Any
+
+import pytest
+from joblib import parallel_config
 
 from hydra_plugins.tcbench_launcher.pool import run_jobs
 
@@ -17,10 +22,19 @@ def _diagnose_fast_staircase(cfg: dict[str, Any]) -> tuple[bool, Any]:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = diagnose(rec, sensor="gyro")
-    return True, (sorted(d.statistics.smooth_tried_s), [str(w.message) for w in caught])
+    return True, (d.statistics.smooth_tried_s, [str(w.message) for w in caught], json.dumps(d.to_json(), default=float, sort_keys=True))
 
 
 def test_a_diagnosis_in_a_sweep_worker_tries_both_windows_without_a_warning() -> None:
-    [(ok, (tried, caught))] = run_jobs([{}], 1, _diagnose_fast_staircase)
+    [(ok, (tried, caught, _))] = run_jobs([{}], 1, _diagnose_fast_staircase)
     assert ok and len(tried) == 2, tried  # the fitted window and the default both diagnosed
     assert not [m for m in caught if "multiprocessing" in m or "n_jobs" in m], caught
+
+
+@pytest.mark.worker_processes
+def test_the_two_windows_on_two_workers_give_the_diagnosis_made_in_turn() -> None:
+    _, (tried, _, two_workers) = _diagnose_fast_staircase({})
+    with parallel_config(backend="sequential"):
+        _, (tried_in_turn, _, in_turn) = _diagnose_fast_staircase({})
+    assert len(tried) == 2 and tried == tried_in_turn
+    assert two_workers == in_turn

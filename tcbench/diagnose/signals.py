@@ -11,7 +11,6 @@ at most 1 s and are read back at the sample times.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import pairwise
 
 import numpy as np
 from scipy.signal import lfilter, oaconvolve, savgol_coeffs, savgol_filter
@@ -112,24 +111,39 @@ def _smoothed(t_s: np.ndarray, temp_c: np.ndarray, window_s: float,
     rate = np.empty_like(temp_c) if with_rate else None
     starts = np.flatnonzero(np.diff(np.concatenate(([-1], seg))))
     bounds = np.append(starts, t_s.size)
-    short_window = _sparse_window_s(t_s, bounds, window_s)
-    wide: tuple[np.ndarray, np.ndarray] | None = None  # the local line, computed if a segment needs it
-    for a, b in pairwise(bounds):
-        n = b - a
-        fs = (n - 1) / max(t_s[b - 1] - t_s[a], 1e-12)
-        w = round(window_s * fs) | 1
-        if MIN_WINDOW_SAMPLES <= n < w:  # a burst: its own samples, not a line across the gaps
-            w = n if n % 2 else n - 1
-        if n >= w >= MIN_SAVGOL_SAMPLES:
-            value[a:b] = savgol(temp_c[a:b], w)
-            if rate is not None:
-                rate[a:b] = savgol(temp_c[a:b], w, deriv=1, delta_s=1.0 / fs)
-        else:
-            wide = local_linear(t_s, temp_c, short_window) if wide is None else wide
-            value[a:b] = wide[0][a:b]
-            if rate is not None:
-                rate[a:b] = wide[1][a:b]
+    first, n = bounds[:-1], np.diff(bounds)
+    fs = (n - 1) / np.maximum(t_s[bounds[1:] - 1] - t_s[first], 1e-12)
+    w = np.round(window_s * fs).astype(np.int64) | 1
+    burst = (MIN_WINDOW_SAMPLES <= n) & (n < w)  # a burst: its own samples, not a line across the gaps
+    w = np.where(burst, n - (n % 2 == 0), w)
+    quadratic = (n >= w) & (w >= MIN_SAVGOL_SAMPLES)
+    for size, window in {(int(a), int(b)) for a, b in zip(n[quadratic], w[quadratic], strict=True)}:
+        members = np.flatnonzero(quadratic & (n == size) & (w == window))
+        _savgol_segments(temp_c, first[members], size, window, fs[members], value, rate)
+    if not quadratic.all():  # the sparse segments: the local line
+        line = np.repeat(~quadratic, n)
+        wide = local_linear(t_s, temp_c, _sparse_window_s(t_s, bounds, window_s))
+        value[line] = wide[0][line]
+        if rate is not None:
+            rate[line] = wide[1][line]
     return value, rate
+
+
+def _savgol_segments(x: np.ndarray, first: np.ndarray, size: int, window: int, fs: np.ndarray,
+                     value: np.ndarray, rate: np.ndarray | None) -> None:
+    """:func:`savgol` of the segments of ``size`` samples starting at ``first`` (sampled at
+    ``fs``, Hz) into ``value`` and ``rate``: many short ones (a clipped record's thousands of
+    kept runs) as the rows of one array, a long or lone one alone."""
+    if first.size == 1 or window > FFT_WINDOW:
+        for a, f in zip(first, fs, strict=True):
+            value[a:a + size] = savgol(x[a:a + size], window)
+            if rate is not None:
+                rate[a:a + size] = savgol(x[a:a + size], window, deriv=1, delta_s=1.0 / f)
+        return
+    rows = first[:, None] + np.arange(size)
+    value[rows] = savgol_filter(x[rows], window, 2, mode="interp", axis=1)
+    if rate is not None:
+        rate[rows] = savgol_filter(x[rows], window, 2, deriv=1, mode="interp", axis=1) * fs[:, None]
 
 
 def _sparse_window_s(t_s: np.ndarray, bounds: np.ndarray, window_s: float) -> np.ndarray:
