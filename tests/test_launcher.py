@@ -49,10 +49,10 @@ def compose_counter(monkeypatch: pytest.MonkeyPatch) -> list[list[str]]:
     return calls
 
 
-@pytest.mark.parametrize("launcher_args, composes", [([], 4), (["hydra/sweeper=basic", "hydra/launcher=basic"], 12)])
+@pytest.mark.parametrize("launcher_args, composes", [([], 2), (["hydra/sweeper=basic", "hydra/launcher=basic"], 12)])
 def test_one_compose_per_group_and_every_job_once(workdir: Path, monkeypatch, launcher_args, composes) -> None:
-    """6 jobs in 2 groups: the sweeper checks and the launcher composes one config per group
-    (2 + 2), where Hydra's basic pair composes each job twice (6 + 6); the runs are the same."""
+    """6 jobs in 2 groups: the launcher composes one config per group (2; the sweeper leaves the
+    check to it), where Hydra's basic pair composes each job twice (6 + 6); the runs are the same."""
     from tcbench.cli import main
 
     calls = compose_counter(monkeypatch)
@@ -71,6 +71,28 @@ def test_one_compose_per_group_and_every_job_once(workdir: Path, monkeypatch, la
         assert f"seed={cfg['seed']}" in overrides and f"optimiser={cfg['optimiser']['name']}" in overrides
         seen.add((cfg["optimiser"]["name"], cfg["seed"]))
     assert len(seen) == 6
+
+
+def test_a_group_that_does_not_compose_stops_the_launch_before_any_job_folder(tmp_path: Path) -> None:
+    """With no check by the sweeper ahead of it, the launcher composes every group before it writes a
+    job folder: a config that does not compose leaves the sweep folder unmade."""
+    from types import SimpleNamespace
+
+    from hydra.errors import ConfigCompositionException
+    from omegaconf import OmegaConf
+
+    from hydra_plugins.tcbench_launcher.launcher import GroupedLauncher
+
+    class Refusing:
+        def load_sweep_config(self, master_config, sweep_overrides):  # type: ignore[no-untyped-def]
+            raise ConfigCompositionException(f"cannot compose {sweep_overrides}")
+
+    launcher = GroupedLauncher()
+    launcher.config = OmegaConf.create({"hydra": {"sweep": {"dir": str(tmp_path / "multirun")}}})
+    launcher.hydra_context = SimpleNamespace(config_loader=Refusing())  # type: ignore[assignment]
+    with pytest.raises(ConfigCompositionException, match="optimiser=nope"):
+        launcher.launch([["optimiser=nope", "seed=0"], ["optimiser=nope", "seed=1"]], 0)
+    assert not (tmp_path / "multirun").exists()
 
 
 @pytest.mark.slow  # the workers' crash and kill cases on two workers (tests/test_sweep_failures.py) stay in CI

@@ -9,7 +9,8 @@ overrides, each group's config is composed (and so checked) once, and every job 
 its own seed and job number.
 
 - :class:`GroupingSweeper` is Hydra's basic sweeper (same ``params`` and batching) checking one
-  config per group.
+  config per group ahead of another launcher, none ahead of tcbench's, which composes every group
+  before its first job starts (Hydra's sweeper would compose each group a second time).
 - :class:`GroupedLauncher` runs the jobs in this process (``n_jobs: 1``, the default) or in
   ``n_jobs`` worker processes, each importing tcbench once and keeping its MLflow client for all
   the jobs it runs. Every job still gets its folder ``<sweep dir>/<subdir>`` with
@@ -71,13 +72,6 @@ def groups(job_overrides: Sequence[Sequence[str]]) -> dict[tuple[str, ...], list
     return out
 
 
-class GroupingSweeper(BasicSweeper):
-    """Hydra's basic sweeper, checking one composed config per group of jobs that differ only in
-    their seed (the launcher composes the same configs again)."""
-
-    def validate_batch_is_legal(self, batch: Sequence[Sequence[str]]) -> None:
-        firsts = [batch[idx[0]] for idx in groups(batch).values()]
-        super().validate_batch_is_legal(firsts)
 
 
 class GroupedLauncher(Launcher):
@@ -100,9 +94,9 @@ class GroupedLauncher(Launcher):
         assert self.config is not None and self.hydra_context is not None
         setup_globals()
         sweep_dir = Path(str(self.config.hydra.sweep.dir))
-        sweep_dir.mkdir(parents=True, exist_ok=True)
         sweep_id = hashlib.sha256(str(sweep_dir.resolve()).encode()).hexdigest()[:12]
         jobs: list[tuple[int, list[str], dict[str, Any], str]] = []
+        folders: list[tuple[Path, str | None, dict[str, Any], list[str]]] = []
         loader = self.hydra_context.config_loader
         for indices in groups(job_overrides).values():
             composed = loader.load_sweep_config(self.config, list(job_overrides[indices[0]]))
@@ -123,8 +117,11 @@ class GroupedLauncher(Launcher):
                     hydra_cfg.job.num = num
                     hydra_cfg.job.id = num
                 out = sweep_dir / str(OmegaConf.select(hydra_cfg, "sweep.subdir"))
-                _write_job_dir(out, str(hydra_cfg.output_subdir) if hydra_cfg.output_subdir else None, cfg, overrides)
+                folders.append((out, str(hydra_cfg.output_subdir) if hydra_cfg.output_subdir else None, cfg, overrides))
                 jobs.append((num, overrides, cfg, str(out)))
+        sweep_dir.mkdir(parents=True, exist_ok=True)  # every config composed: the job folders
+        for folder in folders:
+            _write_job_dir(*folder)
         jobs.sort(key=lambda j: j[0])
         log.info("Launching %d jobs (%d configs composed) %s", len(jobs), len(groups(job_overrides)),
                  "in this process" if self.n_jobs == 1 else f"on {self.n_jobs} worker processes")
@@ -246,3 +243,16 @@ def _run_parallel(configs: list[dict[str, Any]], n_jobs: int,
                 log.error("job %s failed: %s", value.name, value.error)
             FAILURES.append(value)
     return outcomes
+
+
+class GroupingSweeper(BasicSweeper):
+    """Hydra's basic sweeper, checking one composed config per group of jobs that differ only in
+    their seed; none ahead of tcbench's launcher, which composes every group in this process before
+    its first job starts (a config that does not compose stops the sweep there, with nothing run
+    and no job folder written)."""
+
+    def validate_batch_is_legal(self, batch: Sequence[Sequence[str]]) -> None:
+        if isinstance(self.launcher, GroupedLauncher):
+            return
+        firsts = [batch[idx[0]] for idx in groups(batch).values()]
+        super().validate_batch_is_legal(firsts)
