@@ -95,6 +95,27 @@ def test_a_group_that_does_not_compose_stops_the_launch_before_any_job_folder(tm
     assert not (tmp_path / "multirun").exists()
 
 
+def test_the_sweeper_checks_one_config_per_group_ahead_of_another_launcher_only() -> None:
+    from types import SimpleNamespace
+
+    from omegaconf import OmegaConf
+
+    from hydra_plugins.tcbench_launcher.launcher import GroupedLauncher, GroupingSweeper
+
+    checked: list[list[str]] = []
+    loader = SimpleNamespace(load_sweep_config=lambda master_config, sweep_overrides: checked.append(sweep_overrides))
+    sweeper = GroupingSweeper(max_batch_size=None)
+    sweeper.config = OmegaConf.create({})
+    sweeper.hydra_context = SimpleNamespace(config_loader=loader)  # type: ignore[assignment]
+    batch = [["optimiser=fa", "seed=0"], ["optimiser=fa", "seed=1"], ["optimiser=ifa", "seed=0"]]
+    sweeper.launcher = object()  # type: ignore[assignment]  # e.g. joblib's, composing in other processes
+    sweeper.validate_batch_is_legal(batch)
+    assert checked == [["optimiser=fa", "seed=0"], ["optimiser=ifa", "seed=0"]]
+    sweeper.launcher = GroupedLauncher()
+    sweeper.validate_batch_is_legal(batch)
+    assert len(checked) == 2  # tcbench's launcher composes them itself before any job
+
+
 @pytest.mark.slow  # the workers' crash and kill cases on two workers (tests/test_sweep_failures.py) stay in CI
 def test_two_worker_processes_record_every_run_once(workdir: Path) -> None:
     """The launcher's fresh worker processes, started from this process (4 jobs on 2 workers)."""
