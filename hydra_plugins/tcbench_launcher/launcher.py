@@ -72,8 +72,6 @@ def groups(job_overrides: Sequence[Sequence[str]]) -> dict[tuple[str, ...], list
     return out
 
 
-
-
 class GroupedLauncher(Launcher):
     """Runs a sweep's jobs from one composed config per group; see the module docstring."""
 
