@@ -22,7 +22,8 @@ def _diagnose_fast_staircase(cfg: dict[str, Any]) -> tuple[bool, Any]:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = diagnose(rec, sensor="gyro")
-    return True, (d.statistics.smooth_tried_s, [str(w.message) for w in caught], json.dumps(d.to_json(), default=float, sort_keys=True))
+    report = json.dumps(d.to_json(), default=float, sort_keys=True)
+    return True, (d.statistics.smooth_tried_s, [str(w.message) for w in caught], report)
 
 
 def test_a_diagnosis_in_a_sweep_worker_tries_both_windows_without_a_warning() -> None:

@@ -103,7 +103,8 @@ def test_the_sweeper_checks_one_config_per_group_ahead_of_another_launcher_only(
     from hydra_plugins.tcbench_launcher.launcher import GroupedLauncher, GroupingSweeper
 
     checked: list[list[str]] = []
-    loader = SimpleNamespace(load_sweep_config=lambda master_config, sweep_overrides: checked.append(sweep_overrides))
+    loader = SimpleNamespace(
+        load_sweep_config=lambda master_config, sweep_overrides: checked.append(sweep_overrides))
     sweeper = GroupingSweeper(max_batch_size=None)
     sweeper.config = OmegaConf.create({})
     sweeper.hydra_context = SimpleNamespace(config_loader=loader)  # type: ignore[assignment]
