@@ -83,3 +83,32 @@ def test_every_schema_is_registered_with_hydra() -> None:
 
     stored = set(ConfigStore.instance().list("/"))
     assert {f"{spec.schema_node}.yaml" for spec in SPECS.values()} <= stored
+
+
+def test_the_repository_hydra_copies_at_each_compose_shares_the_store() -> None:
+    """Hydra deep-copies its config repository at every compose; the ConfigStore in it is the
+    store itself (not a copy of every schema), so a config registered after the copy is found."""
+    import copy
+
+    from hydra import compose, initialize_config_module
+    from hydra._internal.config_repository import CachingConfigRepository
+    from hydra.core.config_store import ConfigStore
+    from hydra.core.global_hydra import GlobalHydra
+
+    import tcbench.cli.app  # noqa: F401 - registers the schemas
+    from tcbench.config_dir import CONFIG_MODULE
+
+    store = ConfigStore.instance()
+    assert copy.deepcopy(store) is store
+    with initialize_config_module(CONFIG_MODULE, version_base="1.3"):
+        loader = GlobalHydra.instance().config_loader()
+        repo = CachingConfigRepository(loader.repository)  # type: ignore[attr-defined]
+        store.store(name="registered_after_the_copy", node={"answer": 42})
+        try:
+            assert repo.load_config("registered_after_the_copy.yaml") is not None
+            node = store.load("registered_after_the_copy.yaml").node
+            node.answer = 0  # a loaded node is the caller's copy: the store keeps its own
+            assert store.load("registered_after_the_copy.yaml").node.answer == 42
+            assert compose("config", overrides=["task=rastrigin", "optimiser=ifa"]).task.name == "rastrigin"
+        finally:
+            del store.repo["registered_after_the_copy.yaml"]

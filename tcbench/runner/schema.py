@@ -25,14 +25,31 @@ class JobConfig:
     tracking: TrackingConfig = field(default_factory=TrackingConfig)
 
 
+def _store_copied_as_itself() -> None:
+    """A copy of Hydra's ConfigStore is the store itself.
+
+    Hydra 1.3 deep-copies its config repository at every compose (``CachingConfigRepository``),
+    and with it the whole ConfigStore its structured source keeps a reference to: every schema
+    registered (tcbench's command schemas and Hydra's own), 20 of a job's ~100 ms of composition
+    (benchmarks/compose_speed.py). No copy is needed: ``ConfigStore.load`` hands out a deep copy
+    of the node it loads, and a copied store would miss what is registered after the copy
+    (Hydra's later code refetches the singleton instead of keeping it, its pull request 2928)."""
+    from hydra.core.config_store import ConfigStore
+
+    if "__deepcopy__" not in vars(ConfigStore):
+        ConfigStore.__deepcopy__ = lambda self, memo: self  # type: ignore[attr-defined]
+
+
 def register_schema() -> None:
     """Make the schema of every command available to Hydra under the name its primary config's
     defaults list gives it (:attr:`~tcbench.commands.registry.CommandSpec.schema_node`:
-    ``base_config`` for this one, ``simulate_schema`` ...)."""
+    ``base_config`` for this one, ``simulate_schema`` ...); the store is shared by the copies
+    Hydra makes of it (:func:`_store_copied_as_itself`)."""
     from hydra.core.config_store import ConfigStore
 
     from tcbench.commands.registry import SPECS
 
+    _store_copied_as_itself()
     for spec in SPECS.values():
         ConfigStore.instance().store(name=spec.schema_node, node=spec.schema_class())
 
