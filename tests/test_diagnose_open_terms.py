@@ -81,7 +81,7 @@ def test_a_hidden_step_is_named_located_refitted_and_written_to_model_yaml(tmp_p
 
     rec, t0, sigma = _hidden_step(1)
     d = diagnose(rec, sensor="gyro")
-    written = write_report(d, tmp_path / "out")
+    written = write_report(d, tmp_path / "out", with_plots=False)
     assert "bias_step" in written["report.md"].read_text()
     report = d.to_json()
     for entry in report["effects"]:

@@ -137,7 +137,7 @@ def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], clean_
     i = rec.time_s.size // 3
     spiked = _with_spikes(rec, [i, rec.time_s.size - 1], [80.0 * sigma, -300.0 * sigma])
     d = diagnose(spiked)
-    files = write_report(d, tmp_path / "report")
+    files = write_report(d, tmp_path / "report", with_plots=False)
     spec = read_model(files["model.yaml"])
     assert [t for t, _ in spec.outliers] == [pytest.approx(rec.time_s[i]), pytest.approx(rec.time_s[-1])]
     assert [v for _, v in spec.outliers] == [pytest.approx(80.0 * sigma, rel=0.1), pytest.approx(-300.0 * sigma, rel=0.03)]
@@ -150,6 +150,6 @@ def test_model_file_reproduces_the_spikes(clean: tuple[Recording, float], clean_
     assert np.flatnonzero(diff).tolist() == [i, rec.time_s.size - 1]
     assert diff[[i, -1]].tolist() == [v for _, v in spec.outliers]
     # and a model without outliers writes no outliers key (older files stay as they were)
-    clean_files = write_report(clean_diagnosis, tmp_path / "clean")
+    clean_files = write_report(clean_diagnosis, tmp_path / "clean", with_plots=False)
     assert "outliers" not in clean_files["model.yaml"].read_text()
     assert read_model(clean_files["model.yaml"]).outliers == ()
