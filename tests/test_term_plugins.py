@@ -85,6 +85,22 @@ def test_diagnose_names_the_plugin_effect_only_where_it_is(installed: Path, tmp_
     assert bare.returncode != 0 and f"unknown effect {TERM!r}" in bare.stderr
 
 
+def _library_terms_and_their_source() -> list[tuple[str, str]]:
+    return [(t.id, term_source(t.id)) for t in all_terms()]
+
+
+@pytest.mark.worker_processes
+def test_the_diagnosis_workers_have_the_plugin_term(installed: Path) -> None:
+    """A diagnosis tries its two smoothing windows on two joblib workers: the plugin's term is a
+    candidate there as in this process (its folder on their path, its entry point read anew)."""
+    from joblib import Parallel, delayed
+
+    here_terms = _library_terms_and_their_source()
+    assert (TERM, "tcbench-rate2") in here_terms
+    in_workers = Parallel(n_jobs=2)(delayed(_library_terms_and_their_source)() for _ in range(2))
+    assert in_workers == [here_terms, here_terms]
+
+
 def test_example_plugin_own_tests(site: Path) -> None:
     env = {**os.environ, "PYTHONPATH": str(site)}
     out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(EXAMPLE / "tests")],
