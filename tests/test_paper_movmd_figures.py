@@ -76,3 +76,20 @@ def test_every_row_is_paired_with_the_paper_s_method_on_drift() -> None:
     assert table.loc["oracle", "draws_lower_than_paper"] == 30 == table.loc["oracle", "draws_paired_with_paper"]
     assert table.loc["raw", "draws_lower_than_paper"] == 0 and table.loc["raw", "p_drift_vs_paper"] < 1e-5
     assert table.loc[fig19.PAPER_METHOD, ["p_drift_vs_paper", "draws_paired_with_paper"]].isna().all()
+
+
+def test_every_tier_has_its_section_named_as_its_board_default_tier_first() -> None:
+    low = "gyro_driftnoise-dev0-bias_instability.b=0.00083"
+    assert fig19.section_name("gyro_driftnoise-dev0", "next_run") == "gyro_driftnoise-dev0"
+    assert fig19.section_name(low, "new_device") == f"{low}.new_device"  # as the board's file
+    names = [f"{low}.replay", "gyro_driftnoise-dev0.new_profile", low, f"{low}.new_device",
+             "gyro_driftnoise-dev0", "gyro_driftnoise-dev0.new_device"]
+    assert sorted(names, key=fig19._order) == [
+        "gyro_driftnoise-dev0", low, "gyro_driftnoise-dev0.new_device", f"{low}.new_device",
+        "gyro_driftnoise-dev0.new_profile", f"{low}.replay"]
+    runs = pd.concat([_runs((4.0, 6.0)).assign(split=split, task="dev0", drift_dph=float(i))
+                      for i, split in enumerate(("replay", "new_device", "next_run"), start=1)])
+    lines = fig19._tier_table(runs)
+    header = next(line for line in lines if line.startswith("| task"))
+    assert header.split("|")[3:6] == [" next_run ", " new_device ", " replay "]  # the default first
+    assert "| dev0 | raw | 3 (30) | 2 (30) | 1 (30) |" in lines[4]

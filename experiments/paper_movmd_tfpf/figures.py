@@ -2,8 +2,9 @@
 keeps, the verdict on the paper's claim over the restarts, and the Allan curves on one axis.
 
 Reads the finished gyro runs from MLflow and writes ``fig19.md`` (keeping the sections of the devices
-the sweep did not run) and, per task (device variant), ``fig19_<task>.csv`` and ``fig19_allan_<task>.png``
-into ``--out``. Per method: the median over restarts (restart i on draw i of the runs), each gain taken
+and tiers the sweep did not run) and, per task (device variant) and tier, ``fig19_<name>.csv`` and
+``fig19_allan_<name>.png`` into ``--out``, ``<name>`` being the task on the default tier (``next_run``)
+and ``<task>.<tier>`` on the others, as the boards are named: the claim restated on every tier. Per method: the median over restarts (restart i on draw i of the runs), each gain taken
 on the restart's own draw (raw ÷ method) and, for the Allan figure, the curve of the run whose ARW is the
 median one. The paper's factors are judged by the 95 % interval of the median gain.
 
@@ -21,6 +22,7 @@ import pandas as pd
 
 from tcbench.tracking import store as tracking
 from tcbench.leaderboard import compensation as board
+from tcbench.leaderboard.compensation import SPLIT_LINES
 from tcbench.compensation.gyro.plots import allan_methods_figure
 from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
 from tcbench.compensation.data import DEFAULT_TIER
@@ -94,6 +96,21 @@ def _judged(gain: pd.Series, claimed: float) -> str:
     if low >= claimed:
         return "reached"
     return "not reached" if high < claimed else "not shown either way"
+
+
+def section_name(task: str, split: str) -> str:
+    """The name of a task's section and files on a tier: the task on the default tier, else
+    ``<task>.<split>`` (the boards' names)."""
+    return task if split == DEFAULT_TIER else f"{task}.{split}"
+
+
+TIER_ORDER = ("next_run", "new_device", "new_profile", "replay")  # the default first, then as the issue plans them
+
+
+def _order(name: str) -> tuple[int, str]:
+    """Sections in tier order (the default tier's first), then by task."""
+    task, _, tier = name.rpartition(".")
+    return (TIER_ORDER.index(tier), task) if tier in TIER_ORDER else (0, name)
 
 
 def _verdict(runs: pd.DataFrame) -> list[str]:
@@ -172,18 +189,20 @@ def _paper_figures(client, task: str, runs: pd.DataFrame, out: Path) -> list[str
             + ", ".join(f"[{n.split('_')[0]}]({task}/{n})" for n in names) + ".", ""]
 
 
-def _section(client, task: str, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
+def _section(client, task: str, split: str, runs: pd.DataFrame, out: Path) -> list[str]:  # type: ignore[no-untyped-def]
+    name = section_name(task, split)
     table = _table(runs)
-    table.to_csv(out / f"fig19_{task}.csv", index=False)
+    table.to_csv(out / f"fig19_{name}.csv", index=False)
     with tempfile.TemporaryDirectory() as tmp:
         curves = _allan_curves(client, runs, Path(tmp))
     bw = runs.groupby("method")["bandwidth_hz"].median()
-    png = out / f"fig19_allan_{task}.png"
-    allan_methods_figure(png, curves, f"Fig. 19: Allan deviation of every method (test run)\n{task}",
+    png = out / f"fig19_allan_{name}.png"
+    allan_methods_figure(png, curves, f"Fig. 19: Allan deviation of every method (test run)\n{name}",
                          annotations={m: f"bw {bw[m]:.2g} Hz" for m in curves if m in bw})
-    return [f"## {task}", "", markdown_table(table), "", *[f"{line}\n" for line in _verdict(runs)],
-            f"![Allan deviation of every method on {task}]({png.name})", "",
-            *_paper_figures(client, task, runs, out)]
+    tier = [] if split == DEFAULT_TIER else [SPLIT_LINES.get(split, f"**Split {split}.**"), ""]
+    return [f"## {name}", "", *tier, markdown_table(table), "", *[f"{line}\n" for line in _verdict(runs)],
+            f"![Allan deviation of every method on {name}]({png.name})", "",
+            *_paper_figures(client, name, runs, out)]
 
 
 def kept_sections(text: str, replaced: set[str]) -> dict[str, list[str]]:
@@ -204,7 +223,7 @@ def kept_sections(text: str, replaced: set[str]) -> dict[str, list[str]]:
 
 def _tier_table(runs: pd.DataFrame) -> list[str]:
     """Drift (°/h, median over the runs, with their count) of every method run on more than one
-    tier, per task: what the test runs being a replay of the training power-on is worth."""
+    tier, per task: how far each tier's held-out runs are from the training runs, method by method."""
     shared = runs.groupby("method")["split"].nunique()
     g = runs[runs["method"].isin(shared[shared > 1].index) | runs["method"].str.startswith("oracle")]
     if g.empty or g["split"].nunique() < 2:
@@ -212,13 +231,14 @@ def _tier_table(runs: pd.DataFrame) -> list[str]:
     table = g.groupby(["task", "method", "split"])["drift_dph"].agg(["median", "size"]).reset_index()
     table["drift_dph"] = [f"{m:.3g} ({n})" for m, n in zip(table["median"], table["size"], strict=True)]
     wide = table.pivot_table(index=["task", "method"], columns="split", values="drift_dph", aggfunc="first")
-    wide = wide.reset_index().fillna("–")
-    return ["## Tiers: next run against a replay", "",
-            "Drift (°/h, median, number of runs in brackets) of the rows run on both tiers: `next_run` tests "
-            "on new power-ons of the device (the default, every table above), `replay` on new noise over the "
-            "training run's power-on (docs/concepts/split-tiers.md). Restart i of every row trains and tests on draw i "
-            "of the runs of its tier, except on boards made before draws were paired (one draw per method, the "
-            "oracles over 30).", "", markdown_table(wide), ""]
+    wide = wide[[t for t in TIER_ORDER if t in wide.columns]].reset_index().fillna("–")
+    return ["## Tiers", "",
+            "Drift (°/h, median, number of runs in brackets) of the rows run on more than one tier: `next_run` "
+            "tests on new power-ons of the device (the default, the first tables above), `new_device` on other "
+            "units of the lot, `new_profile` under an oven programme the training never saw, `replay` on new "
+            "noise over the training run's power-on (docs/concepts/split-tiers.md). Restart i of every row trains "
+            "and tests on draw i of the runs of its tier, except on boards made before draws were paired (one "
+            "draw per method, the oracles over 30).", "", markdown_table(wide), ""]
 
 
 def main() -> None:
@@ -230,17 +250,16 @@ def main() -> None:
     client = tracking.client()
     runs = one_run_per_job(board.load_runs(client, [args.experiment], args.sweep), ("task", "split", "method", "seed"))
     runs = runs[runs["status"] == "FINISHED"]
-    tiers = runs
-    runs = runs[runs["split"] == DEFAULT_TIER]  # Fig. 19 on the default tier; the others in the tier table
     args.out.mkdir(parents=True, exist_ok=True)
-    sections = {str(task): _section(client, str(task), g, args.out) for task, g in runs.groupby("task")}
+    sections = {section_name(str(task), str(split)): _section(client, str(task), str(split), g, args.out)
+                for (task, split), g in runs.groupby(["task", "split"])}
     path = args.out / "fig19.md"
     kept = kept_sections(path.read_text() if path.is_file() else "", set(sections))
     lines = [
         "# Seed 001 Fig. 19 beside tcbench", "",
         "Simulated 14 h oven runs of gyro 0 at 10 Hz (one to train, one to test; `bash "
         "experiments/paper_movmd_tfpf/run.sh`): the device as simulated by default (flicker B ≈ 33 °/h, "
-        "experiments/raw-sensors/README.md)" + (", and the same device with 3 °/h of flicker" if len(sections | kept) > 1 else "")
+        "experiments/raw-sensors/README.md)" + (", and the same device with 3 °/h of flicker" if len({_order(n)[1] for n in sections | kept}) > 1 else "")
         + ". Medians over restarts (restart i on draw i of the runs, unless a section says they shared one draw); "
         "gains are the median over restarts of raw ÷ method on the restart's own test run; ARW = σ(1 s)/60 "
         "in °/√h (seed 001 prints °/h/√Hz for a value that only fits its bias stability as °/√h, "
@@ -251,8 +270,12 @@ def main() -> None:
         "by draw, and draws_lower_than_paper = on how many of the draws_paired_with_paper the row's drift is the "
         "lower. The paper's rows: its raw ÷ its result.", "",
     ]
-    lines += [line for _, body in sorted((sections | kept).items()) for line in body]
-    lines += _tier_table(tiers)
+    if len({_order(n)[0] for n in sections | kept}) > 1:
+        lines += ["The default tier's sections come first (`next_run`: the test run is a new power-on), then each "
+                  "other tier's, named `<device>.<tier>` as its board; the table at the end sets the tiers side by "
+                  "side.", ""]
+    lines += [line for _, body in sorted((sections | kept).items(), key=lambda kv: _order(kv[0])) for line in body]
+    lines += _tier_table(runs)
     path.write_text("\n".join(lines))
     print(f"wrote {args.out / 'fig19.md'}")
 
