@@ -4,9 +4,9 @@ keeps, the verdict on the paper's claim over the restarts, and the Allan curves 
 Reads the finished gyro runs from MLflow and writes ``fig19.md`` (keeping the sections of the devices
 and tiers the sweep did not run) and, per task (device variant) and tier, ``fig19_<name>.csv`` and
 ``fig19_allan_<name>.png`` into ``--out``, ``<name>`` being the task on the default tier (``next_run``)
-and ``<task>.<tier>`` on the others, as the boards are named: the claim restated on every tier. Per method: the median over restarts (restart i on draw i of the runs), each gain taken
-on the restart's own draw (raw ÷ method) and, for the Allan figure, the curve of the run whose ARW is the
-median one. The paper's factors are judged by the 95 % interval of the median gain.
+and ``<task>.<tier>`` on the others, as the boards are named: the claim restated on every tier. Per
+method: the median over restarts (restart i on draw i of the runs), each gain taken on the restart's
+own draw (raw ÷ method) and, for the Allan figure, the curve of the run whose ARW is the median one. The paper's factors are judged by the 95 % interval of the median gain.
 
     python experiments/paper_movmd_tfpf/figures.py --experiment paper-movmd-tfpf --sweep ID --out DIR
 """
@@ -25,7 +25,7 @@ from tcbench.leaderboard import compensation as board
 from tcbench.leaderboard.compensation import SPLIT_LINES
 from tcbench.compensation.gyro.plots import allan_methods_figure
 from tcbench.leaderboard.optimisation import markdown_table, one_run_per_job
-from tcbench.compensation.data import DEFAULT_TIER
+from tcbench.compensation.data import DEFAULT_TIER, SPLITS
 from tcbench.leaderboard.paired import draw_column, limit_by_draw, n_draws, paired_ratios, pairing_index
 from tcbench.stats import bootstrap_median_ci, paired_p_value
 from tcbench.signal.allan import AllanDeviation
@@ -104,7 +104,7 @@ def section_name(task: str, split: str) -> str:
     return task if split == DEFAULT_TIER else f"{task}.{split}"
 
 
-TIER_ORDER = ("next_run", "new_device", "new_profile", "replay")  # the default first, then as the issue plans them
+TIER_ORDER = (DEFAULT_TIER, *[t for t in reversed(SPLITS) if t != DEFAULT_TIER])  # the default, then hardest first
 
 
 def _order(name: str) -> tuple[int, str]:
