@@ -30,7 +30,7 @@ def _store_copied_as_itself() -> None:
 
     Hydra 1.3 deep-copies its config repository at every compose (``CachingConfigRepository``),
     and with it the whole ConfigStore its structured source keeps a reference to: every schema
-    registered (tcbench's command schemas and Hydra's own), 20 of a job's ~100 ms of composition
+    registered (tcbench's command schemas and Hydra's own), 11 of a job's 91 ms of composition
     (benchmarks/compose_speed.py). No copy is needed: ``ConfigStore.load`` hands out a deep copy
     of the node it loads, and a copied store would miss what is registered after the copy
     (Hydra's later code refetches the singleton instead of keeping it, its pull request 2928)."""
