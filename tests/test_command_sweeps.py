@@ -107,3 +107,26 @@ def test_a_failed_job_of_a_sweep_is_recorded_and_the_sweep_goes_on(workdir: Path
     client = mlflow.MlflowClient(f"sqlite:///{workdir / 'mlflow.db'}")
     assert {"report.md", "report.json", "model.yaml", "config.yaml"} <= {
         a.path for a in client.list_artifacts(done.info.run_id)}
+
+
+def test_a_key_of_a_swept_group_is_set_in_every_job(workdir: Path) -> None:
+    """``task.split`` exists in the compensation tasks, not in the default task (rastrigin), the one
+    Hydra composes a multirun's config with before it sweeps: the key is set in each job instead."""
+    assert main(["run", "-m", "task=msra_zerobias,msra_fulltemp", "task.split=replay", "learner=raw",
+                 "optimiser=none", "tracking.experiment=split"]) == 0
+    runs = _runs(workdir, "split")
+    assert {r.info.status for r in runs} == {"FINISHED"} and len(runs) == 2
+    assert {(r.data.params["task.name"], r.data.params["task.split"]) for r in runs} == {
+        ("msra_zerobias", "replay"), ("msra_fulltemp", "replay")}
+
+
+def test_only_plain_keys_inside_swept_groups_are_deferred() -> None:
+    from tcbench.cli.app import deferred_to_the_jobs
+
+    args = ["-m", "task=a,b", "task.split=replay", "seed=range(3)", "budget=5", "task.k=choice(1,2)",
+            "learner.epochs=3", "~task.upper", "task.note=${oc.env:HOME}", "task.lower=null",
+            "task.effects={bias_instability:{b:8.3e-4}}"]
+    assert deferred_to_the_jobs(args, ("task", "seed")) == [
+        "-m", "task=a,b", "task.split=choice(replay)", "seed=range(3)", "budget=5", "task.k=choice(1,2)",
+        "learner.epochs=3", "~task.upper", "task.note=${oc.env:HOME}", "task.lower=null",
+        "task.effects=choice({bias_instability:{b:8.3e-4}})"]

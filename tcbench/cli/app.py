@@ -70,6 +70,7 @@ class Plan:
     experiment: str
     sweep_id: str
     outs: tuple[str | None, ...] = ()  # each job's out= (None: a job without one)
+    swept: tuple[str, ...] = ()  # the keys and groups the sweep varies (the config's own params included)
 
 
 def sweep_dir(outs: tuple[str | None, ...]) -> str | None:
@@ -453,5 +454,26 @@ def plan(args: list[str], config_name: str = CONFIG_NAME) -> Plan:
     jobs = len(combos) * (len(seeds) if seeds else 1)
     track = last["tracking"]
     return Plan(jobs, track["enabled"], track["resume"], track.get("uri"), track["experiment"],
-                str(track["sweep_id"]), tuple(outs))
+                str(track["sweep_id"]), tuple(outs), (*keys, *(["seed"] if seeds else [])))
+
+
+def deferred_to_the_jobs(args: list[str], swept: tuple[str, ...]) -> list[str]:
+    """``args`` with every plain override of a key inside a swept config group (``task.split=replay``
+    beside ``task=msra_zerobias,msra_fulltemp``) given as a sweep of its one value
+    (``task.split=choice(replay)``). Hydra composes a multirun's config once before it sweeps, with
+    the group at its default (``task: rastrigin``), where the key may not exist ("Could not override
+    'task.split'"); a sweep's value is set in each job's config, where the group's choice holds it.
+    The jobs are the same."""
+    groups = {key for key in swept if "." not in key}
+    parser = OverridesParser.create()
+    out = list(args)
+    for i in _override_positions(args):
+        key, eq, value = args[i].partition("=")
+        if not (eq and "." in key and key.split(".", 1)[0] in groups and "${" not in value):
+            continue
+        (o,) = parser.parse_overrides([args[i]])
+        if o.is_sweep_override() or o.is_delete() or o.value() is None:  # choice() takes no null
+            continue
+        out[i] = f"{key}=choice({value})"
+    return out
 

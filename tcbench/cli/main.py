@@ -159,7 +159,7 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
     from hydra.errors import HydraException
     from omegaconf.errors import OmegaConfBaseException
 
-    from tcbench.cli.app import hydra_app, plan, sweep_dir, with_overrides
+    from tcbench.cli.app import deferred_to_the_jobs, hydra_app, plan, sweep_dir, with_overrides
     from tcbench.errors import ConfigError
     from tcbench.runner.job import FAILURES
 
@@ -201,6 +201,7 @@ def _run_sweep(args: list[str], config_name: str = "config") -> Plan | None:
         print(f"tcbench: {n} job{'s' if n != 1 else ''} to run", file=sys.stderr)
         if (where := sweep_dir(checked.outs)) is not None and not given(args, "hydra.sweep.dir"):
             args = with_overrides(args, [f"hydra.sweep.dir={where}"])  # Hydra's record of the sweep under out=
+        args = deferred_to_the_jobs(args, checked.swept)  # task.split=replay beside task=a,b: set in each job
     saved, full_error = sys.argv, os.environ.get("HYDRA_FULL_ERROR")
     sys.argv = ["tcbench", *args]
     os.environ["HYDRA_FULL_ERROR"] = "1"  # Hydra's errors reach us whole instead of as its traceback
