@@ -85,6 +85,7 @@ def test_every_table_of_every_page_has_as_many_rows_as_its_csv(site) -> None:  #
                 "real-imu": {"board-real-imu": BOARDS / "real-imu/board.csv"},
                 "accel-chamber/devices": {"board-devices": BOARDS / "accel-chamber/devices.csv"},
                 "paper-ifa-bp/claims": {"board-claims": BOARDS / "paper-ifa-bp/claims.csv"},
+                "paper-movmd-tfpf/claims": {"board-claims": BOARDS / "paper-movmd-tfpf/claims.csv"},
                 "optim-suite": {f"board-{p.stem}".replace(".", "-"): p for p in (BOARDS / "optim-suite").glob("*.csv")},
                 "paper-fa-ifa": {f"board-{p.stem}".replace(".", "-"): p for p in (BOARDS / "paper-fa-ifa").glob("*.csv")}}
     for page_id, tables in expected.items():
@@ -139,6 +140,20 @@ def test_the_verdict_says_where_the_papers_method_loses() -> None:
     zero = next(b for b in compensation_boards(FAMILIES["paper-ifa-bp"], BOARDS) if b.stem == "msra_zerobias-dev0")
     said = " ".join(verdicts.compensation_verdict(zero))
     assert "The paper's IFA-BP-gd loses" in said and "not reproduced" in said
+
+
+def test_a_gyro_board_states_the_claims_of_its_own_device_and_tier() -> None:
+    table = pd.read_csv(BOARDS / "paper-movmd-tfpf/claims.csv")
+    stated = 0
+    for board in compensation_boards(FAMILIES["paper-movmd-tfpf"], BOARDS):
+        said = verdicts.claims(board)
+        mine = table[(table["task"] == board.task) & (table["tier"] == board.tier)]
+        assert len(said) == len(mine), board.stem  # a sentence per factor judged on this device and tier, no other
+        for sentence, row in zip(said, mine.itertuples(), strict=True):
+            verdict = {"yes": "**reproduced**", "no": "**not reproduced**"}.get(row.reproduced, "")
+            assert row.claim in sentence and verdict in sentence and f"[{row.ci95_gain}]" in sentence, board.stem
+            stated += 1
+    assert stated >= 6
 
 
 def test_the_ranking_across_tasks_is_the_mean_of_each_boards_places() -> None:

@@ -49,7 +49,7 @@ def test_the_gain_is_taken_on_each_draw_not_between_medians() -> None:
 def test_the_paper_factor_is_judged_by_the_interval() -> None:
     assert "**not reproduced**" in fig19._verdict(_runs((4.0, 6.0)))[0]
     assert "**reproduced**" in fig19._verdict(_runs((300.0, 400.0)))[0]
-    spans = fig19._verdict(_runs((60.0, 400.0)))[0]  # the ARW interval straddles ×102
+    spans = fig19._verdict(_runs((60.0, 400.0)))[0]  # the bias-stability interval straddles ×233
     assert "not shown either way" in spans and "**not decided**" in spans
     made_of = fig19._verdict(_runs((4.0, 6.0)))[1]
     assert "30 draws" not in made_of and "the oracle's on the same draws" in made_of
@@ -93,3 +93,30 @@ def test_every_tier_has_its_section_named_as_its_board_default_tier_first() -> N
     header = next(line for line in lines if line.startswith("| task"))
     assert header.split("|")[3:6] == [" next_run ", " new_device ", " replay "]  # the default first
     assert "| dev0 | raw | 3 (30) | 2 (30) | 1 (30) |" in lines[4]
+
+
+def test_claims_rows_judge_each_factor_by_its_interval() -> None:
+    rows = {r["metric"]: r for r in fig19.claim_rows("dev0", "next_run", _runs((4.0, 6.0)))}
+    assert [r["reproduced"] for r in rows.values()] == ["no", "no"]
+    arw = rows["arw_1s_deg_per_sqrt_h"]
+    assert 4.0 <= float(arw["gain"]) <= 6.0 and arw["claimed_gain"] == 101.6 and arw["draws"] == 30
+    low, high = (float(v) for v in str(arw["ci95_gain"]).split("–"))
+    assert low <= float(arw["gain"]) <= high
+    assert {r["reproduced"] for r in fig19.claim_rows("dev0", "next_run", _runs((300.0, 400.0)))} == {"yes"}
+    straddles = {r["metric"]: r["reproduced"] for r in fig19.claim_rows("dev0", "next_run", _runs((60.0, 400.0)))}
+    # gains uniform in 60-400: a median near 230, above ×102 and around ×233
+    assert straddles == {"arw_1s_deg_per_sqrt_h": "yes", "bias_instability_dph": "not decided"}
+    no_paper = _runs((4.0, 6.0))
+    assert fig19.claim_rows("dev0", "next_run", no_paper[no_paper["method"] != fig19.PAPER_METHOD]) == []
+
+
+def test_a_rerun_tier_replaces_its_claims_and_keeps_the_others(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    def rows(task: str, tier: str, verdict: str) -> pd.DataFrame:
+        return pd.DataFrame(fig19.claim_rows(task, tier, _runs((4.0, 6.0)))).assign(reproduced=verdict)
+
+    path = tmp_path / "claims.csv"
+    pd.concat([rows("dev0-low", "next_run", "old"), rows("dev0", "next_run", "old")]).to_csv(path, index=False)
+    merged = fig19.merged_claims(path, pd.concat([rows("dev0", "new_device", "new"), rows("dev0", "next_run", "new")]))
+    assert list(zip(merged["task"], merged["tier"], merged["reproduced"], strict=True))[::2] == [
+        ("dev0", "next_run", "new"), ("dev0-low", "next_run", "old"), ("dev0", "new_device", "new")]
+    assert len(merged) == 6 and fig19.merged_claims(tmp_path / "none.csv", rows("a", "replay", "x")).shape[0] == 2

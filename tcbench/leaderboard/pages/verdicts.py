@@ -1,7 +1,8 @@
 """The verdict of each board page, computed from its committed CSV (so it cannot drift from the
 table beside it): where the paper's method ranks among the methods (the limits and the memoriser
 left out), what beats it, how far the best is from the limits; and the paper's claims as the
-board's own files state them (``claims.csv`` of seed 000, ``fig19.md`` of seed 001)."""
+board's own files state them (``claims.csv``: seed 000's per tier and selection, seed 001's per device and
+tier; ``fig19.md`` of seed 001 where its folder has no ``claims.csv``)."""
 
 from __future__ import annotations
 
@@ -115,6 +116,8 @@ def _claims_csv(board: CompensationBoard, table: pd.DataFrame) -> list[str]:
     from tcbench.compensation.scoring import METRIC_NAMES
 
     mine = table[(table["tier"] == board.tier) & table["metric"].isin(METRIC_NAMES[board.protocol])]
+    if "task" in table:  # a file over several devices (seed 001's): this board's device only
+        mine = mine[mine["task"] == board.task]
     out = []
     for claim, rows in mine.groupby("claim", sort=False):
         said = rows["reproduced"].astype(str)
@@ -131,10 +134,17 @@ def _claims_csv(board: CompensationBoard, table: pd.DataFrame) -> list[str]:
         else:
             verdict = f"**partly reproduced**: in {yes} of {n} rows" + (
                 f", {partly} more on the table only (failing the ±0.5 g probe)" if partly else "")
-        picks = "; ".join(f"{sel}: {gain}" for sel, gain in zip(rows["selection"].head(2), rows["worst-test gain"].head(2),
-                                                                 strict=True))
-        out.append(f"Claim “{claim}” on this tier: {verdict} ({n} rows of claims.csv; e.g. {picks}).")
+        out.append(f"Claim “{claim}” on this tier: {verdict} ({n} row{'s' if n != 1 else ''} of claims.csv; {_evidence(rows)}).")
     return out
+
+
+def _evidence(rows: pd.DataFrame) -> str:
+    """What a claim's rows measured: seed 000's first two selections and their worst-test gains, or
+    seed 001's median gain over restarts with its interval and draws."""
+    if "selection" in rows:
+        return "e.g. " + "; ".join(f"{sel}: {gain}" for sel, gain in zip(rows["selection"].head(2),
+                                                                          rows["worst-test gain"].head(2), strict=True))
+    return "; ".join(f"gain ×{value(float(r.gain))} [{r.ci95_gain}] over {int(r.draws)} draws" for r in rows.itertuples())
 
 
 def optimisation_verdict(table: pd.DataFrame, paper: tuple[str, ...]) -> str:
