@@ -150,10 +150,15 @@ def test_a_gyro_board_states_the_claims_of_its_own_device_and_tier() -> None:
         mine = table[(table["task"] == board.task) & (table["tier"] == board.tier)]
         assert len(said) == len(mine), board.stem  # a sentence per factor judged on this device and tier, no other
         for sentence, row in zip(said, mine.itertuples(), strict=True):
-            verdict = {"yes": "**reproduced**", "no": "**not reproduced**"}.get(row.reproduced, "")
+            verdict = {"yes": "**reproduced**", "no": "**not reproduced**"}.get(row.reproduced, "**undecided**")
             assert row.claim in sentence and verdict in sentence and f"[{row.ci95_gain}]" in sentence, board.stem
             stated += 1
     assert stated >= 6
+    board = next(b for b in compensation_boards(FAMILIES["paper-movmd-tfpf"], BOARDS) if b.tier == "new_device")
+    spans = table.assign(reproduced="undecided (interval spans ×102)")
+    assert all("**undecided**: the interval spans" in s for s in verdicts._claims_csv(board, spans))
+    mixed = table.assign(reproduced=["no", "undecided (interval spans ×102)"] * (len(table) // 2))
+    assert any("**not reproduced** (undecided in" in s for s in verdicts._claims_csv(board, pd.concat([mixed, table])))
 
 
 def test_the_ranking_across_tasks_is_the_mean_of_each_boards_places() -> None:

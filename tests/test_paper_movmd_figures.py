@@ -105,7 +105,7 @@ def test_claims_rows_judge_each_factor_by_its_interval() -> None:
     assert {r["reproduced"] for r in fig19.claim_rows("dev0", "next_run", _runs((300.0, 400.0)))} == {"yes"}
     straddles = {r["metric"]: r["reproduced"] for r in fig19.claim_rows("dev0", "next_run", _runs((60.0, 400.0)))}
     # gains uniform in 60-400: a median near 230, above ×102 and around ×233
-    assert straddles == {"arw_1s_deg_per_sqrt_h": "yes", "bias_instability_dph": "not decided"}
+    assert straddles == {"arw_1s_deg_per_sqrt_h": "yes", "bias_instability_dph": "undecided (interval spans ×233)"}
     no_paper = _runs((4.0, 6.0))
     assert fig19.claim_rows("dev0", "next_run", no_paper[no_paper["method"] != fig19.PAPER_METHOD]) == []
 

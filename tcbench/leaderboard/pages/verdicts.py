@@ -123,18 +123,22 @@ def _claims_csv(board: CompensationBoard, table: pd.DataFrame) -> list[str]:
         said = rows["reproduced"].astype(str)
         yes = int((said == "yes").sum())
         partly = int(said.str.startswith("yes on").sum())
+        undecided = int(said.str.startswith("undecided").sum())
         n = len(rows)
         if yes == n:
             verdict = "**reproduced**"
+        elif undecided == n:
+            verdict = "**undecided**: the interval spans the paper's factor"
         elif yes == 0 and partly == 0:
-            verdict = "**not reproduced**"
+            verdict = "**not reproduced**" + (f" (undecided in {undecided} of {n} rows)" if undecided else "")
         elif yes == 0:
             verdict = (f"**not reproduced as a compensation**: {partly} of {n} rows reach it on the table while "
                        "failing the ±0.5 g probe, none otherwise")
         else:
             verdict = f"**partly reproduced**: in {yes} of {n} rows" + (
                 f", {partly} more on the table only (failing the ±0.5 g probe)" if partly else "")
-        out.append(f"Claim “{claim}” on this tier: {verdict} ({n} row{'s' if n != 1 else ''} of claims.csv; {_evidence(rows)}).")
+        counted = f"{n} row{'s' if n != 1 else ''} of claims.csv"
+        out.append(f"Claim “{claim}” on this tier: {verdict} ({counted}; {_evidence(rows)}).")
     return out
 
 
