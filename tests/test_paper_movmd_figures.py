@@ -120,3 +120,17 @@ def test_a_rerun_tier_replaces_its_claims_and_keeps_the_others(tmp_path) -> None
     assert list(zip(merged["task"], merged["tier"], merged["reproduced"], strict=True))[::2] == [
         ("dev0", "next_run", "new"), ("dev0-low", "next_run", "old"), ("dev0", "new_device", "new")]
     assert len(merged) == 6 and fig19.merged_claims(tmp_path / "none.csv", rows("a", "replay", "x")).shape[0] == 2
+
+
+def test_superiority_to_a_rival_is_judged_per_draw_on_each_metric() -> None:
+    runs = _runs((4.0, 6.0))
+    mine = runs[runs["method"] == fig19.PAPER_METHOD]
+    rival = mine.assign(method="WTD", arw_1s_deg_per_sqrt_h=mine["arw_1s_deg_per_sqrt_h"] * 0.1,
+                        bias_instability_dph=mine["bias_instability_dph"] * 0.1, drift_dph=mine["drift_dph"] * 1.2)
+    rows = fig19.claim_rows("dev0", "next_run", pd.concat([runs, rival.iloc[:-1]]))  # the rival misses one draw
+    said = {(r["claim"], r["metric"]): r for r in rows}
+    fig19_claim = "superior to WTD (Fig. 19: ARW and bias stability)"
+    assert {said[(fig19_claim, m)]["reproduced"] for m in fig19.METRICS_FIG19} == {"no"}
+    drift = said[("superior to WTD in residual drift over temperature", "drift_dph")]
+    assert drift["reproduced"] == "yes" and abs(float(drift["gain"]) - 1.2) < 1e-9 and drift["restarts"] == drift["draws"] == 29
+    assert not any("random-BP" in r["claim"] for r in rows)  # a rival not on the board has no row

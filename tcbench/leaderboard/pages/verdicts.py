@@ -148,7 +148,8 @@ def _evidence(rows: pd.DataFrame) -> str:
     if "selection" in rows:
         return "e.g. " + "; ".join(f"{sel}: {gain}" for sel, gain in zip(rows["selection"].head(2),
                                                                           rows["worst-test gain"].head(2), strict=True))
-    return "; ".join(f"gain ×{value(float(r.gain))} [{r.ci95_gain}] over {int(r.draws)} draws" for r in rows.itertuples())
+    return "; ".join(f"{r.metric}: ×{value(float(r.gain))} [{r.ci95_gain}] over {int(r.draws)} draws"
+                     for r in rows.itertuples())
 
 
 def optimisation_verdict(table: pd.DataFrame, paper: tuple[str, ...]) -> str:
