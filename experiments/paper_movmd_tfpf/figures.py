@@ -61,11 +61,9 @@ def _table(runs: pd.DataFrame) -> pd.DataFrame:
         if np.isnan(r["arw_gain"]):  # type: ignore[call-overload]
             r["arw_gain"] = raw["arw_1s_deg_per_sqrt_h"] / r["arw_1s_deg_per_sqrt_h"]  # type: ignore[operator]
             r["bi_gain"] = raw["bias_instability_dph"] / r["bias_instability_dph"]  # type: ignore[operator]
-    paper = _drift_by_draw(runs[runs["method"] == PAPER_METHOD])
     for r in (r for r in rows if r["method"] != PAPER_METHOD):  # the drift against the paper's on the same draws
-        mine = _drift_by_draw(runs[runs["method"] == r["method"]])
-        both = pd.concat([mine, paper], axis=1, join="inner").dropna()
-        r["p_drift_vs_paper"] = paired_p_value(mine, paper)
+        both = _paired_with_paper(runs, str(r["method"]), "drift_dph")
+        r["p_drift_vs_paper"] = paired_p_value(both.iloc[:, 0], both.iloc[:, 1])
         r["draws_lower_than_paper"] = int((both.iloc[:, 0] < both.iloc[:, 1]).sum()) if len(both) else np.nan
         r["draws_paired_with_paper"] = len(both)
     for method, (arw, bi) in PAPER.items():
@@ -75,7 +73,7 @@ def _table(runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows).sort_values("drift_dph", na_position="last")
 
 
-def _drift_by_draw(g: pd.DataFrame, metric: str = "drift_dph") -> pd.Series:
+def _metric_by_draw(g: pd.DataFrame, metric: str = "drift_dph") -> pd.Series:
     """A method's ``metric`` (the drift unless named) per run, indexed by (draw, seed) as the boards pair runs."""
     g = g.assign(draw=draw_column(g))
     return pd.Series(g[metric].to_numpy(float), index=pairing_index(g))
@@ -171,11 +169,16 @@ def claim_rows(task: str, split: str, runs: pd.DataFrame) -> list[dict[str, obje
 METRICS_FIG19 = tuple(metric for _, metric, _ in CLAIMS)
 
 
+def _paired_with_paper(runs: pd.DataFrame, method: str, metric: str) -> pd.DataFrame:
+    """``method``'s ``metric`` (first column) beside the paper's pipeline's (second) on the draws both met."""
+    return pd.concat([_metric_by_draw(runs[runs["method"] == m], metric) for m in (method, PAPER_METHOD)],
+                     axis=1, join="inner").dropna()
+
+
 def _rival_ratio(runs: pd.DataFrame, rival: str, metric: str) -> pd.Series:
     """The rival's ``metric`` ÷ the paper's pipeline's on the same draw (above 1: the paper's is the
     lower), over the draws both met."""
-    both = pd.concat([_drift_by_draw(runs[runs["method"] == m], metric) for m in (rival, PAPER_METHOD)],
-                     axis=1, join="inner").dropna()
+    both = _paired_with_paper(runs, rival, metric)
     return both.iloc[:, 0] / both.iloc[:, 1]
 
 
