@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import pytest
 from threadpoolctl import threadpool_limits
@@ -59,6 +60,46 @@ def _joblib_in_turn(request):  # type: ignore[no-untyped-def]
 
     with parallel_config(backend="sequential"):
         yield
+
+
+@pytest.fixture(autouse=True)
+def _figures_unrendered(request, monkeypatch):  # type: ignore[no-untyped-def]
+    """A figure written to a PNG file is built (every line of the code that makes it runs: its data,
+    labels, marks and file name) but not laid out or rasterised, outside the tests marked ``figures``:
+    matplotlib's layout and rendering took 104 CPU-s of the default run over 314 figures (0.1 to 1 s
+    each, most of it text and mathtext tick labels), in tests that only check the file is written,
+    logged or staged. The file then holds a valid one-pixel PNG. The tests marked ``figures`` (the
+    plots' own tests, at least one for every figure the code draws) render as a user's process does,
+    and so do the commands the tests start as processes of their own."""
+    if request.node.get_closest_marker("figures"):
+        yield
+        return
+    from matplotlib.figure import Figure
+
+    rendered = Figure.savefig
+
+    def savefig(self, fname, *args, **kwargs):  # type: ignore[no-untyped-def]
+        if not isinstance(fname, str | os.PathLike) or (kwargs.get("format") or Path(fname).suffix[1:]) != "png":
+            return rendered(self, fname, *args, **kwargs)
+        Path(fname).write_bytes(_ONE_PIXEL_PNG)
+        return None
+
+    monkeypatch.setattr(Figure, "savefig", savefig)
+    monkeypatch.setattr(Figure, "tight_layout", lambda self, *args, **kwargs: None)
+    yield
+
+
+def _one_pixel_png() -> bytes:
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.new("RGB", (1, 1), "white").save(buf, format="png")
+    return buf.getvalue()
+
+
+_ONE_PIXEL_PNG = _one_pixel_png()
 
 
 @pytest.fixture

@@ -40,6 +40,7 @@ def test_the_registry_names_every_kind() -> None:
         kinds.register(accel)
 
 
+@pytest.mark.figures
 def test_chamber_metrics_recover_the_simulated_device(tmp_path: Path) -> None:
     """Through a chamber cycle the bias slope, noise density and flicker floor read from the
     recording are the device's own; heating and cooling open a loop (hysteresis and lag); the

@@ -32,6 +32,7 @@ def gyro_y(workdir: Path, capsys: pytest.CaptureFixture[str]) -> Path:
     return workdir / "rec" / "gyro-y.csv"
 
 
+@pytest.mark.figures
 def test_calibrate_the_tofupilot_gyro(gyro_y: Path, workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(capsys, "calibrate", f"recording={gyro_y}", "out=cal", "train_branches=[0]")
     assert code == 0, err

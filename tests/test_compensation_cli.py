@@ -34,6 +34,7 @@ def test_ifa_bp_job_is_tracked_with_figures(workdir: Path) -> None:
     assert doc["conventions"][0].startswith("scale factor K1") and len(doc["recordings"]) == 2
 
 
+@pytest.mark.figures
 def test_baselines_and_leaderboard(workdir: Path) -> None:
     # no figures per run (the board reads none; test_ifa_bp_job_is_tracked_with_figures draws the task's)
     out = tcbench("run", "-m", "task=msra_fulltemp", "learner=raw,oracle,poly", "optimiser=none",

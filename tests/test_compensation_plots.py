@@ -6,8 +6,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from tcbench.compensation import plots
+
+pytestmark = pytest.mark.figures  # rendered: these tests look at the figures (tests/conftest.py)
 
 PNG_MAGIC = b"\x89PNG"
 

@@ -186,6 +186,7 @@ class _WithOutput(Series):
     output: np.ndarray | None = None
 
 
+@pytest.mark.figures
 def test_plots_mark_every_located_finding(several: Diagnosis, tmp_path: Path) -> None:
     s = several.series
     series = _WithOutput(s.t_s, s.temp_c, s.residual_before, s.residual_after, s.allan_before, s.allan_after,

@@ -15,6 +15,8 @@ from tcbench.diagnose.report.plots import plot_allan, plot_evidence, write_plots
 from tcbench.diagnose.result import Confusion
 from tcbench.sensors.recording import make_recording
 
+pytestmark = pytest.mark.figures  # rendered: these tests look at the figures (tests/conftest.py)
+
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 

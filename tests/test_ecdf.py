@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from tcbench.leaderboard import optimisation as leaderboard
 from tcbench.tracking import store as tracking
@@ -32,6 +33,7 @@ def test_ecdf_fractions() -> None:
     np.testing.assert_allclose(curves[2]["b"], [0.75, 0.75, 0.75, 1.0])
 
 
+@pytest.mark.figures
 def test_ecdf_plots_from_runs(workdir: Path) -> None:
     base = {"task": {"name": "sphere", "dim": 2, "shift": True, "target_precision": 1e-8, "lower": None,
                      "upper": None}, "budget": 300, "progress": False,

@@ -11,6 +11,8 @@ from tcbench.compensation.gyro import plots
 from tcbench.compensation.gyro.pipeline import ModeClasses
 from tcbench.signal.allan import allan_deviation
 
+pytestmark = pytest.mark.figures  # rendered: these tests look at the figures (tests/conftest.py)
+
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 N, K, FS_HZ = 3000, 5, 1.0
 

@@ -277,6 +277,7 @@ def _bursts(n_bursts: int = 25, per_burst: int = 250, spacing_s: float = 305.0, 
     return pd.DataFrame({"t": t, "temp": np.round(temp, 4), "rate": rate})
 
 
+@pytest.mark.figures
 def test_bursts_import_and_metrics(workdir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     _bursts().to_csv("bursts.csv", index=False)
     code, _, err = run(capsys, "import", "csv=bursts.csv", "sensor=gyro", "time=t:s", "temperature=temp:degC",

@@ -143,6 +143,7 @@ def test_an_untracked_job_that_raises_fails_the_sweep(workdir: Path, capsys) -> 
     assert "2 of 4 jobs failed" in out and out.count("  FAILED exploding-sphere-2d") == 2
 
 
+@pytest.mark.figures  # the one run's convergence figure drawn in this process
 def test_sweeps_leave_the_convergence_png_to_the_leaderboard(workdir: Path) -> None:
     """``tracking.plots: null``: a single run logs its convergence PNG, the runs of a sweep do not
     (unless ``tracking.plots=true``)."""

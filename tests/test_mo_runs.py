@@ -45,6 +45,7 @@ def test_single_objective_optimiser_refused_on_mo_task() -> None:
         validate(job("ifa", 0) | {"optimiser": {"name": "ifa", "population": 10}})
 
 
+@pytest.mark.figures
 def test_mo_leaderboard_columns_and_front(workdir: Path, capfd: pytest.CaptureFixture[str]) -> None:
     for seed in range(2):
         assert run_job(job("mopso", seed)) is not None

@@ -152,6 +152,7 @@ def small_tmpfs(tmp_path: Path) -> Iterator[Path]:
         subprocess.run(["umount", str(mount)], check=False)
 
 
+@pytest.mark.figures
 def test_a_real_full_disk(workdir: Path, small_tmpfs: Path) -> None:
     """Simulate, metrics and diagnose into a full tmpfs: one line, exit 2, nothing left there."""
     t_s = np.arange(2000.0)
