@@ -20,7 +20,7 @@ real ones); simulated ones keep the simulator's truth for the oracle. A simulate
 test runs on one of four tiers (:data:`SPLITS`, docs/concepts/split-tiers.md), from easiest to hardest:
 
 - ``replay``: the training runs' power-on again, with new noise (the signal replayed: a
-  diagnostic, not a benchmark — a memoriser of the training runs wins here);
+  diagnostic, not a benchmark — a memoriser of the training runs can win here);
 - ``next_run`` (the default): new power-ons of the same device under the same programme (turn-on
   bias and scale factor, hysteresis state, chamber timing and the thermometer differ,
   :mod:`tcbench.sensors.runs`);

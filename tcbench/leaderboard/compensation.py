@@ -286,7 +286,7 @@ GYRO_KEY = (
 
 SPLIT_LINES = {
     "replay": "**Split replay:** the test runs replay the training runs' power-on with new noise: a diagnostic, "
-              "not a benchmark (a memoriser of the training signal wins here).",
+              "not a benchmark (a memoriser of the training signal can win here).",
     "next_run": "**Split next_run:** the test runs are new power-ons of the same device under the same programme "
                 "(turn-on bias and scale factor, hysteresis state, chamber timing and the thermometer differ; "
                 "docs/concepts/split-tiers.md).",
