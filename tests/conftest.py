@@ -71,8 +71,7 @@ def _figures_unrendered(request, monkeypatch):  # type: ignore[no-untyped-def]
     logged or staged. The file then holds a valid one-pixel PNG. The tests marked ``figures`` (the
     plots' own tests, at least one for every figure the package draws) render as a user's process does,
     and so do the module-scoped fixtures (set up before this one) and the commands the tests start as
-    processes of their own. Measured on two quiet cores: 5.7 min and 642 CPU-s for the default run,
-    6.2 min and 712 CPU-s rendering every figure (README.md)."""
+    processes of their own. What it saves: README.md (the test command's paragraph)."""
     if request.node.get_closest_marker("figures"):
         yield
         return
