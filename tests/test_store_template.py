@@ -138,3 +138,19 @@ def test_the_store_lock_is_an_exclusive_blocking_flock_on_db_lock(workdir: Path)
     assert waiter.wait(timeout=30) == 0 and waiter.stdout.read() == "got\n"
     assert subprocess.run([sys.executable, "-c", _FLOCK, str(lock), "try"], capture_output=True).returncode == 0
     assert lock.is_file()  # left in place for the next process, as before
+
+
+def test_the_tests_stores_commit_without_fsync(tmp_path: Path) -> None:
+    """The tests' own rule (tests/conftest.py): a SQLite connection made through SQLAlchemy, as
+    MLflow makes its store's, skips the fsync per commit; sqlite3's own connections keep the default."""
+    from sqlalchemy import create_engine
+
+    engine = create_engine(f"sqlite:///{tmp_path / 'x.db'}")
+    try:
+        with engine.connect() as con:
+            assert con.exec_driver_sql("pragma synchronous").scalar() == 0  # off
+    finally:
+        engine.dispose()
+    with sqlite3.connect(tmp_path / "y.db") as plain:
+        assert plain.execute("pragma synchronous").fetchone()[0] == 2  # full, SQLite's default
+    plain.close()
