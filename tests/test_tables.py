@@ -37,8 +37,9 @@ def test_committed_optimisation_boards_are_reproduced_from_their_csv() -> None:
         assert markdown_table(failed_as_text(pd.read_csv(csv))) in csv.with_suffix(".md").read_text(), csv
 
 
+# A cell's text is what a UTF-8 board can hold: no lone surrogates (pandas' string columns refuse them).
 _cells = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**6, 10**6),
-                   st.text(st.characters(blacklist_characters="|\n\r"), max_size=6))
+                   st.text(st.characters(codec="utf-8", exclude_characters="|\n\r"), max_size=6))
 
 
 @settings(max_examples=200, deadline=None)
