@@ -65,18 +65,28 @@ def _tracking_store(tmp_path_factory, monkeypatch):  # type: ignore[no-untyped-d
     monkeypatch.setenv("MLFLOW_TRACKING_URI", f"sqlite:///{tmp_path_factory.mktemp('mlflow') / 'mlflow.db'}")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _joblib_in_turn():  # type: ignore[no-untyped-def]
+    """The code's own joblib work (a diagnosis's two smoothing windows) in turn in the test's process,
+    module-scoped fixtures included: the two test workers already hold both cores, so the pool's workers
+    only add their imports and their memory (a module fixture diagnosing three accel cycles: 33 s of CPU
+    with the pool, measured beside the run in turn). Tests marked ``worker_processes`` start the workers
+    as a user's process does (the same results: tests/test_diagnose_in_worker.py)."""
+    from joblib import parallel_config
+
+    with parallel_config(backend="sequential"):
+        yield
+
+
 @pytest.fixture(autouse=True)
-def _joblib_in_turn(request):  # type: ignore[no-untyped-def]
-    """The code's own joblib work (a diagnosis's two smoothing windows) in turn in the test's process:
-    the two test workers already hold both cores, so the pool's workers only add their imports (about 50
-    CPU-s over the run) and their memory. Tests marked ``worker_processes`` start the workers as a
-    user's process does (the same results: tests/test_diagnose_in_worker.py)."""
-    if request.node.get_closest_marker("worker_processes"):
+def _joblib_workers_where_marked(request):  # type: ignore[no-untyped-def]
+    """Tests marked ``worker_processes``: joblib's own default (its process pool), as outside the tests."""
+    if not request.node.get_closest_marker("worker_processes"):
         yield
         return
     from joblib import parallel_config
 
-    with parallel_config(backend="sequential"):
+    with parallel_config(backend="loky"):
         yield
 
 

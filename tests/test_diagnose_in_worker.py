@@ -39,3 +39,18 @@ def test_the_two_windows_on_two_workers_give_the_diagnosis_made_in_turn() -> Non
         _, (tried_in_turn, _, in_turn) = _diagnose_fast_staircase({})
     assert len(tried) == 2 and tried == tried_in_turn
     assert two_workers == in_turn
+
+
+def test_a_tests_joblib_work_runs_in_turn() -> None:
+    """tests/conftest.py: outside the tests marked ``worker_processes`` joblib runs in turn (module
+    fixtures included); the marked ones get joblib's process pool, as a user's process does."""
+    from joblib.parallel import get_active_backend
+
+    assert type(get_active_backend()[0]).__name__ == "SequentialBackend"
+
+
+@pytest.mark.worker_processes
+def test_a_marked_tests_joblib_work_runs_on_processes() -> None:
+    from joblib.parallel import get_active_backend
+
+    assert type(get_active_backend()[0]).__name__ == "LokyBackend"

@@ -62,7 +62,8 @@ def test_protocol_parameters_checked() -> None:
 
 
 def test_cli_simulate_then_metrics(workdir: Path) -> None:
-    out = tcbench("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "out=rec", cwd=workdir)
+    out = tcbench("simulate", "sensor=gyro", "protocol=oven", "device_seed=1", "out=rec",  # 15 min holds, not 1 h
+                  "protocol_params.hold_s=900", "protocol_params.room_s=900", cwd=workdir)
     assert out.returncode == 0, out.stderr
     csv = workdir / "rec" / "gyro-oven-dev1-seed0.csv"
     assert csv.exists() and csv.with_suffix(".json").exists()
