@@ -69,9 +69,9 @@ def _tracking_store(tmp_path_factory, monkeypatch):  # type: ignore[no-untyped-d
 def _joblib_in_turn():  # type: ignore[no-untyped-def]
     """The code's own joblib work (a diagnosis's two smoothing windows) in turn in the test's process,
     module-scoped fixtures included: the two test workers already hold both cores, so the pool's workers
-    only add their imports and their memory (a module fixture diagnosing three accel cycles: 33 s of CPU
-    with the pool, measured beside the run in turn). Tests marked ``worker_processes`` start the workers
-    as a user's process does (the same results: tests/test_diagnose_in_worker.py)."""
+    only add their imports and their memory (tests/test_accel_chamber.py, whose module fixture diagnoses
+    three cycles: 38.9 CPU-s with the pool, 33.7 in turn). Tests marked ``worker_processes`` start the
+    workers as a user's process does (the same results: tests/test_diagnose_in_worker.py)."""
     from joblib import parallel_config
 
     with parallel_config(backend="sequential"):
