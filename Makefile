@@ -5,7 +5,7 @@ PY := $(VENV)/bin/python
 .PHONY: venv quickstart test test-all paper-fa-ifa bench
 
 $(VENV)/bin/tcbench:
-	python3 -m venv $(VENV) && $(VENV)/bin/pip install -q -e '.[test,bench]'
+	python3 -m venv $(VENV) && $(VENV)/bin/pip install -q 'uv>=0.9,<1' && $(VENV)/bin/uv pip install -q --python $(PY) -e '.[test,bench]'
 
 venv: $(VENV)/bin/tcbench
 

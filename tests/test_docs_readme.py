@@ -29,6 +29,22 @@ def test_the_readme_sets_up_twice_and_then_runs_its_examples() -> None:
     assert {info for info, _ in blocks(README)} <= {"bash", "{.bash .no-run}", "text"}
 
 
+def test_ci_and_the_docs_home_page_set_up_as_the_readme_says() -> None:
+    """``.ci/run`` installs as the README's test command does (quieter) and runs its pytest selection;
+    the docs' home page gives the README's two set-up commands word for word."""
+    set_up = [body.strip() for body in runnable(README) if body.startswith(SET_UP)]
+    install, _, tests = set_up[1].partition(" && .venv/bin/python -m pytest ")
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+
+    def words(text: str) -> str:
+        return " ".join(w for w in text.split() if w != "-q")
+
+    assert tests and words(install) in words(ci), "the README's test command and .ci/run install differently"
+    assert f".venv/bin/python -m pytest {tests.replace(' -n 2', '')}" in ci and "-n 2" in ci
+    home = [body.strip() for body in runnable(ROOT / "docs" / "index.md") if body.startswith(SET_UP)]
+    assert home == set_up
+
+
 def test_the_readme_activates_the_environment_before_its_commands() -> None:
     """The set-up installs into .venv, not onto the path: the README says to activate it before the
     first block that calls a bare ``tcbench``, and calls nothing else as ``.venv/bin/...`` after it."""
