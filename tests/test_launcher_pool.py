@@ -56,6 +56,16 @@ def test_every_job_ends_in_order(tmp_path: Path) -> None:
     assert outcomes == [(True, 0.0), (True, 0.01), (True, 0.02)]
 
 
+def _imports_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
+    return True, sorted(m for m in ("mlflow", "tcbench.tracking.store") if m in sys.modules)
+
+
+def test_a_worker_leaves_mlflow_to_the_jobs_that_track() -> None:
+    """A worker hooked its run announcements onto the tracking store, importing MLflow (about 2 s
+    of each worker's start) before a job that tracks nothing."""
+    assert run_jobs([{}], 1, _imports_job) == [(True, [])]
+
+
 def _blas_job(cfg: dict[str, Any]) -> tuple[bool, Any]:
     import os
 

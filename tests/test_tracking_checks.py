@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from tcbench.tracking import checks, store
+from tcbench.tracking import announce, checks, store
 from tcbench.tracking.template import create_store
 
 
@@ -87,7 +87,7 @@ def test_the_store_helpers_on_runs_and_processes(tmp_path: Path, monkeypatch: py
     uri = f"sqlite:///{tmp_path / 'mlflow.db'}"
     create_store(tmp_path / "mlflow.db")  # the migrated empty store, copied
     created: list[str] = []
-    monkeypatch.setattr(store, "on_run_created", created.append)
+    monkeypatch.setattr(announce, "on_run_created", created.append)
     cfg = {"tracking": {"uri": uri, "experiment": "helpers"}, "seed": 0}
     with store.job_run(cfg, "job", {}) as run:
         pass

@@ -107,10 +107,10 @@ def _worker(conn: Connection, job: Job, init: Callable[[], None] | None) -> None
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked while the parent started it
     if init is not None:
         init()
-    from tcbench.tracking import store as tracking
+    from tcbench.tracking import announce  # not the store: a job that tracks imports MLflow itself
 
     current = [-1]
-    tracking.on_run_created = lambda run_id: conn.send(("run", current[0], run_id))
+    announce.on_run_created = lambda run_id: conn.send(("run", current[0], run_id))
     while True:
         try:
             task = conn.recv()

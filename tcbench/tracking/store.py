@@ -17,7 +17,7 @@ import os
 import shutil
 import socket
 import subprocess
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -33,6 +33,7 @@ from mlflow.tracking import MlflowClient  # noqa: E402
 
 from tcbench._version import __version__  # noqa: E402
 from tcbench.errors import disk_full  # noqa: E402
+from tcbench.tracking import announce  # noqa: E402
 from tcbench.tracking.checks import (  # noqa: E402,F401 - the checks are part of this module's interface
     StoreError,
     check_store,
@@ -255,11 +256,6 @@ def _experiment_id(uri: str, name: str) -> str:
     return experiment_id(client(uri), name)
 
 
-# Called with the id of every job run this process creates (a sweep's worker tells its parent,
-# which can then mark the run FAILED if the worker dies).
-on_run_created: Callable[[str], None] | None = None
-
-
 def _host() -> str:
     return socket.gethostname()
 
@@ -339,8 +335,8 @@ def job_run(
     }
     run = c.create_run(exp, run_name=run_name, tags=all_tags)
     run_id = run.info.run_id
-    if on_run_created is not None:
-        on_run_created(run_id)
+    if announce.on_run_created is not None:
+        announce.on_run_created(run_id)
     handle = JobRun(c, run_id, run.info.artifact_uri)
     handle.log_params(flatten(cfg))
     try:
